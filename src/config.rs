@@ -1,0 +1,489 @@
+//! TOML sweep configs: raw serde structs (stage 1), turned into a validated [`Plan`] (stage 2).
+//! Every error names the file and the key; unknown keys are errors.
+//!
+//! An axis is a number, a list of numbers, or a range table
+//! `{ from = .., to = .., n = .. }` (add `log = true` for log spacing) or `{ from, to, step }`.
+
+use crate::contact::LawKind;
+use crate::cpu::{FastOptions, ReferenceOptions, Scheme};
+use crate::plan::{BuildingAxes, Intensity, Plan, PlanError, PlanSpec};
+use crate::record::{
+    read_record, synthetic, Format, ReadOptions, Record, RecordError, SyntheticSpec, Units,
+};
+use crate::restitution::Formula;
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde::Deserialize;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Default directory of real records when `POUND_RECORDS_DIR` is unset (relative to the working
+/// directory, i.e. the repository root beside `shared/`).
+pub const DEFAULT_RECORDS_DIR: &str = "../shared/records";
+
+/// Where `file = ...` records are looked up.
+pub fn records_dir() -> PathBuf {
+    std::env::var_os("POUND_RECORDS_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_RECORDS_DIR))
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{}: cannot read config: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: {message}", path.display())]
+    Toml { path: PathBuf, message: String },
+    #[error("{}: {key}: {message}", path.display())]
+    Invalid {
+        path: PathBuf,
+        key: String,
+        message: String,
+    },
+    #[error("{}: {key}: {source}", path.display())]
+    Record {
+        path: PathBuf,
+        key: String,
+        source: RecordError,
+    },
+}
+
+/// A sweep axis as written.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Axis {
+    List(Vec<f64>),
+    Range(RangeSpec),
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangeSpec {
+    pub from: f64,
+    pub to: f64,
+    pub n: Option<usize>,
+    pub step: Option<f64>,
+    #[serde(default)]
+    pub log: bool,
+}
+
+impl<'de> Deserialize<'de> for Axis {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Axis, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Axis;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number, a list of numbers, or a range table { from, to, n } / { from, to, step }")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Axis, E> {
+                Ok(Axis::List(vec![v]))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Axis, E> {
+                Ok(Axis::List(vec![v as f64]))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Axis, E> {
+                Ok(Axis::List(vec![v as f64]))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Axis, A::Error> {
+                let mut v = Vec::new();
+                while let Some(x) = seq.next_element::<f64>()? {
+                    v.push(x);
+                }
+                Ok(Axis::List(v))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Axis, A::Error> {
+                RangeSpec::deserialize(de::value::MapAccessDeserializer::new(map)).map(Axis::Range)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// Parse `start:stop:step` (the CLI's range syntax) into values, stop included.
+pub fn parse_colon_range(s: &str) -> Option<Vec<f64>> {
+    let p: Vec<f64> = s
+        .split(':')
+        .map(|x| x.trim().parse().ok())
+        .collect::<Option<_>>()?;
+    match p[..] {
+        [v] => Some(vec![v]),
+        [a, b, st] => Axis::Range(RangeSpec {
+            from: a,
+            to: b,
+            n: None,
+            step: Some(st),
+            log: false,
+        })
+        .values()
+        .ok(),
+        _ => None,
+    }
+}
+
+/// Round to 12 significant digits, so generated ranges read as typed (0.35, not
+/// 0.35000000000000003) in outputs.
+fn tidy(v: f64) -> f64 {
+    format!("{v:.11e}").parse().unwrap_or(v)
+}
+
+impl Axis {
+    pub fn values(&self) -> Result<Vec<f64>, String> {
+        match self {
+            Axis::List(v) => Ok(v.clone()),
+            Axis::Range(r) => Self::range_values(r).map(|v| v.into_iter().map(tidy).collect()),
+        }
+    }
+
+    fn range_values(r: &RangeSpec) -> Result<Vec<f64>, String> {
+        if !(r.from.is_finite() && r.to.is_finite()) {
+            return Err("range ends must be finite".into());
+        }
+        match (r.n, r.step) {
+            (Some(n), None) => {
+                if n == 0 || n > 10_000_000 {
+                    return Err(format!("n = {n}: expected 1 to 1e7 points"));
+                }
+                if n == 1 {
+                    return Ok(vec![r.from]);
+                }
+                if r.log {
+                    if !(r.from > 0.0 && r.to > 0.0) {
+                        return Err("a log range needs from > 0 and to > 0".into());
+                    }
+                    let (a, b) = (r.from.ln(), r.to.ln());
+                    Ok((0..n)
+                        .map(|i| {
+                            if i == n - 1 {
+                                r.to
+                            } else {
+                                (a + (b - a) * i as f64 / (n - 1) as f64).exp()
+                            }
+                        })
+                        .collect())
+                } else {
+                    Ok((0..n)
+                        .map(|i| {
+                            if i == n - 1 {
+                                r.to
+                            } else {
+                                r.from + (r.to - r.from) * i as f64 / (n - 1) as f64
+                            }
+                        })
+                        .collect())
+                }
+            }
+            (None, Some(step)) if !r.log => {
+                if !(step.is_finite() && step != 0.0) || (r.to - r.from) * step < 0.0 {
+                    return Err(format!(
+                        "step = {step} does not lead from {} to {}",
+                        r.from, r.to
+                    ));
+                }
+                let count = ((r.to - r.from) / step + 1e-9).floor() as usize + 1;
+                if count > 10_000_000 {
+                    return Err(format!("{count} points: expected at most 1e7"));
+                }
+                Ok((0..count).map(|i| r.from + step * i as f64).collect())
+            }
+            _ => Err("give exactly one of n or step (log ranges take n)".into()),
+        }
+    }
+}
+
+/// One string or a list of strings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum Names {
+    One(String),
+    List(Vec<String>),
+}
+
+impl Names {
+    fn list(&self) -> Vec<String> {
+        match self {
+            Names::One(s) => vec![s.clone()],
+            Names::List(v) => v.clone(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRun {
+    /// "fast" (default) or "reference".
+    pub scheme: Option<String>,
+    pub substeps_per_contact: Option<f64>,
+    /// Stated accuracy of the reference scheme (relative, peak force).
+    pub tol: Option<f64>,
+    pub tail_s: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBuilding {
+    pub mass_kg: Axis,
+    pub period_s: Axis,
+    pub damping_ratio: Axis,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawContact {
+    pub law: Names,
+    pub formula: Option<Names>,
+    pub e: Option<Axis>,
+    pub gap_m: Axis,
+    pub k_n_per_m: Option<Axis>,
+    pub beta_n_per_m1_5: Option<Axis>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSynthetic {
+    pub seed: u64,
+    pub duration_s: Option<f64>,
+    pub dt_s: Option<f64>,
+    pub pga_g: Option<f64>,
+    pub fg_hz: Option<f64>,
+    pub zeta_g: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRecord {
+    /// A file in the records directory (`POUND_RECORDS_DIR`, default `../shared/records`).
+    pub file: Option<String>,
+    /// A file path, relative to the config file.
+    pub path: Option<String>,
+    pub synthetic: Option<RawSynthetic>,
+    /// Label in outputs (default: file stem, or `synthetic-sSEED`).
+    pub name: Option<String>,
+    pub format: Option<String>,
+    pub units: Option<String>,
+    pub dt_s: Option<f64>,
+    pub skip_lines: Option<usize>,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawIntensity {
+    pub pga_g: Option<Axis>,
+    pub scale: Option<Axis>,
+}
+
+/// A config file as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawConfig {
+    #[serde(default)]
+    pub run: RawRun,
+    pub building1: RawBuilding,
+    pub building2: RawBuilding,
+    pub contact: RawContact,
+    #[serde(rename = "record", default)]
+    pub records: Vec<RawRecord>,
+    #[serde(default)]
+    pub intensity: RawIntensity,
+}
+
+/// Read and validate a config file.
+pub fn load(path: &Path) -> Result<Plan, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+        path: path.into(),
+        source,
+    })?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse(&text, path, &base, &records_dir())
+}
+
+/// Parse and validate config text. `path` names the file in errors; `base` resolves `path =`
+/// records; `records` resolves `file =` records.
+pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Plan, ConfigError> {
+    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Toml {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    let invalid = |key: &str, message: String| ConfigError::Invalid {
+        path: path.into(),
+        key: key.into(),
+        message,
+    };
+    let axis = |key: &str, a: &Axis| a.values().map_err(|m| invalid(key, m));
+    let opt_axis =
+        |key: &str, a: &Option<Axis>| a.as_ref().map_or(Ok(Vec::new()), |a| axis(key, a));
+
+    let scheme = match raw.run.scheme.as_deref().unwrap_or("fast") {
+        "fast" => {
+            let mut o = FastOptions::default();
+            if let Some(n) = raw.run.substeps_per_contact {
+                if !(n.is_finite() && n >= 1.0) {
+                    return Err(invalid(
+                        "run.substeps_per_contact",
+                        format!("{n}: expected a number >= 1"),
+                    ));
+                }
+                o.substeps_per_contact = n;
+            }
+            Scheme::Fast(o)
+        }
+        "reference" => {
+            let tol = raw.run.tol.unwrap_or(crate::cpu::reference::DEFAULT_TOL);
+            if !(tol > 1e-13 && tol < 1e-2) {
+                return Err(invalid(
+                    "run.tol",
+                    format!("{tol}: expected 1e-13 < tol < 1e-2"),
+                ));
+            }
+            Scheme::Reference(ReferenceOptions::with_tol(tol))
+        }
+        other => {
+            return Err(invalid(
+                "run.scheme",
+                format!("`{other}`: expected fast or reference"),
+            ))
+        }
+    };
+
+    let mut laws = Vec::new();
+    for (i, k) in raw.contact.law.list().iter().enumerate() {
+        laws.push(LawKind::from_key(k).ok_or_else(|| {
+            invalid(
+                &format!("contact.law[{i}]"),
+                format!("unknown law `{k}`: expected one of {}", LawKind::keys()),
+            )
+        })?);
+    }
+    let mut formulas = Vec::new();
+    for (i, k) in raw
+        .contact
+        .formula
+        .as_ref()
+        .map(Names::list)
+        .unwrap_or_default()
+        .iter()
+        .enumerate()
+    {
+        formulas.push(Formula::from_key(k).ok_or_else(|| {
+            invalid(
+                &format!("contact.formula[{i}]"),
+                format!("unknown formula `{k}`: expected one of {}", Formula::keys()),
+            )
+        })?);
+    }
+
+    let building = |name: &str, b: &RawBuilding| -> Result<BuildingAxes, ConfigError> {
+        Ok(BuildingAxes {
+            mass: axis(&format!("{name}.mass_kg"), &b.mass_kg)?,
+            period: axis(&format!("{name}.period_s"), &b.period_s)?,
+            damping: axis(&format!("{name}.damping_ratio"), &b.damping_ratio)?,
+        })
+    };
+
+    let intensities = match (&raw.intensity.pga_g, &raw.intensity.scale) {
+        (Some(a), None) => axis("intensity.pga_g", a)?
+            .into_iter()
+            .map(Intensity::PgaG)
+            .collect(),
+        (None, Some(a)) => axis("intensity.scale", a)?
+            .into_iter()
+            .map(Intensity::Scale)
+            .collect(),
+        (None, None) => vec![Intensity::Scale(1.0)],
+        (Some(_), Some(_)) => {
+            return Err(invalid("intensity", "give pga_g or scale, not both".into()))
+        }
+    };
+
+    let mut recs = Vec::new();
+    for (i, r) in raw.records.iter().enumerate() {
+        let key = format!("record[{i}]");
+        let rec = load_record(r, base, records).map_err(|e| match e {
+            LoadError::Invalid(m) => invalid(&key, m),
+            LoadError::Record(source) => ConfigError::Record {
+                path: path.into(),
+                key: key.clone(),
+                source,
+            },
+        })?;
+        recs.push(Arc::new(rec));
+    }
+
+    let spec = PlanSpec {
+        laws,
+        formulas,
+        e: opt_axis("contact.e", &raw.contact.e)?,
+        k_linear: opt_axis("contact.k_n_per_m", &raw.contact.k_n_per_m)?,
+        beta: opt_axis("contact.beta_n_per_m1_5", &raw.contact.beta_n_per_m1_5)?,
+        records: recs,
+        intensities,
+        building1: building("building1", &raw.building1)?,
+        building2: building("building2", &raw.building2)?,
+        gaps: axis("contact.gap_m", &raw.contact.gap_m)?,
+        scheme,
+        tail: raw.run.tail_s.unwrap_or(0.0),
+    };
+    Plan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
+}
+
+enum LoadError {
+    Invalid(String),
+    Record(RecordError),
+}
+
+fn load_record(r: &RawRecord, base: &Path, records: &Path) -> Result<Record, LoadError> {
+    let sources = [r.file.is_some(), r.path.is_some(), r.synthetic.is_some()]
+        .iter()
+        .filter(|x| **x)
+        .count();
+    if sources != 1 {
+        return Err(LoadError::Invalid(
+            "give exactly one of file, path or synthetic".into(),
+        ));
+    }
+    let mut rec = if let Some(s) = &r.synthetic {
+        if r.format.is_some() || r.units.is_some() || r.dt_s.is_some() || r.skip_lines.is_some() {
+            return Err(LoadError::Invalid("format, units, dt_s and skip_lines apply to files, not synthetic records (use synthetic.dt_s)".into()));
+        }
+        let d = SyntheticSpec::default();
+        let spec = SyntheticSpec {
+            seed: s.seed,
+            duration: s.duration_s.unwrap_or(d.duration),
+            dt: s.dt_s.unwrap_or(d.dt),
+            pga_g: s.pga_g.unwrap_or(d.pga_g),
+            fg_hz: s.fg_hz.unwrap_or(d.fg_hz),
+            zeta_g: s.zeta_g.unwrap_or(d.zeta_g),
+        };
+        synthetic(&spec).map_err(LoadError::Record)?
+    } else {
+        let file = match (&r.file, &r.path) {
+            (Some(f), _) => records.join(f),
+            (_, Some(p)) => base.join(p),
+            _ => unreachable!("one source checked above"),
+        };
+        let format = match &r.format {
+            Some(f) => Format::parse(f).ok_or_else(|| {
+                LoadError::Invalid(format!("format `{f}`: expected {}", Format::KEYS))
+            })?,
+            None => Format::Auto,
+        };
+        let units = match &r.units {
+            Some(u) => Some(Units::parse(u).ok_or_else(|| {
+                LoadError::Invalid(format!("units `{u}`: expected {}", Units::KEYS))
+            })?),
+            None => None,
+        };
+        let opts = ReadOptions {
+            format,
+            units,
+            dt: r.dt_s,
+            skip_lines: r.skip_lines.unwrap_or(0),
+        };
+        read_record(&file, &opts).map_err(LoadError::Record)?
+    };
+    if let Some(n) = &r.name {
+        rec.name = n.clone();
+    }
+    Ok(rec)
+}

@@ -1,0 +1,275 @@
+//! Contact force laws `F(delta, delta')` of `shared/docs/physics.md` section 2, resolved per run
+//! into a `Contact` that the integrators evaluate.
+//!
+//! Conventions: `delta = u1 - u2 - gap` (penetration, > 0 in contact), `ddelta = u1' - u2'`
+//! (> 0 approaching), `F >= 0` compressive. The integrators track a contact *phase* (approach
+//! or restitution) located at the instant `ddelta` changes sign, so the right-hand side is smooth
+//! inside every step; the phase-switching laws read it instead of the sign of `ddelta`.
+//!
+//! Inside a step the integrator may probe `delta` slightly below 0 before the separation event
+//! is located, so the Hertz-type powers use the odd extension `delta |delta|^(1/2)`: smooth, no NaN.
+
+/// Which law. Keys are the config/CSV spelling.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum LawKind {
+    /// `k delta`
+    Linear,
+    /// `k delta + c delta'`, tension allowed before separation (Anagnostopoulos 1988).
+    KelvinVoigt,
+    /// Kelvin-Voigt clamped at `F >= 0`: contact ends when the force reaches 0.
+    KelvinVoigtNoTension,
+    /// `k delta + c delta'` while approaching, `k delta` while restituting (Mahmoud & Jankowski).
+    ModifiedLinear,
+    /// `beta delta^1.5`
+    Hertz,
+    /// `beta delta^1.5 + c delta'` approaching, `beta delta^1.5` restituting,
+    /// `c = 2 zeta sqrt(beta sqrt(delta) m_eff)` (Jankowski 2005, the seed's eq. 9).
+    NonlinearViscoelastic,
+    /// `beta delta^1.5 (1 + chi delta')`, `chi = 3(1-e)/(2 v0)`.
+    HuntCrossley,
+    /// Hunt-Crossley form with `chi = 3(1-e^2)/(4 v0)` (Lankarani-Nikravesh; "Hertzdamp").
+    LankaraniNikravesh,
+    /// Hunt-Crossley form with `chi = 8(1-e)/(5 e v0)` (Ye, Li & Zhu 2009; Flores et al. 2011).
+    Flores,
+    /// Hunt-Crossley form with `chi = a(e)/v0`, `a` root-found so one isolated collision
+    /// reproduces `e` exactly (the Hunt-Crossley counterpart of the `exact` zeta).
+    HuntCrossleyExact,
+}
+
+impl LawKind {
+    pub const ALL: [LawKind; 10] = [
+        LawKind::Linear,
+        LawKind::KelvinVoigt,
+        LawKind::KelvinVoigtNoTension,
+        LawKind::ModifiedLinear,
+        LawKind::Hertz,
+        LawKind::NonlinearViscoelastic,
+        LawKind::HuntCrossley,
+        LawKind::LankaraniNikravesh,
+        LawKind::Flores,
+        LawKind::HuntCrossleyExact,
+    ];
+
+    pub fn key(self) -> &'static str {
+        match self {
+            LawKind::Linear => "linear",
+            LawKind::KelvinVoigt => "kelvin_voigt",
+            LawKind::KelvinVoigtNoTension => "kelvin_voigt_no_tension",
+            LawKind::ModifiedLinear => "modified_linear",
+            LawKind::Hertz => "hertz",
+            LawKind::NonlinearViscoelastic => "nonlinear_viscoelastic",
+            LawKind::HuntCrossley => "hunt_crossley",
+            LawKind::LankaraniNikravesh => "lankarani_nikravesh",
+            LawKind::Flores => "flores",
+            LawKind::HuntCrossleyExact => "hunt_crossley_exact",
+        }
+    }
+
+    pub fn from_key(s: &str) -> Option<LawKind> {
+        LawKind::ALL.into_iter().find(|l| l.key() == s)
+    }
+
+    pub fn keys() -> String {
+        LawKind::ALL.map(|l| l.key()).join(", ")
+    }
+
+    /// Force grows as `delta^1.5` (stiffness is `beta`, N/m^1.5) rather than `delta` (`k`, N/m).
+    pub fn is_hertzian(self) -> bool {
+        !matches!(
+            self,
+            LawKind::Linear
+                | LawKind::KelvinVoigt
+                | LawKind::KelvinVoigtNoTension
+                | LawKind::ModifiedLinear
+        )
+    }
+
+    /// Uses an impact damping ratio `zeta(e)` from a restitution formula.
+    pub fn uses_zeta(self) -> bool {
+        matches!(
+            self,
+            LawKind::KelvinVoigt
+                | LawKind::KelvinVoigtNoTension
+                | LawKind::ModifiedLinear
+                | LawKind::NonlinearViscoelastic
+        )
+    }
+
+    /// Dissipates energy (takes a coefficient of restitution `e`).
+    pub fn is_damped(self) -> bool {
+        !matches!(self, LawKind::Linear | LawKind::Hertz)
+    }
+
+    /// Hunt-Crossley family: damping `chi = a / v0`.
+    pub fn is_hunt_crossley(self) -> bool {
+        matches!(
+            self,
+            LawKind::HuntCrossley
+                | LawKind::LankaraniNikravesh
+                | LawKind::Flores
+                | LawKind::HuntCrossleyExact
+        )
+    }
+
+    /// Contact ends when the force reaches 0 before `delta` does (clamped at `F >= 0`).
+    pub fn clamps_tension(self) -> bool {
+        self == LawKind::KelvinVoigtNoTension || self.is_hunt_crossley()
+    }
+
+    /// Damping switches off when `delta'` turns negative.
+    pub fn switches_phase(self) -> bool {
+        matches!(
+            self,
+            LawKind::ModifiedLinear | LawKind::NonlinearViscoelastic
+        )
+    }
+
+    /// `a` in `chi = a / v0` for the printed Hunt-Crossley variants.
+    pub fn chi_coefficient(self, e: f64) -> Option<f64> {
+        match self {
+            LawKind::HuntCrossley => Some(1.5 * (1.0 - e)),
+            LawKind::LankaraniNikravesh => Some(0.75 * (1.0 - e * e)),
+            LawKind::Flores => Some(8.0 * (1.0 - e) / (5.0 * e)),
+            _ => None,
+        }
+    }
+}
+
+/// The Hertz contact-duration constant: `t_c = HERTZ_TC * delta_max / v0`, where
+/// `HERTZ_TC = 2 * integral_0^1 (1 - x^(5/2))^(-1/2) dx = (4/5) B(2/5, 1/2)`.
+pub const HERTZ_TC: f64 = 2.943_275_184_324_7;
+
+/// Hunt-Crossley `chi = a / v0` is singular for grazing impacts; `v0` below this (m/s) counts
+/// as this. The same floor applies on every path, so paths agree.
+pub const HC_V0_MIN: f64 = 1e-3;
+
+/// A contact element resolved for one run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Contact {
+    pub kind: LawKind,
+    /// `k` (N/m) for linear laws, `beta` (N/m^1.5) for Hertz-type laws.
+    pub stiffness: f64,
+    /// Linear laws: `c = 2 zeta sqrt(k m_eff)` (N s/m). Nonlinear viscoelastic:
+    /// `c0 = 2 zeta sqrt(beta m_eff)`, so `c = c0 delta^(1/4)`. Hunt-Crossley family: `a` in
+    /// `chi = a / v0`. 0 for elastic laws.
+    pub damping: f64,
+    /// Dimensionless damping measure used to size steps: `zeta`, or `a` for Hunt-Crossley.
+    pub damping_ratio: f64,
+    /// `m1 m2 / (m1 + m2)`, kg.
+    pub m_eff: f64,
+}
+
+impl Contact {
+    /// `kind` with stiffness and dimensionless damping (`zeta`, or `a` for Hunt-Crossley).
+    pub fn new(kind: LawKind, stiffness: f64, damping_ratio: f64, m_eff: f64) -> Contact {
+        let damping = if !kind.is_damped() {
+            0.0
+        } else if kind.is_hunt_crossley() {
+            damping_ratio
+        } else {
+            2.0 * damping_ratio * (stiffness * m_eff).sqrt()
+        };
+        let damping_ratio = if kind.is_damped() { damping_ratio } else { 0.0 };
+        Contact {
+            kind,
+            stiffness,
+            damping,
+            damping_ratio,
+            m_eff,
+        }
+    }
+
+    /// Force while in contact (may be negative only for Kelvin-Voigt with tension, and just
+    /// before a clamped separation is located). `approaching` is the integrator's phase; `v0` the
+    /// approach speed at first touch of the current impact.
+    #[inline]
+    pub fn force(&self, delta: f64, ddelta: f64, v0: f64, approaching: bool) -> f64 {
+        let (k, c) = (self.stiffness, self.damping);
+        match self.kind {
+            LawKind::Linear => k * delta,
+            LawKind::KelvinVoigt | LawKind::KelvinVoigtNoTension => k * delta + c * ddelta,
+            LawKind::ModifiedLinear => k * delta + if approaching { c * ddelta } else { 0.0 },
+            LawKind::Hertz => k * delta * delta.abs().sqrt(),
+            LawKind::NonlinearViscoelastic => {
+                let r = delta.abs().sqrt();
+                k * delta * r
+                    + if approaching {
+                        c * r.sqrt() * ddelta
+                    } else {
+                        0.0
+                    }
+            }
+            LawKind::HuntCrossley
+            | LawKind::LankaraniNikravesh
+            | LawKind::Flores
+            | LawKind::HuntCrossleyExact => {
+                k * delta * delta.abs().sqrt() * (1.0 + self.chi(v0) * ddelta)
+            }
+        }
+    }
+
+    /// Hunt-Crossley `chi` for an impact at `v0` (floored at [`HC_V0_MIN`]).
+    #[inline]
+    pub fn chi(&self, v0: f64) -> f64 {
+        self.damping / v0.max(HC_V0_MIN)
+    }
+
+    /// Positive exactly when the bodies are in contact, and continuous (events are located by
+    /// regula falsi on it): `delta` for most laws. For laws clamped at zero tension it is also
+    /// <= 0 once the force is: Kelvin-Voigt `delta + min(0, (c/k) delta')` (= F/k when that is
+    /// smaller), Hunt-Crossley `delta min(1, 1 + chi delta')` for `delta > 0`.
+    #[inline]
+    pub fn gauge(&self, delta: f64, ddelta: f64, v0: f64) -> f64 {
+        match self.kind {
+            LawKind::KelvinVoigtNoTension => {
+                delta + (self.damping / self.stiffness * ddelta).min(0.0)
+            }
+            k if k.is_hunt_crossley() && delta > 0.0 => {
+                delta * (1.0 + self.chi(v0) * ddelta).min(1.0)
+            }
+            _ => delta,
+        }
+    }
+
+    /// Bound on the contact's fastest rate (1/s) at penetration `delta`: `sqrt(k_loc/m_eff)` plus
+    /// `c_loc/m_eff`, from the local stiffness and damping. Keeps explicit substeps stable when
+    /// the bodies stay pressed together far beyond an impact's penetration.
+    pub fn local_rate(&self, delta: f64, v0: f64) -> f64 {
+        let d = delta.max(0.0);
+        let (k, c) = (self.stiffness, self.damping);
+        let (kl, cl) = match self.kind {
+            LawKind::Linear => (k, 0.0),
+            LawKind::KelvinVoigt | LawKind::KelvinVoigtNoTension | LawKind::ModifiedLinear => {
+                (k, c)
+            }
+            LawKind::Hertz => (1.5 * k * d.sqrt(), 0.0),
+            LawKind::NonlinearViscoelastic => (1.5 * k * d.sqrt(), c * d.sqrt().sqrt()),
+            _ => (1.5 * k * d.sqrt(), k * d * d.sqrt() * self.chi(v0)),
+        };
+        (kl / self.m_eff).sqrt() + cl / self.m_eff
+    }
+
+    /// Estimated contact duration for approach speed `v` (Hertz-type durations shrink as
+    /// `v^(-1/5)`), s.
+    pub fn duration_estimate(&self, v: f64) -> f64 {
+        if self.kind.is_hertzian() {
+            let v = v.max(1e-6);
+            let dmax = (1.25 * self.m_eff * v * v / self.stiffness).powf(0.4);
+            HERTZ_TC * dmax / v
+        } else {
+            std::f64::consts::PI * (self.m_eff / self.stiffness).sqrt()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_round_trip() {
+        for l in LawKind::ALL {
+            assert_eq!(LawKind::from_key(l.key()), Some(l));
+        }
+    }
+}

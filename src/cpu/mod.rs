@@ -1,0 +1,550 @@
+//! CPU integration of one run, in f64. Two schemes share the machinery here:
+//!
+//! - [`fast`] (production): exact linear stepping at the record's `dt` while the buildings are
+//!   apart, fixed RK4 substeps sized to the contact duration only in record steps where a contact
+//!   may happen.
+//! - [`reference`] (truth): adaptive Dormand-Prince 5(4) with error control, steps that never
+//!   cross a record sample (where `ag` has kinks), and a cap on the step in contact.
+//!
+//! Both locate every non-smooth instant inside the step (first touch `delta = 0`, the turn
+//! `delta' = 0`, separation at `delta = 0` or `F = 0`) by regula falsi on re-taken partial
+//! steps, so each step integrates a smooth right-hand side. The contact work
+//! `w' = F delta'` rides along as a fifth state so the dissipated energy is integrated to the
+//! scheme's own order.
+
+pub mod fast;
+pub mod reference;
+
+pub use fast::FastOptions;
+pub use reference::ReferenceOptions;
+
+use crate::contact::Contact;
+use crate::model::{Forcing, Initial, Oscillator, Pair, RunOutput, Status};
+
+/// `[u1, v1, u2, v2, w]`
+pub type State = [f64; 5];
+
+/// Contact mode; changes only at located events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    Free,
+    Approach,
+    Restitution,
+}
+
+/// Which integration scheme a run uses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Scheme {
+    Fast(FastOptions),
+    Reference(ReferenceOptions),
+}
+
+impl Scheme {
+    pub fn key(&self) -> &'static str {
+        match self {
+            Scheme::Fast(_) => "fast",
+            Scheme::Reference(_) => "reference",
+        }
+    }
+}
+
+/// A point handed to an observer after every accepted step and event.
+#[derive(Debug, Clone, Copy)]
+pub struct Sample {
+    pub t: f64,
+    pub z: State,
+    pub force: f64,
+    pub mode: Mode,
+}
+
+/// Simulate one run from rest (or from `init`) over the forcing's whole duration.
+pub fn simulate(pair: &Pair, forcing: &Forcing, init: &Initial, scheme: &Scheme) -> RunOutput {
+    simulate_observed(pair, forcing, init, scheme, None)
+}
+
+/// As [`simulate`], calling `observer` after every step.
+pub fn simulate_observed(
+    pair: &Pair,
+    forcing: &Forcing,
+    init: &Initial,
+    scheme: &Scheme,
+    observer: Option<&mut dyn FnMut(&Sample)>,
+) -> RunOutput {
+    match scheme {
+        Scheme::Fast(o) => fast::run(pair, forcing, init, o, observer),
+        Scheme::Reference(o) => reference::run(pair, forcing, init, o, observer, None),
+    }
+}
+
+/// Result of one isolated collision of two free bodies (NaN fields if the solve failed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collision {
+    /// `-delta'_out / delta'_in`
+    pub e: f64,
+    pub peak_force: f64,
+    pub peak_penetration: f64,
+    pub duration: f64,
+    pub dissipated: f64,
+}
+
+/// Tolerance of the single-collision solves behind the `exact` formula.
+pub const EXACT_RTOL: f64 = 1e-11;
+
+/// Two free bodies (masses `2 m_eff` each) meeting at relative speed `v0` with `contact`; solved
+/// with the reference scheme at `rtol` until they separate.
+pub fn single_collision(contact: &Contact, v0: f64, rtol: f64) -> Collision {
+    let m = 2.0 * contact.m_eff;
+    let pair = Pair {
+        b1: Oscillator::free(m),
+        b2: Oscillator::free(m),
+        gap: 0.0,
+        contact: *contact,
+    };
+    let tc = contact.duration_estimate(v0);
+    let horizon = tc * 200.0 * (1.0 + contact.damping_ratio);
+    let zeros = [0.0, 0.0];
+    let forcing = Forcing {
+        accel: &zeros,
+        dt: horizon,
+        t0: 0.0,
+        scale: 0.0,
+        tail: 0.0,
+    };
+    let init = Initial {
+        u1: 0.0,
+        v1: 0.5 * v0,
+        u2: 0.0,
+        v2: -0.5 * v0,
+    };
+    let opts = ReferenceOptions {
+        rtol,
+        contact_steps: 20.0,
+        max_steps: 50_000_000,
+    };
+    let mut last = [0.0; 5];
+    let mut obs = |s: &Sample| last = s.z;
+    let out = reference::run(&pair, &forcing, &init, &opts, Some(&mut obs), Some(1));
+    if out.status != Status::Ok {
+        return Collision {
+            e: f64::NAN,
+            peak_force: f64::NAN,
+            peak_penetration: f64::NAN,
+            duration: f64::NAN,
+            dissipated: f64::NAN,
+        };
+    }
+    Collision {
+        e: -(last[1] - last[3]) / v0,
+        peak_force: out.peak_force,
+        peak_penetration: out.peak_penetration,
+        duration: out.contact_time,
+        dissipated: out.dissipated_energy,
+    }
+}
+
+/// Ground acceleration over one record interval: linear from `a0` at `t0` to `a1` at `t0 + dt`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Segment {
+    pub t0: f64,
+    pub dt: f64,
+    pub a0: f64,
+    pub a1: f64,
+}
+
+impl Segment {
+    pub fn of(forcing: &Forcing, i: usize) -> Segment {
+        Segment {
+            t0: forcing.t0 + i as f64 * forcing.dt,
+            dt: forcing.dt,
+            a0: forcing.sample(i),
+            a1: forcing.sample(i + 1),
+        }
+    }
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        self.a0 + (self.a1 - self.a0) * ((t - self.t0) / self.dt)
+    }
+    pub fn t1(&self) -> f64 {
+        self.t0 + self.dt
+    }
+}
+
+#[inline]
+pub(crate) fn delta(p: &Pair, z: &State) -> f64 {
+    z[0] - z[2] - p.gap
+}
+
+#[inline]
+pub(crate) fn ddelta(z: &State) -> f64 {
+    z[1] - z[3]
+}
+
+/// Contact force in `mode`.
+#[inline]
+pub(crate) fn force(p: &Pair, mode: Mode, v0: f64, z: &State) -> f64 {
+    match mode {
+        Mode::Free => 0.0,
+        _ => p
+            .contact
+            .force(delta(p, z), ddelta(z), v0, mode == Mode::Approach),
+    }
+}
+
+#[inline]
+pub(crate) fn rhs(p: &Pair, mode: Mode, v0: f64, ag: f64, z: &State) -> State {
+    let f = force(p, mode, v0, z);
+    let (b1, b2) = (&p.b1, &p.b2);
+    [
+        z[1],
+        (-b1.c * z[1] - b1.k * z[0] - f) / b1.m - ag,
+        z[3],
+        (-b2.c * z[3] - b2.k * z[2] + f) / b2.m - ag,
+        f * ddelta(z),
+    ]
+}
+
+/// Relative acceleration `delta''` from the structures alone (the ground motion cancels).
+#[inline]
+pub(crate) fn structural_rel_accel(p: &Pair, z: &State) -> f64 {
+    let (b1, b2) = (&p.b1, &p.b2);
+    -(b1.c * z[1] + b1.k * z[0]) / b1.m + (b2.c * z[3] + b2.k * z[2]) / b2.m
+}
+
+/// Step that resolves an impact at approach speed `v` with `per_contact` steps. The impact
+/// lasts the free-collision duration `t_c(v)`, or less when the structures reverse the relative
+/// motion first (about `2 v / |a|` for a relative deceleration `a`); the kinematic bound is
+/// floored at `t_c / 16` so a grazing touch cannot ask for unbounded steps.
+pub(crate) fn impact_step(p: &Pair, v: f64, a: f64, per_contact: f64) -> f64 {
+    let tc = p.contact.duration_estimate(v);
+    let tk = if a != 0.0 {
+        2.0 * v / a.abs()
+    } else {
+        f64::INFINITY
+    };
+    let t = tc.min(tk.max(tc / 16.0));
+    t / (per_contact * (1.0 + 2.0 * p.contact.damping_ratio))
+}
+
+/// Positive once `mode` must end: first touch (Free), the turn `delta' = 0` (Approach),
+/// separation (Restitution).
+#[inline]
+pub(crate) fn event_value(p: &Pair, mode: Mode, v0: f64, z: &State) -> f64 {
+    match mode {
+        Mode::Free => p.contact.gauge(delta(p, z), ddelta(z), v0),
+        Mode::Approach => -ddelta(z),
+        Mode::Restitution => -p.contact.gauge(delta(p, z), ddelta(z), v0),
+    }
+}
+
+/// Regula falsi (Illinois) for the first instant in `(0, h]` where `f > 0`, given
+/// `f(0) <= 0 < f(h)`. `step(x)` re-takes the step with length `x`. Each estimate is followed
+/// by a guard probe `tol` beyond it (towards the other end), which closes the bracket at once
+/// when the estimate is good and keeps regula falsi from stalling on one side. Returns the length
+/// and state on the far side of the event, so the next mode starts with a consistent sign.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn locate(
+    h: f64,
+    f0: f64,
+    z1: State,
+    f1: f64,
+    tol: f64,
+    max_iter: u32,
+    mut step: impl FnMut(f64) -> State,
+    eval: impl Fn(&State) -> f64,
+) -> (f64, State) {
+    let (mut a, mut fa) = (0.0, f0.min(0.0));
+    let (mut b, mut fb, mut zb) = (h, f1, z1);
+    let mut last = 0i8;
+    for _ in 0..max_iter {
+        if b - a <= tol {
+            break;
+        }
+        let mut x = if fb != fa {
+            b - fb * (b - a) / (fb - fa)
+        } else {
+            0.5 * (a + b)
+        };
+        if !(x > a && x < b) {
+            x = 0.5 * (a + b);
+        }
+        let zx = step(x);
+        let fx = eval(&zx);
+        if fx > 0.0 {
+            (b, fb, zb) = (x, fx, zx);
+            if last == 1 {
+                fa *= 0.5;
+            }
+            last = 1;
+            let g = x - 0.5 * tol;
+            if g > a {
+                let zg = step(g);
+                let fg = eval(&zg);
+                if fg > 0.0 {
+                    (b, fb, zb) = (g, fg, zg);
+                } else {
+                    (a, fa) = (g, fg);
+                }
+            }
+        } else {
+            (a, fa) = (x, fx);
+            if last == -1 {
+                fb *= 0.5;
+            }
+            last = -1;
+            let g = x + 0.5 * tol;
+            if g < b {
+                let zg = step(g);
+                let fg = eval(&zg);
+                if fg > 0.0 {
+                    (b, fb, zb) = (g, fg, zg);
+                } else {
+                    (a, fa) = (g, fg);
+                }
+            }
+        }
+    }
+    (b, zb)
+}
+
+/// In free mode a step whose end is still apart can hide a brief, grazing touch. If the Hermite
+/// cubic of `delta` over the step rises above 0 inside, return the fraction of the step at its
+/// maximum (the step is then re-taken to there and checked for the event).
+pub(crate) fn hidden_touch(p: &Pair, z0: &State, z1: &State, h: f64) -> Option<f64> {
+    let (y0, d0, y1, d1) = (delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1));
+    if y1 > 0.0 || d0 <= 0.0 && d1 >= 0.0 {
+        return None;
+    }
+    let (m0, m1) = (h * d0, h * d1);
+    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
+    let c = 2.0 * (y0 - y1) + m0 + m1;
+    let (qa, qb, qc) = (3.0 * c, 2.0 * b, m0);
+    let mut best: Option<(f64, f64)> = None;
+    let disc = qb * qb - 4.0 * qa * qc;
+    if qa.abs() > 1e-300 && disc >= 0.0 {
+        let r = disc.sqrt();
+        for s in [(-qb + r) / (2.0 * qa), (-qb - r) / (2.0 * qa)] {
+            if s > 0.0 && s < 1.0 {
+                let v = y0 + s * (m0 + s * (b + s * c));
+                if v > 0.0 && best.is_none_or(|(bv, _)| v > bv) {
+                    best = Some((v, s));
+                }
+            }
+        }
+    }
+    best.map(|(_, s)| s)
+}
+
+/// Min and max over `[0, h]` of the cubic Hermite through `(y0, y0')` and `(y1, y1')`.
+#[inline]
+pub(crate) fn hermite_range(y0: f64, d0: f64, y1: f64, d1: f64, h: f64) -> (f64, f64) {
+    let (m0, m1) = (h * d0, h * d1);
+    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
+    let c = 2.0 * (y0 - y1) + m0 + m1;
+    let p = |s: f64| y0 + s * (m0 + s * (b + s * c));
+    let (mut lo, mut hi) = (y0.min(y1), y0.max(y1));
+    let mut check = |s: f64| {
+        if s > 0.0 && s < 1.0 {
+            let v = p(s);
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    };
+    // p'(s) = m0 + 2 b s + 3 c s^2
+    let (qa, qb, qc) = (3.0 * c, 2.0 * b, m0);
+    if qa.abs() < 1e-300 {
+        if qb != 0.0 {
+            check(-qc / qb);
+        }
+    } else {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc >= 0.0 {
+            let r = disc.sqrt();
+            // Stable roots.
+            let q = -0.5 * (qb + qb.signum() * r);
+            if q != 0.0 {
+                check(q / qa);
+                check(qc / q);
+            } else {
+                check(0.0);
+            }
+        }
+    }
+    (lo, hi)
+}
+
+/// Bound on `|u''''|` of a free oscillator over a step (inside a step `ag'' = 0`), for the
+/// Hermite error margin of the near-contact test.
+fn fourth_derivative_bound(o: &Oscillator, u: f64, v: f64, seg: &Segment) -> f64 {
+    let w2 = o.k / o.m;
+    let cm = o.c / o.m;
+    let a2 = w2 * u + cm * v + seg.a0.abs().max(seg.a1.abs());
+    let a3 = w2 * v + cm * a2 + ((seg.a1 - seg.a0) / seg.dt).abs();
+    w2 * a2 + cm * a3
+}
+
+/// Could the bodies touch inside a free step from `z0` to `z1` (length `h`)? Uses the Hermite
+/// cubic of `delta` plus twice its interpolation-error bound `h^4/384 max|delta''''|`.
+pub(crate) fn may_touch(p: &Pair, seg: &Segment, z0: &State, z1: &State, h: f64, v0: f64) -> bool {
+    let (d0, d1) = (delta(p, z0), delta(p, z1));
+    if p.contact.gauge(d0, ddelta(z0), v0) > 0.0 || p.contact.gauge(d1, ddelta(z1), v0) > 0.0 {
+        return true;
+    }
+    let (_, hi) = hermite_range(d0, ddelta(z0), d1, ddelta(z1), h);
+    let (u1, v1) = (z0[0].abs().max(z1[0].abs()), z0[1].abs().max(z1[1].abs()));
+    let (u2, v2) = (z0[2].abs().max(z1[2].abs()), z0[3].abs().max(z1[3].abs()));
+    let bound =
+        fourth_derivative_bound(&p.b1, u1, v1, seg) + fourth_derivative_bound(&p.b2, u2, v2, seg);
+    let h2 = h * h;
+    hi > -2.0 * h2 * h2 / 384.0 * bound
+}
+
+/// Peaks and impact bookkeeping shared by both schemes.
+pub(crate) struct Tracker {
+    pub out: RunOutput,
+    /// Approach speed of the current impact.
+    pub v0: f64,
+    imp_peak: f64,
+    hist: [(f64, f64); 2],
+    nhist: usize,
+    impacts_ended: u32,
+}
+
+impl Tracker {
+    pub fn new() -> Tracker {
+        Tracker {
+            out: RunOutput::default(),
+            v0: 0.0,
+            imp_peak: 0.0,
+            hist: [(0.0, 0.0); 2],
+            nhist: 0,
+            impacts_ended: 0,
+        }
+    }
+
+    pub fn impacts_ended(&self) -> u32 {
+        self.impacts_ended
+    }
+
+    /// Account for a step `t0 -> t0 + h` spent in `mode`, from `z0` to `z1`.
+    pub fn step(&mut self, p: &Pair, mode: Mode, t0: f64, h: f64, z0: &State, z1: &State) {
+        let o = &mut self.out;
+        let (lo, hi) = hermite_range(z0[0], z0[1], z1[0], z1[1], h);
+        o.peak_u1 = o.peak_u1.max(hi.abs()).max(lo.abs());
+        let (lo, hi) = hermite_range(z0[2], z0[3], z1[2], z1[3], h);
+        o.peak_u2 = o.peak_u2.max(hi.abs()).max(lo.abs());
+        if mode != Mode::Free {
+            o.contact_time += h;
+            let (_, dmax) = hermite_range(delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1), h);
+            o.peak_penetration = o.peak_penetration.max(dmax);
+            o.dissipated_energy = z1[4];
+            self.force_sample(t0 + h, force(p, mode, self.v0, z1));
+        }
+    }
+
+    /// A force sample inside the current impact; a local maximum of three samples is refined by
+    /// the vertex of their parabola.
+    fn force_sample(&mut self, t: f64, f: f64) {
+        self.imp_peak = self.imp_peak.max(f);
+        if self.nhist == 2 {
+            let [(x0, y0), (x1, y1)] = self.hist;
+            if y1 >= y0 && y1 >= f && x1 > x0 && t > x1 {
+                let d1 = (y1 - y0) / (x1 - x0);
+                let d2 = (f - y1) / (t - x1);
+                let a = (d2 - d1) / (t - x0);
+                if a < 0.0 {
+                    // Newton form around x0, x1: y(x) = y0 + d1 (x - x0) + a (x - x0)(x - x1).
+                    let xv = (0.5 * (x0 + x1) - 0.5 * d1 / a).clamp(x0, t);
+                    let yv = y0 + d1 * (xv - x0) + a * (xv - x0) * (xv - x1);
+                    self.imp_peak = self.imp_peak.max(yv);
+                }
+            }
+            self.hist = [self.hist[1], (t, f)];
+        } else {
+            self.hist[self.nhist] = (t, f);
+            self.nhist += 1;
+        }
+    }
+
+    pub fn onset(&mut self, t: f64, v0: f64, f: f64) {
+        self.out.impacts += 1;
+        if self.out.first_impact.is_none() {
+            self.out.first_impact = Some(t);
+        }
+        self.v0 = v0;
+        self.imp_peak = 0.0;
+        self.nhist = 0;
+        self.force_sample(t, f);
+    }
+
+    pub fn end_impact(&mut self) {
+        if self.imp_peak > self.out.peak_force {
+            self.out.peak_force = self.imp_peak;
+            self.out.impact_velocity = self.v0;
+        }
+        self.impacts_ended += 1;
+    }
+
+    pub fn finish(mut self, mode: Mode, status: Status) -> RunOutput {
+        if mode != Mode::Free {
+            self.end_impact();
+        }
+        self.out.status = status;
+        self.out
+    }
+}
+
+/// Apply the mode change an event at state `z` (time `t`) calls for; `before` is the state at
+/// the start of the step in which the event was located.
+pub(crate) fn transition(
+    p: &Pair,
+    mode: Mode,
+    t: f64,
+    z: &State,
+    before: &State,
+    tr: &mut Tracker,
+) -> Mode {
+    match mode {
+        Mode::Free => {
+            let v = ddelta(z);
+            // A first touch takes v0 = delta' at delta = 0. A clamped law that re-engages while
+            // still overlapping (force back above 0) continues the previous impact's v0.
+            let v0 = if delta(p, before) <= 0.0 || tr.v0 <= 0.0 {
+                v.abs()
+            } else {
+                tr.v0
+            };
+            let v0 = v0.max(1e-12);
+            let next = if v > 0.0 {
+                Mode::Approach
+            } else {
+                Mode::Restitution
+            };
+            tr.onset(t, v0, force(p, next, v0, z));
+            next
+        }
+        Mode::Approach => Mode::Restitution,
+        Mode::Restitution => {
+            tr.end_impact();
+            Mode::Free
+        }
+    }
+}
+
+/// After a step without a located event: a restituting contact that starts to close again goes
+/// back to the approach phase.
+#[inline]
+pub(crate) fn reapproach(mode: Mode, z: &State) -> Mode {
+    if mode == Mode::Restitution && ddelta(z) > 0.0 {
+        Mode::Approach
+    } else {
+        mode
+    }
+}
+
+pub(crate) fn finite(z: &State) -> bool {
+    z.iter().all(|x| x.is_finite())
+}
+
+pub(crate) fn initial_state(init: &Initial) -> State {
+    [init.u1, init.v1, init.u2, init.v2, 0.0]
+}

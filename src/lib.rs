@@ -1,0 +1,17 @@
+//! pounding: earthquake-induced pounding between adjacent buildings, simulated in large sweeps.
+//!
+//! Layers, bottom up: [`record`] (ground motions), [`contact`] and [`restitution`] (the physics
+//! of an impact), [`model`] and [`propagator`] (the scene and exact linear stepping), [`cpu`]
+//! (integrators), [`plan`] (a validated sweep), [`config`] (TOML to plan), [`sweep`] (parallel
+//! execution and streaming output).
+
+pub mod config;
+pub mod contact;
+pub mod cpu;
+pub mod model;
+pub mod output;
+pub mod plan;
+pub mod propagator;
+pub mod record;
+pub mod restitution;
+pub mod sweep;

@@ -1,0 +1,174 @@
+//! CSV rows for runs, written to `<out>.partial` as chunks finish and renamed to `<out>` only
+//! when the sweep is complete (after flush and fsync). A failed sweep leaves the `.partial`
+//! file with every finished row.
+
+use crate::model::RunOutput;
+use crate::plan::{Intensity, Plan, RunSpec};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Swept parameters, then outputs. Units are in the names.
+pub const COLUMNS: [&str; 27] = [
+    "run",
+    "law",
+    "formula",
+    "e",
+    "impact_damping",
+    "k_n_per_m",
+    "beta_n_per_m1_5",
+    "record",
+    "target_pga_g",
+    "scale_factor",
+    "pga_g",
+    "m1_kg",
+    "t1_s",
+    "xi1",
+    "m2_kg",
+    "t2_s",
+    "xi2",
+    "gap_m",
+    "status",
+    "impacts",
+    "peak_force_n",
+    "peak_penetration_m",
+    "peak_u1_m",
+    "peak_u2_m",
+    "impact_velocity_m_s",
+    "first_impact_s",
+    "contact_time_s",
+];
+
+/// Output columns after the status (kept in one place for readers of the CSV).
+pub const EXTRA_COLUMNS: [&str; 1] = ["dissipated_energy_j"];
+
+/// Shortest round-trip text; scientific notation outside [1e-4, 1e15) so tiny values stay short.
+fn num(x: f64) -> String {
+    let a = x.abs();
+    if a != 0.0 && !(1e-4..1e15).contains(&a) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// The fields of one row, in `COLUMNS` + `EXTRA_COLUMNS` order.
+pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
+    let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+    let hertz = spec.law.is_hertzian();
+    vec![
+        spec.index.to_string(),
+        spec.law.key().to_string(),
+        spec.formula
+            .map(|f| f.key().to_string())
+            .unwrap_or_default(),
+        opt(spec.e),
+        if spec.law.is_damped() {
+            num(spec.damping)
+        } else {
+            String::new()
+        },
+        if hertz {
+            String::new()
+        } else {
+            num(spec.stiffness)
+        },
+        if hertz {
+            num(spec.stiffness)
+        } else {
+            String::new()
+        },
+        plan.spec.records[spec.record].name.clone(),
+        match spec.intensity {
+            Intensity::PgaG(g) => num(g),
+            Intensity::Scale(_) => String::new(),
+        },
+        num(spec.scale),
+        num(spec.pga_g),
+        num(spec.m1),
+        num(spec.t1),
+        num(spec.xi1),
+        num(spec.m2),
+        num(spec.t2),
+        num(spec.xi2),
+        num(spec.gap),
+        out.status.key().to_string(),
+        out.impacts.to_string(),
+        num(out.peak_force),
+        num(out.peak_penetration),
+        num(out.peak_u1),
+        num(out.peak_u2),
+        num(out.impact_velocity),
+        opt(out.first_impact),
+        num(out.contact_time),
+        num(out.dissipated_energy),
+    ]
+}
+
+/// All column names.
+pub fn header() -> Vec<&'static str> {
+    COLUMNS
+        .iter()
+        .chain(EXTRA_COLUMNS.iter())
+        .copied()
+        .collect()
+}
+
+/// A CSV file that appears under its final name only when complete.
+pub struct CsvOut {
+    path: PathBuf,
+    partial: PathBuf,
+    w: csv::Writer<BufWriter<File>>,
+}
+
+impl CsvOut {
+    pub fn create(path: &Path) -> std::io::Result<CsvOut> {
+        let mut partial = path.as_os_str().to_owned();
+        partial.push(".partial");
+        let partial = PathBuf::from(partial);
+        let file = File::create(&partial)?;
+        let mut w = csv::Writer::from_writer(BufWriter::new(file));
+        w.write_record(header()).map_err(std::io::Error::other)?;
+        Ok(CsvOut {
+            path: path.into(),
+            partial,
+            w,
+        })
+    }
+
+    pub fn partial_path(&self) -> &Path {
+        &self.partial
+    }
+
+    /// Append rows and push them to the OS, so a crash keeps them in the `.partial` file.
+    pub fn write(&mut self, rows: impl IntoIterator<Item = Vec<String>>) -> std::io::Result<()> {
+        for r in rows {
+            self.w.write_record(&r).map_err(std::io::Error::other)?;
+        }
+        self.w.flush()
+    }
+
+    /// Flush, fsync and rename to the final name.
+    pub fn finish(self) -> std::io::Result<PathBuf> {
+        let buf = self
+            .w
+            .into_inner()
+            .map_err(|e| std::io::Error::other(e.to_string()))?;
+        let file = buf.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        drop(file);
+        std::fs::rename(&self.partial, &self.path)?;
+        Ok(self.path)
+    }
+}
+
+/// Write `bytes` to `path` atomically (temporary file, fsync, rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".partial");
+    let tmp = PathBuf::from(tmp);
+    let mut f = File::create(&tmp)?;
+    f.write_all(bytes)?;
+    f.sync_all()?;
+    std::fs::rename(&tmp, path)
+}

@@ -1,0 +1,97 @@
+//! Ground-motion records: the `Record` type, file readers (`read`), and the seeded synthetic
+//! generator (`synthetic`). Accelerations are stored in m/s^2 whatever the file's units.
+
+mod read;
+mod synthetic;
+
+pub use read::{read_record, Format, ReadOptions, Units};
+pub use synthetic::{synthetic, SyntheticSpec};
+
+use std::path::PathBuf;
+
+/// Standard gravity, m/s^2 (the factor used by PEER files).
+pub const G: f64 = 9.80665;
+
+/// A uniformly sampled ground acceleration history.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    /// Label used in outputs (file stem or `synthetic-seedN`).
+    pub name: String,
+    /// Sample interval, s.
+    pub dt: f64,
+    /// Time of the first sample, s (two-column files may start at `dt`, not 0).
+    pub t0: f64,
+    /// Ground acceleration samples, m/s^2.
+    pub accel: Vec<f64>,
+}
+
+/// Peak ground acceleration and where it occurs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Peak {
+    /// max |a|, m/s^2
+    pub value: f64,
+    /// Index of the sample.
+    pub index: usize,
+    /// Time of the sample, s.
+    pub time: f64,
+}
+
+impl Record {
+    pub fn npts(&self) -> usize {
+        self.accel.len()
+    }
+
+    /// Duration as PEER quotes it: `npts * dt`.
+    pub fn duration(&self) -> f64 {
+        self.accel.len() as f64 * self.dt
+    }
+
+    /// Peak |a| (first occurrence on ties).
+    pub fn pga(&self) -> Peak {
+        let mut best = Peak {
+            value: 0.0,
+            index: 0,
+            time: self.t0,
+        };
+        for (i, a) in self.accel.iter().enumerate() {
+            if a.abs() > best.value {
+                best = Peak {
+                    value: a.abs(),
+                    index: i,
+                    time: self.t0 + i as f64 * self.dt,
+                };
+            }
+        }
+        best
+    }
+
+    /// Factor that scales this record to the target PGA (m/s^2).
+    pub fn scale_to_pga(&self, target: f64) -> Result<f64, RecordError> {
+        let pga = self.pga().value;
+        if pga <= 0.0 {
+            return Err(RecordError::Invalid {
+                path: PathBuf::from(&self.name),
+                message: "record is all zeros: it cannot be scaled to a target PGA".into(),
+            });
+        }
+        Ok(target / pga)
+    }
+}
+
+/// Errors from reading or generating records. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    #[error("{}: cannot read: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}:{line}: {message}", path.display())]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    #[error("{}: {message}", path.display())]
+    Invalid { path: PathBuf, message: String },
+}

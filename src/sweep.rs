@@ -1,0 +1,80 @@
+//! Run a plan on the CPU with rayon: chunks of consecutive runs in parallel, handed to a sink in
+//! run order as each batch finishes (so output streams and is identical for any thread count).
+
+use crate::cpu::{simulate, Scheme};
+use crate::model::{Initial, RunOutput, Status};
+use crate::plan::{Plan, RunSpec};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Totals of a finished sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Summary {
+    pub runs: u64,
+    pub seconds: f64,
+    pub runs_with_impacts: u64,
+    pub impacts: u64,
+    pub failures: u64,
+}
+
+impl Summary {
+    pub fn runs_per_second(&self) -> f64 {
+        self.runs as f64 / self.seconds.max(1e-9)
+    }
+}
+
+/// Run one plan entry.
+pub fn run_one(plan: &Plan, spec: &RunSpec, scheme: &Scheme) -> RunOutput {
+    simulate(
+        &spec.pair(),
+        &plan.forcing(spec),
+        &Initial::default(),
+        scheme,
+    )
+}
+
+/// Run every run of `plan` with `scheme`, `chunk` runs per task; `sink` gets each chunk's results
+/// in run order, `progress` the number of runs done so far.
+pub fn run<E>(
+    plan: &Plan,
+    scheme: &Scheme,
+    chunk: usize,
+    mut sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    mut progress: impl FnMut(u64),
+) -> Result<Summary, E> {
+    let start = Instant::now();
+    let chunk = chunk.max(1) as u64;
+    let n = plan.len();
+    let nchunks = n.div_ceil(chunk);
+    let batch = (rayon::current_num_threads() as u64 * 4).max(1);
+    let mut s = Summary::default();
+    let mut c0 = 0;
+    while c0 < nchunks {
+        let c1 = (c0 + batch).min(nchunks);
+        let results: Vec<Vec<(RunSpec, RunOutput)>> = (c0..c1)
+            .into_par_iter()
+            .map(|c| {
+                (c * chunk..((c + 1) * chunk).min(n))
+                    .map(|i| {
+                        let spec = plan.run(i);
+                        let out = run_one(plan, &spec, scheme);
+                        (spec, out)
+                    })
+                    .collect()
+            })
+            .collect();
+        for r in &results {
+            for (_, o) in r {
+                s.runs += 1;
+                s.impacts += o.impacts as u64;
+                s.runs_with_impacts += (o.impacts > 0) as u64;
+                s.failures += (o.status != Status::Ok) as u64;
+            }
+            sink(r)?;
+        }
+        progress(s.runs);
+        c0 = c1;
+    }
+    s.seconds = start.elapsed().as_secs_f64();
+    Ok(s)
+}
