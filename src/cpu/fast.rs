@@ -23,8 +23,8 @@
 //! `M` RK4 substeps only for the record steps near or in contact.
 
 use super::{
-    ddelta, delta, event_value, finite, hidden_touch, impact_step, initial_state, locate,
-    may_touch, reapproach, structural_rel_accel, transition, Mode, Sample, Segment, State, Tracker,
+    ddelta, delta, finite, impact_step, may_touch, structural_rel_accel, Integration, Mode, Sample,
+    Segment, State,
 };
 use crate::model::{Forcing, Initial, Pair, RunOutput, Status};
 use crate::propagator::Propagator;
@@ -75,41 +75,24 @@ pub(crate) fn run(
     forcing: &Forcing,
     init: &Initial,
     o: &FastOptions,
-    mut observer: Option<&mut dyn FnMut(&Sample)>,
+    observer: Option<&mut dyn FnMut(&Sample)>,
 ) -> RunOutput {
     let dt = forcing.dt;
     let (p1, p2) = (Propagator::new(&pair.b1, dt), Propagator::new(&pair.b2, dt));
-    let mut z = initial_state(init);
-    let mut mode = Mode::Free;
-    let mut tr = Tracker::new();
+    let mut run = Integration::start(pair, init, forcing.t0, observer);
     let mut substeps: u64 = 0;
-    let mut emit = |t: f64, z: &State, mode: Mode, v0: f64| {
-        if let Some(obs) = observer.as_mut() {
-            obs(&Sample {
-                t,
-                z: *z,
-                force: super::force(pair, mode, v0, z),
-                mode,
-            });
-        }
-    };
-    if event_value(pair, mode, tr.v0, &z) > 0.0 {
-        mode = transition(pair, mode, forcing.t0, &z, &z, &mut tr);
-    }
-    emit(forcing.t0, &z, mode, tr.v0);
     for i in 0..forcing.intervals() {
         let seg = Segment::of(forcing, i);
-        let (v_est, d_est, a_est) = if mode == Mode::Free {
+        let z = run.z;
+        let (v_est, d_est, a_est) = if run.mode == Mode::Free {
             let (u1, v1) = p1.step(z[0], z[1], seg.a0, seg.a1);
             let (u2, v2) = p2.step(z[2], z[3], seg.a0, seg.a1);
             let z1 = [u1, v1, u2, v2, z[4]];
-            if !may_touch(pair, &seg, &z, &z1, dt, tr.v0) {
-                tr.step(pair, mode, seg.t0, dt, &z, &z1);
-                z = z1;
-                if !finite(&z) {
-                    return tr.finish(mode, Status::NonFinite);
+            if !may_touch(pair, &seg, &z, &z1, dt, run.tr.v0) {
+                run.free_step(seg.t0, dt, z1);
+                if !finite(&run.z) {
+                    return run.finish(Status::NonFinite);
                 }
-                emit(seg.t1(), &z, mode, tr.v0);
                 continue;
             }
             let a = structural_rel_accel(pair, &z).abs();
@@ -120,17 +103,17 @@ pub(crate) fn run(
             )
         } else {
             let a = structural_rel_accel(pair, &z).abs();
-            (tr.v0.max(ddelta(&z).abs()), delta(pair, &z), a)
+            (run.tr.v0.max(ddelta(&z).abs()), delta(pair, &z), a)
         };
         // Resolve an impact at v_est, and stay stable at the current penetration (twice it, as
         // it may grow within the step).
         let h_rate = 2.0 * std::f64::consts::PI
             / o.substeps_per_contact
-            / pair.contact.local_rate(2.0 * d_est, tr.v0);
+            / pair.contact.local_rate(2.0 * d_est, run.tr.v0);
         let h = impact_step(pair, v_est, a_est, o.substeps_per_contact).min(h_rate);
         let m = (dt / h).ceil().max(1.0);
         if m.is_nan() || m > o.max_substeps_per_step as f64 {
-            return tr.finish(mode, Status::StepLimit);
+            return run.finish(Status::StepLimit);
         }
         let m = m as u32;
         let h = dt / m as f64;
@@ -144,52 +127,18 @@ pub(crate) fn run(
             while t_target - t > 1e-9 * h {
                 substeps += 1;
                 if substeps > o.max_substeps {
-                    return tr.finish(mode, Status::StepLimit);
+                    return run.finish(Status::StepLimit);
                 }
                 let hs = t_target - t;
-                let v0 = tr.v0;
-                let mut trial = rk4(pair, mode, v0, &seg, t, &z, hs);
-                let mut f1 = event_value(pair, mode, v0, &trial);
-                let mut hs = hs;
-                if mode == Mode::Free && f1 <= 0.0 {
-                    if let Some(s) = hidden_touch(pair, &z, &trial, hs) {
-                        let zs = rk4(pair, mode, v0, &seg, t, &z, s * hs);
-                        let fs = event_value(pair, mode, v0, &zs);
-                        if fs > 0.0 {
-                            (trial, f1, hs) = (zs, fs, s * hs);
-                        }
-                    }
+                let (z0, mode, v0) = (run.z, run.mode, run.tr.v0);
+                let step = |x: f64| rk4(pair, mode, v0, &seg, t, &z0, x);
+                t += run.accept(t, hs, step(hs), 1e-9, 16, step);
+                if !finite(&run.z) {
+                    return run.finish(Status::NonFinite);
                 }
-                if f1 > 0.0 {
-                    let f0 = event_value(pair, mode, v0, &z);
-                    let z0 = z;
-                    let (x, zb) = locate(
-                        hs,
-                        f0,
-                        trial,
-                        f1,
-                        1e-9 * hs,
-                        16,
-                        |x| rk4(pair, mode, v0, &seg, t, &z0, x),
-                        |s| event_value(pair, mode, v0, s),
-                    );
-                    tr.step(pair, mode, t, x, &z0, &zb);
-                    mode = transition(pair, mode, t + x, &zb, &z0, &mut tr);
-                    z = zb;
-                    t += x;
-                } else {
-                    tr.step(pair, mode, t, hs, &z, &trial);
-                    z = trial;
-                    t += hs;
-                    mode = reapproach(mode, &z);
-                }
-                if !finite(&z) {
-                    return tr.finish(mode, Status::NonFinite);
-                }
-                emit(t, &z, mode, tr.v0);
             }
             t = t_target;
         }
     }
-    tr.finish(mode, Status::Ok)
+    run.finish(Status::Ok)
 }

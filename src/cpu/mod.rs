@@ -493,6 +493,107 @@ impl Tracker {
     }
 }
 
+/// The state of one run being integrated, shared by both schemes: they decide step lengths and
+/// take trial steps; [`Integration::accept`] does the rest.
+pub(crate) struct Integration<'a, 'o> {
+    pub pair: &'a Pair,
+    pub z: State,
+    pub mode: Mode,
+    pub tr: Tracker,
+    observer: Option<&'o mut dyn FnMut(&Sample)>,
+}
+
+impl<'a, 'o> Integration<'a, 'o> {
+    /// Start at `t0` from `init` (already in contact if the bodies overlap).
+    pub fn start(
+        pair: &'a Pair,
+        init: &Initial,
+        t0: f64,
+        observer: Option<&'o mut dyn FnMut(&Sample)>,
+    ) -> Self {
+        let z = [init.u1, init.v1, init.u2, init.v2, 0.0];
+        let mut run = Integration {
+            pair,
+            z,
+            mode: Mode::Free,
+            tr: Tracker::new(),
+            observer,
+        };
+        if event_value(pair, run.mode, 0.0, &z) > 0.0 {
+            run.mode = transition(pair, run.mode, t0, &z, &z, &mut run.tr);
+        }
+        run.emit(t0);
+        run
+    }
+
+    pub fn emit(&mut self, t: f64) {
+        if let Some(obs) = self.observer.as_mut() {
+            let force = force(self.pair, self.mode, self.tr.v0, &self.z);
+            obs(&Sample {
+                t,
+                z: self.z,
+                force,
+                mode: self.mode,
+            });
+        }
+    }
+
+    /// A free step `t -> t + h` with no possible contact (already checked by the caller).
+    pub fn free_step(&mut self, t: f64, h: f64, z1: State) {
+        self.tr.step(self.pair, self.mode, t, h, &self.z, &z1);
+        self.z = z1;
+        self.emit(t + h);
+    }
+
+    /// Accept `trial`, the step `t -> t + h` in the current mode; `step(x)` re-takes it with
+    /// length `x`. A touch hidden inside a free step and any event inside the step are located
+    /// (to `tol_rel * h`, at most `max_iter` iterations); the step then ends there. Updates peaks
+    /// and mode and returns the length advanced.
+    pub fn accept(
+        &mut self,
+        t: f64,
+        h: f64,
+        trial: State,
+        tol_rel: f64,
+        max_iter: u32,
+        mut step: impl FnMut(f64) -> State,
+    ) -> f64 {
+        let (p, mode, v0, z0) = (self.pair, self.mode, self.tr.v0, self.z);
+        let (mut trial, mut h) = (trial, h);
+        let mut f1 = event_value(p, mode, v0, &trial);
+        if mode == Mode::Free && f1 <= 0.0 {
+            if let Some(s) = hidden_touch(p, &z0, &trial, h) {
+                let zs = step(s * h);
+                let fs = event_value(p, mode, v0, &zs);
+                if fs > 0.0 {
+                    (trial, f1, h) = (zs, fs, s * h);
+                }
+            }
+        }
+        let advanced = if f1 > 0.0 {
+            let f0 = event_value(p, mode, v0, &z0);
+            let tol = (tol_rel * h).max(4.0 * f64::EPSILON * t.abs());
+            let eval = |s: &State| event_value(p, mode, v0, s);
+            let (x, zb) = locate(h, f0, trial, f1, tol, max_iter, &mut step, eval);
+            self.tr.step(p, mode, t, x, &z0, &zb);
+            self.mode = transition(p, mode, t + x, &zb, &z0, &mut self.tr);
+            self.z = zb;
+            x
+        } else {
+            self.tr.step(p, mode, t, h, &z0, &trial);
+            self.z = trial;
+            self.mode = reapproach(mode, &self.z);
+            h
+        };
+        self.emit(t + advanced);
+        advanced
+    }
+
+    pub fn finish(self, status: Status) -> RunOutput {
+        self.tr.finish(self.mode, status)
+    }
+}
+
 /// Apply the mode change an event at state `z` (time `t`) calls for; `before` is the state at
 /// the start of the step in which the event was located.
 pub(crate) fn transition(
@@ -543,8 +644,4 @@ pub(crate) fn reapproach(mode: Mode, z: &State) -> Mode {
 
 pub(crate) fn finite(z: &State) -> bool {
     z.iter().all(|x| x.is_finite())
-}
-
-pub(crate) fn initial_state(init: &Initial) -> State {
-    [init.u1, init.v1, init.u2, init.v2, 0.0]
 }

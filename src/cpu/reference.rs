@@ -5,8 +5,8 @@
 //! at `t_c / contact_steps` so the parabola-refined peak force is resolved to about `rtol`.
 
 use super::{
-    ddelta, event_value, finite, hidden_touch, impact_step, initial_state, locate, may_touch,
-    reapproach, structural_rel_accel, transition, Mode, Sample, Segment, State, Tracker,
+    ddelta, finite, impact_step, may_touch, structural_rel_accel, Integration, Mode, Sample,
+    Segment, State,
 };
 use crate::model::{Forcing, Initial, Pair, RunOutput, Status};
 
@@ -151,27 +151,11 @@ pub(crate) fn run(
     forcing: &Forcing,
     init: &Initial,
     o: &ReferenceOptions,
-    mut observer: Option<&mut dyn FnMut(&Sample)>,
+    observer: Option<&mut dyn FnMut(&Sample)>,
     stop_after_impacts: Option<u32>,
 ) -> RunOutput {
-    let mut z = initial_state(init);
-    let mut mode = Mode::Free;
-    let mut tr = Tracker::new();
+    let mut run = Integration::start(pair, init, forcing.t0, observer);
     let mut steps: u64 = 0;
-    let mut emit = |t: f64, z: &State, mode: Mode, v0: f64| {
-        if let Some(obs) = observer.as_mut() {
-            obs(&Sample {
-                t,
-                z: *z,
-                force: super::force(pair, mode, v0, z),
-                mode,
-            });
-        }
-    };
-    if event_value(pair, mode, tr.v0, &z) > 0.0 {
-        mode = transition(pair, mode, forcing.t0, &z, &z, &mut tr);
-    }
-    emit(forcing.t0, &z, mode, tr.v0);
     let mut h = forcing.dt / 8.0;
     for i in 0..forcing.intervals() {
         let seg = Segment::of(forcing, i);
@@ -180,16 +164,16 @@ pub(crate) fn run(
         while t1 - t > 1e-12 * seg.dt {
             steps += 1;
             if steps > o.max_steps {
-                return tr.finish(mode, Status::StepLimit);
+                return run.finish(Status::StepLimit);
             }
+            let (z0, mode, v0) = (run.z, run.mode, run.tr.v0);
             let mut hs = h.min(t1 - t);
             if mode != Mode::Free {
-                let a = structural_rel_accel(pair, &z);
-                hs = hs.min(impact_step(pair, tr.v0, a, o.contact_steps));
+                let a = structural_rel_accel(pair, &z0);
+                hs = hs.min(impact_step(pair, v0, a, o.contact_steps));
             }
-            let v0 = tr.v0;
             let cs = ContactScales::of(pair, v0);
-            let (trial, err) = dopri(pair, mode, v0, &seg, t, &z, hs, o.rtol, &cs);
+            let (trial, err) = dopri(pair, mode, v0, &seg, t, &z0, hs, o.rtol, &cs);
             if err.is_nan() || err > 1.0 {
                 // Rejected (or non-finite): shrink. Only floating-point resolution bounds the
                 // step: the delta^(1/4) damping of the nonlinear viscoelastic law needs very short
@@ -201,7 +185,7 @@ pub(crate) fn run(
                     } else {
                         Status::NonFinite
                     };
-                    return tr.finish(mode, status);
+                    return run.finish(status);
                 }
                 h = if err.is_finite() {
                     hs * (0.9 * err.powf(-0.2)).max(0.1)
@@ -211,56 +195,22 @@ pub(crate) fn run(
                 continue;
             }
             if mode == Mode::Free {
-                let v_est = 1.5 * ddelta(&z).abs().max(ddelta(&trial).abs());
-                let a = structural_rel_accel(pair, &z).abs();
+                let v_est = 1.5 * ddelta(&z0).abs().max(ddelta(&trial).abs());
+                let a = structural_rel_accel(pair, &z0).abs();
                 let a = a.max(structural_rel_accel(pair, &trial).abs());
                 let h_touch = impact_step(pair, v_est, a, 8.0);
-                if hs > h_touch && may_touch(pair, &seg, &z, &trial, hs, v0) {
+                if hs > h_touch && may_touch(pair, &seg, &z0, &trial, hs, v0) {
                     h = h_touch;
                     continue;
                 }
             }
-            let mut f1 = event_value(pair, mode, v0, &trial);
-            let (mut trial, mut hs) = (trial, hs);
-            if mode == Mode::Free && f1 <= 0.0 {
-                if let Some(s) = hidden_touch(pair, &z, &trial, hs) {
-                    let zs = dopri(pair, mode, v0, &seg, t, &z, s * hs, o.rtol, &cs).0;
-                    let fs = event_value(pair, mode, v0, &zs);
-                    if fs > 0.0 {
-                        (trial, f1, hs) = (zs, fs, s * hs);
-                    }
-                }
-            }
-            if f1 > 0.0 {
-                let f0 = event_value(pair, mode, v0, &z);
-                let z0 = z;
-                let tol = (1e-13 * hs).max(4.0 * f64::EPSILON * t.abs());
-                let (x, zb) = locate(
-                    hs,
-                    f0,
-                    trial,
-                    f1,
-                    tol,
-                    100,
-                    |x| dopri(pair, mode, v0, &seg, t, &z0, x, o.rtol, &cs).0,
-                    |s| event_value(pair, mode, v0, s),
-                );
-                tr.step(pair, mode, t, x, &z0, &zb);
-                mode = transition(pair, mode, t + x, &zb, &z0, &mut tr);
-                z = zb;
-                t += x;
-            } else {
-                tr.step(pair, mode, t, hs, &z, &trial);
-                z = trial;
-                t += hs;
-                mode = reapproach(mode, &z);
-            }
-            emit(t, &z, mode, tr.v0);
-            if stop_after_impacts.is_some_and(|n| tr.impacts_ended() >= n) {
-                return tr.finish(mode, Status::Ok);
+            let step = |x: f64| dopri(pair, mode, v0, &seg, t, &z0, x, o.rtol, &cs).0;
+            t += run.accept(t, hs, trial, 1e-13, 100, step);
+            if stop_after_impacts.is_some_and(|n| run.tr.impacts_ended() >= n) {
+                return run.finish(Status::Ok);
             }
             h = hs * (0.9 * err.max(1e-12).powf(-0.2)).min(5.0);
         }
     }
-    tr.finish(mode, Status::Ok)
+    run.finish(Status::Ok)
 }
