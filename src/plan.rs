@@ -403,13 +403,6 @@ impl Plan {
     }
 
     pub fn forcing(&self, run: &RunSpec) -> Forcing<'_> {
-        let r = &self.spec.records[run.record];
-        Forcing {
-            accel: &r.accel,
-            dt: r.dt,
-            t0: r.t0,
-            scale: run.scale,
-            tail: self.spec.tail,
-        }
+        self.spec.records[run.record].forcing(run.scale, self.spec.tail)
     }
 }

@@ -269,37 +269,28 @@ pub(crate) fn locate(
         }
         let zx = step(x);
         let fx = eval(&zx);
-        if fx > 0.0 {
+        let g = if fx > 0.0 {
             (b, fb, zb) = (x, fx, zx);
             if last == 1 {
                 fa *= 0.5;
             }
             last = 1;
-            let g = x - 0.5 * tol;
-            if g > a {
-                let zg = step(g);
-                let fg = eval(&zg);
-                if fg > 0.0 {
-                    (b, fb, zb) = (g, fg, zg);
-                } else {
-                    (a, fa) = (g, fg);
-                }
-            }
+            x - 0.5 * tol
         } else {
             (a, fa) = (x, fx);
             if last == -1 {
                 fb *= 0.5;
             }
             last = -1;
-            let g = x + 0.5 * tol;
-            if g < b {
-                let zg = step(g);
-                let fg = eval(&zg);
-                if fg > 0.0 {
-                    (b, fb, zb) = (g, fg, zg);
-                } else {
-                    (a, fa) = (g, fg);
-                }
+            x + 0.5 * tol
+        };
+        if g > a && g < b {
+            let zg = step(g);
+            let fg = eval(&zg);
+            if fg > 0.0 {
+                (b, fb, zb) = (g, fg, zg);
+            } else {
+                (a, fa) = (g, fg);
             }
         }
     }

@@ -65,6 +65,18 @@ impl Record {
         best
     }
 
+    /// This record as the ground motion of a run: multiplied by `scale`, followed by `tail`
+    /// seconds of free vibration.
+    pub fn forcing(&self, scale: f64, tail: f64) -> crate::model::Forcing<'_> {
+        crate::model::Forcing {
+            accel: &self.accel,
+            dt: self.dt,
+            t0: self.t0,
+            scale,
+            tail,
+        }
+    }
+
     /// Factor that scales this record to the target PGA (m/s^2).
     pub fn scale_to_pga(&self, target: f64) -> Result<f64, RecordError> {
         let pga = self.pga().value;

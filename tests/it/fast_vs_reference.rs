@@ -2,11 +2,10 @@
 //! formulas and e, synthetic and real records, short and long periods, mass ratios, gaps from 0
 //! to beyond contact.
 
-use crate::support::{records_dir, rel};
+use crate::support::{collect, records_dir, rel};
 use pounding::config;
 use pounding::cpu::{FastOptions, ReferenceOptions, Scheme};
 use pounding::model::Status;
-use pounding::sweep;
 use std::path::Path;
 
 pub const MIXED: &str = r#"
@@ -64,23 +63,12 @@ fn mixed_plan() -> pounding::plan::Plan {
 fn fast_matches_reference_on_mixed_runs() {
     let plan = mixed_plan();
     assert!(plan.len() >= 300, "{} runs", plan.len());
-    let collect = |scheme: Scheme| {
-        let mut rows = Vec::new();
-        sweep::run(
-            &plan,
-            &scheme,
-            8,
-            |c| -> Result<(), ()> {
-                rows.extend_from_slice(c);
-                Ok(())
-            },
-            |_| {},
-        )
-        .unwrap();
-        rows
-    };
-    let fast = collect(Scheme::Fast(FastOptions::default()));
-    let refr = collect(Scheme::Reference(ReferenceOptions::with_tol(1e-7)));
+    let fast = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
+    let refr = collect(
+        &plan,
+        &Scheme::Reference(ReferenceOptions::with_tol(1e-7)),
+        8,
+    );
     let mut force_errs = Vec::new();
     let mut laws_pounded = std::collections::BTreeSet::new();
     for ((spec, f), (_, r)) in fast.iter().zip(&refr) {
@@ -152,21 +140,7 @@ fn results_independent_of_threads_and_chunks() {
             .num_threads(threads)
             .build()
             .unwrap();
-        let mut rows = Vec::new();
-        pool.install(|| {
-            sweep::run(
-                &plan,
-                &scheme,
-                chunk,
-                |c| -> Result<(), ()> {
-                    rows.extend_from_slice(c);
-                    Ok(())
-                },
-                |_| {},
-            )
-        })
-        .unwrap();
-        rows
+        pool.install(|| collect(&plan, &scheme, chunk))
     };
     let a = run(1, 1000);
     let b = run(3, 7);

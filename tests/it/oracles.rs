@@ -126,13 +126,7 @@ fn no_contact_beyond_free_relative_displacement() {
         ..Default::default()
     })
     .unwrap();
-    let forcing = Forcing {
-        accel: &rec.accel,
-        dt: rec.dt,
-        t0: 0.0,
-        scale: 1.0,
-        tail: 0.0,
-    };
+    let forcing = rec.forcing(1.0, 0.0);
     let (b1, b2) = ((1e5, 0.4, 0.05), (3e5, 1.1, 0.05));
     for scheme in schemes() {
         let mut max_rel: f64 = 0.0;
@@ -375,13 +369,7 @@ fn reference_tolerance_is_converged() {
         ..Default::default()
     })
     .unwrap();
-    let forcing = Forcing {
-        accel: &rec.accel,
-        dt: rec.dt,
-        t0: 0.0,
-        scale: 1.0,
-        tail: 0.0,
-    };
+    let forcing = rec.forcing(1.0, 0.0);
     for (law, k, d) in [
         (LawKind::NonlinearViscoelastic, 2.75e9, 0.35),
         (LawKind::KelvinVoigt, 1e9, 0.2),

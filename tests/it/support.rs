@@ -1,7 +1,10 @@
 //! Shared helpers: temp dirs, a diffing text comparison, records dir, scene builders.
 
 use pounding::contact::{Contact, LawKind};
+use pounding::cpu::Scheme;
+use pounding::model::RunOutput;
 use pounding::model::{Oscillator, Pair};
+use pounding::plan::{Plan, RunSpec};
 use std::path::PathBuf;
 
 /// The real-records directory (`POUND_RECORDS_DIR`, default `../shared/records`). Tests that need
@@ -73,4 +76,15 @@ pub fn pair(
         gap,
         contact: Contact::new(law, stiffness, damping, Pair::m_eff(&b1, &b2)),
     }
+}
+
+/// Every run of `plan` with `scheme`, in run order.
+pub fn collect(plan: &Plan, scheme: &Scheme, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
+    let mut rows = Vec::new();
+    let sink = |c: &[(RunSpec, RunOutput)]| -> Result<(), ()> {
+        rows.extend_from_slice(c);
+        Ok(())
+    };
+    pounding::sweep::run(plan, scheme, chunk, sink, |_| {}).unwrap();
+    rows
 }
