@@ -30,10 +30,10 @@ pub fn records_dir() -> PathBuf {
 
 #[derive(Debug, thiserror::Error)]
 pub enum ConfigError {
-    #[error("{}: cannot read config: {source}", path.display())]
+    #[error("{}: cannot read config: {error}", path.display())]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{}: {message}", path.display())]
     Toml { path: PathBuf, message: String },
@@ -43,11 +43,11 @@ pub enum ConfigError {
         key: String,
         message: String,
     },
-    #[error("{}: {key}: {source}", path.display())]
+    #[error("{}: {key}: {error}", path.display())]
     Record {
         path: PathBuf,
         key: String,
-        source: RecordError,
+        error: RecordError,
     },
 }
 
@@ -290,9 +290,9 @@ pub struct RawConfig {
 
 /// Read and validate a config file.
 pub fn load(path: &Path) -> Result<Plan, ConfigError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
         path: path.into(),
-        source,
+        error,
     })?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     parse(&text, path, &base, &records_dir())
@@ -401,10 +401,10 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
         let key = format!("record[{i}]");
         let rec = load_record(r, base, records).map_err(|e| match e {
             LoadError::Invalid(m) => invalid(&key, m),
-            LoadError::Record(source) => ConfigError::Record {
+            LoadError::Record(error) => ConfigError::Record {
                 path: path.into(),
                 key: key.clone(),
-                source,
+                error,
             },
         })?;
         recs.push(Arc::new(rec));

@@ -93,10 +93,10 @@ impl Record {
 /// Errors from reading or generating records. Every variant names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
-    #[error("{}: cannot read: {source}", path.display())]
+    #[error("{}: cannot read: {error}", path.display())]
     Io {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{}:{line}: {message}", path.display())]
     Parse {

@@ -88,9 +88,9 @@ impl Default for ReadOptions {
 
 /// Read and parse a record file.
 pub fn read_record(path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
-    let bytes = std::fs::read(path).map_err(|source| RecordError::Io {
+    let bytes = std::fs::read(path).map_err(|error| RecordError::Io {
         path: path.into(),
-        source,
+        error,
     })?;
     let text = String::from_utf8_lossy(&bytes);
     let name = path
