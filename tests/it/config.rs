@@ -41,7 +41,7 @@ pga_g = [0.2, 0.4]
 fn shipped_configs_load() {
     let q = config::load(Path::new("configs/quickstart.toml")).unwrap();
     assert_eq!(q.len(), 2700);
-    for (name, runs) in [("e", 70), ("period", 100), ("damping", 105), ("gap", 105)] {
+    for (name, runs) in [("e", 70), ("period", 100), ("damping", 105), ("gap", 100)] {
         let p = config::load(Path::new(&format!("configs/paper-{name}.toml")))
             .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(p.len(), runs, "paper-{name}");
