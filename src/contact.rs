@@ -250,21 +250,54 @@ impl Contact {
     }
 
     /// Estimated contact duration for approach speed `v` (Hertz-type durations shrink as
-    /// `v^(-1/5)`), s.
+    /// `v^(-1/5)`), s: `tc_coef()` for linear laws, `tc_coef() v^(-1/5)` for Hertz-type laws
+    /// (the fifth root by Newton steps, so the shader computes the same number without `pow`).
     pub fn duration_estimate(&self, v: f64) -> f64 {
         if self.kind.is_hertzian() {
-            let v = v.max(1e-6);
-            let dmax = (1.25 * self.m_eff * v * v / self.stiffness).powf(0.4);
-            HERTZ_TC * dmax / v
+            self.tc_coef() * inv_fifth_root(v.max(1e-6))
+        } else {
+            self.tc_coef()
+        }
+    }
+
+    /// The speed-independent factor of [`Contact::duration_estimate`]: `pi sqrt(m_eff / k)` for
+    /// linear laws; for Hertz-type laws, from `delta_max = (5 m_eff v^2 / (4 beta))^(2/5)`,
+    /// `HERTZ_TC (1.25 m_eff / beta)^(2/5)`.
+    pub fn tc_coef(&self) -> f64 {
+        if self.kind.is_hertzian() {
+            HERTZ_TC * (1.25 * self.m_eff / self.stiffness).powf(0.4)
         } else {
             std::f64::consts::PI * (self.m_eff / self.stiffness).sqrt()
         }
     }
 }
 
+/// `v^(-1/5)` for `v > 0`: an f32 `powf` seed and two Newton steps on `y^-5 = v`
+/// (`y <- y (6 - v y^5) / 5`), arithmetic only in f64; mirrored in the shader.
+#[inline]
+pub fn inv_fifth_root(v: f64) -> f64 {
+    let mut y = (v as f32).powf(-0.2) as f64;
+    for _ in 0..2 {
+        let y2 = y * y;
+        y = y * (6.0 - v * (y2 * y2 * y)) / 5.0;
+    }
+    y
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn inv_fifth_root_is_accurate() {
+        for v in [1e-6f64, 3.7e-4, 0.01, 0.5, 1.0, 2.3, 47.0, 1e3] {
+            let exact = v.powf(-0.2);
+            assert!(
+                (inv_fifth_root(v) - exact).abs() <= 4.0 * f64::EPSILON * exact,
+                "{v}"
+            );
+        }
+    }
 
     #[test]
     fn keys_round_trip() {

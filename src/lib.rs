@@ -5,9 +5,11 @@
 //! (integrators), [`plan`] (a validated sweep), [`config`] (TOML to plan), [`sweep`] (parallel
 //! execution and streaming output).
 
+pub mod bench;
 pub mod config;
 pub mod contact;
 pub mod cpu;
+pub mod gpu;
 pub mod model;
 pub mod output;
 pub mod plan;

@@ -78,3 +78,73 @@ pub fn run<E>(
     s.seconds = start.elapsed().as_secs_f64();
     Ok(s)
 }
+
+/// Where a GPU sweep spent its time, s (packing is host work; upload, kernel and readback are
+/// timed around the GPU calls that wait for completion).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GpuTimes {
+    pub pack: f64,
+    pub upload: f64,
+    pub kernel: f64,
+    pub readback: f64,
+    pub sink: f64,
+}
+
+/// Run every run of `plan` on the GPU, `chunk` runs per chunk (capped by the device's limits);
+/// `sink` gets each chunk's results in run order as it finishes. Rows already handed to `sink`
+/// stay there if a later chunk fails (device loss, out of memory).
+pub fn run_gpu<E: From<crate::gpu::GpuError>>(
+    plan: &Plan,
+    ctx: &crate::gpu::GpuContext,
+    opts: &crate::gpu::GpuOptions,
+    chunk: usize,
+    mut sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    mut progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), E> {
+    use crate::gpu::{pack, run_chunk, GpuRecords};
+    let start = Instant::now();
+    let mut times = GpuTimes::default();
+    let accels: Vec<&[f64]> = plan.spec.records.iter().map(|r| &r.accel[..]).collect();
+    let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
+    let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
+    let n = plan.len();
+    let mut s = Summary::default();
+    let mut c0 = 0;
+    while c0 < n {
+        let c1 = (c0 + chunk).min(n);
+        let t = Instant::now();
+        let (specs, packed): (Vec<RunSpec>, Vec<_>) = (c0..c1)
+            .into_par_iter()
+            .map(|i| {
+                let spec = plan.run(i);
+                let p = pack(
+                    &spec.pair(),
+                    &plan.forcing(&spec),
+                    spec.record,
+                    &recs,
+                    &opts.fast,
+                );
+                (spec, p)
+            })
+            .unzip();
+        times.pack += t.elapsed().as_secs_f64();
+        let (outs, ct) = run_chunk(ctx, &recs, &packed, opts)?;
+        times.upload += ct.upload.as_secs_f64();
+        times.kernel += ct.kernel.as_secs_f64();
+        times.readback += ct.readback.as_secs_f64();
+        let t = Instant::now();
+        let rows: Vec<(RunSpec, RunOutput)> = specs.into_iter().zip(outs).collect();
+        for (_, o) in &rows {
+            s.runs += 1;
+            s.impacts += o.impacts as u64;
+            s.runs_with_impacts += (o.impacts > 0) as u64;
+            s.failures += (o.status != Status::Ok) as u64;
+        }
+        sink(&rows)?;
+        times.sink += t.elapsed().as_secs_f64();
+        progress(s.runs);
+        c0 = c1;
+    }
+    s.seconds = start.elapsed().as_secs_f64();
+    Ok((s, times))
+}

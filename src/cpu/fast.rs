@@ -36,16 +36,20 @@ pub struct FastOptions {
     pub substeps_per_contact: f64,
     /// A record step that would need more substeps than this ends the run with `step_limit`.
     pub max_substeps_per_step: u32,
-    /// Substep budget of one run.
-    pub max_substeps: u64,
+    /// Substep budget of one run (u32 as on the GPU).
+    pub max_substeps: u32,
 }
+
+/// Accepted pieces one substep may be cut into by events before the run ends with
+/// `step_limit` (a guard against a stalled event search; the shader has the same cap).
+pub const MAX_PIECES_PER_SUBSTEP: u32 = 64;
 
 impl Default for FastOptions {
     fn default() -> Self {
         FastOptions {
             substeps_per_contact: 64.0,
             max_substeps_per_step: 1 << 20,
-            max_substeps: 1 << 32,
+            max_substeps: 1 << 30,
         }
     }
 }
@@ -80,7 +84,7 @@ pub(crate) fn run(
     let dt = forcing.dt;
     let (p1, p2) = (Propagator::new(&pair.b1, dt), Propagator::new(&pair.b2, dt));
     let mut run = Integration::start(pair, init, forcing.t0, observer);
-    let mut substeps: u64 = 0;
+    let mut substeps: u32 = 0;
     for i in 0..forcing.intervals() {
         let seg = Segment::of(forcing, i);
         let z = run.z;
@@ -124,9 +128,11 @@ pub(crate) fn run(
             } else {
                 seg.t0 + j as f64 * h
             };
+            let mut pieces = 0;
             while t_target - t > 1e-9 * h {
                 substeps += 1;
-                if substeps > o.max_substeps {
+                pieces += 1;
+                if substeps > o.max_substeps || pieces > MAX_PIECES_PER_SUBSTEP {
                     return run.finish(Status::StepLimit);
                 }
                 let hs = t_target - t;

@@ -395,6 +395,9 @@ pub(crate) struct Tracker {
     /// Approach speed of the current impact.
     pub v0: f64,
     imp_peak: f64,
+    /// Onset time of the current impact; force-sample times are kept relative to it, as the
+    /// shader does (so f32 times keep their resolution late in a record).
+    t_onset: f64,
     hist: [(f64, f64); 2],
     nhist: usize,
     impacts_ended: u32,
@@ -406,6 +409,7 @@ impl Tracker {
             out: RunOutput::default(),
             v0: 0.0,
             imp_peak: 0.0,
+            t_onset: 0.0,
             hist: [(0.0, 0.0); 2],
             nhist: 0,
             impacts_ended: 0,
@@ -428,11 +432,12 @@ impl Tracker {
             let (_, dmax) = hermite_range(delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1), h);
             o.peak_penetration = o.peak_penetration.max(dmax);
             o.dissipated_energy = z1[4];
-            self.force_sample(t0 + h, force(p, mode, self.v0, z1));
+            let f = force(p, mode, self.v0, z1);
+            self.force_sample(t0 + h - self.t_onset, f);
         }
     }
 
-    /// A force sample inside the current impact; a local maximum of three samples is refined by
+    /// A force sample `t` after the onset of the current impact; a local maximum of three samples is refined by
     /// the vertex of their parabola.
     fn force_sample(&mut self, t: f64, f: f64) {
         self.imp_peak = self.imp_peak.max(f);
@@ -463,8 +468,9 @@ impl Tracker {
         }
         self.v0 = v0;
         self.imp_peak = 0.0;
+        self.t_onset = t;
         self.nhist = 0;
-        self.force_sample(t, f);
+        self.force_sample(0.0, f);
     }
 
     pub fn end_impact(&mut self) {

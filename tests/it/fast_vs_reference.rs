@@ -39,7 +39,7 @@ pga_g = 0.4
 "#;
 
 /// The plan is cut to the first 6 s of each record to keep the reference affordable.
-fn mixed_plan() -> pounding::plan::Plan {
+pub fn mixed_plan() -> pounding::plan::Plan {
     let mut plan = config::parse(
         MIXED,
         Path::new("mixed.toml"),

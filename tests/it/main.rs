@@ -2,7 +2,8 @@
 
 mod cli;
 mod config;
-mod fast_vs_reference;
+pub mod fast_vs_reference;
+mod gpu;
 mod oracles;
 mod records;
 mod support;

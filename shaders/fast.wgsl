@@ -1,0 +1,705 @@
+// The `fast` scheme, one invocation per run: the GPU twin of src/cpu/fast.rs and the helpers in
+// src/cpu/mod.rs and src/contact.rs, function for function (same names, same operation order).
+// Each dispatch does at most `disp.budget` units of work per run (a free record interval, or one
+// piece of an RK4 substep) and saves the state, so the host repeats dispatches until no run is
+// active: no dispatch runs long, and lavapipe's loop limiter (about 65,535 loop iterations per
+// invocation; a loop past it silently exits) is never reached. The resumable form changes no
+// arithmetic: the CPU path takes the same steps in one pass.
+//
+// The host prepends a prelude (src/gpu/shader.rs): `alias real = f32;` or `f64;`, the precision
+// constants EPS, TINY, BIG, and WG (the workgroup size). Only sqrt, abs, min, max, ceil on reals:
+// lavapipe's f64 pow/exp/sin are wrong, so every transcendental coefficient comes precomputed in
+// `Params`, and the one fifth root is an f32 seed refined by Newton steps in `real`.
+
+// Keep in sync with src/gpu/layout.rs (the layout test checks sizes and offsets).
+struct Params {
+    m1: real, c1: real, k1: real, m2: real, c2: real, k2: real,
+    gap: real,
+    stiffness: real,
+    damping: real,
+    damping_ratio: real,
+    m_eff: real,
+    tc_coef: real,
+    dt: real, t0: real, scale: real,
+    substeps_per_contact: real,
+    p1_uu: real, p1_uv: real, p1_ua0: real, p1_ua1: real,
+    p1_vu: real, p1_vv: real, p1_va0: real, p1_va1: real,
+    p2_uu: real, p2_uv: real, p2_ua0: real, p2_ua1: real,
+    p2_vu: real, p2_vv: real, p2_va0: real, p2_va1: real,
+}
+
+struct State {
+    u1: real, v1: real, u2: real, v2: real,
+    w: real,
+    v0: real,
+    imp_peak: real,
+    h_t0: real, h_f0: real, h_t1: real, h_f1: real,
+    tau_onset: real,
+    tau: real,
+    peak_force: real, impact_velocity: real, peak_penetration: real, peak_u1: real, peak_u2: real,
+    first_impact: real,
+    contact_time: real,
+    dissipated: real,
+}
+
+struct Meta {
+    law: u32,
+    rec_offset: u32,
+    rec_len: u32,
+    intervals: u32,
+}
+
+struct Counters {
+    mode: u32,
+    nhist: u32,
+    impacts: u32,
+    status: u32,
+    substeps: u32,
+    i_onset: u32,
+    i: u32,
+    j: u32,
+    m: u32,
+    pieces: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+struct Dispatch {
+    budget: u32,
+    nruns: u32,
+    max_substeps_per_step: u32,
+    max_substeps: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+    _pad3: u32,
+}
+
+// Codes (keep in sync with LawKind::ALL order and the MODE_/STATUS_ constants in layout.rs).
+const LAW_LINEAR: u32 = 0u;
+const LAW_KELVIN_VOIGT: u32 = 1u;
+const LAW_KELVIN_VOIGT_NO_TENSION: u32 = 2u;
+const LAW_MODIFIED_LINEAR: u32 = 3u;
+const LAW_HERTZ: u32 = 4u;
+const LAW_NONLINEAR_VISCOELASTIC: u32 = 5u;
+// 6..9: the Hunt-Crossley family.
+const MODE_FREE: u32 = 0u;
+const MODE_APPROACH: u32 = 1u;
+const MODE_RESTITUTION: u32 = 2u;
+const STATUS_OK: u32 = 0u;
+const STATUS_NON_FINITE: u32 = 1u;
+const STATUS_STEP_LIMIT: u32 = 2u;
+// contact::HC_V0_MIN, contact::HERTZ floor on v, fast::MAX_PIECES_PER_SUBSTEP.
+const HC_V0_MIN: real = 1e-3;
+const V_MIN: real = 1e-6;
+const MAX_PIECES_PER_SUBSTEP: u32 = 64u;
+const LOCATE_TOL: real = 1e-9;
+const LOCATE_ITER: u32 = 16u;
+
+@group(0) @binding(0) var<uniform> disp: Dispatch;
+@group(0) @binding(1) var<storage, read> params: array<Params>;
+@group(0) @binding(2) var<storage, read> metas: array<Meta>;
+@group(0) @binding(3) var<storage, read> records: array<real>;
+@group(0) @binding(4) var<storage, read_write> states: array<State>;
+@group(0) @binding(5) var<storage, read_write> counters: array<Counters>;
+// Runs still integrating after this dispatch.
+@group(0) @binding(6) var<storage, read_write> active_runs: atomic<u32>;
+
+// This invocation's run.
+var<private> P: Params;
+var<private> M: Meta;
+var<private> S: State;
+var<private> C: Counters;
+// The state [u1, v1, u2, v2, w].
+var<private> ZS: Z;
+
+// [u1, v1, u2, v2, w]
+struct Z { u1: real, v1: real, u2: real, v2: real, w: real }
+
+struct Seg { a0: real, a1: real, dt: real }
+
+fn seg_at(s: Seg, tau: real) -> real {
+    return s.a0 + (s.a1 - s.a0) * (tau / s.dt);
+}
+
+fn sample(i: u32) -> real {
+    if (i < M.rec_len) {
+        return records[M.rec_offset + i] * P.scale;
+    }
+    return 0.0;
+}
+
+fn is_hertzian() -> bool {
+    return M.law >= LAW_HERTZ;
+}
+
+fn is_hunt_crossley() -> bool {
+    return M.law > LAW_NONLINEAR_VISCOELASTIC;
+}
+
+// ---- contact.rs ----
+
+fn chi(v0: real) -> real {
+    return P.damping / max(v0, HC_V0_MIN);
+}
+
+fn contact_force(d: real, dd: real, v0: real, approaching: bool) -> real {
+    let k = P.stiffness;
+    let c = P.damping;
+    switch M.law {
+        case LAW_LINEAR: { return k * d; }
+        case LAW_KELVIN_VOIGT, LAW_KELVIN_VOIGT_NO_TENSION: { return k * d + c * dd; }
+        case LAW_MODIFIED_LINEAR: {
+            var f = k * d;
+            if (approaching) { f = f + c * dd; }
+            return f;
+        }
+        case LAW_HERTZ: { return k * d * sqrt(abs(d)); }
+        case LAW_NONLINEAR_VISCOELASTIC: {
+            let r = sqrt(abs(d));
+            var f = k * d * r;
+            if (approaching) { f = f + c * sqrt(r) * dd; }
+            return f;
+        }
+        default: { return k * d * sqrt(abs(d)) * (1.0 + chi(v0) * dd); }
+    }
+}
+
+fn gauge(d: real, dd: real, v0: real) -> real {
+    if (M.law == LAW_KELVIN_VOIGT_NO_TENSION) {
+        return d + min(P.damping / P.stiffness * dd, 0.0);
+    }
+    if (is_hunt_crossley() && d > 0.0) {
+        return d * min(1.0 + chi(v0) * dd, 1.0);
+    }
+    return d;
+}
+
+fn local_rate(delta: real, v0: real) -> real {
+    let d = max(delta, 0.0);
+    let k = P.stiffness;
+    let c = P.damping;
+    var kl = k;
+    var cl: real = 0.0;
+    switch M.law {
+        case LAW_LINEAR: {}
+        case LAW_KELVIN_VOIGT, LAW_KELVIN_VOIGT_NO_TENSION, LAW_MODIFIED_LINEAR: { cl = c; }
+        case LAW_HERTZ: { kl = 1.5 * k * sqrt(d); }
+        case LAW_NONLINEAR_VISCOELASTIC: { kl = 1.5 * k * sqrt(d); cl = c * sqrt(sqrt(d)); }
+        default: { kl = 1.5 * k * sqrt(d); cl = k * d * sqrt(d) * chi(v0); }
+    }
+    return sqrt(kl / P.m_eff) + cl / P.m_eff;
+}
+
+// Two Newton steps, unrolled (every loop iteration counts against lavapipe's limiter).
+fn inv_fifth_root(v: real) -> real {
+    var y = real(pow(f32(v), -0.2));
+    var y2 = y * y;
+    y = y * (6.0 - v * (y2 * y2 * y)) / 5.0;
+    y2 = y * y;
+    y = y * (6.0 - v * (y2 * y2 * y)) / 5.0;
+    return y;
+}
+
+fn duration_estimate(v: real) -> real {
+    if (is_hertzian()) {
+        return P.tc_coef * inv_fifth_root(max(v, V_MIN));
+    }
+    return P.tc_coef;
+}
+
+// ---- cpu/mod.rs ----
+
+fn delta(z: Z) -> real {
+    return z.u1 - z.u2 - P.gap;
+}
+
+fn ddelta(z: Z) -> real {
+    return z.v1 - z.v2;
+}
+
+fn force(mode: u32, v0: real, z: Z) -> real {
+    if (mode == MODE_FREE) {
+        return 0.0;
+    }
+    return contact_force(delta(z), ddelta(z), v0, mode == MODE_APPROACH);
+}
+
+fn rhs(mode: u32, v0: real, ag: real, z: Z) -> Z {
+    let f = force(mode, v0, z);
+    return Z(
+        z.v1,
+        (-P.c1 * z.v1 - P.k1 * z.u1 - f) / P.m1 - ag,
+        z.v2,
+        (-P.c2 * z.v2 - P.k2 * z.u2 + f) / P.m2 - ag,
+        f * ddelta(z),
+    );
+}
+
+fn structural_rel_accel(z: Z) -> real {
+    return -(P.c1 * z.v1 + P.k1 * z.u1) / P.m1 + (P.c2 * z.v2 + P.k2 * z.u2) / P.m2;
+}
+
+fn impact_step(v: real, a: real) -> real {
+    let tc = duration_estimate(v);
+    var t = tc;
+    if (a != 0.0) {
+        t = min(tc, max(2.0 * v / abs(a), tc / 16.0));
+    }
+    return t / (P.substeps_per_contact * (1.0 + 2.0 * P.damping_ratio));
+}
+
+fn event_value(mode: u32, v0: real, z: Z) -> real {
+    switch mode {
+        case MODE_FREE: { return gauge(delta(z), ddelta(z), v0); }
+        case MODE_APPROACH: { return -ddelta(z); }
+        default: { return -gauge(delta(z), ddelta(z), v0); }
+    }
+}
+
+fn zadd(z: Z, k: Z, s: real) -> Z {
+    return Z(z.u1 + s * k.u1, z.v1 + s * k.v1, z.u2 + s * k.u2, z.v2 + s * k.v2, z.w + s * k.w);
+}
+
+// fast.rs `rk4`: classic RK4 over `h` from local time `tau`.
+fn rk4(mode: u32, v0: real, seg: Seg, tau: real, z: Z, h: real) -> Z {
+    let k1 = rhs(mode, v0, seg_at(seg, tau), z);
+    let k2 = rhs(mode, v0, seg_at(seg, tau + 0.5 * h), zadd(z, k1, 0.5 * h));
+    let k3 = rhs(mode, v0, seg_at(seg, tau + 0.5 * h), zadd(z, k2, 0.5 * h));
+    let k4 = rhs(mode, v0, seg_at(seg, tau + h), zadd(z, k3, h));
+    let h6 = h / 6.0;
+    return Z(
+        z.u1 + h6 * (k1.u1 + 2.0 * k2.u1 + 2.0 * k3.u1 + k4.u1),
+        z.v1 + h6 * (k1.v1 + 2.0 * k2.v1 + 2.0 * k3.v1 + k4.v1),
+        z.u2 + h6 * (k1.u2 + 2.0 * k2.u2 + 2.0 * k3.u2 + k4.u2),
+        z.v2 + h6 * (k1.v2 + 2.0 * k2.v2 + 2.0 * k3.v2 + k4.v2),
+        z.w + h6 * (k1.w + 2.0 * k2.w + 2.0 * k3.w + k4.w),
+    );
+}
+
+struct Located { x: real, z: Z }
+
+// Illinois regula falsi with a guard probe; the step is re-taken by rk4 from (tau, z0).
+fn locate(h: real, f0: real, z1: Z, f1: real, tol: real,
+          mode: u32, v0: real, seg: Seg, tau: real, z0: Z) -> Located {
+    var a: real = 0.0;
+    var fa = min(f0, 0.0);
+    var b = h;
+    var fb = f1;
+    var zb = z1;
+    var last = 0;
+    for (var it = 0u; it < LOCATE_ITER; it++) {
+        if (b - a <= tol) { break; }
+        var x = 0.5 * (a + b);
+        if (fb != fa) {
+            x = b - fb * (b - a) / (fb - fa);
+        }
+        if (!(x > a && x < b)) {
+            x = 0.5 * (a + b);
+        }
+        let zx = rk4(mode, v0, seg, tau, z0, x);
+        let fx = event_value(mode, v0, zx);
+        var g: real;
+        if (fx > 0.0) {
+            b = x; fb = fx; zb = zx;
+            if (last == 1) { fa = fa * 0.5; }
+            last = 1;
+            g = x - 0.5 * tol;
+        } else {
+            a = x; fa = fx;
+            if (last == -1) { fb = fb * 0.5; }
+            last = -1;
+            g = x + 0.5 * tol;
+        }
+        if (g > a && g < b) {
+            let zg = rk4(mode, v0, seg, tau, z0, g);
+            let fg = event_value(mode, v0, zg);
+            if (fg > 0.0) {
+                b = g; fb = fg; zb = zg;
+            } else {
+                a = g; fa = fg;
+            }
+        }
+    }
+    return Located(b, zb);
+}
+
+// Fraction of the step at the maximum of delta's Hermite cubic if it rises above 0 inside; -1 if not.
+fn hidden_touch(z0: Z, z1: Z, h: real) -> real {
+    let y0 = delta(z0);
+    let d0 = ddelta(z0);
+    let y1 = delta(z1);
+    let d1 = ddelta(z1);
+    if (y1 > 0.0 || (d0 <= 0.0 && d1 >= 0.0)) {
+        return -1.0;
+    }
+    let m0 = h * d0;
+    let m1 = h * d1;
+    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
+    let c = 2.0 * (y0 - y1) + m0 + m1;
+    let qa = 3.0 * c;
+    let qb = 2.0 * b;
+    let qc = m0;
+    var best_v: real = 0.0;
+    var best_s: real = -1.0;
+    let disc = qb * qb - 4.0 * qa * qc;
+    if (abs(qa) > TINY && disc >= 0.0) {
+        let r = sqrt(disc);
+        // Both roots, unrolled.
+        let s1 = (-qb + r) / (2.0 * qa);
+        if (s1 > 0.0 && s1 < 1.0) {
+            let v = y0 + s1 * (m0 + s1 * (b + s1 * c));
+            if (v > 0.0) {
+                best_v = v;
+                best_s = s1;
+            }
+        }
+        let s2 = (-qb - r) / (2.0 * qa);
+        if (s2 > 0.0 && s2 < 1.0) {
+            let v = y0 + s2 * (m0 + s2 * (b + s2 * c));
+            if (v > 0.0 && (best_s < 0.0 || v > best_v)) {
+                best_v = v;
+                best_s = s2;
+            }
+        }
+    }
+    return best_s;
+}
+
+struct Range { lo: real, hi: real }
+
+fn hermite_eval(y0: real, m0: real, b: real, c: real, s: real) -> real {
+    return y0 + s * (m0 + s * (b + s * c));
+}
+
+fn range_check(r: Range, y0: real, m0: real, b: real, c: real, s: real) -> Range {
+    var o = r;
+    if (s > 0.0 && s < 1.0) {
+        let v = hermite_eval(y0, m0, b, c, s);
+        o.lo = min(o.lo, v);
+        o.hi = max(o.hi, v);
+    }
+    return o;
+}
+
+fn hermite_range(y0: real, d0: real, y1: real, d1: real, h: real) -> Range {
+    let m0 = h * d0;
+    let m1 = h * d1;
+    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
+    let c = 2.0 * (y0 - y1) + m0 + m1;
+    var r = Range(min(y0, y1), max(y0, y1));
+    let qa = 3.0 * c;
+    let qb = 2.0 * b;
+    let qc = m0;
+    if (abs(qa) < TINY) {
+        if (qb != 0.0) {
+            r = range_check(r, y0, m0, b, c, -qc / qb);
+        }
+    } else {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if (disc >= 0.0) {
+            let rt = sqrt(disc);
+            // Rust's signum: +1 for +0.
+            var sg: real = 1.0;
+            if (qb < 0.0) { sg = -1.0; }
+            let q = -0.5 * (qb + sg * rt);
+            if (q != 0.0) {
+                r = range_check(r, y0, m0, b, c, q / qa);
+                r = range_check(r, y0, m0, b, c, qc / q);
+            }
+        }
+    }
+    return r;
+}
+
+fn fourth_derivative_bound(m: real, k: real, c: real, u: real, v: real, seg: Seg) -> real {
+    let w2 = k / m;
+    let cm = c / m;
+    let a2 = w2 * u + cm * v + max(abs(seg.a0), abs(seg.a1));
+    let a3 = w2 * v + cm * a2 + abs((seg.a1 - seg.a0) / seg.dt);
+    return w2 * a2 + cm * a3;
+}
+
+fn may_touch(seg: Seg, z0: Z, z1: Z, h: real, v0: real) -> bool {
+    let d0 = delta(z0);
+    let d1 = delta(z1);
+    if (gauge(d0, ddelta(z0), v0) > 0.0 || gauge(d1, ddelta(z1), v0) > 0.0) {
+        return true;
+    }
+    let r = hermite_range(d0, ddelta(z0), d1, ddelta(z1), h);
+    let u1 = max(abs(z0.u1), abs(z1.u1));
+    let v1 = max(abs(z0.v1), abs(z1.v1));
+    let u2 = max(abs(z0.u2), abs(z1.u2));
+    let v2 = max(abs(z0.v2), abs(z1.v2));
+    let bound = fourth_derivative_bound(P.m1, P.k1, P.c1, u1, v1, seg)
+        + fourth_derivative_bound(P.m2, P.k2, P.c2, u2, v2, seg);
+    let h2 = h * h;
+    return r.hi > -2.0 * h2 * h2 / 384.0 * bound;
+}
+
+// ---- Tracker ----
+
+// Time since the current impact's onset at local time tau of the current interval.
+fn since_onset(tau: real) -> real {
+    return real(C.i - C.i_onset) * P.dt + (tau - S.tau_onset);
+}
+
+fn force_sample(t: real, f: real) {
+    S.imp_peak = max(S.imp_peak, f);
+    if (C.nhist == 2u) {
+        let x0 = S.h_t0;
+        let y0 = S.h_f0;
+        let x1 = S.h_t1;
+        let y1 = S.h_f1;
+        if (y1 >= y0 && y1 >= f && x1 > x0 && t > x1) {
+            let d1 = (y1 - y0) / (x1 - x0);
+            let d2 = (f - y1) / (t - x1);
+            let a = (d2 - d1) / (t - x0);
+            if (a < 0.0) {
+                let xv = clamp(0.5 * (x0 + x1) - 0.5 * d1 / a, x0, t);
+                let yv = y0 + d1 * (xv - x0) + a * (xv - x0) * (xv - x1);
+                S.imp_peak = max(S.imp_peak, yv);
+            }
+        }
+        S.h_t0 = x1;
+        S.h_f0 = y1;
+        S.h_t1 = t;
+        S.h_f1 = f;
+    } else if (C.nhist == 1u) {
+        S.h_t1 = t;
+        S.h_f1 = f;
+        C.nhist = 2u;
+    } else {
+        S.h_t0 = t;
+        S.h_f0 = f;
+        C.nhist = 1u;
+    }
+}
+
+fn track_step(mode: u32, tau0: real, h: real, z0: Z, z1: Z) {
+    let r1 = hermite_range(z0.u1, z0.v1, z1.u1, z1.v1, h);
+    S.peak_u1 = max(max(S.peak_u1, abs(r1.hi)), abs(r1.lo));
+    let r2 = hermite_range(z0.u2, z0.v2, z1.u2, z1.v2, h);
+    S.peak_u2 = max(max(S.peak_u2, abs(r2.hi)), abs(r2.lo));
+    if (mode != MODE_FREE) {
+        S.contact_time = S.contact_time + h;
+        let rd = hermite_range(delta(z0), ddelta(z0), delta(z1), ddelta(z1), h);
+        S.peak_penetration = max(S.peak_penetration, rd.hi);
+        S.dissipated = z1.w;
+        let f = force(mode, S.v0, z1);
+        force_sample(since_onset(tau0 + h), f);
+    }
+}
+
+fn onset(tau: real, v0: real, f: real) {
+    C.impacts = C.impacts + 1u;
+    if (C.impacts == 1u) {
+        S.first_impact = P.t0 + real(C.i) * P.dt + tau;
+    }
+    S.v0 = v0;
+    S.imp_peak = 0.0;
+    C.i_onset = C.i;
+    S.tau_onset = tau;
+    C.nhist = 0u;
+    force_sample(0.0, f);
+}
+
+fn end_impact() {
+    if (S.imp_peak > S.peak_force) {
+        S.peak_force = S.imp_peak;
+        S.impact_velocity = S.v0;
+    }
+}
+
+fn transition(mode: u32, tau: real, z: Z, before: Z) -> u32 {
+    if (mode == MODE_FREE) {
+        let v = ddelta(z);
+        var v0 = S.v0;
+        if (delta(before) <= 0.0 || S.v0 <= 0.0) {
+            v0 = abs(v);
+        }
+        v0 = max(v0, 1e-12);
+        var next = MODE_RESTITUTION;
+        if (v > 0.0) { next = MODE_APPROACH; }
+        onset(tau, v0, force(next, v0, z));
+        return next;
+    }
+    if (mode == MODE_APPROACH) {
+        return MODE_RESTITUTION;
+    }
+    end_impact();
+    return MODE_FREE;
+}
+
+fn reapproach(mode: u32, z: Z) -> u32 {
+    if (mode == MODE_RESTITUTION && ddelta(z) > 0.0) {
+        return MODE_APPROACH;
+    }
+    return mode;
+}
+
+// Integration::accept for an RK4 trial step tau -> tau + h from z0; returns the length advanced
+// and leaves the new state in `out`.
+fn accept(tau: real, h_in: real, trial_in: Z, seg: Seg, z0: Z, out: ptr<function, Z>) -> real {
+    let mode = C.mode;
+    let v0 = S.v0;
+    var trial = trial_in;
+    var h = h_in;
+    var f1 = event_value(mode, v0, trial);
+    if (mode == MODE_FREE && f1 <= 0.0) {
+        let s = hidden_touch(z0, trial, h);
+        if (s >= 0.0) {
+            let zs = rk4(mode, v0, seg, tau, z0, s * h);
+            let fs = event_value(mode, v0, zs);
+            if (fs > 0.0) {
+                trial = zs;
+                f1 = fs;
+                h = s * h;
+            }
+        }
+    }
+    if (f1 > 0.0) {
+        let f0 = event_value(mode, v0, z0);
+        let tol = max(LOCATE_TOL * h, 4.0 * EPS * P.dt);
+        let l = locate(h, f0, trial, f1, tol, mode, v0, seg, tau, z0);
+        track_step(mode, tau, l.x, z0, l.z);
+        C.mode = transition(mode, tau + l.x, l.z, z0);
+        *out = l.z;
+        return l.x;
+    }
+    track_step(mode, tau, h, z0, trial);
+    *out = trial;
+    C.mode = reapproach(mode, trial);
+    return h;
+}
+
+fn finite(z: Z) -> bool {
+    // abs(x) <= BIG is false for NaN and for +-inf.
+    return abs(z.u1) <= BIG && abs(z.v1) <= BIG && abs(z.u2) <= BIG && abs(z.v2) <= BIG
+        && abs(z.w) <= BIG;
+}
+
+// The start of the current record interval (fast.rs `run`, loop body): take it with the exact
+// free step if no contact can occur inside, else set up its M RK4 substeps.
+fn begin_interval(seg: Seg) {
+    let dt = P.dt;
+    let z0 = ZS;
+    var v_est: real;
+    var d_est: real;
+    var a_est: real;
+    var substep = true;
+    if (C.mode == MODE_FREE) {
+        let u1 = P.p1_uu * z0.u1 + P.p1_uv * z0.v1 + P.p1_ua0 * seg.a0 + P.p1_ua1 * seg.a1;
+        let v1 = P.p1_vu * z0.u1 + P.p1_vv * z0.v1 + P.p1_va0 * seg.a0 + P.p1_va1 * seg.a1;
+        let u2 = P.p2_uu * z0.u2 + P.p2_uv * z0.v2 + P.p2_ua0 * seg.a0 + P.p2_ua1 * seg.a1;
+        let v2 = P.p2_vu * z0.u2 + P.p2_vv * z0.v2 + P.p2_va0 * seg.a0 + P.p2_va1 * seg.a1;
+        let z1 = Z(u1, v1, u2, v2, z0.w);
+        if (!may_touch(seg, z0, z1, dt, S.v0)) {
+            track_step(C.mode, 0.0, dt, z0, z1);
+            ZS = z1;
+            if (!finite(z1)) {
+                C.status = STATUS_NON_FINITE;
+            }
+            C.i = C.i + 1u;
+            substep = false;
+        } else {
+            let a = abs(structural_rel_accel(z0));
+            v_est = 1.5 * max(abs(ddelta(z0)), abs(ddelta(z1)));
+            d_est = max(delta(z0), delta(z1));
+            a_est = max(a, abs(structural_rel_accel(z1)));
+        }
+    } else {
+        v_est = max(S.v0, abs(ddelta(z0)));
+        d_est = delta(z0);
+        a_est = abs(structural_rel_accel(z0));
+    }
+    if (substep) {
+        // Resolve an impact at v_est, and stay stable at twice the current penetration.
+        let h_rate = 6.283185307179586 / P.substeps_per_contact / local_rate(2.0 * d_est, S.v0);
+        let h0 = min(impact_step(v_est, a_est), h_rate);
+        let mf = max(ceil(dt / h0), 1.0);
+        if (!(mf <= real(disp.max_substeps_per_step))) {
+            C.status = STATUS_STEP_LIMIT;
+        } else {
+            C.m = u32(mf);
+            C.j = 1u;
+            C.pieces = 0u;
+            S.tau = 0.0;
+        }
+    }
+}
+
+// One piece of substep j of the current interval: an RK4 step to the substep's end, cut short
+// at a located event; or, once the end is reached, the move to the next substep or interval.
+fn piece(seg: Seg) {
+    let dt = P.dt;
+    let h = dt / real(C.m);
+    var tau_target = dt;
+    if (C.j < C.m) {
+        tau_target = real(C.j) * h;
+    }
+    if (tau_target - S.tau > max(LOCATE_TOL * h, 4.0 * EPS * dt)) {
+        C.substeps = C.substeps + 1u;
+        C.pieces = C.pieces + 1u;
+        if (C.substeps > disp.max_substeps || C.pieces > MAX_PIECES_PER_SUBSTEP) {
+            C.status = STATUS_STEP_LIMIT;
+        } else {
+            let z = ZS;
+            let hs = tau_target - S.tau;
+            let trial = rk4(C.mode, S.v0, seg, S.tau, z, hs);
+            var znew: Z;
+            S.tau = S.tau + accept(S.tau, hs, trial, seg, z, &znew);
+            ZS = znew;
+            if (!finite(znew)) {
+                C.status = STATUS_NON_FINITE;
+            }
+        }
+    } else {
+        S.tau = tau_target;
+        C.j = C.j + 1u;
+        C.pieces = 0u;
+        if (C.j > C.m) {
+            C.j = 0u;
+            C.i = C.i + 1u;
+        }
+    }
+}
+
+@compute @workgroup_size(WG)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let r = gid.x;
+    if (r >= disp.nruns) {
+        return;
+    }
+    C = counters[r];
+    M = metas[r];
+    if (C.status != STATUS_OK || C.i >= M.intervals) {
+        return;
+    }
+    P = params[r];
+    S = states[r];
+    ZS = Z(S.u1, S.v1, S.u2, S.v2, S.w);
+    var budget = disp.budget;
+    loop {
+        if (C.status != STATUS_OK || C.i >= M.intervals || budget == 0u) {
+            break;
+        }
+        budget = budget - 1u;
+        let seg = Seg(sample(C.i), sample(C.i + 1u), P.dt);
+        if (C.j == 0u) {
+            begin_interval(seg);
+        } else {
+            piece(seg);
+        }
+    }
+    S.u1 = ZS.u1;
+    S.v1 = ZS.v1;
+    S.u2 = ZS.u2;
+    S.v2 = ZS.v2;
+    S.w = ZS.w;
+    states[r] = S;
+    counters[r] = C;
+    if (C.status == STATUS_OK && C.i < M.intervals) {
+        atomicAdd(&active_runs, 1u);
+    }
+}

@@ -1,0 +1,179 @@
+//! `pound bench`: runs per second of the CPU and GPU paths on the same sweeps, with where the
+//! time goes. The sweep is the quickstart physics (nonlinear viscoelastic contact, Ebrahimi
+//! zeta, e = 0.65) on a 20 s synthetic record at dt = 0.01 s, gaps 0..50 mm: most runs pound.
+
+use crate::cpu::{FastOptions, Scheme};
+use crate::gpu::{GpuContext, GpuError, GpuOptions};
+use crate::model::RunOutput;
+use crate::plan::{Plan, RunSpec};
+use std::path::Path;
+use std::time::Instant;
+
+/// A sweep of about `n` runs (periods of both buildings x 10 gaps).
+pub fn config(n: u64) -> String {
+    let per = (n as f64 / 10.0).max(1.0);
+    let a = per.sqrt().ceil().max(1.0) as u64;
+    let b = (per / a as f64).ceil().max(1.0) as u64;
+    format!(
+        r#"[building1]
+mass_kg = 1.0e5
+period_s = {{ from = 0.2, to = 2.0, n = {a} }}
+damping_ratio = 0.05
+
+[building2]
+mass_kg = 1.0e5
+period_s = {{ from = 0.15, to = 1.5, n = {b} }}
+damping_ratio = 0.05
+
+[contact]
+law = "nonlinear_viscoelastic"
+formula = "ebrahimi"
+e = 0.65
+beta_n_per_m1_5 = 2.75e9
+gap_m = {{ from = 0.0, to = 0.05, n = 10 }}
+
+[[record]]
+synthetic = {{ seed = 1, duration_s = 20.0, dt_s = 0.01, pga_g = 0.35 }}
+"#
+    )
+}
+
+/// The bench plan for about `n` runs.
+pub fn plan(n: u64) -> Plan {
+    crate::config::parse(
+        &config(n),
+        Path::new("bench.toml"),
+        Path::new("."),
+        Path::new("."),
+    )
+    .expect("bench config is valid")
+}
+
+/// One measured sweep; times in seconds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    pub runs: u64,
+    pub backend: String,
+    pub seconds: f64,
+    pub pack: f64,
+    pub upload: f64,
+    pub kernel: f64,
+    pub readback: f64,
+    pub csv: f64,
+    pub impacts: u64,
+}
+
+impl Row {
+    pub fn runs_per_second(&self) -> f64 {
+        self.runs as f64 / self.seconds.max(1e-12)
+    }
+}
+
+/// Formats each chunk's rows as CSV into a sink, timing it (the cost a real sweep pays).
+struct CsvSink<'a> {
+    plan: &'a Plan,
+    w: csv::Writer<std::io::Sink>,
+    seconds: f64,
+}
+
+impl CsvSink<'_> {
+    fn write(&mut self, rows: &[(RunSpec, RunOutput)]) {
+        let t = Instant::now();
+        for (s, o) in rows {
+            self.w
+                .write_record(crate::output::row(self.plan, s, o))
+                .expect("writing to a sink cannot fail");
+        }
+        self.seconds += t.elapsed().as_secs_f64();
+    }
+}
+
+/// The CPU fast path with rayon on all threads of the current pool.
+pub fn cpu(plan: &Plan) -> Row {
+    let mut sink = CsvSink {
+        plan,
+        w: csv::Writer::from_writer(std::io::sink()),
+        seconds: 0.0,
+    };
+    let s = crate::sweep::run(
+        plan,
+        &Scheme::Fast(FastOptions::default()),
+        64,
+        |rows| -> Result<(), ()> {
+            sink.write(rows);
+            Ok(())
+        },
+        |_| {},
+    )
+    .expect("sink cannot fail");
+    Row {
+        runs: s.runs,
+        backend: format!("cpu ({} threads)", rayon::current_num_threads()),
+        seconds: s.seconds,
+        pack: 0.0,
+        upload: 0.0,
+        kernel: s.seconds - sink.seconds,
+        readback: 0.0,
+        csv: sink.seconds,
+        impacts: s.impacts,
+    }
+}
+
+/// The GPU path on `ctx`, `chunk` runs per chunk.
+pub fn gpu(
+    plan: &Plan,
+    ctx: &GpuContext,
+    opts: &GpuOptions,
+    chunk: usize,
+) -> Result<Row, GpuError> {
+    let mut sink = CsvSink {
+        plan,
+        w: csv::Writer::from_writer(std::io::sink()),
+        seconds: 0.0,
+    };
+    let (s, t) = crate::sweep::run_gpu(
+        plan,
+        ctx,
+        opts,
+        chunk,
+        |rows| -> Result<(), GpuError> {
+            sink.write(rows);
+            Ok(())
+        },
+        |_| {},
+    )?;
+    Ok(Row {
+        runs: s.runs,
+        backend: format!("gpu {} ({})", opts.precision.key(), ctx.info.name),
+        seconds: s.seconds,
+        pack: t.pack,
+        upload: t.upload,
+        kernel: t.kernel,
+        readback: t.readback,
+        csv: sink.seconds,
+        impacts: s.impacts,
+    })
+}
+
+/// A markdown table of rows.
+pub fn table(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "| runs | backend | total s | runs/s | pack s | upload s | kernel s | readback s | csv s | impacts |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        s.push_str(&format!(
+            "| {} | {} | {:.3} | {:.0} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} |\n",
+            r.runs,
+            r.backend,
+            r.seconds,
+            r.runs_per_second(),
+            r.pack,
+            r.upload,
+            r.kernel,
+            r.readback,
+            r.csv,
+            r.impacts
+        ));
+    }
+    s
+}

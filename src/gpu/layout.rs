@@ -1,0 +1,240 @@
+//! Every struct shared with the WGSL shaders, one `#[repr(C)]` Pod type each, and the
+//! workgroup/buffer-size arithmetic. Keep in sync with `shaders/fast.wgsl` (the struct and field
+//! names there are the same; `tests/it/gpu.rs` parses the shader with naga and checks every size
+//! and offset against these types).
+//!
+//! Structs of reals come in two precisions with the same fields (`...64` for f64, `...32` for
+//! f32): the shader is compiled with `alias real = f64;` or `f32;` prepended. Each is all-real so
+//! it has no padding in either precision; integer fields live in separate all-`u32` structs.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Invocations per workgroup (`@workgroup_size` in the shader is substituted from this).
+pub const WORKGROUP_SIZE: u32 = 64;
+
+/// Field names and byte offsets of a shared struct, for the layout test.
+pub trait Layout {
+    const NAME: &'static str;
+    fn fields() -> Vec<(&'static str, usize)>;
+}
+
+macro_rules! real_structs {
+    ($(#[$doc:meta])* $name:literal, $n64:ident, $n32:ident { $($(#[$fdoc:meta])* $f:ident),* $(,)? }) => {
+        $(#[$doc])*
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+        pub struct $n64 { $($(#[$fdoc])* pub $f: f64),* }
+
+        /// f32 twin of the f64 struct of the same name.
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+        pub struct $n32 { $(pub $f: f32),* }
+
+        impl $n32 {
+            pub fn from_f64(x: &$n64) -> Self {
+                $n32 { $($f: x.$f as f32),* }
+            }
+            pub fn to_f64(&self) -> $n64 {
+                $n64 { $($f: self.$f as f64),* }
+            }
+        }
+
+        impl Layout for $n64 {
+            const NAME: &'static str = $name;
+            fn fields() -> Vec<(&'static str, usize)> {
+                vec![$((stringify!($f), core::mem::offset_of!($n64, $f))),*]
+            }
+        }
+
+        impl Layout for $n32 {
+            const NAME: &'static str = $name;
+            fn fields() -> Vec<(&'static str, usize)> {
+                vec![$((stringify!($f), core::mem::offset_of!($n32, $f))),*]
+            }
+        }
+    };
+}
+
+real_structs! {
+    /// Per-run parameters, all precomputed on the host (no transcendentals in the shader).
+    "Params", Params64, Params32 {
+        m1, c1, k1, m2, c2, k2,
+        /// m
+        gap,
+        /// `k` or `beta`
+        stiffness,
+        /// `c`, `c0` or Hunt-Crossley `a` (see `Contact::damping`)
+        damping,
+        damping_ratio,
+        m_eff,
+        /// Contact duration: `t_c = tc_coef` (linear laws) or `tc_coef v^(-1/5)` (Hertz-type).
+        tc_coef,
+        /// Record step and start, s; factor applied to the record's samples.
+        dt, t0, scale,
+        /// RK4 substeps per estimated contact duration.
+        substeps_per_contact,
+        /// Exact propagator of building 1 over `dt` (see `propagator::Propagator`).
+        p1_uu, p1_uv, p1_ua0, p1_ua1, p1_vu, p1_vv, p1_va0, p1_va1,
+        /// Same for building 2.
+        p2_uu, p2_uv, p2_ua0, p2_ua1, p2_vu, p2_vv, p2_va0, p2_va1,
+    }
+}
+
+real_structs! {
+    /// Per-run integration state and running results; carried from one dispatch to the next.
+    "State", State64, State32 {
+        u1, v1, u2, v2,
+        /// Contact work so far, J.
+        w,
+        /// Approach speed of the current impact.
+        v0,
+        /// Peak force of the current impact.
+        imp_peak,
+        /// The last two force samples `(time since onset, force)` of the current impact.
+        h_t0, h_f0, h_t1, h_f1,
+        /// Local time of the current impact's onset within its record interval.
+        tau_onset,
+        /// Local time reached within the current record interval.
+        tau,
+        peak_force, impact_velocity, peak_penetration, peak_u1, peak_u2,
+        /// Valid when `impacts > 0`.
+        first_impact,
+        contact_time,
+        dissipated,
+    }
+}
+
+/// Per-run integers fixed for the sweep.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Meta {
+    /// `LAW_*` code.
+    pub law: u32,
+    /// First sample of the run's record in the records buffer.
+    pub rec_offset: u32,
+    /// Samples in the record.
+    pub rec_len: u32,
+    /// Record intervals to simulate (record plus tail).
+    pub intervals: u32,
+}
+
+/// Per-run integer state, carried between dispatches.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Counters {
+    /// `MODE_*`
+    pub mode: u32,
+    /// Force samples held in `State::h_*` (0, 1 or 2).
+    pub nhist: u32,
+    pub impacts: u32,
+    /// `STATUS_*`; a run that is not `STATUS_OK` is not stepped again.
+    pub status: u32,
+    /// RK4 substeps taken so far.
+    pub substeps: u32,
+    /// Record interval of the current impact's onset.
+    pub i_onset: u32,
+    /// Current record interval.
+    pub i: u32,
+    /// Current RK4 substep of interval `i` (1..=m), 0 before the interval is started.
+    pub j: u32,
+    /// RK4 substeps of interval `i`.
+    pub m: u32,
+    /// Pieces (event cuts) taken in substep `j`.
+    pub pieces: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// Uniforms of one dispatch: at most `budget` units of work (a free interval, or one piece of a
+/// substep) for each of runs `[0, nruns)`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Dispatch {
+    pub budget: u32,
+    pub nruns: u32,
+    /// A record step needing more substeps ends the run with `STATUS_STEP_LIMIT`.
+    pub max_substeps_per_step: u32,
+    /// Substep budget of one run.
+    pub max_substeps: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+    pub _pad3: u32,
+}
+
+impl Layout for Meta {
+    const NAME: &'static str = "Meta";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("law", offset_of!(Meta, law)),
+            ("rec_offset", offset_of!(Meta, rec_offset)),
+            ("rec_len", offset_of!(Meta, rec_len)),
+            ("intervals", offset_of!(Meta, intervals)),
+        ]
+    }
+}
+
+impl Layout for Counters {
+    const NAME: &'static str = "Counters";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("mode", offset_of!(Counters, mode)),
+            ("nhist", offset_of!(Counters, nhist)),
+            ("impacts", offset_of!(Counters, impacts)),
+            ("status", offset_of!(Counters, status)),
+            ("substeps", offset_of!(Counters, substeps)),
+            ("i_onset", offset_of!(Counters, i_onset)),
+            ("i", offset_of!(Counters, i)),
+            ("j", offset_of!(Counters, j)),
+            ("m", offset_of!(Counters, m)),
+            ("pieces", offset_of!(Counters, pieces)),
+            ("_pad0", offset_of!(Counters, _pad0)),
+            ("_pad1", offset_of!(Counters, _pad1)),
+        ]
+    }
+}
+
+impl Layout for Dispatch {
+    const NAME: &'static str = "Dispatch";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("budget", offset_of!(Dispatch, budget)),
+            ("nruns", offset_of!(Dispatch, nruns)),
+            (
+                "max_substeps_per_step",
+                offset_of!(Dispatch, max_substeps_per_step),
+            ),
+            ("max_substeps", offset_of!(Dispatch, max_substeps)),
+            ("_pad0", offset_of!(Dispatch, _pad0)),
+            ("_pad1", offset_of!(Dispatch, _pad1)),
+            ("_pad2", offset_of!(Dispatch, _pad2)),
+            ("_pad3", offset_of!(Dispatch, _pad3)),
+        ]
+    }
+}
+
+// Codes shared with the shader (keep in sync with the `const`s in `shaders/fast.wgsl`).
+pub const MODE_FREE: u32 = 0;
+pub const MODE_APPROACH: u32 = 1;
+pub const MODE_RESTITUTION: u32 = 2;
+pub const STATUS_OK: u32 = 0;
+pub const STATUS_NON_FINITE: u32 = 1;
+pub const STATUS_STEP_LIMIT: u32 = 2;
+
+/// Workgroups for `n` runs.
+pub fn workgroups(n: u32) -> u32 {
+    n.div_ceil(WORKGROUP_SIZE)
+}
+
+/// Bytes of one `Params` at `precision`.
+pub fn params_bytes(precision: super::Precision) -> usize {
+    core::mem::size_of::<Params64>() / 8 * precision.bytes()
+}
+
+/// Bytes of one `State` at `precision`.
+pub fn state_bytes(precision: super::Precision) -> usize {
+    core::mem::size_of::<State64>() / 8 * precision.bytes()
+}

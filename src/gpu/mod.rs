@@ -1,0 +1,11 @@
+//! The GPU path: the `fast` scheme as a WGSL compute shader (`shaders/fast.wgsl`), one
+//! invocation per run.
+
+pub mod context;
+pub mod layout;
+pub mod run;
+pub mod shader;
+
+pub use context::{GpuContext, GpuError};
+pub use run::{output, pack, run_chunk, ChunkTimes, GpuOptions, GpuRecords};
+pub use shader::Precision;

@@ -1,0 +1,444 @@
+//! Packing runs into buffers, dispatching the kernel in windows of record intervals, reading
+//! back. The work functions take a [`GpuContext`], so tests can pass their own device.
+
+use super::context::{GpuContext, GpuError};
+use super::layout::{
+    self, Counters, Dispatch, Meta, Params32, Params64, State32, State64, MODE_FREE,
+    STATUS_NON_FINITE, STATUS_OK,
+};
+use super::shader::Precision;
+use crate::contact::LawKind;
+use crate::cpu::FastOptions;
+use crate::model::{Forcing, Pair, RunOutput, Status};
+use crate::propagator::Propagator;
+use std::time::{Duration, Instant};
+use wgpu::util::DeviceExt;
+
+/// Settings of the GPU path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GpuOptions {
+    pub precision: Precision,
+    /// The scheme's settings (the same as the CPU `fast` path's).
+    pub fast: FastOptions,
+    /// Units of work (a free record interval, or one piece of an RK4 substep) per run and
+    /// dispatch: keeps each dispatch short (drivers reset a GPU that runs one dispatch for
+    /// about 2 s). Capped at [`CPU_ADAPTER_BUDGET`] on a software adapter.
+    pub units_per_dispatch: u32,
+}
+
+impl Default for GpuOptions {
+    fn default() -> Self {
+        GpuOptions {
+            precision: Precision::F32,
+            fast: FastOptions::default(),
+            units_per_dispatch: 4096,
+        }
+    }
+}
+
+/// Budget cap on CPU (software) adapters: lavapipe ends any loop after about 65,535
+/// iterations per invocation without an error, and one unit runs at most 17 loop iterations.
+pub const CPU_ADAPTER_BUDGET: u32 = 1024;
+
+/// Where time went in one chunk.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ChunkTimes {
+    pub upload: Duration,
+    pub kernel: Duration,
+    pub readback: Duration,
+}
+
+impl std::ops::AddAssign for ChunkTimes {
+    fn add_assign(&mut self, o: ChunkTimes) {
+        self.upload += o.upload;
+        self.kernel += o.kernel;
+        self.readback += o.readback;
+    }
+}
+
+/// Every record of a sweep in one buffer, converted to the kernel's precision.
+pub struct GpuRecords {
+    buffer: wgpu::Buffer,
+    offsets: Vec<u32>,
+    lens: Vec<u32>,
+}
+
+impl GpuRecords {
+    pub fn upload(
+        ctx: &GpuContext,
+        precision: Precision,
+        records: &[&[f64]],
+    ) -> Result<GpuRecords, GpuError> {
+        let mut offsets = Vec::with_capacity(records.len());
+        let mut lens = Vec::with_capacity(records.len());
+        let mut all: Vec<f64> = Vec::new();
+        for r in records {
+            offsets.push(all.len() as u32);
+            lens.push(r.len() as u32);
+            all.extend_from_slice(r);
+        }
+        if all.is_empty() {
+            all.push(0.0);
+        }
+        let bytes = match precision {
+            Precision::F64 => bytemuck::cast_slice(&all).to_vec(),
+            Precision::F32 => {
+                let v: Vec<f32> = all.iter().map(|&x| x as f32).collect();
+                bytemuck::cast_slice(&v).to_vec()
+            }
+        };
+        let buffer = storage(ctx, "records", &bytes, wgpu::BufferUsages::empty())?;
+        Ok(GpuRecords {
+            buffer,
+            offsets,
+            lens,
+        })
+    }
+}
+
+fn law_code(l: LawKind) -> u32 {
+    LawKind::ALL.iter().position(|&k| k == l).unwrap() as u32
+}
+
+/// Pack one run: `record` is the index of its record in the [`GpuRecords`] it will run with.
+pub fn pack(
+    pair: &Pair,
+    forcing: &Forcing,
+    record: usize,
+    recs: &GpuRecords,
+    fast: &FastOptions,
+) -> (Params64, Meta) {
+    let (p1, p2) = (
+        Propagator::new(&pair.b1, forcing.dt),
+        Propagator::new(&pair.b2, forcing.dt),
+    );
+    pack_with(pair, forcing, record, recs, fast, &p1, &p2)
+}
+
+/// [`pack`] with the propagators given (callers cache them: they depend on building and `dt`).
+pub fn pack_with(
+    pair: &Pair,
+    forcing: &Forcing,
+    record: usize,
+    recs: &GpuRecords,
+    fast: &FastOptions,
+    p1: &Propagator,
+    p2: &Propagator,
+) -> (Params64, Meta) {
+    let c = &pair.contact;
+    let params = Params64 {
+        m1: pair.b1.m,
+        c1: pair.b1.c,
+        k1: pair.b1.k,
+        m2: pair.b2.m,
+        c2: pair.b2.c,
+        k2: pair.b2.k,
+        gap: pair.gap,
+        stiffness: c.stiffness,
+        damping: c.damping,
+        damping_ratio: c.damping_ratio,
+        m_eff: c.m_eff,
+        tc_coef: c.tc_coef(),
+        dt: forcing.dt,
+        t0: forcing.t0,
+        scale: forcing.scale,
+        substeps_per_contact: fast.substeps_per_contact,
+        p1_uu: p1.uu,
+        p1_uv: p1.uv,
+        p1_ua0: p1.ua0,
+        p1_ua1: p1.ua1,
+        p1_vu: p1.vu,
+        p1_vv: p1.vv,
+        p1_va0: p1.va0,
+        p1_va1: p1.va1,
+        p2_uu: p2.uu,
+        p2_uv: p2.uv,
+        p2_ua0: p2.ua0,
+        p2_ua1: p2.ua1,
+        p2_vu: p2.vu,
+        p2_vv: p2.vv,
+        p2_va0: p2.va0,
+        p2_va1: p2.va1,
+    };
+    debug_assert_eq!(forcing.accel.len(), recs.lens[record] as usize);
+    let meta = Meta {
+        law: law_code(c.kind),
+        rec_offset: recs.offsets[record],
+        rec_len: recs.lens[record],
+        intervals: forcing.intervals() as u32,
+    };
+    (params, meta)
+}
+
+/// A run's results from its final state (what `Tracker::finish` does on the CPU).
+pub fn output(s: &State64, c: &Counters) -> RunOutput {
+    let (mut peak_force, mut impact_velocity) = (s.peak_force, s.impact_velocity);
+    if c.mode != MODE_FREE && s.imp_peak > peak_force {
+        peak_force = s.imp_peak;
+        impact_velocity = s.v0;
+    }
+    RunOutput {
+        status: match c.status {
+            STATUS_OK => Status::Ok,
+            STATUS_NON_FINITE => Status::NonFinite,
+            _ => Status::StepLimit,
+        },
+        impacts: c.impacts,
+        peak_force,
+        peak_penetration: s.peak_penetration,
+        peak_u1: s.peak_u1,
+        peak_u2: s.peak_u2,
+        impact_velocity,
+        first_impact: (c.impacts > 0).then_some(s.first_impact),
+        contact_time: s.contact_time,
+        dissipated_energy: s.dissipated,
+    }
+}
+
+fn storage(
+    ctx: &GpuContext,
+    label: &str,
+    bytes: &[u8],
+    extra: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer, GpuError> {
+    let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let buffer = ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE | extra,
+        });
+    if pollster::block_on(scope.pop()).is_some() {
+        return Err(GpuError::OutOfMemory {
+            what: label.to_string(),
+            bytes: bytes.len() as u64,
+        });
+    }
+    Ok(buffer)
+}
+
+fn wait(ctx: &GpuContext) -> Result<(), GpuError> {
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| GpuError::Other {
+            message: e.to_string(),
+        })?;
+    match ctx.take_error() {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+fn read(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let size = src.size();
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback copy"),
+        });
+    enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
+    ctx.queue.submit([enc.finish()]);
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, move |r| drop(tx.send(r)));
+    wait(ctx)?;
+    rx.recv()
+        .map_err(|e| GpuError::Other {
+            message: e.to_string(),
+        })?
+        .map_err(|e| GpuError::Other {
+            message: format!("reading results back: {e}"),
+        })?;
+    let data = staging
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| GpuError::Other {
+            message: format!("reading results back: {e}"),
+        })?
+        .to_vec();
+    staging.unmap();
+    Ok(data)
+}
+
+/// Integrate packed runs from rest over their whole records; results in input order.
+pub fn run_chunk(
+    ctx: &GpuContext,
+    recs: &GpuRecords,
+    runs: &[(Params64, Meta)],
+    opts: &GpuOptions,
+) -> Result<(Vec<RunOutput>, ChunkTimes), GpuError> {
+    let mut times = ChunkTimes::default();
+    if runs.is_empty() {
+        return Ok((Vec::new(), times));
+    }
+    let kernel = ctx.kernel(opts.precision)?;
+    let n = runs.len();
+    let t = Instant::now();
+    let params: Vec<u8> = match opts.precision {
+        Precision::F64 => runs
+            .iter()
+            .flat_map(|(p, _)| bytemuck::bytes_of(p).to_vec())
+            .collect(),
+        Precision::F32 => runs
+            .iter()
+            .flat_map(|(p, _)| bytemuck::bytes_of(&Params32::from_f64(p)).to_vec())
+            .collect(),
+    };
+    let metas: Vec<Meta> = runs.iter().map(|(_, m)| *m).collect();
+    let states = vec![0u8; n * layout::state_bytes(opts.precision)];
+    let counters = vec![Counters::default(); n];
+    let params = storage(ctx, "params", &params, wgpu::BufferUsages::empty())?;
+    let metas_buf = storage(
+        ctx,
+        "metas",
+        bytemuck::cast_slice(&metas),
+        wgpu::BufferUsages::empty(),
+    )?;
+    let states = storage(ctx, "states", &states, wgpu::BufferUsages::COPY_SRC)?;
+    let counters = storage(
+        ctx,
+        "counters",
+        bytemuck::cast_slice(&counters),
+        wgpu::BufferUsages::COPY_SRC,
+    )?;
+    let active = storage(
+        ctx,
+        "active runs",
+        &[0; 4],
+        wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+    )?;
+    let uniform = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("dispatch"),
+        size: size_of::<Dispatch>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bind = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("fast bind group"),
+        layout: &kernel.layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: params.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: metas_buf.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: recs.buffer.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: states.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: counters.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 6,
+                resource: active.as_entire_binding(),
+            },
+        ],
+    });
+    wait(ctx)?;
+    times.upload = t.elapsed();
+
+    let t = Instant::now();
+    let mut budget = opts.units_per_dispatch.max(1);
+    if ctx.info.device_type == wgpu::DeviceType::Cpu {
+        budget = budget.min(CPU_ADAPTER_BUDGET);
+    }
+    let d = Dispatch {
+        budget,
+        nruns: n as u32,
+        max_substeps_per_step: opts.fast.max_substeps_per_step,
+        max_substeps: opts.fast.max_substeps,
+        ..Default::default()
+    };
+    ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&d));
+    let active_staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("active readback"),
+        size: 4,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    loop {
+        ctx.queue.write_buffer(&active, 0, &[0; 4]);
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("fast dispatch"),
+            });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("fast pass"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&kernel.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.dispatch_workgroups(layout::workgroups(n as u32), 1, 1);
+        }
+        enc.copy_buffer_to_buffer(&active, 0, &active_staging, 0, 4);
+        ctx.queue.submit([enc.finish()]);
+        let (tx, rx) = std::sync::mpsc::channel();
+        active_staging
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, move |r| drop(tx.send(r)));
+        wait(ctx)?;
+        rx.recv()
+            .ok()
+            .and_then(|r| r.ok())
+            .ok_or_else(|| GpuError::Other {
+                message: "reading the active-run count back failed".into(),
+            })?;
+        let still = {
+            let v = active_staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Other {
+                    message: e.to_string(),
+                })?;
+            u32::from_le_bytes([v[0], v[1], v[2], v[3]])
+        };
+        active_staging.unmap();
+        if still == 0 {
+            break;
+        }
+    }
+    times.kernel = t.elapsed();
+
+    let t = Instant::now();
+    let sbytes = read(ctx, &states)?;
+    let cbytes = read(ctx, &counters)?;
+    let cs: &[Counters] = bytemuck::cast_slice(&cbytes);
+    let out: Vec<RunOutput> = match opts.precision {
+        Precision::F64 => {
+            let ss: &[State64] = bytemuck::cast_slice(&sbytes);
+            ss.iter().zip(cs).map(|(s, c)| output(s, c)).collect()
+        }
+        Precision::F32 => {
+            let ss: &[State32] = bytemuck::cast_slice(&sbytes);
+            ss.iter()
+                .zip(cs)
+                .map(|(s, c)| output(&s.to_f64(), c))
+                .collect()
+        }
+    };
+    times.readback = t.elapsed();
+    Ok((out, times))
+}

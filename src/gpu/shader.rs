@@ -1,0 +1,48 @@
+//! WGSL sources and their per-precision prelude.
+
+use super::layout::WORKGROUP_SIZE;
+
+/// Floating-point precision of the GPU path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Precision {
+    F32,
+    F64,
+}
+
+impl Precision {
+    pub fn key(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+
+    pub fn from_key(s: &str) -> Option<Precision> {
+        match s {
+            "f32" => Some(Precision::F32),
+            "f64" => Some(Precision::F64),
+            _ => None,
+        }
+    }
+
+    /// Bytes per real.
+    pub fn bytes(self) -> usize {
+        match self {
+            Precision::F32 => 4,
+            Precision::F64 => 8,
+        }
+    }
+}
+
+/// The fast-scheme kernel, one file per stage as in `shaders/`.
+pub const FAST_WGSL: &str = include_str!("../../shaders/fast.wgsl");
+
+/// `shaders/fast.wgsl` with the prelude for `precision`: the `real` alias, its epsilon, a tiny
+/// and a huge number (for degenerate-cubic and finiteness tests), and the workgroup size.
+pub fn fast_source(precision: Precision) -> String {
+    let prelude = match precision {
+        Precision::F32 => "alias real = f32;\nconst EPS: real = 1.1920929e-7;\nconst TINY: real = 1e-30;\nconst BIG: real = 1e37;\n",
+        Precision::F64 => "alias real = f64;\nconst EPS: real = 2.220446049250313e-16;\nconst TINY: real = 1e-300;\nconst BIG: real = 1e300;\n",
+    };
+    format!("{prelude}const WG: u32 = {WORKGROUP_SIZE}u;\n{FAST_WGSL}")
+}
