@@ -54,7 +54,7 @@ pub fn mixed_plan() -> pounding::plan::Plan {
     pounding::plan::Plan::new(plan.spec.clone()).unwrap()
 }
 
-/// Measured on this grid (1,296 runs, 1,088 pounding; see README "Accuracy"): peak-force error
+/// Measured on this grid (1,632 runs; see README "Integration schemes"): peak-force error
 /// median 6e-7, p99 6e-4, max 1.0e-3 (worst in the nonlinear viscoelastic law, whose
 /// delta^(1/4) damping is singular at first touch and slows RK4's convergence); dissipated energy
 /// max 1.5e-3; peak displacements max 5e-4; impact counts equal on every run. The bounds below
