@@ -18,6 +18,14 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// Count one finished run.
+    fn count(&mut self, o: &RunOutput) {
+        self.runs += 1;
+        self.impacts += o.impacts as u64;
+        self.runs_with_impacts += (o.impacts > 0) as u64;
+        self.failures += (o.status != Status::Ok) as u64;
+    }
+
     pub fn runs_per_second(&self) -> f64 {
         self.runs as f64 / self.seconds.max(1e-9)
     }
@@ -65,10 +73,7 @@ pub fn run<E>(
             .collect();
         for r in &results {
             for (_, o) in r {
-                s.runs += 1;
-                s.impacts += o.impacts as u64;
-                s.runs_with_impacts += (o.impacts > 0) as u64;
-                s.failures += (o.status != Status::Ok) as u64;
+                s.count(o);
             }
             sink(r)?;
         }
@@ -135,10 +140,7 @@ pub fn run_gpu<E: From<crate::gpu::GpuError>>(
         let t = Instant::now();
         let rows: Vec<(RunSpec, RunOutput)> = specs.into_iter().zip(outs).collect();
         for (_, o) in &rows {
-            s.runs += 1;
-            s.impacts += o.impacts as u64;
-            s.runs_with_impacts += (o.impacts > 0) as u64;
-            s.failures += (o.status != Status::Ok) as u64;
+            s.count(o);
         }
         sink(&rows)?;
         times.sink += t.elapsed().as_secs_f64();

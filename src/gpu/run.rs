@@ -48,14 +48,6 @@ pub struct ChunkTimes {
     pub readback: Duration,
 }
 
-impl std::ops::AddAssign for ChunkTimes {
-    fn add_assign(&mut self, o: ChunkTimes) {
-        self.upload += o.upload;
-        self.kernel += o.kernel;
-        self.readback += o.readback;
-    }
-}
-
 /// Every record of a sweep in one buffer, converted to the kernel's precision.
 pub struct GpuRecords {
     buffer: wgpu::Buffer,
@@ -112,19 +104,6 @@ pub fn pack(
         Propagator::new(&pair.b1, forcing.dt),
         Propagator::new(&pair.b2, forcing.dt),
     );
-    pack_with(pair, forcing, record, recs, fast, &p1, &p2)
-}
-
-/// [`pack`] with the propagators given (callers cache them: they depend on building and `dt`).
-pub fn pack_with(
-    pair: &Pair,
-    forcing: &Forcing,
-    record: usize,
-    recs: &GpuRecords,
-    fast: &FastOptions,
-    p1: &Propagator,
-    p2: &Propagator,
-) -> (Params64, Meta) {
     let c = &pair.contact;
     let params = Params64 {
         m1: pair.b1.m,
@@ -230,6 +209,28 @@ fn wait(ctx: &GpuContext) -> Result<(), GpuError> {
     }
 }
 
+/// Map a MAP_READ buffer whose copy has been submitted, wait, and return its bytes.
+fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let failed = |e: String| GpuError::Other {
+        message: format!("reading results back: {e}"),
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, move |r| drop(tx.send(r)));
+    wait(ctx)?;
+    rx.recv()
+        .map_err(|e| failed(e.to_string()))?
+        .map_err(|e| failed(e.to_string()))?;
+    let data = staging
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| failed(e.to_string()))?
+        .to_vec();
+    staging.unmap();
+    Ok(data)
+}
+
 fn read(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
     let size = src.size();
     let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -245,27 +246,7 @@ fn read(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
         });
     enc.copy_buffer_to_buffer(src, 0, &staging, 0, size);
     ctx.queue.submit([enc.finish()]);
-    let (tx, rx) = std::sync::mpsc::channel();
-    staging
-        .slice(..)
-        .map_async(wgpu::MapMode::Read, move |r| drop(tx.send(r)));
-    wait(ctx)?;
-    rx.recv()
-        .map_err(|e| GpuError::Other {
-            message: e.to_string(),
-        })?
-        .map_err(|e| GpuError::Other {
-            message: format!("reading results back: {e}"),
-        })?;
-    let data = staging
-        .slice(..)
-        .get_mapped_range()
-        .map_err(|e| GpuError::Other {
-            message: format!("reading results back: {e}"),
-        })?
-        .to_vec();
-    staging.unmap();
-    Ok(data)
+    map_read(ctx, &staging)
 }
 
 /// Integrate packed runs from rest over their whole records; results in input order.
@@ -395,27 +376,8 @@ pub fn run_chunk(
         }
         enc.copy_buffer_to_buffer(&active, 0, &active_staging, 0, 4);
         ctx.queue.submit([enc.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        active_staging
-            .slice(..)
-            .map_async(wgpu::MapMode::Read, move |r| drop(tx.send(r)));
-        wait(ctx)?;
-        rx.recv()
-            .ok()
-            .and_then(|r| r.ok())
-            .ok_or_else(|| GpuError::Other {
-                message: "reading the active-run count back failed".into(),
-            })?;
-        let still = {
-            let v = active_staging
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| GpuError::Other {
-                    message: e.to_string(),
-                })?;
-            u32::from_le_bytes([v[0], v[1], v[2], v[3]])
-        };
-        active_staging.unmap();
+        let v = map_read(ctx, &active_staging)?;
+        let still = u32::from_le_bytes([v[0], v[1], v[2], v[3]]);
         if still == 0 {
             break;
         }
