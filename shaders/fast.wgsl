@@ -66,10 +66,10 @@ struct Counters {
 
 struct Dispatch {
     budget: u32,
-    nruns: u32,
+    nactive: u32,
     max_substeps_per_step: u32,
     max_substeps: u32,
-    _pad0: u32,
+    handoff_substeps_per_step: u32,
     _pad1: u32,
     _pad2: u32,
     _pad3: u32,
@@ -89,6 +89,7 @@ const MODE_RESTITUTION: u32 = 2u;
 const STATUS_OK: u32 = 0u;
 const STATUS_NON_FINITE: u32 = 1u;
 const STATUS_STEP_LIMIT: u32 = 2u;
+const STATUS_HANDOFF: u32 = 3u;
 // contact::HC_V0_MIN, contact::HERTZ floor on v, fast::MAX_PIECES_PER_SUBSTEP.
 const HC_V0_MIN: real = 1e-3;
 const V_MIN: real = 1e-6;
@@ -102,8 +103,12 @@ const LOCATE_ITER: u32 = 16u;
 @group(0) @binding(3) var<storage, read> records: array<real>;
 @group(0) @binding(4) var<storage, read_write> states: array<State>;
 @group(0) @binding(5) var<storage, read_write> counters: array<Counters>;
-// Runs still integrating after this dispatch.
+// Runs still integrating after this dispatch: their count, and their indices (in any order)
+// for the next dispatch, which then launches only those. Packing the unfinished runs together
+// keeps lanes busy: runs that pound for long are rare and spread over every workgroup.
 @group(0) @binding(6) var<storage, read_write> active_runs: atomic<u32>;
+@group(0) @binding(7) var<storage, read> run_ids: array<u32>;
+@group(0) @binding(8) var<storage, read_write> next_ids: array<u32>;
 
 // This invocation's run.
 var<private> P: Params;
@@ -620,6 +625,10 @@ fn begin_interval(seg: Seg) {
         let mf = max(ceil(dt / h0), 1.0);
         if (!(mf <= real(disp.max_substeps_per_step))) {
             C.status = STATUS_STEP_LIMIT;
+        } else if (mf > real(disp.handoff_substeps_per_step)) {
+            // More substeps than this precision resolves (f32 increments drown in rounding):
+            // the host finishes the run on the CPU in f64.
+            C.status = STATUS_HANDOFF;
         } else {
             C.m = u32(mf);
             C.j = 1u;
@@ -667,10 +676,10 @@ fn piece(seg: Seg) {
 
 @compute @workgroup_size(WG)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let r = gid.x;
-    if (r >= disp.nruns) {
+    if (gid.x >= disp.nactive) {
         return;
     }
+    let r = run_ids[gid.x];
     C = counters[r];
     M = metas[r];
     if (C.status != STATUS_OK || C.i >= M.intervals) {
@@ -700,6 +709,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     states[r] = S;
     counters[r] = C;
     if (C.status == STATUS_OK && C.i < M.intervals) {
-        atomicAdd(&active_runs, 1u);
+        next_ids[atomicAdd(&active_runs, 1u)] = r;
     }
 }

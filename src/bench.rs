@@ -59,8 +59,12 @@ pub struct Row {
     pub upload: f64,
     pub kernel: f64,
     pub readback: f64,
+    /// Finishing handed-back runs on the CPU.
+    pub handoff: f64,
     pub csv: f64,
     pub impacts: u64,
+    /// Runs the kernel handed back to the CPU.
+    pub handed_off: u64,
 }
 
 impl Row {
@@ -114,8 +118,10 @@ pub fn cpu(plan: &Plan) -> Row {
         upload: 0.0,
         kernel: s.seconds - sink.seconds,
         readback: 0.0,
+        handoff: 0.0,
         csv: sink.seconds,
         impacts: s.impacts,
+        handed_off: 0,
     }
 }
 
@@ -150,19 +156,21 @@ pub fn gpu(
         upload: t.upload,
         kernel: t.kernel,
         readback: t.readback,
+        handoff: t.handoff,
         csv: sink.seconds,
         impacts: s.impacts,
+        handed_off: t.handed_off,
     })
 }
 
 /// A markdown table of rows.
 pub fn table(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| runs | backend | total s | runs/s | pack s | upload s | kernel s | readback s | csv s | impacts |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| runs | backend | total s | runs/s | pack s | upload s | kernel s | readback s | handoff s (runs) | csv s | impacts |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         s.push_str(&format!(
-            "| {} | {} | {:.3} | {:.0} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {} |\n",
+            "| {} | {} | {:.3} | {:.0} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} ({}) | {:.3} | {} |\n",
             r.runs,
             r.backend,
             r.seconds,
@@ -171,6 +179,8 @@ pub fn table(rows: &[Row]) -> String {
             r.upload,
             r.kernel,
             r.readback,
+            r.handoff,
+            r.handed_off,
             r.csv,
             r.impacts
         ));

@@ -264,6 +264,8 @@ pub struct RawRecord {
     pub units: Option<String>,
     pub dt_s: Option<f64>,
     pub skip_lines: Option<usize>,
+    /// `[start, end]`, s: simulate only this part of the record.
+    pub window_s: Option<[f64; 2]>,
 }
 
 #[derive(Debug, Clone, Default, Deserialize)]
@@ -482,6 +484,16 @@ fn load_record(r: &RawRecord, base: &Path, records: &Path) -> Result<Record, Loa
         };
         read_record(&file, &opts).map_err(LoadError::Record)?
     };
+    if let Some([start, end]) = r.window_s {
+        rec = rec.window(start, end).ok_or_else(|| {
+            LoadError::Invalid(format!(
+                "window_s = [{start}, {end}]: expected start < end holding at least two samples of the record ({} s to {} s, dt {} s)",
+                rec.t0,
+                rec.t0 + (rec.npts().max(1) - 1) as f64 * rec.dt,
+                rec.dt
+            ))
+        })?;
+    }
     if let Some(n) = &r.name {
         rec.name = n.clone();
     }

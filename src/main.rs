@@ -284,7 +284,7 @@ fn sweep(
                         fast,
                         ..Default::default()
                     };
-                    let (s, _) = pounding::sweep::run_gpu(
+                    let (s, t) = pounding::sweep::run_gpu(
                         &plan,
                         ctx,
                         &opts,
@@ -292,6 +292,16 @@ fn sweep(
                         &mut write,
                         |done| bar.set_position(done),
                     )?;
+                    if t.handed_off > 0 {
+                        bar.suspend(|| {
+                            eprintln!(
+                                "{} runs needed more than {} RK4 substeps per record step, past what {} resolves: finished on the CPU in f64",
+                                t.handed_off,
+                                opts.handoff(),
+                                precision.key()
+                            )
+                        });
+                    }
                     Ok(s)
                 }
                 _ => {

@@ -139,4 +139,7 @@ pub struct RunOutput {
     pub contact_time: f64,
     /// Net work of the contact force on the relative motion (energy taken out by impacts), J.
     pub dissipated_energy: f64,
+    /// Integration work beyond the exact free steps: RK4 substeps (fast scheme, both backends)
+    /// or trial steps (reference). 0 for a run that never came near contact.
+    pub substeps: u64,
 }

@@ -40,7 +40,7 @@ pub const COLUMNS: [&str; 27] = [
 ];
 
 /// Output columns after the status (kept in one place for readers of the CSV).
-pub const EXTRA_COLUMNS: [&str; 1] = ["dissipated_energy_j"];
+pub const EXTRA_COLUMNS: [&str; 2] = ["dissipated_energy_j", "substeps"];
 
 /// Shortest round-trip text; scientific notation outside [1e-4, 1e15) so tiny values stay short.
 fn num(x: f64) -> String {
@@ -102,6 +102,7 @@ pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
         opt(out.first_impact),
         num(out.contact_time),
         num(out.dissipated_energy),
+        out.substeps.to_string(),
     ]
 }
 

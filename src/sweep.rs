@@ -92,12 +92,18 @@ pub struct GpuTimes {
     pub upload: f64,
     pub kernel: f64,
     pub readback: f64,
+    /// Finishing handed-back runs on the CPU.
+    pub handoff: f64,
     pub sink: f64,
+    /// Runs handed back by the kernel and finished on the CPU in f64.
+    pub handed_off: u64,
 }
 
 /// Run every run of `plan` on the GPU, `chunk` runs per chunk (capped by the device's limits);
-/// `sink` gets each chunk's results in run order as it finishes. Rows already handed to `sink`
-/// stay there if a later chunk fails (device loss, out of memory).
+/// `sink` gets each chunk's results in run order as it finishes. Runs the kernel hands back
+/// (more substeps per record step than its precision resolves) are finished on the CPU's fast
+/// path in f64. Rows already handed to `sink` stay there if a later chunk fails (device loss,
+/// out of memory).
 pub fn run_gpu<E: From<crate::gpu::GpuError>>(
     plan: &Plan,
     ctx: &crate::gpu::GpuContext,
@@ -138,7 +144,18 @@ pub fn run_gpu<E: From<crate::gpu::GpuError>>(
         times.kernel += ct.kernel.as_secs_f64();
         times.readback += ct.readback.as_secs_f64();
         let t = Instant::now();
-        let rows: Vec<(RunSpec, RunOutput)> = specs.into_iter().zip(outs).collect();
+        let cpu = Scheme::Fast(opts.fast);
+        times.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
+        let rows: Vec<(RunSpec, RunOutput)> = specs
+            .into_par_iter()
+            .zip(outs)
+            .map(|(spec, o)| {
+                let o = o.unwrap_or_else(|| run_one(plan, &spec, &cpu));
+                (spec, o)
+            })
+            .collect();
+        times.handoff += t.elapsed().as_secs_f64();
+        let t = Instant::now();
         for (_, o) in &rows {
             s.count(o);
         }

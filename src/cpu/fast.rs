@@ -95,7 +95,7 @@ pub(crate) fn run(
             if !may_touch(pair, &seg, &z, &z1, dt, run.tr.v0) {
                 run.free_step(seg.t0, dt, z1);
                 if !finite(&run.z) {
-                    return run.finish(Status::NonFinite);
+                    return run.finish(Status::NonFinite, substeps as u64);
                 }
                 continue;
             }
@@ -117,7 +117,7 @@ pub(crate) fn run(
         let h = impact_step(pair, v_est, a_est, o.substeps_per_contact).min(h_rate);
         let m = (dt / h).ceil().max(1.0);
         if m.is_nan() || m > o.max_substeps_per_step as f64 {
-            return run.finish(Status::StepLimit);
+            return run.finish(Status::StepLimit, substeps as u64);
         }
         let m = m as u32;
         let h = dt / m as f64;
@@ -133,18 +133,18 @@ pub(crate) fn run(
                 substeps += 1;
                 pieces += 1;
                 if substeps > o.max_substeps || pieces > MAX_PIECES_PER_SUBSTEP {
-                    return run.finish(Status::StepLimit);
+                    return run.finish(Status::StepLimit, substeps as u64);
                 }
                 let hs = t_target - t;
                 let (z0, mode, v0) = (run.z, run.mode, run.tr.v0);
                 let step = |x: f64| rk4(pair, mode, v0, &seg, t, &z0, x);
                 t += run.accept(t, hs, step(hs), 1e-9, 16, step);
                 if !finite(&run.z) {
-                    return run.finish(Status::NonFinite);
+                    return run.finish(Status::NonFinite, substeps as u64);
                 }
             }
             t = t_target;
         }
     }
-    run.finish(Status::Ok)
+    run.finish(Status::Ok, substeps as u64)
 }

@@ -586,8 +586,11 @@ impl<'a, 'o> Integration<'a, 'o> {
         advanced
     }
 
-    pub fn finish(self, status: Status) -> RunOutput {
-        self.tr.finish(self.mode, status)
+    /// End the run with `status`, after `substeps` steps of integration work.
+    pub fn finish(self, status: Status, substeps: u64) -> RunOutput {
+        let mut out = self.tr.finish(self.mode, status);
+        out.substeps = substeps;
+        out
     }
 }
 

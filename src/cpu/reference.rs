@@ -164,7 +164,7 @@ pub(crate) fn run(
         while t1 - t > 1e-12 * seg.dt {
             steps += 1;
             if steps > o.max_steps {
-                return run.finish(Status::StepLimit);
+                return run.finish(Status::StepLimit, steps);
             }
             let (z0, mode, v0) = (run.z, run.mode, run.tr.v0);
             let mut hs = h.min(t1 - t);
@@ -185,7 +185,7 @@ pub(crate) fn run(
                     } else {
                         Status::NonFinite
                     };
-                    return run.finish(status);
+                    return run.finish(status, steps);
                 }
                 h = if err.is_finite() {
                     hs * (0.9 * err.powf(-0.2)).max(0.1)
@@ -207,10 +207,10 @@ pub(crate) fn run(
             let step = |x: f64| dopri(pair, mode, v0, &seg, t, &z0, x, o.rtol, &cs).0;
             t += run.accept(t, hs, trial, 1e-13, 100, step);
             if stop_after_impacts.is_some_and(|n| run.tr.impacts_ended() >= n) {
-                return run.finish(Status::Ok);
+                return run.finish(Status::Ok, steps);
             }
             h = hs * (0.9 * err.max(1e-12).powf(-0.2)).min(5.0);
         }
     }
-    run.finish(Status::Ok)
+    run.finish(Status::Ok, steps)
 }

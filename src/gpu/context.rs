@@ -206,6 +206,8 @@ impl GpuContext {
                 entry(4, storage(false)),
                 entry(5, storage(false)),
                 entry(6, storage(false)),
+                entry(7, storage(true)),
+                entry(8, storage(false)),
             ],
         });
         let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

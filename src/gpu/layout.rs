@@ -146,17 +146,18 @@ pub struct Counters {
 }
 
 /// Uniforms of one dispatch: at most `budget` units of work (a free interval, or one piece of a
-/// substep) for each of runs `[0, nruns)`.
+/// substep) for each of the `nactive` runs listed in the dispatch's run-id buffer.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct Dispatch {
     pub budget: u32,
-    pub nruns: u32,
+    pub nactive: u32,
     /// A record step needing more substeps ends the run with `STATUS_STEP_LIMIT`.
     pub max_substeps_per_step: u32,
     /// Substep budget of one run.
     pub max_substeps: u32,
-    pub _pad0: u32,
+    /// A record step needing more substeps ends the run with `STATUS_HANDOFF`.
+    pub handoff_substeps_per_step: u32,
     pub _pad1: u32,
     pub _pad2: u32,
     pub _pad3: u32,
@@ -202,13 +203,16 @@ impl Layout for Dispatch {
         use core::mem::offset_of;
         vec![
             ("budget", offset_of!(Dispatch, budget)),
-            ("nruns", offset_of!(Dispatch, nruns)),
+            ("nactive", offset_of!(Dispatch, nactive)),
             (
                 "max_substeps_per_step",
                 offset_of!(Dispatch, max_substeps_per_step),
             ),
             ("max_substeps", offset_of!(Dispatch, max_substeps)),
-            ("_pad0", offset_of!(Dispatch, _pad0)),
+            (
+                "handoff_substeps_per_step",
+                offset_of!(Dispatch, handoff_substeps_per_step),
+            ),
             ("_pad1", offset_of!(Dispatch, _pad1)),
             ("_pad2", offset_of!(Dispatch, _pad2)),
             ("_pad3", offset_of!(Dispatch, _pad3)),
@@ -223,6 +227,9 @@ pub const MODE_RESTITUTION: u32 = 2;
 pub const STATUS_OK: u32 = 0;
 pub const STATUS_NON_FINITE: u32 = 1;
 pub const STATUS_STEP_LIMIT: u32 = 2;
+/// The run needs more substeps per record step than the kernel's precision resolves; the host
+/// finishes it on the CPU.
+pub const STATUS_HANDOFF: u32 = 3;
 
 /// Workgroups for `n` runs.
 pub fn workgroups(n: u32) -> u32 {

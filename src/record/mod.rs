@@ -65,6 +65,25 @@ impl Record {
         best
     }
 
+    /// The samples at times `start <= t <= end` (a strong-motion window); times keep the
+    /// record's clock, so onsets in outputs read against the full record. `None` if the window
+    /// holds fewer than two samples.
+    pub fn window(&self, start: f64, end: f64) -> Option<Record> {
+        let tol = 1e-9 * self.dt;
+        let first = ((start - self.t0 - tol) / self.dt).ceil().max(0.0) as usize;
+        let last =
+            (((end - self.t0 + tol) / self.dt).floor() as usize).min(self.npts().checked_sub(1)?);
+        if end < start || last < first + 1 {
+            return None;
+        }
+        Some(Record {
+            name: self.name.clone(),
+            dt: self.dt,
+            t0: self.t0 + first as f64 * self.dt,
+            accel: self.accel[first..=last].to_vec(),
+        })
+    }
+
     /// This record as the ground motion of a run: multiplied by `scale`, followed by `tail`
     /// seconds of free vibration.
     pub fn forcing(&self, scale: f64, tail: f64) -> crate::model::Forcing<'_> {

@@ -284,3 +284,34 @@ fn ranges_expand() {
         "{got:?}"
     );
 }
+
+/// `window_s` keeps the samples inside the window on the record's own clock, and a window with
+/// fewer than two samples is an error naming the record and the record's span.
+#[test]
+fn record_windows_cut_the_record() {
+    let text = BASE.replacen(
+        "synthetic = { seed = 2, duration_s = 5.0 }",
+        "synthetic = { seed = 2, duration_s = 5.0, dt_s = 0.01 }\nwindow_s = [1.0, 2.5]",
+        1,
+    );
+    let full = parse(
+        BASE.replacen("duration_s = 5.0 }", "duration_s = 5.0, dt_s = 0.01 }", 1)
+            .as_str(),
+    )
+    .unwrap();
+    let cut = parse(&text).unwrap();
+    let (f, c) = (&full.spec.records[0], &cut.spec.records[0]);
+    assert_eq!(c.npts(), 151);
+    assert!((c.t0 - 1.0).abs() < 1e-12, "t0 {}", c.t0);
+    assert_eq!(c.accel[..], f.accel[100..=250]);
+    let bad = BASE.replacen(
+        "synthetic = { seed = 2, duration_s = 5.0 }",
+        "synthetic = { seed = 2, duration_s = 5.0 }\nwindow_s = [4.0, 3.0]",
+        1,
+    );
+    let e = parse(&bad).unwrap_err().to_string();
+    assert!(
+        e.contains("record[0]: window_s = [4, 3]: expected start < end"),
+        "{e}"
+    );
+}

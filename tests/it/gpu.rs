@@ -88,46 +88,106 @@ fn gpu_collect(plan: &Plan, opts: &GpuOptions, chunk: usize) -> Vec<(RunSpec, Ru
     rows
 }
 
+/// The GPU-vs-CPU grid: every law and every formula, e from 0.1 (overdamped contact) to 1,
+/// periods 0.05 to 3 s (an undamped stiff building beside a flexible one), gaps from 0 (touching
+/// at rest) to 2 m (never touching), a synthetic record (dt 0.01 s) and the strong part of Kobe
+/// (dt 0.02 s), 6 s each at 0.5 g: 2,352 runs.
+pub const WIDE: &str = r#"
+[run]
+tail_s = 0.0
+
+[building1]
+mass_kg = 1.0e5
+period_s = [0.05, 3.0]
+damping_ratio = 0.0
+
+[building2]
+mass_kg = 1.0e5
+period_s = [0.4, 1.2]
+damping_ratio = 0.05
+
+[contact]
+law = ["linear", "kelvin_voigt", "kelvin_voigt_no_tension", "modified_linear", "hertz",
+       "nonlinear_viscoelastic", "hunt_crossley", "lankarani_nikravesh", "flores", "hunt_crossley_exact"]
+formula = ["anagnostopoulos", "mahmoud_jankowski", "jankowski", "barros", "khatami", "ebrahimi", "exact"]
+e = [0.1, 0.55, 1.0]
+k_n_per_m = 1.0e9
+beta_n_per_m1_5 = 2.75e9
+gap_m = [0.0, 0.02, 2.0]
+
+[[record]]
+synthetic = { seed = 21, duration_s = 6.0, dt_s = 0.01 }
+
+[[record]]
+file = "kobe1995_jma_ns_RSN1106_KJM000.AT2"
+window_s = [5.0, 11.0]
+
+[intensity]
+pga_g = 0.5
+"#;
+
+fn wide() -> &'static (Plan, Vec<(RunSpec, RunOutput)>) {
+    static WIDE_CPU: OnceLock<(Plan, Vec<(RunSpec, RunOutput)>)> = OnceLock::new();
+    WIDE_CPU.get_or_init(|| {
+        let plan = pounding::config::parse(
+            WIDE,
+            std::path::Path::new("wide.toml"),
+            std::path::Path::new("."),
+            &crate::support::records_dir(),
+        )
+        .unwrap();
+        let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
+        (plan, cpu)
+    })
+}
+
+/// Largest relative difference of the peak outputs of two results of one run.
+fn peak_diff(a: &RunOutput, b: &RunOutput) -> f64 {
+    [
+        rel(a.peak_force, b.peak_force),
+        rel(a.peak_u1, b.peak_u1),
+        rel(a.peak_u2, b.peak_u2),
+        rel(a.peak_penetration, b.peak_penetration),
+        rel(a.impact_velocity, b.impact_velocity),
+    ]
+    .into_iter()
+    .filter(|x| x.is_finite())
+    .fold(0.0, f64::max)
+}
+
 /// f64 on the GPU runs the CPU fast path's arithmetic, so the two agree to rounding: measured
-/// on these 1,632 mixed runs, max 1.4e-11 for nine laws. The nonlinear viscoelastic law differs
-/// by up to 7.2e-6 on lavapipe (123 of its runs above 1e-9). Its `delta^(1/4)` damping is
-/// singular at first touch, and on the CPU alone moving the damping by 4 ulps changes some of
-/// those runs by as much (7.2e-6), but not all of them, so the cause is not pinned down yet
-/// (issue 4's accuracy work): it gets a bound of 3x its measured maximum, every other law 1e-9.
+/// on the 2,352 wide-grid runs (`cargo test --release gpu_f64 -- --nocapture`), median 0 and max
+/// 1.8e-9 over nine laws (the largest on long pressed Kelvin-Voigt contacts at gap 0, where
+/// rounding differences grow over hundreds of substeps). The nonlinear viscoelastic law differs
+/// by up to 7.7e-6: its `delta^(1/4)` damping is singular at first touch, and on the CPU alone
+/// moving the damping by 4 ulps changes some of those runs by as much, but not all of them, so
+/// the cause is not pinned down: it gets 3x its measured maximum, every other law 1e-8.
 #[test]
-fn gpu_f64_matches_cpu_fast_on_mixed_runs() {
+fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
     let Some(ctx) = ctx() else { return };
     assert!(ctx.supports_f64(), "{} has no SHADER_F64", ctx.describe());
-    let plan = crate::fast_vs_reference::mixed_plan();
-    let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
+    let (plan, cpu) = wide();
     let opts = GpuOptions {
         precision: pounding::gpu::Precision::F64,
         ..Default::default()
     };
-    let gpu = gpu_collect(&plan, &opts, 100_000);
+    let gpu = gpu_collect(plan, &opts, 100_000);
     assert_eq!(cpu.len(), gpu.len());
-    let (mut worst, mut worst_nlve) = (0.0f64, 0.0f64);
+    let mut worst = std::collections::BTreeMap::new();
+    let mut all = Vec::new();
     for ((s, c), (_, g)) in cpu.iter().zip(&gpu) {
         assert_eq!(c.status, g.status, "run {}", s.index);
         assert_eq!(c.impacts, g.impacts, "run {}", s.index);
         assert_eq!(c.peak_force == 0.0, g.peak_force == 0.0, "run {}", s.index);
-        let e = [
-            rel(g.peak_force, c.peak_force),
-            rel(g.peak_u1, c.peak_u1),
-            rel(g.peak_u2, c.peak_u2),
-            rel(g.peak_penetration, c.peak_penetration),
-            rel(g.impact_velocity, c.impact_velocity),
-        ]
-        .into_iter()
-        .filter(|x| x.is_finite())
-        .fold(0.0, f64::max);
-        let nlve = s.law == pounding::contact::LawKind::NonlinearViscoelastic;
-        if nlve {
-            worst_nlve = worst_nlve.max(e);
+        let e = peak_diff(g, c);
+        let w = worst.entry(s.law.key()).or_insert(0.0f64);
+        *w = w.max(e);
+        all.push(e);
+        let bound = if s.law == pounding::contact::LawKind::NonlinearViscoelastic {
+            2.5e-5
         } else {
-            worst = worst.max(e);
-        }
-        let bound = if nlve { 2e-5 } else { 1e-9 };
+            1e-9 + 1e-14 * c.substeps as f64
+        };
         assert!(
             e <= bound,
             "run {} ({}): GPU-CPU difference {e:e}",
@@ -135,19 +195,27 @@ fn gpu_f64_matches_cpu_fast_on_mixed_runs() {
             s.law.key()
         );
     }
-    eprintln!("f64 GPU vs CPU: max {worst:e} (nonlinear viscoelastic {worst_nlve:e})");
+    all.sort_by(f64::total_cmp);
+    eprintln!(
+        "f64 GPU vs CPU on {} runs: median {:e}; max by law {worst:?}",
+        all.len(),
+        all[all.len() / 2]
+    );
 }
 
-/// f32 against the CPU f64 fast path on the same 1,632 runs. Measured: peak force median 1e-6,
-/// p99 7.2e-5, max 1.4e-4; peak displacements max 5.9e-5; impact counts equal on every run. The
-/// scheme's own error against the reference is ~1e-3 (fast_vs_reference), so f32 adds at most a
-/// seventh of it. Bounds: 7x the measured maxima (f32 rounding moves with the record and law).
+/// f32 against the CPU f64 fast path on the wide grid (runs past f32's reach are handed to the
+/// CPU, `gpu_hands_runs_past_its_precision_to_the_cpu`: 187 of the 2,352 here, all at e = 0.1
+/// with a formula giving zeta = 5 to 125). Measured over runs with equal impact counts (all of
+/// them here): peak force median 1.3e-6, p99 1.5e-4, max 6.2e-4 (nonlinear viscoelastic);
+/// peak displacements max 2.3e-3 (a long pressed contact at gap 0). Without the hand-off the
+/// same grid gave 7 % and 12 %. The fast scheme's own peak-force error against the reference is
+/// up to 1.3e-3, so f32 is the default. Bounds: about 3x the measured maxima and p99, 8x the
+/// median (f32 rounding moves with the record, law and adapter).
 #[test]
 fn gpu_f32_error_against_cpu_f64() {
     let Some(_) = ctx() else { return };
-    let plan = crate::fast_vs_reference::mixed_plan();
-    let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
-    let gpu = gpu_collect(&plan, &GpuOptions::default(), 100_000);
+    let (plan, cpu) = wide();
+    let gpu = gpu_collect(plan, &GpuOptions::default(), 100_000);
     let mut f: Vec<f64> = Vec::new();
     let mut u: Vec<f64> = Vec::new();
     let mut imp_diff = 0;
@@ -155,6 +223,7 @@ fn gpu_f32_error_against_cpu_f64() {
         assert_eq!(c.status, g.status, "run {}", s.index);
         if c.impacts != g.impacts {
             imp_diff += 1;
+            continue;
         }
         if c.peak_force > 0.0 {
             f.push(rel(g.peak_force, c.peak_force));
@@ -164,18 +233,118 @@ fn gpu_f32_error_against_cpu_f64() {
     f.sort_by(f64::total_cmp);
     u.sort_by(f64::total_cmp);
     let q = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p) as usize];
-    assert_eq!(imp_diff, 0, "impact counts differ");
-    assert!(
-        q(&f, 1.0) < 1e-3 && q(&f, 0.5) < 1e-5,
-        "peak force {:e} {:e}",
-        q(&f, 1.0),
-        q(&f, 0.5)
-    );
-    assert!(q(&u, 1.0) < 4e-4, "peak displacement {:e}", q(&u, 1.0));
     eprintln!(
         "f32: peak force median {:e} p99 {:e} max {:e}; peak u median {:e} max {:e}; impact counts differ on {imp_diff}/{}",
         q(&f, 0.5), q(&f, 0.99), q(&f, 1.0), q(&u, 0.5), q(&u, 1.0), cpu.len()
     );
+    assert!(
+        q(&f, 1.0) < 2e-3 && q(&f, 0.99) < 5e-4 && q(&f, 0.5) < 1e-5,
+        "peak force median {:e} p99 {:e} max {:e}",
+        q(&f, 0.5),
+        q(&f, 0.99),
+        q(&f, 1.0)
+    );
+    assert!(q(&u, 1.0) < 5e-3, "peak displacement {:e}", q(&u, 1.0));
+}
+
+/// Contacts of a CPU run that a small change of the trajectory can add or remove, for a
+/// distance scale `tau`: an impact whose peak penetration is below `tau`, a separation between
+/// two impacts that opens less than `tau`, and an approach in free flight that comes within `tau`
+/// of touching without touching. Closest approaches are maxima of the Hermite cubic of `delta`
+/// over each step.
+fn grazing_contacts(plan: &Plan, spec: &RunSpec, tau: f64) -> usize {
+    use pounding::cpu::{simulate_observed, Mode, Sample};
+    let pair = spec.pair();
+    let delta = |z: &[f64; 5]| z[0] - z[2] - pair.gap;
+    let mut prev: Option<Sample> = None;
+    let (mut count, mut impacts, mut pen) = (0usize, 0u32, 0.0f64);
+    // Most open and closest distances of the current free episode; a local max of delta.
+    let (mut opening, mut rising) = (0.0f64, false);
+    let mut obs = |s: &Sample| {
+        if let Some(p) = prev {
+            match (p.mode, s.mode) {
+                (Mode::Free, Mode::Free) => {
+                    let (y0, d0, y1, d1) =
+                        (delta(&p.z), p.z[1] - p.z[3], delta(&s.z), s.z[1] - s.z[3]);
+                    let h = s.t - p.t;
+                    let (m0, m1) = (h * d0, h * d1);
+                    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
+                    let c = 2.0 * (y0 - y1) + m0 + m1;
+                    for k in 0..=64 {
+                        let x = k as f64 / 64.0;
+                        let y = y0 + x * (m0 + x * (b + x * c));
+                        opening = opening.max(-y);
+                        let dy = m0 + x * (2.0 * b + 3.0 * c * x);
+                        if rising && dy < 0.0 && y > -tau {
+                            count += 1; // a near miss
+                        }
+                        rising = dy > 0.0;
+                    }
+                }
+                (Mode::Free, _) => {
+                    if impacts > 0 && opening < tau {
+                        count += 1; // the bodies barely separated before this impact
+                    }
+                    impacts += 1;
+                    pen = delta(&s.z).max(0.0);
+                }
+                (_, Mode::Free) => {
+                    if pen < tau {
+                        count += 1; // a barely touching impact
+                    }
+                    (opening, rising) = (0.0, false);
+                }
+                _ => pen = pen.max(delta(&s.z)),
+            }
+        }
+        prev = Some(*s);
+    };
+    simulate_observed(
+        &pair,
+        &plan.forcing(spec),
+        &pounding::model::Initial::default(),
+        &Scheme::Fast(FastOptions::default()),
+        Some(&mut obs),
+    );
+    count
+}
+
+/// An impact count may differ between f32 and f64 only where a contact is grazing: for every
+/// run of the quickstart sweep and the wide grid whose counts differ, the f64 run must hold at
+/// least as many grazing contacts (see `grazing_contacts`) as the counts differ by, at a distance
+/// scale of 1e-3 of the run's peak displacement (the f32 displacement error is at most 1.1e-3 of
+/// it, `gpu_f32_error_against_cpu_f64`). Measured: one run in 2,700 of the quickstart differs
+/// (15 impacts against 14: two impacts 0.9 ms apart, re-touching at 1.4 mm/s), none of the wide
+/// grid (without the f32 hand-off, 7 runs there, each with as many grazing contacts).
+#[test]
+fn gpu_f32_impact_counts_differ_only_at_grazing_contacts() {
+    let Some(_) = ctx() else { return };
+    let quick = pounding::config::load(std::path::Path::new("configs/quickstart.toml")).unwrap();
+    let quick_cpu = collect(&quick, &Scheme::Fast(FastOptions::default()), 8);
+    let (wide_plan, wide_cpu) = wide();
+    let mut differ = 0;
+    for (plan, cpu) in [(&quick, &quick_cpu), (wide_plan, wide_cpu)] {
+        let gpu = gpu_collect(plan, &GpuOptions::default(), 100_000);
+        for ((s, c), (_, g)) in cpu.iter().zip(&gpu) {
+            if c.impacts == g.impacts {
+                continue;
+            }
+            differ += 1;
+            let tau = 1e-3 * c.peak_u1.max(c.peak_u2);
+            let grazing = grazing_contacts(plan, s, tau);
+            let by = c.impacts.abs_diff(g.impacts) as usize;
+            eprintln!(
+                "run {}: {} impacts in f64, {} in f32; {grazing} grazing contacts at {tau:e} m",
+                s.index, c.impacts, g.impacts
+            );
+            assert!(
+                grazing >= by,
+                "run {} ({:?}): impact counts {} (f64) and {} (f32) differ by {by} but only {grazing} contacts are grazing at {tau:e} m",
+                s.index, s, c.impacts, g.impacts
+            );
+        }
+    }
+    eprintln!("{differ} runs with different impact counts, each explained by grazing contacts");
 }
 
 fn csv_text(plan: &Plan, rows: &[(RunSpec, RunOutput)]) -> String {
@@ -203,4 +372,44 @@ fn gpu_chunking_does_not_change_results() {
         &csv_text(&plan, &many),
         &csv_text(&plan, &one),
     );
+}
+
+/// Runs needing more substeps per record step than the hand-off threshold come back from the
+/// kernel unfinished and are finished on the CPU: with a threshold of 16, exactly the handed-off
+/// runs equal the CPU f64 result bit for bit (an f32 result never does), and the rest were
+/// integrated on the GPU.
+#[test]
+fn gpu_hands_runs_past_its_precision_to_the_cpu() {
+    let Some(ctx) = ctx() else { return };
+    let plan = pounding::bench::plan(200);
+    let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
+    let opts = GpuOptions {
+        handoff_substeps_per_step: Some(16),
+        ..Default::default()
+    };
+    let mut gpu = Vec::new();
+    let (_, t) = pounding::sweep::run_gpu(
+        &plan,
+        ctx,
+        &opts,
+        1000,
+        |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::gpu::GpuError> {
+            gpu.extend_from_slice(c);
+            Ok(())
+        },
+        |_| {},
+    )
+    .unwrap();
+    let exact = cpu
+        .iter()
+        .zip(&gpu)
+        .filter(|((_, c), (_, g))| c == g)
+        .count() as u64;
+    eprintln!("{} of {} runs handed off", t.handed_off, plan.len());
+    assert!(
+        t.handed_off > 0 && t.handed_off < plan.len(),
+        "{} handed off",
+        t.handed_off
+    );
+    assert_eq!(exact, t.handed_off);
 }
