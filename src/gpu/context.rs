@@ -118,12 +118,11 @@ impl GpuContext {
             slot.lock().unwrap().get_or_insert(err);
         }));
         let slot = errors.clone();
+        // A loss explains any validation errors that follow it, so it replaces them.
         device.set_device_lost_callback(move |reason, message| {
-            if reason != wgpu::DeviceLostReason::Destroyed {
-                slot.lock().unwrap().get_or_insert(GpuError::DeviceLost {
-                    reason: format!("{reason:?}: {message}"),
-                });
-            }
+            *slot.lock().unwrap() = Some(GpuError::DeviceLost {
+                reason: format!("{reason:?}: {message}"),
+            });
         });
         GpuContext {
             device,

@@ -12,7 +12,6 @@ use crate::cpu::FastOptions;
 use crate::model::{Forcing, Pair, RunOutput, Status};
 use crate::propagator::Propagator;
 use std::time::{Duration, Instant};
-use wgpu::util::DeviceExt;
 
 /// Settings of the GPU path.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -206,13 +205,15 @@ fn storage(
     extra: wgpu::BufferUsages,
 ) -> Result<wgpu::Buffer, GpuError> {
     let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-    let buffer = ctx
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE | extra,
-        });
+    // Not `create_buffer_init`: a buffer mapped at creation panics on a lost device, and a
+    // lost device must come back as an error.
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: (bytes.len() as u64).next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+        mapped_at_creation: false,
+    });
+    ctx.queue.write_buffer(&buffer, 0, bytes);
     if pollster::block_on(scope.pop()).is_some() {
         return Err(GpuError::OutOfMemory {
             what: label.to_string(),

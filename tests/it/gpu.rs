@@ -60,7 +60,7 @@ use pounding::plan::{Plan, RunSpec};
 use std::sync::OnceLock;
 
 /// The shared test device. With `POUND_REQUIRE_GPU=1` (CI) a missing adapter fails the test.
-fn ctx() -> Option<&'static GpuContext> {
+pub fn ctx() -> Option<&'static GpuContext> {
     static CTX: OnceLock<Option<GpuContext>> = OnceLock::new();
     CTX.get_or_init(|| match GpuContext::new() {
         Ok(c) => {
@@ -78,7 +78,7 @@ fn ctx() -> Option<&'static GpuContext> {
     .as_ref()
 }
 
-fn gpu_collect(plan: &Plan, opts: &GpuOptions, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
+pub fn gpu_collect(plan: &Plan, opts: &GpuOptions, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
     let mut rows = Vec::new();
     let sink = |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::gpu::GpuError> {
         rows.extend_from_slice(c);
@@ -142,7 +142,7 @@ fn wide() -> &'static (Plan, Vec<(RunSpec, RunOutput)>) {
 }
 
 /// Largest relative difference of the peak outputs of two results of one run.
-fn peak_diff(a: &RunOutput, b: &RunOutput) -> f64 {
+pub fn peak_diff(a: &RunOutput, b: &RunOutput) -> f64 {
     [
         rel(a.peak_force, b.peak_force),
         rel(a.peak_u1, b.peak_u1),
@@ -252,7 +252,7 @@ fn gpu_f32_error_against_cpu_f64() {
 /// two impacts that opens less than `tau`, and an approach in free flight that comes within `tau`
 /// of touching without touching. Closest approaches are maxima of the Hermite cubic of `delta`
 /// over each step.
-fn grazing_contacts(plan: &Plan, spec: &RunSpec, tau: f64) -> usize {
+pub fn grazing_contacts(plan: &Plan, spec: &RunSpec, tau: f64) -> usize {
     use pounding::cpu::{simulate_observed, Mode, Sample};
     let pair = spec.pair();
     let delta = |z: &[f64; 5]| z[0] - z[2] - pair.gap;
@@ -412,4 +412,41 @@ fn gpu_hands_runs_past_its_precision_to_the_cpu() {
         t.handed_off
     );
     assert_eq!(exact, t.handed_off);
+}
+
+/// A device lost in the middle of a sweep ends it with `DeviceLost` (a message that points to
+/// `--backend cpu`), and the chunks finished before the loss stay with the sink. The loss is
+/// real: the device is destroyed from the sink after the first chunk.
+#[test]
+fn gpu_device_loss_keeps_finished_chunks() {
+    let Some(_) = ctx() else { return };
+    let own = GpuContext::new().unwrap();
+    let plan = pounding::bench::plan(200);
+    let mut rows = Vec::new();
+    let res = pounding::sweep::run_gpu(
+        &plan,
+        &own,
+        &GpuOptions::default(),
+        50,
+        |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::gpu::GpuError> {
+            rows.extend_from_slice(c);
+            if rows.len() == 50 {
+                own.device.destroy();
+            }
+            Ok(())
+        },
+        |_| {},
+    );
+    let err = res.expect_err("a sweep on a destroyed device must fail");
+    assert!(
+        matches!(err, pounding::gpu::GpuError::DeviceLost { .. }),
+        "{err:?}"
+    );
+    assert!(err.to_string().contains("--backend cpu"), "{err}");
+    assert_eq!(rows.len(), 50);
+    for (i, (s, o)) in rows.iter().enumerate() {
+        assert_eq!(s.index, i as u64);
+        assert_eq!(o.status, pounding::model::Status::Ok, "run {i}");
+    }
+    assert!(rows.iter().any(|(_, o)| o.impacts > 0));
 }

@@ -4,6 +4,7 @@ mod cli;
 mod config;
 pub mod fast_vs_reference;
 mod gpu;
+mod hard;
 mod oracles;
 mod records;
 mod support;
