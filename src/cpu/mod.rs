@@ -93,6 +93,19 @@ pub const EXACT_RTOL: f64 = 1e-11;
 /// Two free bodies (masses `2 m_eff` each) meeting at relative speed `v0` with `contact`; solved
 /// with the reference scheme at `rtol` until they separate.
 pub fn single_collision(contact: &Contact, v0: f64, rtol: f64) -> Collision {
+    single_collision_observed(contact, v0, rtol, 20.0, &mut |_| {})
+}
+
+/// As [`single_collision`], with at least `contact_steps` steps per estimated contact duration,
+/// calling `observer` after every step (body 1 starts at `u1 = 0` touching body 2, so
+/// `delta = u1 - u2`).
+pub fn single_collision_observed(
+    contact: &Contact,
+    v0: f64,
+    rtol: f64,
+    contact_steps: f64,
+    observer: &mut dyn FnMut(&Sample),
+) -> Collision {
     let m = 2.0 * contact.m_eff;
     let pair = Pair {
         b1: Oscillator::free(m),
@@ -118,11 +131,14 @@ pub fn single_collision(contact: &Contact, v0: f64, rtol: f64) -> Collision {
     };
     let opts = ReferenceOptions {
         rtol,
-        contact_steps: 20.0,
+        contact_steps,
         max_steps: 50_000_000,
     };
     let mut last = [0.0; 5];
-    let mut obs = |s: &Sample| last = s.z;
+    let mut obs = |s: &Sample| {
+        last = s.z;
+        observer(s);
+    };
     let out = reference::run(&pair, &forcing, &init, &opts, Some(&mut obs), Some(1));
     if out.status != Status::Ok {
         return Collision {

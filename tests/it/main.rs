@@ -3,6 +3,7 @@
 mod cli;
 mod config;
 pub mod fast_vs_reference;
+mod fidelity;
 mod gpu;
 mod hard;
 mod oracles;
