@@ -63,24 +63,26 @@ fn hysteresis_loop_area_is_the_dissipated_energy() {
     }
 }
 
+/// `pound ARGS -o OUT --plot PLOT`; its stdout on success.
+fn pound_with_outputs(args: &[&str], out: &std::path::Path, plot: &std::path::Path) -> String {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pound"))
+        .args(args)
+        .arg("-o")
+        .arg(out)
+        .arg("--plot")
+        .arg(plot)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8(o.stdout).unwrap()
+}
+
 #[test]
 fn restitution_and_hysteresis_commands_write_csv_and_svg() {
     let d = tempdir();
     let csv = d.path().join("r.csv");
     let svg = d.path().join("r.svg");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pound"))
-        .args(["restitution", "--e", "0.4:0.8:0.2", "-o"])
-        .arg(&csv)
-        .arg("--plot")
-        .arg(&svg)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let table = String::from_utf8(out.stdout).unwrap();
+    let table = pound_with_outputs(&["restitution", "--e", "0.4:0.8:0.2"], &csv, &svg);
     assert!(table.contains("| kelvin_voigt | 0.000 |"), "{table}");
     let text = std::fs::read_to_string(&csv).unwrap();
     assert_eq!(text.lines().count(), 1 + (4 * 7 + 4) * 3);
@@ -99,25 +101,17 @@ fn restitution_and_hysteresis_commands_write_csv_and_svg() {
 
     let loops = d.path().join("l.csv");
     let lsvg = d.path().join("l.svg");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pound"))
-        .args([
+    pound_with_outputs(
+        &[
             "hysteresis",
             "kelvin_voigt",
             "--formula",
             "exact",
             "--e",
             "0.5,0.9",
-            "-o",
-        ])
-        .arg(&loops)
-        .arg("--plot")
-        .arg(&lsvg)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        ],
+        &loops,
+        &lsvg,
     );
     let text = std::fs::read_to_string(&loops).unwrap();
     assert!(text.starts_with("e,delta_m,force_n\n"));
