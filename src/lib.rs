@@ -5,6 +5,7 @@
 //! (integrators), [`plan`] (a validated sweep), [`config`] (TOML to plan), [`sweep`] (parallel
 //! execution and streaming output).
 
+pub mod accuracy;
 pub mod bench;
 pub mod config;
 pub mod contact;

@@ -99,6 +99,26 @@ enum Cmd {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
+    /// Speed against error of every path and accuracy setting on a benchmark sweep, against the
+    /// reference solved once.
+    Accuracy {
+        #[arg(default_value = "configs/accuracy.toml")]
+        config: PathBuf,
+        /// RK4 substeps per contact duration to try.
+        #[arg(long, value_delimiter = ',', default_value = "8,16,32,64,128")]
+        settings: Vec<f64>,
+        /// Stated relative accuracy of the reference.
+        #[arg(long, default_value_t = 1e-8)]
+        tol: f64,
+        /// `auto` adds the GPU paths when an adapter is found; `cpu` leaves them out.
+        #[arg(long, value_enum, default_value = "auto")]
+        backend: BackendArg,
+        #[arg(short, long, default_value = "accuracy.csv")]
+        output: PathBuf,
+        /// Work-precision plot (SVG).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
     /// Impact damping zeta(e) of every formula, and `exact` per law.
     Formulas {
         /// Values of e: start:stop:step, or one value.
@@ -216,6 +236,14 @@ fn run(cli: Cli) -> Result<()> {
             output,
         } => bench(&sizes, max_cpu_runs, precision.get(), chunk, output),
         Cmd::Formulas { e } => formulas(&e),
+        Cmd::Accuracy {
+            config,
+            settings,
+            tol,
+            backend,
+            output,
+            plot,
+        } => accuracy(&config, &settings, tol, backend, &output, plot.as_deref()),
         Cmd::Restitution { e, output, plot } => restitution(&e, &output, plot.as_deref()),
         Cmd::Hysteresis {
             law,
@@ -493,6 +521,52 @@ fn formulas(e: &str) -> Result<()> {
             row.push(format!("{:.6}", exact_damping(l, e)?));
         }
         println!("{}", row.join(","));
+    }
+    Ok(())
+}
+
+fn accuracy(
+    config: &std::path::Path,
+    settings: &[f64],
+    tol: f64,
+    backend: BackendArg,
+    output: &std::path::Path,
+    plot: Option<&std::path::Path>,
+) -> Result<()> {
+    use pounding::accuracy;
+    if let Some(bad) = settings.iter().find(|s| !(**s >= 1.0 && s.is_finite())) {
+        bail!("--settings: {bad} is out of range: expected substeps per contact >= 1");
+    }
+    if !(tol > 0.0 && tol < 1e-3) {
+        bail!("--tol: {tol} is out of range: expected 0 < tol < 1e-3");
+    }
+    let plan = config::load(config)?;
+    let ctx = match backend {
+        BackendArg::Cpu => None,
+        BackendArg::Gpu => Some(GpuContext::new()?),
+        BackendArg::Auto => match GpuContext::new() {
+            Ok(c) => Some(c),
+            Err(e) => {
+                eprintln!("notice: CPU path only: {e}");
+                None
+            }
+        },
+    };
+    eprintln!(
+        "{}: {} runs; reference at tol {tol:e}, then {} settings on {} paths",
+        config.display(),
+        plan.len(),
+        settings.len(),
+        if ctx.is_some() { 3 } else { 1 }
+    );
+    println!("{}", accuracy::MARKDOWN_HEADER);
+    let points = accuracy::study(&plan, ctx.as_ref(), settings, tol, |p| {
+        println!("{}", accuracy::markdown_row(p))
+    })?;
+    pounding::output::write_atomic(output, accuracy::csv(&points).as_bytes())
+        .with_context(|| format!("writing {}", output.display()))?;
+    if let Some(p) = plot {
+        pounding::plot::svg(p, &accuracy::panels(&points), 2)?;
     }
     Ok(())
 }

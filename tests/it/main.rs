@@ -1,5 +1,6 @@
 //! Integration tests: one binary, one module per area.
 
+mod accuracy;
 mod cli;
 mod config;
 pub mod fast_vs_reference;

@@ -1,0 +1,240 @@
+//! Speed against error: each path (CPU fast f64, GPU f32, GPU f64) at each accuracy setting
+//! (RK4 substeps per contact duration) on one benchmark sweep, against the reference solved once.
+
+use crate::cpu::{FastOptions, ReferenceOptions, Scheme};
+use crate::gpu::{GpuContext, GpuError, GpuOptions, Precision};
+use crate::model::{RunOutput, Status};
+use crate::plan::{Plan, RunSpec};
+use crate::plot::{Panel, Series};
+
+/// One path at one setting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// `cpu-fast-f64`, `gpu-f32`, `gpu-f64`.
+    pub path: String,
+    pub substeps_per_contact: f64,
+    pub runs_per_second: f64,
+    pub errors: Errors,
+}
+
+/// Relative errors against the reference over the runs both end `ok` with equal impact counts
+/// (medians and 99th percentiles), and the fraction of runs whose impact count differs.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Errors {
+    pub force_median: f64,
+    pub force_p99: f64,
+    pub displacement_median: f64,
+    pub displacement_p99: f64,
+    pub energy_median: f64,
+    pub energy_p99: f64,
+    pub impact_count_differs: f64,
+    pub failed: u64,
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs().max(1e-300)
+}
+
+fn quantile(v: &mut [f64], p: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * p).round() as usize]
+}
+
+/// Errors of `out` against `truth`, run by run.
+pub fn errors(truth: &[RunOutput], out: &[RunOutput]) -> Errors {
+    let (mut f, mut u, mut w) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut differ, mut failed) = (0usize, 0u64);
+    for (t, o) in truth.iter().zip(out) {
+        if t.status != Status::Ok || o.status != Status::Ok {
+            failed += 1;
+            continue;
+        }
+        if t.impacts != o.impacts {
+            differ += 1;
+            continue;
+        }
+        if t.peak_force > 0.0 {
+            f.push(rel(o.peak_force, t.peak_force));
+        }
+        u.push(rel(o.peak_u1, t.peak_u1).max(rel(o.peak_u2, t.peak_u2)));
+        // Elastic laws dissipate only rounding.
+        if t.dissipated_energy > 1e-9 * t.peak_force * t.peak_penetration.max(1e-300) {
+            w.push(rel(o.dissipated_energy, t.dissipated_energy));
+        }
+    }
+    Errors {
+        force_median: quantile(&mut f, 0.5),
+        force_p99: quantile(&mut f, 0.99),
+        displacement_median: quantile(&mut u, 0.5),
+        displacement_p99: quantile(&mut u, 0.99),
+        energy_median: quantile(&mut w, 0.5),
+        energy_p99: quantile(&mut w, 0.99),
+        impact_count_differs: differ as f64 / truth.len().max(1) as f64,
+        failed,
+    }
+}
+
+/// Every run of `plan` on the CPU with `scheme`; outputs in run order and runs per second.
+pub fn cpu(plan: &Plan, scheme: &Scheme) -> (Vec<RunOutput>, f64) {
+    let mut outs = Vec::with_capacity(plan.len() as usize);
+    let s = crate::sweep::run(
+        plan,
+        scheme,
+        16,
+        |c: &[(RunSpec, RunOutput)]| -> Result<(), ()> {
+            outs.extend(c.iter().map(|(_, o)| *o));
+            Ok(())
+        },
+        |_| {},
+    )
+    .expect("collecting cannot fail");
+    (outs, s.runs_per_second())
+}
+
+/// Every run of `plan` on the GPU.
+pub fn gpu(
+    plan: &Plan,
+    ctx: &GpuContext,
+    opts: &GpuOptions,
+) -> Result<(Vec<RunOutput>, f64), GpuError> {
+    let mut outs = Vec::with_capacity(plan.len() as usize);
+    let (s, _) = crate::sweep::run_gpu(
+        plan,
+        ctx,
+        opts,
+        65536,
+        |c: &[(RunSpec, RunOutput)]| -> Result<(), GpuError> {
+            outs.extend(c.iter().map(|(_, o)| *o));
+            Ok(())
+        },
+        |_| {},
+    )?;
+    Ok((outs, s.runs_per_second()))
+}
+
+/// The reference at `tol`, then every path at every setting. `progress` hears each point.
+pub fn study(
+    plan: &Plan,
+    ctx: Option<&GpuContext>,
+    settings: &[f64],
+    tol: f64,
+    mut progress: impl FnMut(&Point),
+) -> Result<Vec<Point>, GpuError> {
+    let (truth, _) = cpu(plan, &Scheme::Reference(ReferenceOptions::with_tol(tol)));
+    let mut points = Vec::new();
+    for &spc in settings {
+        let fast = FastOptions {
+            substeps_per_contact: spc,
+            ..Default::default()
+        };
+        let mut runs = vec![("cpu-fast-f64".to_string(), cpu(plan, &Scheme::Fast(fast)))];
+        if let Some(ctx) = ctx {
+            for precision in [Precision::F32, Precision::F64] {
+                if precision == Precision::F64 && !ctx.supports_f64() {
+                    continue;
+                }
+                let opts = GpuOptions {
+                    precision,
+                    fast,
+                    ..Default::default()
+                };
+                runs.push((format!("gpu-{}", precision.key()), gpu(plan, ctx, &opts)?));
+            }
+        }
+        for (path, (outs, rps)) in runs {
+            let p = Point {
+                path,
+                substeps_per_contact: spc,
+                runs_per_second: rps,
+                errors: errors(&truth, &outs),
+            };
+            progress(&p);
+            points.push(p);
+        }
+    }
+    Ok(points)
+}
+
+impl Errors {
+    /// Medians and 99th percentiles: force, displacement, energy.
+    pub fn quantiles(&self) -> [f64; 6] {
+        [
+            self.force_median,
+            self.force_p99,
+            self.displacement_median,
+            self.displacement_p99,
+            self.energy_median,
+            self.energy_p99,
+        ]
+    }
+}
+
+/// The points as CSV.
+pub fn csv(points: &[Point]) -> String {
+    let mut s = String::from("path,substeps_per_contact,runs_per_second,force_median,force_p99,displacement_median,displacement_p99,energy_median,energy_p99,impact_count_differs,failed\n");
+    for p in points {
+        let q = p.errors.quantiles().map(|x| format!("{x:e}"));
+        s.push_str(&format!(
+            "{},{},{:.1},{},{},{}\n",
+            p.path,
+            p.substeps_per_contact,
+            p.runs_per_second,
+            q.join(","),
+            p.errors.impact_count_differs,
+            p.errors.failed
+        ));
+    }
+    s
+}
+
+/// Work-precision panels: runs/s against the median and the 99th percentile of the peak-force
+/// error, one line per path through its settings.
+pub fn panels(points: &[Point]) -> Vec<Panel> {
+    let mut paths: Vec<&str> = points.iter().map(|p| p.path.as_str()).collect();
+    paths.sort();
+    paths.dedup();
+    let panel = |title: &str, err: fn(&Errors) -> f64| Panel {
+        title: title.into(),
+        x_label: "peak-force relative error".into(),
+        y_label: "runs/s".into(),
+        log_x: true,
+        log_y: true,
+        series: paths
+            .iter()
+            .map(|path| Series {
+                name: path.to_string(),
+                points: points
+                    .iter()
+                    .filter(|p| p.path == *path)
+                    .map(|p| (err(&p.errors), p.runs_per_second))
+                    .collect(),
+                scatter: false,
+            })
+            .collect(),
+    };
+    vec![
+        panel("median error", |e| e.force_median),
+        panel("99th percentile error", |e| e.force_p99),
+    ]
+}
+
+/// A markdown table header for [`markdown_row`].
+pub const MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | peak force median / p99 | peak u median / p99 | energy median / p99 | impact counts differ |\n|---|---:|---:|---|---|---|---:|";
+
+/// One point as a markdown table row.
+pub fn markdown_row(p: &Point) -> String {
+    let q = p.errors.quantiles().map(|x| format!("{x:.1e}"));
+    format!(
+        "| {} | {} | {:.0} | {} | {:.2} % |",
+        p.path,
+        p.substeps_per_contact,
+        p.runs_per_second,
+        [&q[0..2], &q[2..4], &q[4..6]]
+            .map(|pair| pair.join(" / "))
+            .join(" | "),
+        100.0 * p.errors.impact_count_differs
+    )
+}
