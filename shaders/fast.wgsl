@@ -417,6 +417,60 @@ fn hermite_range(y0: real, d0: real, y1: real, d1: real, h: real) -> Range {
     return r;
 }
 
+// cpu::quintic_peak_abs: largest |y| over [0, h] of the quintic Hermite through (y, y', y'')
+// at both ends; each cubic extremum inside the step refined by three Newton steps.
+fn quintic_peak_abs(y0: real, y1: real, d0: real, d1: real, a0: real, a1: real, h: real) -> real {
+    let m0 = h * d0;
+    let m1 = h * d1;
+    let q0 = h * h * a0;
+    let q1 = h * h * a1;
+    let dy = y1 - y0;
+    let c2 = 0.5 * q0;
+    let c3 = 10.0 * dy - 6.0 * m0 - 4.0 * m1 - 1.5 * q0 + 0.5 * q1;
+    let c4 = -15.0 * dy + 8.0 * m0 + 7.0 * m1 + 1.5 * q0 - q1;
+    let c5 = 6.0 * dy - 3.0 * m0 - 3.0 * m1 - 0.5 * q0 + 0.5 * q1;
+    var peak = max(abs(y0), abs(y1));
+    let b = 3.0 * dy - 2.0 * m0 - m1;
+    let c = -2.0 * dy + m0 + m1;
+    let qa = 3.0 * c;
+    let qb = 2.0 * b;
+    let qc = m0;
+    var roots = array<real, 2>(-1.0, -1.0);
+    if (abs(qa) < TINY) {
+        if (qb != 0.0) {
+            roots[0] = -qc / qb;
+        }
+    } else {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if (disc >= 0.0) {
+            var sg: real = 1.0;
+            if (qb < 0.0) { sg = -1.0; }
+            let q = -0.5 * (qb + sg * sqrt(disc));
+            if (q != 0.0) {
+                roots[0] = q / qa;
+                roots[1] = qc / q;
+            }
+        }
+    }
+    // Unrolled: two candidates, three Newton steps each (no long loops on lavapipe).
+    for (var k = 0u; k < 2u; k = k + 1u) {
+        let s0 = roots[k];
+        if (s0 > 0.0 && s0 < 1.0) {
+            var s = s0;
+            for (var it = 0u; it < 3u; it = it + 1u) {
+                let g1 = m0 + s * (2.0 * c2 + s * (3.0 * c3 + s * (4.0 * c4 + s * 5.0 * c5)));
+                let g2 = 2.0 * c2 + s * (6.0 * c3 + s * (12.0 * c4 + s * 20.0 * c5));
+                if (g2 != 0.0) {
+                    s = clamp(s - g1 / g2, 0.0, 1.0);
+                }
+            }
+            let v = y0 + s * (m0 + s * (c2 + s * (c3 + s * (c4 + s * c5))));
+            peak = max(peak, abs(v));
+        }
+    }
+    return peak;
+}
+
 fn fourth_derivative_bound(m: real, k: real, c: real, u: real, v: real, seg: Seg) -> real {
     let w2 = k / m;
     let cm = c / m;
@@ -479,6 +533,16 @@ fn force_sample(t: real, f: real) {
         S.h_f0 = f;
         C.nhist = 1u;
     }
+}
+
+// Tracker::free_step: a free record step's peak displacements from the quintic Hermite.
+fn track_free_step(seg: Seg, z0: Z, z1: Z) {
+    let a10 = (-P.c1 * z0.v1 - P.k1 * z0.u1) / P.m1 - seg.a0;
+    let a11 = (-P.c1 * z1.v1 - P.k1 * z1.u1) / P.m1 - seg.a1;
+    S.peak_u1 = max(S.peak_u1, quintic_peak_abs(z0.u1, z1.u1, z0.v1, z1.v1, a10, a11, seg.dt));
+    let a20 = (-P.c2 * z0.v2 - P.k2 * z0.u2) / P.m2 - seg.a0;
+    let a21 = (-P.c2 * z1.v2 - P.k2 * z1.u2) / P.m2 - seg.a1;
+    S.peak_u2 = max(S.peak_u2, quintic_peak_abs(z0.u2, z1.u2, z0.v2, z1.v2, a20, a21, seg.dt));
 }
 
 fn track_step(mode: u32, tau0: real, h: real, z0: Z, z1: Z) {
@@ -600,7 +664,7 @@ fn begin_interval(seg: Seg) {
         let v2 = P.p2_vu * z0.u2 + P.p2_vv * z0.v2 + P.p2_va0 * seg.a0 + P.p2_va1 * seg.a1;
         let z1 = Z(u1, v1, u2, v2, z0.w);
         if (!may_touch(seg, z0, z1, dt, S.v0)) {
-            track_step(C.mode, 0.0, dt, z0, z1);
+            track_free_step(seg, z0, z1);
             ZS = z1;
             if (!finite(z1)) {
                 C.status = STATUS_NON_FINITE;

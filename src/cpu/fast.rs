@@ -17,7 +17,9 @@
 //!    aligned with the record step.
 //! 4. The peak force of each impact is the largest force sample, refined by the vertex of the
 //!    parabola through the three samples around a local maximum; the peak penetration and the
-//!    peak displacements are maxima of the Hermite cubics of each step.
+//!    peak displacements are maxima of the Hermite cubics of each step, except over free record
+//!    steps, where peak displacements come from the quintic Hermite (the accelerations at both
+//!    ends are known; the cubic's `(omega dt)^4 / 384` error was 5e-3 at T = 0.1 s, dt = 0.02 s).
 //!
 //! Cost is therefore one cheap exact step per record sample for runs that never pound, plus
 //! `M` RK4 substeps only for the record steps near or in contact.
@@ -93,7 +95,7 @@ pub(crate) fn run(
             let (u2, v2) = p2.step(z[2], z[3], seg.a0, seg.a1);
             let z1 = [u1, v1, u2, v2, z[4]];
             if !may_touch(pair, &seg, &z, &z1, dt, run.tr.v0) {
-                run.free_step(seg.t0, dt, z1);
+                run.free_step(&seg, z1);
                 if !finite(&run.z) {
                     return run.finish(Status::NonFinite, substeps as u64);
                 }
