@@ -187,3 +187,41 @@ fn record_info_prints_pga() {
     );
     assert!(!Path::new("results.csv.partial").exists());
 }
+
+/// `pound accuracy` on a small config: one table row and one CSV row per path and setting, a
+/// plot, and bad settings refused with the flag named.
+#[test]
+fn accuracy_writes_table_csv_and_plot() {
+    let d = tempdir();
+    let cfg = d.path().join("small.toml");
+    std::fs::write(&cfg, SMALL).unwrap();
+    let (csv, svg) = (d.path().join("a.csv"), d.path().join("a.svg"));
+    let out = ok(&pound(&[
+        "accuracy",
+        cfg.to_str().unwrap(),
+        "--settings",
+        "16,64",
+        "--backend",
+        "cpu",
+        "-o",
+        csv.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]));
+    assert_eq!(
+        out.lines()
+            .filter(|l| l.starts_with("| cpu-fast-f64 |"))
+            .count(),
+        2,
+        "{out}"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(text.lines().count(), 3, "{text}");
+    assert!(std::fs::read_to_string(&svg)
+        .unwrap()
+        .contains("\nmedian error\n"));
+    let bad = pound(&["accuracy", cfg.to_str().unwrap(), "--settings", "0.5"]);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("--settings: 0.5 is out of range"), "{err}");
+}
