@@ -393,28 +393,34 @@ fn hermite_range(y0: real, d0: real, y1: real, d1: real, h: real) -> Range {
     let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
     let c = 2.0 * (y0 - y1) + m0 + m1;
     var r = Range(min(y0, y1), max(y0, y1));
+    let ex = hermite_extrema(m0, b, c);
+    r = range_check(r, y0, m0, b, c, ex[0]);
+    r = range_check(r, y0, m0, b, c, ex[1]);
+    return r;
+}
+
+// cpu::hermite_extrema: roots of m0 + 2 b s + 3 c s^2 by the stable formula, -1 where none.
+fn hermite_extrema(m0: real, b: real, c: real) -> array<real, 2> {
     let qa = 3.0 * c;
     let qb = 2.0 * b;
     let qc = m0;
     if (abs(qa) < TINY) {
         if (qb != 0.0) {
-            r = range_check(r, y0, m0, b, c, -qc / qb);
+            return array<real, 2>(-qc / qb, -1.0);
         }
     } else {
         let disc = qb * qb - 4.0 * qa * qc;
         if (disc >= 0.0) {
-            let rt = sqrt(disc);
             // Rust's signum: +1 for +0.
             var sg: real = 1.0;
             if (qb < 0.0) { sg = -1.0; }
-            let q = -0.5 * (qb + sg * rt);
+            let q = -0.5 * (qb + sg * sqrt(disc));
             if (q != 0.0) {
-                r = range_check(r, y0, m0, b, c, q / qa);
-                r = range_check(r, y0, m0, b, c, qc / q);
+                return array<real, 2>(q / qa, qc / q);
             }
         }
     }
-    return r;
+    return array<real, 2>(-1.0, -1.0);
 }
 
 // cpu::quintic_peak_abs: largest |y| over [0, h] of the quintic Hermite through (y, y', y'')
@@ -432,26 +438,7 @@ fn quintic_peak_abs(y0: real, y1: real, d0: real, d1: real, a0: real, a1: real, 
     var peak = max(abs(y0), abs(y1));
     let b = 3.0 * dy - 2.0 * m0 - m1;
     let c = -2.0 * dy + m0 + m1;
-    let qa = 3.0 * c;
-    let qb = 2.0 * b;
-    let qc = m0;
-    var roots = array<real, 2>(-1.0, -1.0);
-    if (abs(qa) < TINY) {
-        if (qb != 0.0) {
-            roots[0] = -qc / qb;
-        }
-    } else {
-        let disc = qb * qb - 4.0 * qa * qc;
-        if (disc >= 0.0) {
-            var sg: real = 1.0;
-            if (qb < 0.0) { sg = -1.0; }
-            let q = -0.5 * (qb + sg * sqrt(disc));
-            if (q != 0.0) {
-                roots[0] = q / qa;
-                roots[1] = qc / q;
-            }
-        }
-    }
+    var roots = hermite_extrema(m0, b, c);
     // Unrolled: two candidates, three Newton steps each (no long loops on lavapipe).
     for (var k = 0u; k < 2u; k = k + 1u) {
         let s0 = roots[k];

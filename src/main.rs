@@ -121,7 +121,7 @@ enum Cmd {
     },
     /// Impact damping zeta(e) of every formula, and `exact` per law.
     Formulas {
-        /// Values of e: start:stop:step, or one value.
+        /// Values of e: start:stop:step, a list a,b,c, or one value.
         #[arg(long, default_value = "0.1:1:0.05")]
         e: String,
     },
@@ -302,20 +302,12 @@ fn sweep(
         Scheme::Fast(o) => Some(o),
         Scheme::Reference(_) => None,
     };
-    let gpu = match (backend, fast) {
-        (BackendArg::Cpu, _) => None,
-        (BackendArg::Gpu, None) => {
-            bail!("--backend gpu runs the fast scheme only; use --scheme fast or --backend cpu")
-        }
-        (BackendArg::Auto, None) => None,
-        (BackendArg::Gpu, Some(_)) => Some(GpuContext::new()?),
-        (BackendArg::Auto, Some(_)) => match GpuContext::new() {
-            Ok(c) => Some(c),
-            Err(e) => {
-                eprintln!("notice: running on the CPU: {e}");
-                None
-            }
-        },
+    if backend == BackendArg::Gpu && fast.is_none() {
+        bail!("--backend gpu runs the fast scheme only; use --scheme fast or --backend cpu")
+    }
+    let gpu = match fast {
+        Some(_) => gpu_context(backend, "running on the CPU")?,
+        None => None,
     };
     if let Some(ctx) = &gpu {
         if precision == Precision::F64 && !ctx.supports_f64() {
@@ -488,8 +480,7 @@ fn bench(
 }
 
 fn formulas(e: &str) -> Result<()> {
-    let es = config::parse_colon_range(e)
-        .with_context(|| format!("--e `{e}`: expected start:stop:step or one value"))?;
+    let es = e_values(e)?;
     let exact_laws = [
         LawKind::KelvinVoigt,
         LawKind::KelvinVoigtNoTension,
@@ -507,7 +498,6 @@ fn formulas(e: &str) -> Result<()> {
     head.push("exact_a:hunt_crossley".into());
     println!("{}", head.join(","));
     for &e in &es {
-        let e = (e * 1e12).round() / 1e12;
         let mut row = vec![format!("{e}")];
         for f in Formula::ALL.iter().filter(|f| **f != Formula::Exact) {
             let z = f.zeta(e)?.expect("printed formula");
@@ -523,6 +513,22 @@ fn formulas(e: &str) -> Result<()> {
         println!("{}", row.join(","));
     }
     Ok(())
+}
+
+/// The GPU `backend` asks for: none for `cpu`, an error if `gpu` finds none, and for `auto` the
+/// default adapter or, without one, a one-line notice (`fallback: why`) and none.
+fn gpu_context(backend: BackendArg, fallback: &str) -> Result<Option<GpuContext>> {
+    Ok(match backend {
+        BackendArg::Cpu => None,
+        BackendArg::Gpu => Some(GpuContext::new()?),
+        BackendArg::Auto => match GpuContext::new() {
+            Ok(c) => Some(c),
+            Err(e) => {
+                eprintln!("notice: {fallback}: {e}");
+                None
+            }
+        },
+    })
 }
 
 fn accuracy(
@@ -541,17 +547,7 @@ fn accuracy(
         bail!("--tol: {tol} is out of range: expected 0 < tol < 1e-3");
     }
     let plan = config::load(config)?;
-    let ctx = match backend {
-        BackendArg::Cpu => None,
-        BackendArg::Gpu => Some(GpuContext::new()?),
-        BackendArg::Auto => match GpuContext::new() {
-            Ok(c) => Some(c),
-            Err(e) => {
-                eprintln!("notice: CPU path only: {e}");
-                None
-            }
-        },
-    };
+    let ctx = gpu_context(backend, "CPU path only")?;
     eprintln!(
         "{}: {} runs; reference at tol {tol:e}, then {} settings on {} paths",
         config.display(),
@@ -580,7 +576,7 @@ fn e_values(e: &str) -> Result<Vec<f64>> {
     .with_context(|| format!("--e `{e}`: expected start:stop:step, a list a,b,c or one value"))?;
     let es: Vec<f64> = es.iter().map(|e| (e * 1e12).round() / 1e12).collect();
     if let Some(bad) = es.iter().find(|e| !(**e > 0.0 && **e <= 1.0)) {
-        bail!("--e: {bad} is out of range: expected 0 < e <= 1");
+        bail!("--e: e = {bad} is out of range: expected 0 < e <= 1");
     }
     Ok(es)
 }

@@ -349,34 +349,36 @@ pub(crate) fn hermite_range(y0: f64, d0: f64, y1: f64, d1: f64, h: f64) -> (f64,
     let c = 2.0 * (y0 - y1) + m0 + m1;
     let p = |s: f64| y0 + s * (m0 + s * (b + s * c));
     let (mut lo, mut hi) = (y0.min(y1), y0.max(y1));
-    let mut check = |s: f64| {
+    for s in hermite_extrema(m0, b, c) {
         if s > 0.0 && s < 1.0 {
             let v = p(s);
             lo = lo.min(v);
             hi = hi.max(v);
         }
-    };
-    // p'(s) = m0 + 2 b s + 3 c s^2
+    }
+    (lo, hi)
+}
+
+/// Where the cubic Hermite `y0 + s (m0 + s (b + s c))` may have extrema: the roots of
+/// `p'(s) = m0 + 2 b s + 3 c s^2` by the stable formula, -1 where there is none. Callers keep
+/// those in `(0, 1)`.
+#[inline]
+pub(crate) fn hermite_extrema(m0: f64, b: f64, c: f64) -> [f64; 2] {
     let (qa, qb, qc) = (3.0 * c, 2.0 * b, m0);
     if qa.abs() < 1e-300 {
         if qb != 0.0 {
-            check(-qc / qb);
+            return [-qc / qb, -1.0];
         }
     } else {
         let disc = qb * qb - 4.0 * qa * qc;
         if disc >= 0.0 {
-            let r = disc.sqrt();
-            // Stable roots.
-            let q = -0.5 * (qb + qb.signum() * r);
+            let q = -0.5 * (qb + qb.signum() * disc.sqrt());
             if q != 0.0 {
-                check(q / qa);
-                check(qc / q);
-            } else {
-                check(0.0);
+                return [q / qa, qc / q];
             }
         }
     }
-    (lo, hi)
+    [-1.0, -1.0]
 }
 
 /// Largest `|y|` over `[0, h]` of the quintic Hermite through `(y, y', y'')` at both ends.
@@ -392,25 +394,9 @@ pub(crate) fn quintic_peak_abs(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) ->
     let c4 = -15.0 * dy + 8.0 * m0 + 7.0 * m1 + 1.5 * q0 - q1;
     let c5 = 6.0 * dy - 3.0 * m0 - 3.0 * m1 - 0.5 * q0 + 0.5 * q1;
     let mut peak = y[0].abs().max(y[1].abs());
-    // The cubic's extrema: roots of m0 + 2 b s + 3 c s^2 (as in `hermite_range`).
     let b = 3.0 * dy - 2.0 * m0 - m1;
     let c = -2.0 * dy + m0 + m1;
-    let (qa, qb, qc) = (3.0 * c, 2.0 * b, m0);
-    let mut roots = [-1.0, -1.0];
-    if qa.abs() < 1e-300 {
-        if qb != 0.0 {
-            roots[0] = -qc / qb;
-        }
-    } else {
-        let disc = qb * qb - 4.0 * qa * qc;
-        if disc >= 0.0 {
-            let q = -0.5 * (qb + qb.signum() * disc.sqrt());
-            if q != 0.0 {
-                roots = [q / qa, qc / q];
-            }
-        }
-    }
-    for s0 in roots {
+    for s0 in hermite_extrema(m0, b, c) {
         if !(s0 > 0.0 && s0 < 1.0) {
             continue;
         }
