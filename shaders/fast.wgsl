@@ -40,6 +40,7 @@ struct State {
     first_impact: real,
     contact_time: real,
     dissipated: real,
+    e_in: real, e_damp: real, e_peak: real,
 }
 
 struct Meta {
@@ -70,7 +71,7 @@ struct Dispatch {
     max_substeps_per_step: u32,
     max_substeps: u32,
     handoff_substeps_per_step: u32,
-    _pad1: u32,
+    energy: u32,
     _pad2: u32,
     _pad3: u32,
 }
@@ -109,17 +110,22 @@ const LOCATE_ITER: u32 = 16u;
 @group(0) @binding(6) var<storage, read_write> active_runs: atomic<u32>;
 @group(0) @binding(7) var<storage, read> run_ids: array<u32>;
 @group(0) @binding(8) var<storage, read_write> next_ids: array<u32>;
+// Exact free-step energy integrals, FORMS reals per run (layout::forms); read only when
+// `disp.energy` is 1 (otherwise a one-element placeholder).
+@group(0) @binding(9) var<storage, read> forms: array<real>;
 
 // This invocation's run.
 var<private> P: Params;
 var<private> M: Meta;
 var<private> S: State;
 var<private> C: Counters;
-// The state [u1, v1, u2, v2, w].
+// The state [u1, v1, u2, v2, w, ein, ed].
 var<private> ZS: Z;
+// This invocation's run index (for `forms`).
+var<private> R: u32;
 
-// [u1, v1, u2, v2, w]
-struct Z { u1: real, v1: real, u2: real, v2: real, w: real }
+// cpu::State: [u1, v1, u2, v2, w, e_in, e_damp]
+struct Z { u1: real, v1: real, u2: real, v2: real, w: real, ein: real, ed: real }
 
 struct Seg { a0: real, a1: real, dt: real }
 
@@ -238,6 +244,8 @@ fn rhs(mode: u32, v0: real, ag: real, z: Z) -> Z {
         z.v2,
         (-P.c2 * z.v2 - P.k2 * z.u2 + f) / P.m2 - ag,
         f * ddelta(z),
+        -ag * (P.m1 * z.v1 + P.m2 * z.v2),
+        P.c1 * z.v1 * z.v1 + P.c2 * z.v2 * z.v2,
     );
 }
 
@@ -263,7 +271,8 @@ fn event_value(mode: u32, v0: real, z: Z) -> real {
 }
 
 fn zadd(z: Z, k: Z, s: real) -> Z {
-    return Z(z.u1 + s * k.u1, z.v1 + s * k.v1, z.u2 + s * k.u2, z.v2 + s * k.v2, z.w + s * k.w);
+    return Z(z.u1 + s * k.u1, z.v1 + s * k.v1, z.u2 + s * k.u2, z.v2 + s * k.v2, z.w + s * k.w,
+             z.ein + s * k.ein, z.ed + s * k.ed);
 }
 
 // fast.rs `rk4`: classic RK4 over `h` from local time `tau`.
@@ -279,6 +288,8 @@ fn rk4(mode: u32, v0: real, seg: Seg, tau: real, z: Z, h: real) -> Z {
         z.u2 + h6 * (k1.u2 + 2.0 * k2.u2 + 2.0 * k3.u2 + k4.u2),
         z.v2 + h6 * (k1.v2 + 2.0 * k2.v2 + 2.0 * k3.v2 + k4.v2),
         z.w + h6 * (k1.w + 2.0 * k2.w + 2.0 * k3.w + k4.w),
+        z.ein + h6 * (k1.ein + 2.0 * k2.ein + 2.0 * k3.ein + k4.ein),
+        z.ed + h6 * (k1.ed + 2.0 * k2.ed + 2.0 * k3.ed + k4.ed),
     );
 }
 
@@ -530,6 +541,7 @@ fn track_free_step(seg: Seg, z0: Z, z1: Z) {
     let a20 = (-P.c2 * z0.v2 - P.k2 * z0.u2) / P.m2 - seg.a0;
     let a21 = (-P.c2 * z1.v2 - P.k2 * z1.u2) / P.m2 - seg.a1;
     S.peak_u2 = max(S.peak_u2, quintic_peak_abs(z0.u2, z1.u2, z0.v2, z1.v2, a20, a21, seg.dt));
+    S.e_peak = max(S.e_peak, z1.ein);
 }
 
 fn track_step(mode: u32, tau0: real, h: real, z0: Z, z1: Z) {
@@ -537,6 +549,7 @@ fn track_step(mode: u32, tau0: real, h: real, z0: Z, z1: Z) {
     S.peak_u1 = max(max(S.peak_u1, abs(r1.hi)), abs(r1.lo));
     let r2 = hermite_range(z0.u2, z0.v2, z1.u2, z1.v2, h);
     S.peak_u2 = max(max(S.peak_u2, abs(r2.hi)), abs(r2.lo));
+    S.e_peak = max(S.e_peak, z1.ein);
     if (mode != MODE_FREE) {
         S.contact_time = S.contact_time + h;
         let rd = hermite_range(delta(z0), ddelta(z0), delta(z1), ddelta(z1), h);
@@ -632,7 +645,17 @@ fn accept(tau: real, h_in: real, trial_in: Z, seg: Seg, z0: Z, out: ptr<function
 fn finite(z: Z) -> bool {
     // abs(x) <= BIG is false for NaN and for +-inf.
     return abs(z.u1) <= BIG && abs(z.v1) <= BIG && abs(z.u2) <= BIG && abs(z.v2) <= BIG
-        && abs(z.w) <= BIG;
+        && abs(z.w) <= BIG && abs(z.ein) <= BIG && abs(z.ed) <= BIG;
+}
+
+// propagator::quadratic: y^T form y for y = [u, v, a0, a1], the form's 10 upper-triangle
+// coefficients at forms[base..].
+fn quadratic(base: u32, u: real, v: real, a0: real, a1: real) -> real {
+    let c = base;
+    return u * (forms[c] * u + forms[c + 1u] * v + forms[c + 2u] * a0 + forms[c + 3u] * a1)
+        + v * (forms[c + 4u] * v + forms[c + 5u] * a0 + forms[c + 6u] * a1)
+        + a0 * (forms[c + 7u] * a0 + forms[c + 8u] * a1)
+        + a1 * forms[c + 9u] * a1;
 }
 
 // The start of the current record interval (fast.rs `run`, loop body): take it with the exact
@@ -649,8 +672,18 @@ fn begin_interval(seg: Seg) {
         let v1 = P.p1_vu * z0.u1 + P.p1_vv * z0.v1 + P.p1_va0 * seg.a0 + P.p1_va1 * seg.a1;
         let u2 = P.p2_uu * z0.u2 + P.p2_uv * z0.v2 + P.p2_ua0 * seg.a0 + P.p2_ua1 * seg.a1;
         let v2 = P.p2_vu * z0.u2 + P.p2_vv * z0.v2 + P.p2_va0 * seg.a0 + P.p2_va1 * seg.a1;
-        let z1 = Z(u1, v1, u2, v2, z0.w);
+        var z1 = Z(u1, v1, u2, v2, z0.w, z0.ein, z0.ed);
         if (!may_touch(seg, z0, z1, dt, S.v0)) {
+            if (disp.energy == 1u) {
+                // fast.rs: the exact free-step input and damping work (EnergyForms::integrals).
+                let b = R * FORMS;
+                let vv1 = quadratic(b, z0.u1, z0.v1, seg.a0, seg.a1);
+                let agv1 = quadratic(b + 10u, z0.u1, z0.v1, seg.a0, seg.a1);
+                let vv2 = quadratic(b + 20u, z0.u2, z0.v2, seg.a0, seg.a1);
+                let agv2 = quadratic(b + 30u, z0.u2, z0.v2, seg.a0, seg.a1);
+                z1.ein = z1.ein - (P.m1 * agv1 + P.m2 * agv2);
+                z1.ed = z1.ed + (P.c1 * vv1 + P.c2 * vv2);
+            }
             track_free_step(seg, z0, z1);
             ZS = z1;
             if (!finite(z1)) {
@@ -731,6 +764,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let r = run_ids[gid.x];
+    R = r;
     C = counters[r];
     M = metas[r];
     if (C.status != STATUS_OK || C.i >= M.intervals) {
@@ -738,7 +772,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     P = params[r];
     S = states[r];
-    ZS = Z(S.u1, S.v1, S.u2, S.v2, S.w);
+    ZS = Z(S.u1, S.v1, S.u2, S.v2, S.w, S.e_in, S.e_damp);
     var budget = disp.budget;
     loop {
         if (C.status != STATUS_OK || C.i >= M.intervals || budget == 0u) {
@@ -757,6 +791,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     S.u2 = ZS.u2;
     S.v2 = ZS.v2;
     S.w = ZS.w;
+    S.e_in = ZS.ein;
+    S.e_damp = ZS.ed;
     states[r] = S;
     counters[r] = C;
     if (C.status == STATUS_OK && C.i < M.intervals) {

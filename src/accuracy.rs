@@ -1,5 +1,7 @@
 //! Speed against error: each path (CPU fast f64, GPU f32, GPU f64) at each accuracy setting
 //! (RK4 substeps per contact duration) on one benchmark sweep, against the reference solved once.
+//! Every path runs with the energy balance on, so each point also carries the distribution of
+//! the runs' energy residuals (the check a user gets on any sweep without a reference).
 
 use crate::cpu::{FastOptions, ReferenceOptions, Scheme};
 use crate::gpu::{GpuContext, GpuError, GpuOptions, Precision};
@@ -10,7 +12,8 @@ use crate::plot::{Panel, Series};
 /// One path at one setting.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Point {
-    /// `cpu-fast-f64`, `gpu-f32`, `gpu-f64`.
+    /// `reference` (errors 0 by definition; its speed and energy residual), `cpu-fast-f64`,
+    /// `gpu-f32`, `gpu-f64`.
     pub path: String,
     pub substeps_per_contact: f64,
     pub runs_per_second: f64,
@@ -29,6 +32,9 @@ pub struct Errors {
     pub energy_p99: f64,
     pub impact_count_differs: f64,
     pub failed: u64,
+    /// `|energy residual|` over the runs that end `ok` (`model::EnergyBalance`).
+    pub residual_median: f64,
+    pub residual_p99: f64,
 }
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -47,7 +53,11 @@ fn quantile(v: &mut [f64], p: f64) -> f64 {
 pub fn errors(truth: &[RunOutput], out: &[RunOutput]) -> Errors {
     let (mut f, mut u, mut w) = (Vec::new(), Vec::new(), Vec::new());
     let (mut differ, mut failed) = (0usize, 0u64);
+    let mut r = Vec::new();
     for (t, o) in truth.iter().zip(out) {
+        if o.status == Status::Ok {
+            r.extend(o.energy.map(|e| e.residual.abs()));
+        }
         if t.status != Status::Ok || o.status != Status::Ok {
             failed += 1;
             continue;
@@ -74,6 +84,8 @@ pub fn errors(truth: &[RunOutput], out: &[RunOutput]) -> Errors {
         energy_p99: quantile(&mut w, 0.99),
         impact_count_differs: differ as f64 / truth.len().max(1) as f64,
         failed,
+        residual_median: quantile(&mut r, 0.5),
+        residual_p99: quantile(&mut r, 0.99),
     }
 }
 
@@ -123,11 +135,19 @@ pub fn study(
     tol: f64,
     mut progress: impl FnMut(&Point),
 ) -> Result<Vec<Point>, GpuError> {
-    let (truth, _) = cpu(plan, &Scheme::Reference(ReferenceOptions::with_tol(tol)));
-    let mut points = Vec::new();
+    let (truth, rps) = cpu(plan, &Scheme::Reference(ReferenceOptions::with_tol(tol)));
+    let reference = Point {
+        path: "reference".into(),
+        substeps_per_contact: f64::NAN,
+        runs_per_second: rps,
+        errors: errors(&truth, &truth),
+    };
+    progress(&reference);
+    let mut points = vec![reference];
     for &spc in settings {
         let fast = FastOptions {
             substeps_per_contact: spc,
+            energy: true,
             ..Default::default()
         };
         let mut runs = vec![("cpu-fast-f64".to_string(), cpu(plan, &Scheme::Fast(fast)))];
@@ -159,8 +179,8 @@ pub fn study(
 }
 
 impl Errors {
-    /// Medians and 99th percentiles: force, displacement, energy.
-    pub fn quantiles(&self) -> [f64; 6] {
+    /// Medians and 99th percentiles: force, displacement, energy, energy residual.
+    pub fn quantiles(&self) -> [f64; 8] {
         [
             self.force_median,
             self.force_p99,
@@ -168,19 +188,25 @@ impl Errors {
             self.displacement_p99,
             self.energy_median,
             self.energy_p99,
+            self.residual_median,
+            self.residual_p99,
         ]
     }
 }
 
 /// The points as CSV.
 pub fn csv(points: &[Point]) -> String {
-    let mut s = String::from("path,substeps_per_contact,runs_per_second,force_median,force_p99,displacement_median,displacement_p99,energy_median,energy_p99,impact_count_differs,failed\n");
+    let mut s = String::from("path,substeps_per_contact,runs_per_second,force_median,force_p99,displacement_median,displacement_p99,energy_median,energy_p99,residual_median,residual_p99,impact_count_differs,failed\n");
     for p in points {
         let q = p.errors.quantiles().map(|x| format!("{x:e}"));
         s.push_str(&format!(
             "{},{},{:.1},{},{},{}\n",
             p.path,
-            p.substeps_per_contact,
+            if p.substeps_per_contact.is_nan() {
+                String::new()
+            } else {
+                p.substeps_per_contact.to_string()
+            },
             p.runs_per_second,
             q.join(","),
             p.errors.impact_count_differs,
@@ -193,7 +219,11 @@ pub fn csv(points: &[Point]) -> String {
 /// Work-precision panels: runs/s against the median and the 99th percentile of the peak-force
 /// error, one line per path through its settings.
 pub fn panels(points: &[Point]) -> Vec<Panel> {
-    let mut paths: Vec<&str> = points.iter().map(|p| p.path.as_str()).collect();
+    let mut paths: Vec<&str> = points
+        .iter()
+        .map(|p| p.path.as_str())
+        .filter(|p| *p != "reference")
+        .collect();
     paths.sort();
     paths.dedup();
     let panel = |title: &str, err: fn(&Errors) -> f64| Panel {
@@ -222,7 +252,7 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
 }
 
 /// A markdown table header for [`markdown_row`].
-pub const MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | peak force median / p99 | peak u median / p99 | energy median / p99 | impact counts differ |\n|---|---:|---:|---|---|---|---:|";
+pub const MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | peak force median / p99 | peak u median / p99 | energy median / p99 | energy residual median / p99 | impact counts differ |\n|---|---:|---:|---|---|---|---|---:|";
 
 /// One point as a markdown table row.
 pub fn markdown_row(p: &Point) -> String {
@@ -230,9 +260,13 @@ pub fn markdown_row(p: &Point) -> String {
     format!(
         "| {} | {} | {:.0} | {} | {:.2} % |",
         p.path,
-        p.substeps_per_contact,
+        if p.substeps_per_contact.is_nan() {
+            "-".to_string()
+        } else {
+            p.substeps_per_contact.to_string()
+        },
         p.runs_per_second,
-        [&q[0..2], &q[2..4], &q[4..6]]
+        [&q[0..2], &q[2..4], &q[4..6], &q[6..8]]
             .map(|pair| pair.join(" / "))
             .join(" | "),
         100.0 * p.errors.impact_count_differs

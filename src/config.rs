@@ -218,6 +218,8 @@ pub struct RawRun {
     /// Stated accuracy of the reference scheme (relative, peak force).
     pub tol: Option<f64>,
     pub tail_s: Option<f64>,
+    /// Report each run's energy balance (fast scheme; the reference always does).
+    pub energy: Option<bool>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -328,6 +330,7 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
                 }
                 o.substeps_per_contact = n;
             }
+            o.energy = raw.run.energy.unwrap_or(false);
             Scheme::Fast(o)
         }
         "reference" => {

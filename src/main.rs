@@ -52,31 +52,38 @@ impl PrecisionArg {
     }
 }
 
+#[derive(clap::Args)]
+struct SweepArgs {
+    config: PathBuf,
+    /// Output CSV (written as OUT.partial, renamed when complete).
+    #[arg(short, long, default_value = "results.csv")]
+    output: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Override the config's integration scheme.
+    #[arg(long, value_enum)]
+    scheme: Option<SchemeArg>,
+    /// Where runs are integrated. The GPU runs the `fast` scheme only.
+    #[arg(long, value_enum, default_value = "auto")]
+    backend: BackendArg,
+    /// GPU arithmetic. f32 (default) adds a peak-force error of at most 6.2e-4 to the fast
+    /// scheme's (measured, README); f64 needs an adapter with SHADER_F64.
+    #[arg(long, value_enum, default_value = "f32")]
+    precision: PrecisionArg,
+    /// Runs per parallel task (CPU, default 64) or per GPU chunk (default 65536).
+    #[arg(long)]
+    chunk: Option<usize>,
+    /// Write each run's energy balance (input, damping work, relative residual); the same
+    /// as `energy = true` under `[run]`. The reference scheme always writes it.
+    #[arg(long)]
+    energy: bool,
+}
+
 #[derive(Subcommand)]
 enum Cmd {
     /// Run every run of a sweep config and write one CSV row per run.
-    Sweep {
-        config: PathBuf,
-        /// Output CSV (written as OUT.partial, renamed when complete).
-        #[arg(short, long, default_value = "results.csv")]
-        output: PathBuf,
-        /// Worker threads (default: all cores).
-        #[arg(long)]
-        threads: Option<usize>,
-        /// Override the config's integration scheme.
-        #[arg(long, value_enum)]
-        scheme: Option<SchemeArg>,
-        /// Where runs are integrated. The GPU runs the `fast` scheme only.
-        #[arg(long, value_enum, default_value = "auto")]
-        backend: BackendArg,
-        /// GPU arithmetic. f32 (default) adds a peak-force error of at most 6.2e-4 to the fast
-        /// scheme's (measured, README); f64 needs an adapter with SHADER_F64.
-        #[arg(long, value_enum, default_value = "f32")]
-        precision: PrecisionArg,
-        /// Runs per parallel task (CPU, default 64) or per GPU chunk (default 65536).
-        #[arg(long)]
-        chunk: Option<usize>,
-    },
+    Sweep(SweepArgs),
     /// GPU adapters.
     Gpu {
         #[command(subcommand)]
@@ -210,23 +217,7 @@ fn main() -> std::process::ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.cmd {
-        Cmd::Sweep {
-            config,
-            output,
-            threads,
-            scheme,
-            backend,
-            precision,
-            chunk,
-        } => sweep(
-            config,
-            output,
-            threads,
-            scheme,
-            backend,
-            precision.get(),
-            chunk,
-        ),
+        Cmd::Sweep(a) => sweep(a),
         Cmd::Gpu { cmd: GpuCmd::Info } => gpu_info(),
         Cmd::Bench {
             sizes,
@@ -277,15 +268,18 @@ fn run(cli: Cli) -> Result<()> {
     }
 }
 
-fn sweep(
-    config: PathBuf,
-    output: PathBuf,
-    threads: Option<usize>,
-    scheme: Option<SchemeArg>,
-    backend: BackendArg,
-    precision: Precision,
-    chunk: Option<usize>,
-) -> Result<()> {
+fn sweep(a: SweepArgs) -> Result<()> {
+    let SweepArgs {
+        config,
+        output,
+        threads,
+        scheme,
+        backend,
+        precision,
+        chunk,
+        energy,
+    } = a;
+    let precision = precision.get();
     let plan = config::load(&config)?;
     let scheme = match scheme {
         None => plan.spec.scheme,
@@ -299,9 +293,13 @@ fn sweep(
         }),
     };
     let fast = match scheme {
-        Scheme::Fast(o) => Some(o),
+        Scheme::Fast(o) => Some(FastOptions {
+            energy: o.energy || energy,
+            ..o
+        }),
         Scheme::Reference(_) => None,
     };
+    let scheme = fast.map_or(scheme, Scheme::Fast);
     if backend == BackendArg::Gpu && fast.is_none() {
         bail!("--backend gpu runs the fast scheme only; use --scheme fast or --backend cpu")
     }

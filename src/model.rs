@@ -142,4 +142,20 @@ pub struct RunOutput {
     /// Integration work beyond the exact free steps: RK4 substeps (fast scheme, both backends)
     /// or trial steps (reference). 0 for a run that never came near contact.
     pub substeps: u64,
+    /// The run's energy balance, where it was asked for (always with the reference scheme).
+    pub energy: Option<EnergyBalance>,
+}
+
+/// Energy balance of a run, J: what the ground put in against what the run holds and spent.
+/// `initial + input = kinetic + strain + damping + contact work`, where the contact work is
+/// [`RunOutput::dissipated_energy`] (plus what a contact still stores at the end).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EnergyBalance {
+    /// `-int ag (m1 v1 + m2 v2) dt`: work of the ground motion on the relative motion.
+    pub input: f64,
+    /// `int (c1 v1^2 + c2 v2^2) dt`: work of the structural dampers.
+    pub damping: f64,
+    /// `(initial + input - kinetic - strain - damping - contact work) / scale`, where the scale
+    /// is the largest `initial + input` reached during the run (0 for a run that never moves).
+    pub residual: f64,
 }

@@ -39,8 +39,15 @@ pub const COLUMNS: [&str; 27] = [
     "contact_time_s",
 ];
 
-/// Output columns after the status (kept in one place for readers of the CSV).
-pub const EXTRA_COLUMNS: [&str; 2] = ["dissipated_energy_j", "substeps"];
+/// Output columns after the status (kept in one place for readers of the CSV). The last three,
+/// the energy balance, are empty unless it was asked for (`run.energy`, `--energy`).
+pub const EXTRA_COLUMNS: [&str; 5] = [
+    "dissipated_energy_j",
+    "substeps",
+    "input_energy_j",
+    "damping_energy_j",
+    "energy_residual",
+];
 
 /// Shortest round-trip text; scientific notation outside [1e-4, 1e15) so tiny values stay short.
 fn num(x: f64) -> String {
@@ -103,6 +110,9 @@ pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
         num(out.contact_time),
         num(out.dissipated_energy),
         out.substeps.to_string(),
+        opt(out.energy.map(|e| e.input)),
+        opt(out.energy.map(|e| e.damping)),
+        opt(out.energy.map(|e| e.residual)),
     ]
 }
 

@@ -29,7 +29,7 @@ use super::{
     Segment, State,
 };
 use crate::model::{Forcing, Initial, Pair, RunOutput, Status};
-use crate::propagator::Propagator;
+use crate::propagator::{EnergyForms, Propagator};
 
 /// Accuracy and safety settings of the fast scheme.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,6 +40,9 @@ pub struct FastOptions {
     pub max_substeps_per_step: u32,
     /// Substep budget of one run (u32 as on the GPU).
     pub max_substeps: u32,
+    /// Integrate the input and damping work over free steps too, and report the energy
+    /// balance ([`crate::model::EnergyBalance`]).
+    pub energy: bool,
 }
 
 /// Accepted pieces one substep may be cut into by events before the run ends with
@@ -52,6 +55,7 @@ impl Default for FastOptions {
             substeps_per_contact: 64.0,
             max_substeps_per_step: 1 << 20,
             max_substeps: 1 << 30,
+            energy: false,
         }
     }
 }
@@ -85,7 +89,14 @@ pub(crate) fn run(
 ) -> RunOutput {
     let dt = forcing.dt;
     let (p1, p2) = (Propagator::new(&pair.b1, dt), Propagator::new(&pair.b2, dt));
+    let forms = o.energy.then(|| {
+        (
+            EnergyForms::new(&pair.b1, dt),
+            EnergyForms::new(&pair.b2, dt),
+        )
+    });
     let mut run = Integration::start(pair, init, forcing.t0, observer);
+    run.energy = o.energy;
     let mut substeps: u32 = 0;
     for i in 0..forcing.intervals() {
         let seg = Segment::of(forcing, i);
@@ -93,8 +104,14 @@ pub(crate) fn run(
         let (v_est, d_est, a_est) = if run.mode == Mode::Free {
             let (u1, v1) = p1.step(z[0], z[1], seg.a0, seg.a1);
             let (u2, v2) = p2.step(z[2], z[3], seg.a0, seg.a1);
-            let z1 = [u1, v1, u2, v2, z[4]];
+            let mut z1 = [u1, v1, u2, v2, z[4], z[5], z[6]];
             if !may_touch(pair, &seg, &z, &z1, dt, run.tr.v0) {
+                if let Some((f1, f2)) = &forms {
+                    let (vv1, agv1) = f1.integrals(z[0], z[1], seg.a0, seg.a1);
+                    let (vv2, agv2) = f2.integrals(z[2], z[3], seg.a0, seg.a1);
+                    z1[5] -= pair.b1.m * agv1 + pair.b2.m * agv2;
+                    z1[6] += pair.b1.c * vv1 + pair.b2.c * vv2;
+                }
                 run.free_step(&seg, z1);
                 if !finite(&run.z) {
                     return run.finish(Status::NonFinite, substeps as u64);

@@ -19,10 +19,13 @@ pub use fast::FastOptions;
 pub use reference::ReferenceOptions;
 
 use crate::contact::Contact;
-use crate::model::{Forcing, Initial, Oscillator, Pair, RunOutput, Status};
+use crate::model::{EnergyBalance, Forcing, Initial, Oscillator, Pair, RunOutput, Status};
 
-/// `[u1, v1, u2, v2, w]`
-pub type State = [f64; 5];
+/// `[u1, v1, u2, v2, w, e_in, e_damp]`: displacements and velocities, then the contact work
+/// `w' = F delta'`, the input work `e_in' = -ag (m1 v1 + m2 v2)` and the structural damping work
+/// `e_damp' = c1 v1^2 + c2 v2^2`. The last two ride along for the energy balance; error control
+/// and events look only at the first five.
+pub type State = [f64; 7];
 
 /// Contact mode; changes only at located events.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -134,7 +137,7 @@ pub fn single_collision_observed(
         contact_steps,
         max_steps: 50_000_000,
     };
-    let mut last = [0.0; 5];
+    let mut last = [0.0; 7];
     let mut obs = |s: &Sample| {
         last = s.z;
         observer(s);
@@ -206,7 +209,9 @@ pub(crate) fn force(p: &Pair, mode: Mode, v0: f64, z: &State) -> f64 {
     }
 }
 
-#[inline]
+// Always inlined: with the energy terms it grew past the inliner's threshold, and the call
+// cost 25 % of the CPU fast path's runs/s.
+#[inline(always)]
 pub(crate) fn rhs(p: &Pair, mode: Mode, v0: f64, ag: f64, z: &State) -> State {
     let f = force(p, mode, v0, z);
     let (b1, b2) = (&p.b1, &p.b2);
@@ -216,6 +221,8 @@ pub(crate) fn rhs(p: &Pair, mode: Mode, v0: f64, ag: f64, z: &State) -> State {
         z[3],
         (-b2.c * z[3] - b2.k * z[2] + f) / b2.m - ag,
         f * ddelta(z),
+        -ag * (b1.m * z[1] + b2.m * z[3]),
+        b1.c * z[1] * z[1] + b2.c * z[3] * z[3],
     ]
 }
 
@@ -446,6 +453,10 @@ pub(crate) struct Tracker {
     /// Approach speed of the current impact.
     pub v0: f64,
     imp_peak: f64,
+    /// Kinetic plus strain energy at the start, and the largest `initial + input` so far (the
+    /// energy balance's scale).
+    e_initial: f64,
+    e_peak: f64,
     /// Onset time of the current impact; force-sample times are kept relative to it, as the
     /// shader does (so f32 times keep their resolution late in a record).
     t_onset: f64,
@@ -460,6 +471,8 @@ impl Tracker {
             out: RunOutput::default(),
             v0: 0.0,
             imp_peak: 0.0,
+            e_initial: 0.0,
+            e_peak: 0.0,
             t_onset: 0.0,
             hist: [(0.0, 0.0); 2],
             nhist: 0,
@@ -489,6 +502,7 @@ impl Tracker {
         ];
         let pk = quintic_peak_abs([z0[2], z1[2]], [z0[3], z1[3]], a2, seg.dt);
         o.peak_u2 = o.peak_u2.max(pk);
+        self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
     }
 
     /// Account for a step `t0 -> t0 + h` spent in `mode`, from `z0` to `z1`.
@@ -498,6 +512,7 @@ impl Tracker {
         o.peak_u1 = o.peak_u1.max(hi.abs()).max(lo.abs());
         let (lo, hi) = hermite_range(z0[2], z0[3], z1[2], z1[3], h);
         o.peak_u2 = o.peak_u2.max(hi.abs()).max(lo.abs());
+        self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
         if mode != Mode::Free {
             o.contact_time += h;
             let (_, dmax) = hermite_range(delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1), h);
@@ -559,6 +574,24 @@ impl Tracker {
         self.out.status = status;
         self.out
     }
+
+    /// The energy balance at state `z`.
+    pub fn energy(&self, p: &Pair, z: &State) -> EnergyBalance {
+        let held = mechanical_energy(p, z);
+        let scale = self.e_peak.max(self.e_initial);
+        let r = self.e_initial + z[5] - held - z[6] - z[4];
+        EnergyBalance {
+            input: z[5],
+            damping: z[6],
+            residual: if scale > 0.0 { r / scale } else { 0.0 },
+        }
+    }
+}
+
+/// Kinetic plus strain energy of both buildings, J.
+pub(crate) fn mechanical_energy(p: &Pair, z: &State) -> f64 {
+    let (b1, b2) = (&p.b1, &p.b2);
+    0.5 * (b1.m * z[1] * z[1] + b1.k * z[0] * z[0] + b2.m * z[3] * z[3] + b2.k * z[2] * z[2])
 }
 
 /// The state of one run being integrated, shared by both schemes: they decide step lengths and
@@ -568,6 +601,8 @@ pub(crate) struct Integration<'a, 'o> {
     pub z: State,
     pub mode: Mode,
     pub tr: Tracker,
+    /// Report the energy balance (its integrals are complete).
+    pub energy: bool,
     observer: Option<&'o mut dyn FnMut(&Sample)>,
 }
 
@@ -579,14 +614,16 @@ impl<'a, 'o> Integration<'a, 'o> {
         t0: f64,
         observer: Option<&'o mut dyn FnMut(&Sample)>,
     ) -> Self {
-        let z = [init.u1, init.v1, init.u2, init.v2, 0.0];
+        let z = [init.u1, init.v1, init.u2, init.v2, 0.0, 0.0, 0.0];
         let mut run = Integration {
             pair,
             z,
             mode: Mode::Free,
             tr: Tracker::new(),
+            energy: true,
             observer,
         };
+        run.tr.e_initial = mechanical_energy(pair, &z);
         if event_value(pair, run.mode, 0.0, &z) > 0.0 {
             run.mode = transition(pair, run.mode, t0, &z, &z, &mut run.tr);
         }
@@ -660,8 +697,10 @@ impl<'a, 'o> Integration<'a, 'o> {
 
     /// End the run with `status`, after `substeps` steps of integration work.
     pub fn finish(self, status: Status, substeps: u64) -> RunOutput {
+        let energy = self.energy.then(|| self.tr.energy(self.pair, &self.z));
         let mut out = self.tr.finish(self.mode, status);
         out.substeps = substeps;
+        out.energy = energy;
         out
     }
 }

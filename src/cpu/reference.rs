@@ -128,6 +128,7 @@ pub(crate) fn dopri(
     let atol = rtol * 1e-6;
     let mut err: f64 = 0.0;
     let mut ev = [0.0; 5];
+    // The energy integrals (z[5], z[6]) follow from the others; they are not error-controlled.
     for i in 0..5 {
         ev[i] = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
         let mut sc = z[i].abs().max(y[i].abs());

@@ -207,6 +207,7 @@ impl GpuContext {
                 entry(6, storage(false)),
                 entry(7, storage(true)),
                 entry(8, storage(false)),
+                entry(9, storage(true)),
             ],
         });
         let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

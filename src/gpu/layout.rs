@@ -101,6 +101,9 @@ real_structs! {
         first_impact,
         contact_time,
         dissipated,
+        /// Input and structural damping work so far, and the largest input reached, J (the
+        /// energy balance: `cpu::State` and `Tracker`).
+        e_in, e_damp, e_peak,
     }
 }
 
@@ -158,7 +161,8 @@ pub struct Dispatch {
     pub max_substeps: u32,
     /// A record step needing more substeps ends the run with `STATUS_HANDOFF`.
     pub handoff_substeps_per_step: u32,
-    pub _pad1: u32,
+    /// 1: add the free steps' input and damping work from the `forms` buffer.
+    pub energy: u32,
     pub _pad2: u32,
     pub _pad3: u32,
 }
@@ -213,7 +217,7 @@ impl Layout for Dispatch {
                 "handoff_substeps_per_step",
                 offset_of!(Dispatch, handoff_substeps_per_step),
             ),
-            ("_pad1", offset_of!(Dispatch, _pad1)),
+            ("energy", offset_of!(Dispatch, energy)),
             ("_pad2", offset_of!(Dispatch, _pad2)),
             ("_pad3", offset_of!(Dispatch, _pad3)),
         ]
@@ -230,6 +234,23 @@ pub const STATUS_STEP_LIMIT: u32 = 2;
 /// The run needs more substeps per record step than the kernel's precision resolves; the host
 /// finishes it on the CPU.
 pub const STATUS_HANDOFF: u32 = 3;
+
+/// Reals per run in the `forms` buffer: the exact free-step energy integrals
+/// (`propagator::EnergyForms`) of building 1 (`vv`, then `agv`), then building 2. The shader's
+/// `FORMS` constant comes from here (see `shader::fast_source`).
+pub const FORMS_PER_RUN: usize = 40;
+
+/// A run's `forms` entries.
+pub fn forms(
+    f1: &crate::propagator::EnergyForms,
+    f2: &crate::propagator::EnergyForms,
+) -> [f64; FORMS_PER_RUN] {
+    let mut out = [0.0; FORMS_PER_RUN];
+    for (k, c) in [f1.vv, f1.agv, f2.vv, f2.agv].iter().enumerate() {
+        out[10 * k..10 * k + 10].copy_from_slice(c);
+    }
+    out
+}
 
 /// Workgroups for `n` runs.
 pub fn workgroups(n: u32) -> u32 {

@@ -9,8 +9,8 @@ use super::layout::{
 use super::shader::Precision;
 use crate::contact::LawKind;
 use crate::cpu::FastOptions;
-use crate::model::{Forcing, Pair, RunOutput, Status};
-use crate::propagator::Propagator;
+use crate::model::{EnergyBalance, Forcing, Pair, RunOutput, Status};
+use crate::propagator::{EnergyForms, Propagator};
 use std::time::{Duration, Instant};
 
 /// Settings of the GPU path.
@@ -111,6 +111,15 @@ fn law_code(l: LawKind) -> u32 {
     LawKind::ALL.iter().position(|&k| k == l).unwrap() as u32
 }
 
+/// One run, packed for the kernel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Packed {
+    pub params: Params64,
+    pub meta: Meta,
+    /// The free-step energy integrals, when the energy balance is asked for.
+    pub forms: Option<[f64; layout::FORMS_PER_RUN]>,
+}
+
 /// Pack one run: `record` is the index of its record in the [`GpuRecords`] it will run with.
 pub fn pack(
     pair: &Pair,
@@ -118,7 +127,7 @@ pub fn pack(
     record: usize,
     recs: &GpuRecords,
     fast: &FastOptions,
-) -> (Params64, Meta) {
+) -> Packed {
     let (p1, p2) = (
         Propagator::new(&pair.b1, forcing.dt),
         Propagator::new(&pair.b2, forcing.dt),
@@ -165,12 +174,22 @@ pub fn pack(
         rec_len: recs.lens[record],
         intervals: forcing.intervals() as u32,
     };
-    (params, meta)
+    let forms = fast.energy.then(|| {
+        layout::forms(
+            &EnergyForms::new(&pair.b1, forcing.dt),
+            &EnergyForms::new(&pair.b2, forcing.dt),
+        )
+    });
+    Packed {
+        params,
+        meta,
+        forms,
+    }
 }
 
-/// A run's results from its final state (what `Tracker::finish` does on the CPU); None for a
-/// run handed back to the host (`STATUS_HANDOFF`).
-pub fn output(s: &State64, c: &Counters) -> Option<RunOutput> {
+/// A run's results from its final state (what `Tracker::finish` and `Tracker::energy` do on
+/// the CPU; GPU runs start at rest); None for a run handed back to the host (`STATUS_HANDOFF`).
+pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<RunOutput> {
     if c.status == STATUS_HANDOFF {
         return None;
     }
@@ -195,6 +214,19 @@ pub fn output(s: &State64, c: &Counters) -> Option<RunOutput> {
         contact_time: s.contact_time,
         dissipated_energy: s.dissipated,
         substeps: c.substeps as u64,
+        energy: energy.then(|| {
+            let held = 0.5
+                * (p.m1 * s.v1 * s.v1
+                    + p.k1 * s.u1 * s.u1
+                    + p.m2 * s.v2 * s.v2
+                    + p.k2 * s.u2 * s.u2);
+            let r = s.e_in - held - s.e_damp - s.w;
+            EnergyBalance {
+                input: s.e_in,
+                damping: s.e_damp,
+                residual: if s.e_peak > 0.0 { r / s.e_peak } else { 0.0 },
+            }
+        }),
     })
 }
 
@@ -280,7 +312,7 @@ fn read(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
 pub fn run_chunk(
     ctx: &GpuContext,
     recs: &GpuRecords,
-    runs: &[(Params64, Meta)],
+    runs: &[Packed],
     opts: &GpuOptions,
 ) -> Result<(Vec<Option<RunOutput>>, ChunkTimes), GpuError> {
     let mut times = ChunkTimes::default();
@@ -293,14 +325,30 @@ pub fn run_chunk(
     let params: Vec<u8> = match opts.precision {
         Precision::F64 => runs
             .iter()
-            .flat_map(|(p, _)| bytemuck::bytes_of(p).to_vec())
+            .flat_map(|r| bytemuck::bytes_of(&r.params).to_vec())
             .collect(),
         Precision::F32 => runs
             .iter()
-            .flat_map(|(p, _)| bytemuck::bytes_of(&Params32::from_f64(p)).to_vec())
+            .flat_map(|r| bytemuck::bytes_of(&Params32::from_f64(&r.params)).to_vec())
             .collect(),
     };
-    let metas: Vec<Meta> = runs.iter().map(|(_, m)| *m).collect();
+    let metas: Vec<Meta> = runs.iter().map(|r| r.meta).collect();
+    let energy = opts.fast.energy;
+    let forms: Vec<f64> = if energy {
+        runs.iter()
+            .flat_map(|r| r.forms.expect("packed with the energy forms"))
+            .collect()
+    } else {
+        vec![0.0]
+    };
+    let forms = match opts.precision {
+        Precision::F64 => bytemuck::cast_slice(&forms).to_vec(),
+        Precision::F32 => {
+            let v: Vec<f32> = forms.iter().map(|&x| x as f32).collect();
+            bytemuck::cast_slice(&v).to_vec()
+        }
+    };
+    let forms = storage(ctx, "energy forms", &forms, wgpu::BufferUsages::empty())?;
     let states = vec![0u8; n * layout::state_bytes(opts.precision)];
     let counters = vec![Counters::default(); n];
     let params = storage(ctx, "params", &params, wgpu::BufferUsages::empty())?;
@@ -357,6 +405,7 @@ pub fn run_chunk(
             &active,
             from,
             to,
+            &forms,
         ];
         let entries: Vec<wgpu::BindGroupEntry> = buffers
             .iter()
@@ -390,6 +439,7 @@ pub fn run_chunk(
         max_substeps_per_step: opts.fast.max_substeps_per_step,
         max_substeps: opts.fast.max_substeps,
         handoff_substeps_per_step: opts.handoff(),
+        energy: energy as u32,
         ..Default::default()
     };
     let active_staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -432,13 +482,18 @@ pub fn run_chunk(
     let out: Vec<Option<RunOutput>> = match opts.precision {
         Precision::F64 => {
             let ss: &[State64] = bytemuck::cast_slice(&sbytes);
-            ss.iter().zip(cs).map(|(s, c)| output(s, c)).collect()
+            ss.iter()
+                .zip(cs)
+                .zip(runs)
+                .map(|((s, c), r)| output(s, c, &r.params, energy))
+                .collect()
         }
         Precision::F32 => {
             let ss: &[State32] = bytemuck::cast_slice(&sbytes);
             ss.iter()
                 .zip(cs)
-                .map(|(s, c)| output(&s.to_f64(), c))
+                .zip(runs)
+                .map(|((s, c), r)| output(&s.to_f64(), c, &r.params, energy))
                 .collect()
         }
     };

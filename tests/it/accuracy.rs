@@ -10,7 +10,12 @@ fn errors_fall_with_more_substeps_on_every_path() {
     let plan = pounding::bench::plan(60);
     let points = study(&plan, ctx(), &[8.0, 64.0], 1e-8, |_| {}).unwrap();
     let paths = if ctx().is_some() { 3 } else { 1 };
-    assert_eq!(points.len(), 2 * paths);
+    assert_eq!(points.len(), 1 + 2 * paths);
+    assert_eq!(points[0].path, "reference");
+    // Its own truth; a residual at its tolerance.
+    assert_eq!(points[0].errors.force_p99, 0.0);
+    assert!(points[0].errors.residual_p99 < 1e-8, "{:?}", points[0]);
+    let points = &points[1..];
     for p in &points[..paths] {
         let fine = points[paths..].iter().find(|q| q.path == p.path).unwrap();
         assert!(p.runs_per_second > 0.0 && fine.runs_per_second > 0.0);
@@ -32,11 +37,22 @@ fn errors_fall_with_more_substeps_on_every_path() {
             fine.errors
         );
         assert_eq!(fine.errors.failed, 0);
+        // The energy residual, the check without a reference, falls with the error (f32
+        // rounding puts a floor under it).
+        let floor = if p.path == "gpu-f32" { 1e-4 } else { 0.0 };
+        assert!(
+            fine.errors.residual_median * 4.0 < p.errors.residual_median.max(floor)
+                && fine.errors.residual_p99 < 1e-4,
+            "{}: {:?} then {:?}",
+            p.path,
+            p.errors,
+            fine.errors
+        );
     }
     let d = tempdir();
     let svg = d.path().join("a.svg");
-    pounding::plot::svg(&svg, &panels(&points), 2).unwrap();
+    pounding::plot::svg(&svg, &panels(points), 2).unwrap();
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("\ncpu-fast-f64\n") && text.contains("\n99th percentile error\n"));
-    assert_eq!(csv(&points).lines().count(), 1 + points.len());
+    assert_eq!(csv(points).lines().count(), 1 + points.len());
 }

@@ -106,6 +106,32 @@ fn sweep_writes_complete_csv_atomically() {
         let law = &r[col("law")];
         assert_eq!(r[col("formula")].is_empty(), law == "linear");
         assert_eq!(r[col("beta_n_per_m1_5")].is_empty(), law == "linear");
+        assert_eq!(
+            &r[col("energy_residual")],
+            "",
+            "asked for with --energy only"
+        );
+    }
+    // --energy adds the balance and changes nothing else.
+    let out3 = d.path().join("three.csv");
+    ok(&pound(&[
+        "sweep",
+        cfg.to_str().unwrap(),
+        "-o",
+        out3.to_str().unwrap(),
+        "--energy",
+    ]));
+    let c = std::fs::read_to_string(&out3).unwrap();
+    let mut rdr = csv::Reader::from_reader(c.as_bytes());
+    let n = col("input_energy_j");
+    for (r, plain) in rdr.records().map(|r| r.unwrap()).zip(&rows) {
+        assert_eq!(
+            r.iter().take(n).collect::<Vec<_>>(),
+            plain.iter().take(n).collect::<Vec<_>>()
+        );
+        let field = |name: &str| -> f64 { r[col(name)].parse().unwrap() };
+        assert!(field("input_energy_j") > 0.0 && field("damping_energy_j") > 0.0);
+        assert!(field("energy_residual").abs() < 1e-4, "{r:?}");
     }
 }
 
@@ -215,8 +241,10 @@ fn accuracy_writes_table_csv_and_plot() {
         2,
         "{out}"
     );
+    assert!(out.contains("\n| reference | - |"), "{out}");
     let text = std::fs::read_to_string(&csv).unwrap();
-    assert_eq!(text.lines().count(), 3, "{text}");
+    // Header, the reference, two settings.
+    assert_eq!(text.lines().count(), 4, "{text}");
     assert!(std::fs::read_to_string(&svg)
         .unwrap()
         .contains("\nmedian error\n"));

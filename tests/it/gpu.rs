@@ -126,6 +126,14 @@ window_s = [5.0, 11.0]
 pga_g = 0.5
 "#;
 
+/// The wide grid's settings: the defaults, with the energy balance.
+const WIDE_FAST: FastOptions = FastOptions {
+    substeps_per_contact: 64.0,
+    max_substeps_per_step: 1 << 20,
+    max_substeps: 1 << 30,
+    energy: true,
+};
+
 fn wide() -> &'static (Plan, Vec<(RunSpec, RunOutput)>) {
     static WIDE_CPU: OnceLock<(Plan, Vec<(RunSpec, RunOutput)>)> = OnceLock::new();
     WIDE_CPU.get_or_init(|| {
@@ -136,7 +144,7 @@ fn wide() -> &'static (Plan, Vec<(RunSpec, RunOutput)>) {
             &crate::support::records_dir(),
         )
         .unwrap();
-        let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
+        let cpu = collect(&plan, &Scheme::Fast(WIDE_FAST), 8);
         (plan, cpu)
     })
 }
@@ -169,16 +177,25 @@ fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
     let (plan, cpu) = wide();
     let opts = GpuOptions {
         precision: pounding::gpu::Precision::F64,
+        fast: WIDE_FAST,
         ..Default::default()
     };
     let gpu = gpu_collect(plan, &opts, 100_000);
     assert_eq!(cpu.len(), gpu.len());
     let mut worst = std::collections::BTreeMap::new();
+    let mut worst_residual = 0.0f64;
     let mut all = Vec::new();
     for ((s, c), (_, g)) in cpu.iter().zip(&gpu) {
         assert_eq!(c.status, g.status, "run {}", s.index);
         assert_eq!(c.impacts, g.impacts, "run {}", s.index);
         assert_eq!(c.peak_force == 0.0, g.peak_force == 0.0, "run {}", s.index);
+        let (rg, rc) = (g.energy.unwrap().residual, c.energy.unwrap().residual);
+        worst_residual = worst_residual.max((rg - rc).abs());
+        assert!(
+            (rg - rc).abs() < 1e-8,
+            "run {}: energy residual {rg:e} on the GPU, {rc:e} on the CPU",
+            s.index
+        );
         let e = peak_diff(g, c);
         let w = worst.entry(s.law.key()).or_insert(0.0f64);
         *w = w.max(e);
@@ -197,7 +214,7 @@ fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
     }
     all.sort_by(f64::total_cmp);
     eprintln!(
-        "f64 GPU vs CPU on {} runs: median {:e}; max by law {worst:?}",
+        "f64 GPU vs CPU on {} runs: median {:e}; max by law {worst:?}; energy residuals differ by at most {worst_residual:e}",
         all.len(),
         all[all.len() / 2]
     );
@@ -215,12 +232,18 @@ fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
 fn gpu_f32_error_against_cpu_f64() {
     let Some(_) = ctx() else { return };
     let (plan, cpu) = wide();
-    let gpu = gpu_collect(plan, &GpuOptions::default(), 100_000);
+    let opts = GpuOptions {
+        fast: WIDE_FAST,
+        ..Default::default()
+    };
+    let gpu = gpu_collect(plan, &opts, 100_000);
     let mut f: Vec<f64> = Vec::new();
     let mut u: Vec<f64> = Vec::new();
     let mut imp_diff = 0;
+    let mut residual = 0.0f64;
     for ((s, c), (_, g)) in cpu.iter().zip(&gpu) {
         assert_eq!(c.status, g.status, "run {}", s.index);
+        residual = residual.max(g.energy.unwrap().residual.abs());
         if c.impacts != g.impacts {
             imp_diff += 1;
             continue;
@@ -234,9 +257,10 @@ fn gpu_f32_error_against_cpu_f64() {
     u.sort_by(f64::total_cmp);
     let q = |v: &[f64], p: f64| v[((v.len() - 1) as f64 * p) as usize];
     eprintln!(
-        "f32: peak force median {:e} p99 {:e} max {:e}; peak u median {:e} max {:e}; impact counts differ on {imp_diff}/{}",
+        "f32: peak force median {:e} p99 {:e} max {:e}; peak u median {:e} max {:e}; impact counts differ on {imp_diff}/{}; energy residual max {residual:e}",
         q(&f, 0.5), q(&f, 0.99), q(&f, 1.0), q(&u, 0.5), q(&u, 1.0), cpu.len()
     );
+    assert!(residual < 5e-4, "energy residual {residual:e}");
     assert!(
         q(&f, 1.0) < 2e-3 && q(&f, 0.99) < 5e-4 && q(&f, 0.5) < 1e-5,
         "peak force median {:e} p99 {:e} max {:e}",
@@ -255,7 +279,7 @@ fn gpu_f32_error_against_cpu_f64() {
 pub fn grazing_contacts(plan: &Plan, spec: &RunSpec, tau: f64) -> usize {
     use pounding::cpu::{simulate_observed, Mode, Sample};
     let pair = spec.pair();
-    let delta = |z: &[f64; 5]| z[0] - z[2] - pair.gap;
+    let delta = |z: &pounding::cpu::State| z[0] - z[2] - pair.gap;
     let mut prev: Option<Sample> = None;
     let (mut count, mut impacts, mut pen) = (0usize, 0u32, 0.0f64);
     // Most open and closest distances of the current free episode; a local max of delta.

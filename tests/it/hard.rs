@@ -170,13 +170,18 @@ fn run_case(dir: &Path, case: &Case) -> String {
     let text = config(&case.edits);
     let plan = pounding::config::parse(&text, Path::new("hard.toml"), dir, &records_dir())
         .unwrap_or_else(|e| panic!("{}: {e}", case.name));
-    let fast = collect(&plan, &Scheme::Fast(FastOptions::default()), 4);
+    let fast_opts = FastOptions {
+        energy: true,
+        ..Default::default()
+    };
+    let fast = collect(&plan, &Scheme::Fast(fast_opts), 4);
     let refr = collect(
         &plan,
         &Scheme::Reference(ReferenceOptions::with_tol(1e-7)),
         4,
     );
     let mut worst = (0.0f64, 0.0f64, 0usize);
+    let mut resid = (0.0f64, 0.0f64);
     for ((s, f), (_, r)) in fast.iter().zip(&refr) {
         let what = format!(
             "{} run {} ({} {:?} gap {})",
@@ -185,6 +190,12 @@ fn run_case(dir: &Path, case: &Case) -> String {
             s.law.key(),
             s.formula,
             s.gap
+        );
+        let (ef_res, er_res) = (residual(f), residual(r));
+        resid = (resid.0.max(ef_res), resid.1.max(er_res));
+        assert!(
+            ef_res < ENERGY_RESIDUAL_FAST && er_res < ENERGY_RESIDUAL_REFERENCE,
+            "{what}: energy residual {ef_res:e} fast, {er_res:e} reference"
         );
         if !comparable(&plan, s, &what, f, r) {
             worst.2 += 1;
@@ -206,15 +217,17 @@ fn run_case(dir: &Path, case: &Case) -> String {
             r.peak_force
         );
     }
-    let mut line = format!("{}: {} runs; fast vs reference: peak force max {:.1e}, peak u max {:.1e}, {} grazing count differences", case.name, plan.len(), worst.0, worst.1, worst.2);
+    let mut line = format!("{}: {} runs; fast vs reference: peak force max {:.1e}, peak u max {:.1e}, {} grazing count differences; energy residual max {:.1e} fast, {:.1e} reference", case.name, plan.len(), worst.0, worst.1, worst.2, resid.0, resid.1);
     if ctx().is_some() {
         for precision in [Precision::F64, Precision::F32] {
             let opts = GpuOptions {
                 precision,
+                fast: fast_opts,
                 ..Default::default()
             };
             let gpu = gpu_collect(&plan, &opts, 100_000);
             let mut w = 0.0f64;
+            let mut wr = 0.0f64;
             for ((s, c), (_, g)) in fast.iter().zip(&gpu) {
                 let what = format!(
                     "{} run {} ({} {:?} gap {}) on the GPU in {}",
@@ -225,6 +238,13 @@ fn run_case(dir: &Path, case: &Case) -> String {
                     s.gap,
                     precision.key()
                 );
+                let r = residual(g);
+                wr = wr.max(r);
+                let bound = match precision {
+                    Precision::F64 => ENERGY_RESIDUAL_FAST,
+                    Precision::F32 => ENERGY_RESIDUAL_F32,
+                };
+                assert!(r < bound, "{what}: energy residual {r:e}");
                 if !comparable(&plan, s, &what, g, c) {
                     continue;
                 }
@@ -241,7 +261,12 @@ fn run_case(dir: &Path, case: &Case) -> String {
                 };
                 assert!(d <= bound, "{what}: GPU-CPU difference {d:e}");
             }
-            line.push_str(&format!("; GPU {} vs CPU max {:.1e}", precision.key(), w));
+            line.push_str(&format!(
+                "; GPU {} vs CPU max {:.1e}, energy residual max {:.1e}",
+                precision.key(),
+                w,
+                wr
+            ));
         }
     }
     line.push_str(&format!(" ({:.1} s)", start.elapsed().as_secs_f64()));
@@ -273,6 +298,16 @@ fn comparable(
     false
 }
 
+/// Bounds on `|energy residual|` (`model::EnergyBalance`), about 3x the measured maxima (see
+/// the test's docs).
+const ENERGY_RESIDUAL_FAST: f64 = 2e-6;
+const ENERGY_RESIDUAL_REFERENCE: f64 = 1e-8;
+const ENERGY_RESIDUAL_F32: f64 = 5e-4;
+
+fn residual(o: &RunOutput) -> f64 {
+    o.energy.expect("energy balance asked for").residual.abs()
+}
+
 fn sane(what: &str, o: &RunOutput) {
     assert_eq!(o.status, Status::Ok, "{what}: {o:?}");
     for x in [
@@ -295,6 +330,8 @@ fn sane(what: &str, o: &RunOutput) {
 /// `gpu_f64_matches_cpu_fast_on_a_wide_grid`), other laws within 1e-9 + 1e-14 per substep; GPU
 /// f32 max 3.9e-4 (e = 0.05). Bounds: fast 3e-3 (7x), f32 2e-3 (5x). f32 handles the 1e12
 /// stiffnesses (max 7.8e-5); runs past its reach (Barros' zeta = 508) go to the CPU.
+/// Energy balance residual (every run): fast max 5.5e-7 (very soft contact; GPU f64 the same),
+/// reference max 2.9e-9 (periods 0.02 and 5 s), GPU f32 max 1.8e-4 (e = 0.05).
 #[test]
 fn hard_cases_are_stable_and_converged_on_every_path() {
     let dir = tempdir();

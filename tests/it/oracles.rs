@@ -116,6 +116,67 @@ fn harmonic_response_matches_closed_form() {
     }
 }
 
+/// Energy balance under a constant ground acceleration `a` from rest: the input work is
+/// `-a sum m_i int v_i dt = -a (m1 u1(T) + m2 u2(T))` whatever the damping, and the damping work
+/// is what the input leaves after the kinetic and strain energy. Apart and pounding (the balance
+/// then also holds the contact work). The fast scheme's free steps are exact, so apart its
+/// residual is rounding.
+#[test]
+fn energy_balance_under_constant_ground_acceleration() {
+    let a = 1.5;
+    let accel = vec![a; 801];
+    let forcing = Forcing {
+        accel: &accel,
+        dt: 0.01,
+        t0: 0.0,
+        scale: 1.0,
+        tail: 0.0,
+    };
+    let fast = Scheme::Fast(FastOptions {
+        energy: true,
+        ..Default::default()
+    });
+    let schemes = [fast, Scheme::Reference(ReferenceOptions::default())];
+    // Apart; then touching: building 1 (stiffer, heavier) rests against building 2.
+    let touching = pair(
+        LawKind::KelvinVoigt,
+        1e8,
+        0.3,
+        (1e5, 0.3, 0.05),
+        (2e5, 1.1, 0.02),
+        0.0,
+    );
+    for (p, bound) in [(apart(0.7, 0.05, 1.3, 0.02), 1e-12), (touching, 1e-6)] {
+        for scheme in &schemes {
+            let bound = match scheme {
+                Scheme::Fast(_) => bound,
+                Scheme::Reference(_) => 1e-8,
+            };
+            let mut last = None;
+            let mut obs = |s: &Sample| last = Some(s.z);
+            let out = simulate_observed(&p, &forcing, &Initial::default(), scheme, Some(&mut obs));
+            let z = last.unwrap();
+            let e = out.energy.expect("energy asked for");
+            let input = -a * (p.b1.m * z[0] + p.b2.m * z[2]);
+            let held = 0.5
+                * (p.b1.m * z[1] * z[1]
+                    + p.b1.k * z[0] * z[0]
+                    + p.b2.m * z[3] * z[3]
+                    + p.b2.k * z[2] * z[2]);
+            let what = format!("{} gap {}", scheme.key(), p.gap);
+            assert!(rel(e.input, input) < 1e-9, "{what}: {} vs {input}", e.input);
+            let damping = input - held - out.dissipated_energy;
+            assert!(
+                (e.damping - damping).abs() < 1e-8 * input,
+                "{what}: {} vs {damping}",
+                e.damping
+            );
+            assert!(e.damping > 0.0 && e.residual.abs() < bound, "{what}: {e:?}");
+            assert_eq!(out.impacts > 0, p.gap == 0.0, "{what}");
+        }
+    }
+}
+
 /// With a gap just above the largest free relative displacement there is no contact and each
 /// building's response equals its uncoupled response; just below it, they pound.
 #[test]
