@@ -91,10 +91,11 @@ const STATUS_OK: u32 = 0u;
 const STATUS_NON_FINITE: u32 = 1u;
 const STATUS_STEP_LIMIT: u32 = 2u;
 const STATUS_HANDOFF: u32 = 3u;
-// contact::HC_V0_MIN, contact::HERTZ floor on v, fast::MAX_PIECES_PER_SUBSTEP.
+// contact::HC_V0_MIN, contact::HERTZ floor on v, fast::MAX_PIECES_PER_SUBSTEP, fast::SUSTAINED.
 const HC_V0_MIN: real = 1e-3;
 const V_MIN: real = 1e-6;
 const MAX_PIECES_PER_SUBSTEP: u32 = 64u;
+const SUSTAINED: real = 2.0;
 const LOCATE_TOL: real = 1e-9;
 const LOCATE_ITER: u32 = 16u;
 
@@ -705,7 +706,11 @@ fn begin_interval(seg: Seg) {
     if (substep) {
         // Resolve an impact at v_est, and stay stable at twice the current penetration.
         let h_rate = 6.283185307179586 / P.substeps_per_contact / local_rate(2.0 * d_est, S.v0);
-        let h0 = min(impact_step(v_est, a_est), h_rate);
+        // fast.rs: a contact that has lasted SUSTAINED contact durations needs only h_rate.
+        var h0 = h_rate;
+        if (!(C.mode != MODE_FREE && since_onset(0.0) > SUSTAINED * duration_estimate(S.v0))) {
+            h0 = min(impact_step(v_est, a_est), h_rate);
+        }
         let mf = max(ceil(dt / h0), 1.0);
         if (!(mf <= real(disp.max_substeps_per_step))) {
             C.status = STATUS_STEP_LIMIT;

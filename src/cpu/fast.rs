@@ -11,10 +11,11 @@
 //!    shorter of the free-collision duration at the approach speed, estimated from the step's end
 //!    velocities or the current impact's `v0`, and the time the structures take to reverse the
 //!    relative motion), and keeps RK4 stable at the current penetration
-//!    ([`crate::contact::Contact::local_rate`]). Inside a substep, the instants of first touch,
-//!    of the turn `delta' = 0` and of separation are located by regula falsi on re-taken partial
-//!    RK4 steps, so no substep integrates across a kink of the force; the substep grid stays
-//!    aligned with the record step.
+//!    ([`crate::contact::Contact::local_rate`]). A contact that has lasted [`SUSTAINED`] contact
+//!    durations is no longer an impact to resolve: only the local-rate bound applies. Inside a
+//!    substep, the instants of first touch, of the turn `delta' = 0` and of separation are
+//!    located by regula falsi on re-taken partial RK4 steps, so no substep integrates across a
+//!    kink of the force; the substep grid stays aligned with the record step.
 //! 4. The peak force of each impact is the largest force sample, refined by the vertex of the
 //!    parabola through the three samples around a local maximum; the peak penetration and the
 //!    peak displacements are maxima of the Hermite cubics of each step, except over free record
@@ -44,6 +45,11 @@ pub struct FastOptions {
     /// balance ([`crate::model::EnergyBalance`]).
     pub energy: bool,
 }
+
+/// An impact that has lasted this many estimated contact durations is a sustained contact: the
+/// buildings stay pressed together and move with the structures, so the step need only resolve
+/// the contact's local rate (`h_rate`), not a fresh impact.
+pub const SUSTAINED: f64 = 2.0;
 
 /// Accepted pieces one substep may be cut into by events before the run ends with
 /// `step_limit` (a guard against a stalled event search; the shader has the same cap).
@@ -133,7 +139,13 @@ pub(crate) fn run(
         let h_rate = 2.0 * std::f64::consts::PI
             / o.substeps_per_contact
             / pair.contact.local_rate(2.0 * d_est, run.tr.v0);
-        let h = impact_step(pair, v_est, a_est, o.substeps_per_contact).min(h_rate);
+        let sustained = run.mode != Mode::Free
+            && seg.t0 - run.tr.onset_time() > SUSTAINED * pair.contact.duration_estimate(run.tr.v0);
+        let h = if sustained {
+            h_rate
+        } else {
+            impact_step(pair, v_est, a_est, o.substeps_per_contact).min(h_rate)
+        };
         let m = (dt / h).ceil().max(1.0);
         if m.is_nan() || m > o.max_substeps_per_step as f64 {
             return run.finish(Status::StepLimit, substeps as u64);

@@ -138,8 +138,10 @@ pub fn single_collision_observed(
         max_steps: 50_000_000,
     };
     let mut last = [0.0; 7];
+    let mut separated = false;
     let mut obs = |s: &Sample| {
         last = s.z;
+        separated = s.mode == Mode::Free;
         observer(s);
     };
     let out = reference::run(&pair, &forcing, &init, &opts, Some(&mut obs), Some(1));
@@ -153,7 +155,12 @@ pub fn single_collision_observed(
         };
     }
     Collision {
-        e: -(last[1] - last[3]) / v0,
+        // Overdamped Kelvin-Voigt never lets go: the bodies creep together until the horizon.
+        e: if separated {
+            -(last[1] - last[3]) / v0
+        } else {
+            0.0
+        },
         peak_force: out.peak_force,
         peak_penetration: out.peak_penetration,
         duration: out.contact_time,
@@ -478,6 +485,11 @@ impl Tracker {
             nhist: 0,
             impacts_ended: 0,
         }
+    }
+
+    /// Onset time of the current (or last) impact.
+    pub fn onset_time(&self) -> f64 {
+        self.t_onset
     }
 
     pub fn impacts_ended(&self) -> u32 {

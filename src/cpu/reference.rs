@@ -1,9 +1,11 @@
 //! The reference scheme: adaptive Dormand-Prince 5(4) in f64, local extrapolation, error per
 //! component against `atol + rtol |z|`. Steps end on every record sample (where `ag` has kinks),
 //! every non-smooth contact instant is located inside the step (see [`super`]), a free step that
-//! could hide a contact is shortened to the contact time scale, and steps in contact are capped
-//! at `t_c / contact_steps` so the parabola-refined peak force is resolved to about `rtol`.
+//! could hide a contact is shortened to the contact time scale, and steps in an impact are capped
+//! at `t_c / contact_steps` so the parabola-refined peak force is resolved to about `rtol` (not
+//! once the contact is sustained, see [`super::fast::SUSTAINED`]).
 
+use super::fast::SUSTAINED;
 use super::{
     ddelta, finite, impact_step, may_touch, structural_rel_accel, Integration, Mode, Sample,
     Segment, State,
@@ -169,7 +171,11 @@ pub(crate) fn run(
             }
             let (z0, mode, v0) = (run.z, run.mode, run.tr.v0);
             let mut hs = h.min(t1 - t);
-            if mode != Mode::Free {
+            // The cap resolves an impact's force peak; a sustained contact (as in the fast
+            // scheme) is left to the error control.
+            let sustained =
+                t - run.tr.onset_time() > SUSTAINED * pair.contact.duration_estimate(v0);
+            if mode != Mode::Free && !sustained {
                 let a = structural_rel_accel(pair, &z0);
                 hs = hs.min(impact_step(pair, v0, a, o.contact_steps));
             }

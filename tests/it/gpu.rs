@@ -52,6 +52,56 @@ fn shared_structs_match_the_shader_in_both_precisions() {
     check::<layout::Meta>(&m, size_of::<layout::Meta>());
 }
 
+/// The value of the shader's `const name` (a literal).
+fn constant(module: &naga::Module, name: &str) -> f64 {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("const {name} not in shader"));
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(l) => match l {
+            naga::Literal::F64(x) | naga::Literal::AbstractFloat(x) => x,
+            naga::Literal::F32(x) => x as f64,
+            naga::Literal::U32(x) => x as f64,
+            naga::Literal::I32(x) => x as f64,
+            naga::Literal::AbstractInt(x) => x as f64,
+            other => panic!("const {name}: {other:?}"),
+        },
+        ref e => panic!("const {name} is not a literal: {e:?}"),
+    }
+}
+
+/// Every constant the shader shares with the Rust side ("keep in sync" on both).
+#[test]
+fn shared_constants_match_the_shader() {
+    use pounding::cpu::fast;
+    let m = parse(Precision::F64);
+    for (name, rust) in [
+        ("HC_V0_MIN", pounding::contact::HC_V0_MIN),
+        (
+            "MAX_PIECES_PER_SUBSTEP",
+            fast::MAX_PIECES_PER_SUBSTEP as f64,
+        ),
+        ("SUSTAINED", fast::SUSTAINED),
+        ("MODE_FREE", layout::MODE_FREE as f64),
+        ("MODE_APPROACH", layout::MODE_APPROACH as f64),
+        ("MODE_RESTITUTION", layout::MODE_RESTITUTION as f64),
+        ("STATUS_OK", layout::STATUS_OK as f64),
+        ("STATUS_NON_FINITE", layout::STATUS_NON_FINITE as f64),
+        ("STATUS_STEP_LIMIT", layout::STATUS_STEP_LIMIT as f64),
+        ("STATUS_HANDOFF", layout::STATUS_HANDOFF as f64),
+        ("FORMS", layout::FORMS_PER_RUN as f64),
+        ("WG", layout::WORKGROUP_SIZE as f64),
+    ] {
+        assert_eq!(constant(&m, name), rust, "const {name}");
+    }
+    for (i, law) in pounding::contact::LawKind::ALL.iter().enumerate().take(6) {
+        let name = format!("LAW_{}", law.key().to_uppercase());
+        assert_eq!(constant(&m, &name), i as f64, "{name}");
+    }
+}
+
 use crate::support::{collect, rel};
 use pounding::cpu::{FastOptions, Scheme};
 use pounding::gpu::{GpuContext, GpuOptions};
