@@ -6,11 +6,12 @@
 
 use crate::contact::LawKind;
 use crate::cpu::{FastOptions, ReferenceOptions, Scheme};
-use crate::plan::{BuildingAxes, Intensity, Plan, PlanError, PlanSpec};
+use crate::plan::{BuildingAxes, Intensity, Plan, PlanError, PlanSpec, SampledAxis, Samples};
 use crate::record::{
     read_record, synthetic, Format, ReadOptions, Record, RecordError, SyntheticSpec, Units,
 };
 use crate::restitution::Formula;
+use crate::sample::{draw, Dist, Method};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 use std::fmt;
@@ -225,9 +226,38 @@ pub struct RawRun {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawBuilding {
-    pub mass_kg: Axis,
-    pub period_s: Axis,
-    pub damping_ratio: Axis,
+    /// Each may be left out when `[[sample.axis]]` samples it.
+    pub mass_kg: Option<Axis>,
+    pub period_s: Option<Axis>,
+    pub damping_ratio: Option<Axis>,
+}
+
+/// `[sample]`: uncertain parameters drawn jointly, crossed with every grid axis.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSample {
+    /// `latin_hypercube` (default) or `monte_carlo`.
+    pub method: Option<String>,
+    pub n: usize,
+    pub seed: u64,
+    #[serde(rename = "axis", default)]
+    pub axes: Vec<RawSampledAxis>,
+}
+
+/// One `[[sample.axis]]`: `key` names the parameter as in the grid (`building1.period_s`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSampledAxis {
+    pub key: String,
+    /// `uniform` (min, max), `normal` (mean, sd; min, max optional) or `lognormal` (median,
+    /// beta = the log standard deviation; min, max optional).
+    pub dist: String,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub mean: Option<f64>,
+    pub sd: Option<f64>,
+    pub median: Option<f64>,
+    pub beta: Option<f64>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -236,7 +266,8 @@ pub struct RawContact {
     pub law: Names,
     pub formula: Option<Names>,
     pub e: Option<Axis>,
-    pub gap_m: Axis,
+    /// May be left out when sampled.
+    pub gap_m: Option<Axis>,
     pub k_n_per_m: Option<Axis>,
     pub beta_n_per_m1_5: Option<Axis>,
 }
@@ -290,6 +321,7 @@ pub struct RawConfig {
     pub records: Vec<RawRecord>,
     #[serde(default)]
     pub intensity: RawIntensity,
+    pub sample: Option<RawSample>,
 }
 
 /// Read and validate a config file.
@@ -378,11 +410,34 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
         })?);
     }
 
+    let samples = raw
+        .sample
+        .as_ref()
+        .map(|s| samples(s, &invalid))
+        .transpose()?;
+    let sampled = |key: &str| {
+        samples
+            .as_ref()
+            .is_some_and(|s| s.axes.iter().any(|a| a.key() == key))
+    };
+    // A grid axis or a sampled one, not both; a sampled axis holds one placeholder in the grid
+    // (0.5: valid for every axis, never used).
+    let grid = |key: &str, a: &Option<Axis>| -> Result<Vec<f64>, ConfigError> {
+        match (a, sampled(key)) {
+            (Some(a), false) => axis(key, a),
+            (None, true) => Ok(vec![0.5]),
+            (Some(_), true) => Err(invalid(
+                key,
+                "is sampled under [sample]: remove it from the grid".into(),
+            )),
+            (None, false) => Err(invalid(key, "missing: give values or sample it".into())),
+        }
+    };
     let building = |name: &str, b: &RawBuilding| -> Result<BuildingAxes, ConfigError> {
         Ok(BuildingAxes {
-            mass: axis(&format!("{name}.mass_kg"), &b.mass_kg)?,
-            period: axis(&format!("{name}.period_s"), &b.period_s)?,
-            damping: axis(&format!("{name}.damping_ratio"), &b.damping_ratio)?,
+            mass: grid(&format!("{name}.mass_kg"), &b.mass_kg)?,
+            period: grid(&format!("{name}.period_s"), &b.period_s)?,
+            damping: grid(&format!("{name}.damping_ratio"), &b.damping_ratio)?,
         })
     };
 
@@ -425,11 +480,140 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
         intensities,
         building1: building("building1", &raw.building1)?,
         building2: building("building2", &raw.building2)?,
-        gaps: axis("contact.gap_m", &raw.contact.gap_m)?,
+        gaps: grid("contact.gap_m", &raw.contact.gap_m)?,
         scheme,
         tail: raw.run.tail_s.unwrap_or(0.0),
+        samples,
     };
     Plan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
+}
+
+/// Stage 2 of `[sample]`: distributions checked, points drawn.
+fn samples(
+    s: &RawSample,
+    invalid: &dyn Fn(&str, String) -> ConfigError,
+) -> Result<Samples, ConfigError> {
+    let method = match s.method.as_deref().unwrap_or("latin_hypercube") {
+        "latin_hypercube" => Method::LatinHypercube,
+        "monte_carlo" => Method::MonteCarlo,
+        other => {
+            return Err(invalid(
+                "sample.method",
+                format!("`{other}`: expected latin_hypercube or monte_carlo"),
+            ))
+        }
+    };
+    if s.n == 0 {
+        return Err(invalid(
+            "sample.n",
+            "is 0: expected at least one sample".into(),
+        ));
+    }
+    if s.axes.is_empty() {
+        return Err(invalid(
+            "sample.axis",
+            "is empty: add [[sample.axis]] entries (key, dist, ...)".into(),
+        ));
+    }
+    let mut axes = Vec::new();
+    let mut dists = Vec::new();
+    for (i, a) in s.axes.iter().enumerate() {
+        let key = format!("sample.axis[{i}]");
+        let axis = SampledAxis::from_key(&a.key).ok_or_else(|| {
+            invalid(
+                &format!("{key}.key"),
+                format!(
+                    "`{}`: expected one of {}",
+                    a.key,
+                    SampledAxis::ALL.map(|x| x.key()).join(", ")
+                ),
+            )
+        })?;
+        if axes.contains(&axis) {
+            return Err(invalid(
+                &format!("{key}.key"),
+                format!("`{}` is sampled twice", a.key),
+            ));
+        }
+        let need = |name: &str, v: Option<f64>| {
+            v.filter(|x| x.is_finite()).ok_or_else(|| {
+                invalid(
+                    &format!("{key}.{name}"),
+                    format!("a {} distribution needs a finite `{name}`", a.dist),
+                )
+            })
+        };
+        let (lo, hi) = (
+            a.min.unwrap_or(f64::NEG_INFINITY),
+            a.max.unwrap_or(f64::INFINITY),
+        );
+        let allowed: &[&str] = match a.dist.as_str() {
+            "uniform" => &["min", "max"],
+            "normal" => &["mean", "sd", "min", "max"],
+            "lognormal" => &["median", "beta", "min", "max"],
+            _ => &[],
+        };
+        for (name, given) in [
+            ("min", a.min),
+            ("max", a.max),
+            ("mean", a.mean),
+            ("sd", a.sd),
+            ("median", a.median),
+            ("beta", a.beta),
+        ] {
+            if given.is_some() && !allowed.is_empty() && !allowed.contains(&name) {
+                return Err(invalid(
+                    &format!("{key}.{name}"),
+                    format!(
+                        "does not apply to a {} distribution (it takes {})",
+                        a.dist,
+                        allowed.join(", ")
+                    ),
+                ));
+            }
+        }
+        let d = match a.dist.as_str() {
+            "uniform" => Dist::Uniform {
+                min: need("min", a.min)?,
+                max: need("max", a.max)?,
+            },
+            "normal" => Dist::Normal {
+                mean: need("mean", a.mean)?,
+                sd: need("sd", a.sd)?,
+                min: lo,
+                max: hi,
+            },
+            "lognormal" => Dist::LogNormal {
+                median: need("median", a.median)?,
+                beta: need("beta", a.beta)?,
+                min: lo,
+                max: hi,
+            },
+            other => {
+                return Err(invalid(
+                    &format!("{key}.dist"),
+                    format!("`{other}`: expected uniform, normal or lognormal"),
+                ))
+            }
+        };
+        let bad = match d {
+            Dist::Uniform { min, max } => (min >= max).then_some("expected min < max"),
+            Dist::Normal { sd, .. } if sd <= 0.0 => Some("expected sd > 0"),
+            Dist::LogNormal { median, beta, .. } if median <= 0.0 || beta <= 0.0 => {
+                Some("expected median > 0 and beta > 0")
+            }
+            _ => (lo >= hi).then_some("expected min < max"),
+        };
+        if let Some(m) = bad {
+            return Err(invalid(&key, m.into()));
+        }
+        axes.push(axis);
+        dists.push(d);
+    }
+    Ok(Samples {
+        axes,
+        points: draw(method, s.n, &dists, s.seed),
+    })
 }
 
 enum LoadError {

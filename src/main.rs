@@ -80,6 +80,68 @@ struct SweepArgs {
     energy: bool,
 }
 
+#[derive(clap::Args)]
+struct PlotArgs {
+    /// A CSV written by `pound sweep` (or any CSV with a header row).
+    results: PathBuf,
+    /// Column on the x axis (a swept parameter, e.g. gap_m, e, t1_s, pga_g).
+    #[arg(long)]
+    x: String,
+    /// Column on the y axis (an output, e.g. peak_force_n).
+    #[arg(long)]
+    y: String,
+    /// One series per value of this column (e.g. record, law).
+    #[arg(long)]
+    by: Option<String>,
+    /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
+    #[arg(long = "where", value_name = "FILTER")]
+    filters: Vec<String>,
+    /// How rows that share x (and series) are combined: the other swept parameters are
+    /// aggregated. `none` draws every row as a point.
+    #[arg(long, value_enum, default_value = "max")]
+    agg: AggArg,
+    #[arg(long)]
+    log_x: bool,
+    #[arg(long)]
+    log_y: bool,
+    /// Output: .svg, or .png (needs a TrueType font, see README).
+    #[arg(short, long, default_value = "plot.svg")]
+    output: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct FragilityArgs {
+    /// A CSV written by `pound sweep`.
+    results: PathBuf,
+    /// Intensity measure column (e.g. pga_g, scale_factor).
+    #[arg(long, default_value = "pga_g")]
+    im: String,
+    /// Demand column (e.g. peak_force_n; `impacts` with threshold 0 for "pounds at all").
+    #[arg(long, default_value = "peak_force_n")]
+    edp: String,
+    /// Exceedance thresholds (EDP > threshold), comma-separated.
+    #[arg(long, value_delimiter = ',', required = true)]
+    threshold: Vec<f64>,
+    /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
+    #[arg(long = "where", value_name = "FILTER")]
+    filters: Vec<String>,
+    /// Counts per threshold and level (CSV).
+    #[arg(short, long, default_value = "fragility.csv")]
+    output: PathBuf,
+    /// Observed fractions and fitted curves (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum AggArg {
+    Max,
+    Mean,
+    Median,
+    Min,
+    None,
+}
+
 #[derive(Subcommand)]
 enum Cmd {
     /// Run every run of a sweep config and write one CSV row per run.
@@ -131,7 +193,19 @@ enum Cmd {
         /// Values of e: start:stop:step, a list a,b,c, or one value.
         #[arg(long, default_value = "0.1:1:0.05")]
         e: String,
+        /// Also plot zeta against e for every formula (the seed's Fig. 2): .svg or .png.
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
+    /// Plot an output of a results CSV against a swept parameter, one series per value of a
+    /// grouping column (SVG, or PNG for a .png name).
+    Plot(PlotArgs),
+    /// Fragility curves from a results CSV: the share of runs whose EDP exceeds each threshold
+    /// at each intensity level, and a lognormal curve fitted by maximum likelihood.
+    Fragility(FragilityArgs),
+    /// The seed paper's cheap checks: Table 1 (e from the drop heights) and Fig. 2 (zeta(e) of
+    /// every formula). The rest of the reproduction: docs/paper-reproduction.md.
+    Paper,
     /// Restitution fidelity: one isolated collision per damped law, formula and e; the
     /// achieved e and the energy taken out against 0.5 m_eff (1 - e^2) v0^2.
     Restitution {
@@ -226,7 +300,13 @@ fn run(cli: Cli) -> Result<()> {
             chunk,
             output,
         } => bench(&sizes, max_cpu_runs, precision.get(), chunk, output),
-        Cmd::Formulas { e } => formulas(&e),
+        Cmd::Formulas { e, plot } => formulas(&e, plot.as_deref()),
+        Cmd::Plot(a) => plot(a),
+        Cmd::Fragility(a) => fragility(a),
+        Cmd::Paper => {
+            print!("{}", pounding::paper::report()?);
+            Ok(())
+        }
         Cmd::Accuracy {
             config,
             settings,
@@ -477,8 +557,17 @@ fn bench(
     Ok(())
 }
 
-fn formulas(e: &str) -> Result<()> {
+fn formulas(e: &str, plot: Option<&std::path::Path>) -> Result<()> {
     let es = e_values(e)?;
+    if let Some(path) = plot {
+        let panels = pounding::restitution::zeta_panels(&es)?;
+        pounding::plot::save(path, &panels, 2)?;
+        eprintln!(
+            "zeta(e) of {} formulas -> {}",
+            Formula::ALL.len(),
+            path.display()
+        );
+    }
     let exact_laws = [
         LawKind::KelvinVoigt,
         LawKind::KelvinVoigtNoTension,
@@ -510,6 +599,98 @@ fn formulas(e: &str) -> Result<()> {
         }
         println!("{}", row.join(","));
     }
+    Ok(())
+}
+
+fn fragility(a: FragilityArgs) -> Result<()> {
+    use pounding::fragility::{csv, fit, levels, panel, FragilitySpec};
+    let table = pounding::table::Table::read(&a.results)?;
+    let spec = FragilitySpec {
+        im: a.im,
+        edp: a.edp,
+        thresholds: a.threshold,
+        filters: a
+            .filters
+            .iter()
+            .map(|f| pounding::table::Filter::parse(f))
+            .collect::<Result<Vec<_>, _>>()?,
+    };
+    let (lv, skipped) = levels(&table, &spec)?;
+    let runs: u64 = lv.first().map_or(0, |l| l.iter().map(|x| x.n).sum());
+    if runs == 0 {
+        bail!(
+            "{}: no runs left to count (check --where)",
+            a.results.display()
+        );
+    }
+    let fits: Vec<_> = lv.iter().map(|l| fit(l)).collect();
+    println!(
+        "{runs} runs at {} levels of {}{}",
+        lv[0].len(),
+        spec.im,
+        if skipped > 0 {
+            format!(" ({skipped} rows left out: status not ok, or no value)")
+        } else {
+            String::new()
+        }
+    );
+    println!("\n| {} > | median {} | beta | se(ln median) | se(beta) | log-likelihood |\n|---:|---:|---:|---:|---:|---:|", spec.edp, spec.im);
+    for (t, f) in spec.thresholds.iter().zip(&fits) {
+        match f {
+            Ok(f) => println!(
+                "| {t} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} |",
+                f.median, f.beta, f.se_ln_median, f.se_beta, f.log_likelihood
+            ),
+            Err(e) => println!("| {t} | no fit: {e} | | | | |"),
+        }
+    }
+    pounding::output::write_atomic(&a.output, csv(&spec, &lv).as_bytes())
+        .with_context(|| format!("writing {}", a.output.display()))?;
+    if let Some(p) = &a.plot {
+        pounding::plot::save(p, &[panel(&spec, &lv, &fits)], 1)?;
+    }
+    Ok(())
+}
+
+fn plot(a: PlotArgs) -> Result<()> {
+    use pounding::sensitivity::{panel, Aggregate, PlotSpec};
+    let table = pounding::table::Table::read(&a.results)?;
+    let filters = a
+        .filters
+        .iter()
+        .map(|f| pounding::table::Filter::parse(f))
+        .collect::<Result<Vec<_>, _>>()?;
+    let spec = PlotSpec {
+        x: a.x,
+        y: a.y,
+        by: a.by,
+        filters,
+        aggregate: match a.agg {
+            AggArg::Max => Aggregate::Max,
+            AggArg::Mean => Aggregate::Mean,
+            AggArg::Median => Aggregate::Median,
+            AggArg::Min => Aggregate::Min,
+            AggArg::None => Aggregate::None,
+        },
+        log_x: a.log_x,
+        log_y: a.log_y,
+    };
+    let p = panel(&table, &spec)?;
+    let points: usize = p.series.iter().map(|s| s.points.len()).sum();
+    if points == 0 {
+        bail!(
+            "{}: no rows left to plot (check --where and that {} and {} have values)",
+            a.results.display(),
+            spec.x,
+            spec.y
+        );
+    }
+    pounding::plot::save(&a.output, std::slice::from_ref(&p), 1)?;
+    eprintln!(
+        "{} series, {points} points -> {}",
+        p.series.len(),
+        a.output.display()
+    );
     Ok(())
 }
 

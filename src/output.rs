@@ -9,7 +9,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 /// Swept parameters, then outputs. Units are in the names.
-pub const COLUMNS: [&str; 27] = [
+pub const COLUMNS: [&str; 28] = [
     "run",
     "law",
     "formula",
@@ -28,6 +28,7 @@ pub const COLUMNS: [&str; 27] = [
     "t2_s",
     "xi2",
     "gap_m",
+    "sample",
     "status",
     "impacts",
     "peak_force_n",
@@ -99,6 +100,7 @@ pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
         num(spec.t2),
         num(spec.xi2),
         num(spec.gap),
+        spec.sample.map(|s| s.to_string()).unwrap_or_default(),
         out.status.key().to_string(),
         out.impacts.to_string(),
         num(out.peak_force),

@@ -3,7 +3,8 @@
 //! Runs are grouped by contact law. Within a law's block, only the axes that law uses vary
 //! (elastic laws ignore `e` and the formula; linear laws take `k`, Hertz-type laws `beta`), so no
 //! run is a duplicate of another. Axis order, outermost first: law, formula, e, stiffness, record,
-//! intensity, m1, T1, xi1, m2, T2, xi2, gap. Run `i` is decoded from its index (mixed radix), so
+//! intensity, sample, m1, T1, xi1, m2, T2, xi2, gap. A sample (of uncertain parameters, see
+//! [`Samples`]) sets the parameters it holds; their grid axes then hold one placeholder value. Run `i` is decoded from its index (mixed radix), so
 //! the plan is never expanded in memory and run numbers do not depend on threads or chunking.
 
 use crate::contact::{Contact, LawKind};
@@ -52,6 +53,64 @@ pub struct PlanSpec {
     pub scheme: Scheme,
     /// Free vibration after each record, s.
     pub tail: f64,
+    /// Sampled parameters, crossed with every grid axis.
+    pub samples: Option<Samples>,
+}
+
+/// A parameter that a sample can set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampledAxis {
+    Mass1,
+    Period1,
+    Damping1,
+    Mass2,
+    Period2,
+    Damping2,
+    Gap,
+    /// `k` of linear laws.
+    KLinear,
+    /// `beta` of Hertz-type laws.
+    Beta,
+}
+
+impl SampledAxis {
+    pub const ALL: [SampledAxis; 9] = [
+        SampledAxis::Mass1,
+        SampledAxis::Period1,
+        SampledAxis::Damping1,
+        SampledAxis::Mass2,
+        SampledAxis::Period2,
+        SampledAxis::Damping2,
+        SampledAxis::Gap,
+        SampledAxis::KLinear,
+        SampledAxis::Beta,
+    ];
+
+    /// The config key.
+    pub fn key(self) -> &'static str {
+        match self {
+            SampledAxis::Mass1 => "building1.mass_kg",
+            SampledAxis::Period1 => "building1.period_s",
+            SampledAxis::Damping1 => "building1.damping_ratio",
+            SampledAxis::Mass2 => "building2.mass_kg",
+            SampledAxis::Period2 => "building2.period_s",
+            SampledAxis::Damping2 => "building2.damping_ratio",
+            SampledAxis::Gap => "contact.gap_m",
+            SampledAxis::KLinear => "contact.k_n_per_m",
+            SampledAxis::Beta => "contact.beta_n_per_m1_5",
+        }
+    }
+
+    pub fn from_key(s: &str) -> Option<SampledAxis> {
+        SampledAxis::ALL.into_iter().find(|a| a.key() == s)
+    }
+}
+
+/// Joint samples of some parameters: `points[s][j]` is the value of `axes[j]` in sample `s`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Samples {
+    pub axes: Vec<SampledAxis>,
+    pub points: Vec<Vec<f64>>,
 }
 
 /// A plan value that is out of range; `key` is the config key (with index).
@@ -69,14 +128,14 @@ fn err(key: impl Into<String>, message: impl Into<String>) -> PlanError {
     }
 }
 
-const NAXES: usize = 12;
+const NAXES: usize = 13;
 
 #[derive(Debug, Clone)]
 struct Block {
     law: LawKind,
     start: u64,
     len: u64,
-    /// Sizes of the 12 axes below the law, outermost first.
+    /// Sizes of the 13 axes below the law, outermost first.
     dims: [usize; NAXES],
 }
 
@@ -117,6 +176,8 @@ pub struct RunSpec {
     pub t2: f64,
     pub xi2: f64,
     pub gap: f64,
+    /// Index of the sample that set the sampled parameters (None without sampling).
+    pub sample: Option<usize>,
 }
 
 impl RunSpec {
@@ -185,6 +246,30 @@ impl Plan {
             |v| v.is_finite() && v >= 0.0,
             "a gap >= 0 m",
         )?;
+        if let Some(s) = &spec.samples {
+            if s.points.is_empty() {
+                return Err(err("sample.n", "is 0: expected at least one sample"));
+            }
+            for (j, a) in s.axes.iter().enumerate() {
+                let col: Vec<f64> = s.points.iter().map(|p| p[j]).collect();
+                let (ok, expected): (fn(f64) -> bool, &str) = match a {
+                    SampledAxis::Damping1 | SampledAxis::Damping2 => {
+                        (|v| (0.0..1.0).contains(&v), "0 <= damping ratio < 1")
+                    }
+                    SampledAxis::Gap => (|v| v.is_finite() && v >= 0.0, "a gap >= 0 m"),
+                    _ => (|v| v.is_finite() && v > 0.0, "a value > 0"),
+                };
+                if let Some(i) = col.iter().position(|&v| !ok(v)) {
+                    return Err(err(
+                        format!("sample.axis[{j}] ({})", a.key()),
+                        format!(
+                            "sample {i} drew {}: expected {expected}; truncate the distribution with min/max",
+                            col[i]
+                        ),
+                    ));
+                }
+            }
+        }
         if spec.laws.is_empty() {
             return Err(err(
                 "contact.law",
@@ -306,6 +391,7 @@ impl Plan {
                 },
                 spec.records.len(),
                 spec.intensities.len(),
+                spec.samples.as_ref().map_or(1, |s| s.points.len()),
                 b1.mass.len(),
                 b1.period.len(),
                 b1.damping.len(),
@@ -381,7 +467,7 @@ impl Plan {
         };
         let (record, inten) = (ix[3], ix[4]);
         let scale = self.scales[record][inten];
-        RunSpec {
+        let mut run = RunSpec {
             index,
             law,
             formula,
@@ -392,14 +478,33 @@ impl Plan {
             intensity: s.intensities[inten],
             scale,
             pga_g: s.records[record].pga().value * scale / G,
-            m1: s.building1.mass[ix[5]],
-            t1: s.building1.period[ix[6]],
-            xi1: s.building1.damping[ix[7]],
-            m2: s.building2.mass[ix[8]],
-            t2: s.building2.period[ix[9]],
-            xi2: s.building2.damping[ix[10]],
-            gap: s.gaps[ix[11]],
+            m1: s.building1.mass[ix[6]],
+            t1: s.building1.period[ix[7]],
+            xi1: s.building1.damping[ix[8]],
+            m2: s.building2.mass[ix[9]],
+            t2: s.building2.period[ix[10]],
+            xi2: s.building2.damping[ix[11]],
+            gap: s.gaps[ix[12]],
+            sample: None,
+        };
+        if let Some(smp) = &s.samples {
+            run.sample = Some(ix[5]);
+            for (a, &v) in smp.axes.iter().zip(&smp.points[ix[5]]) {
+                match a {
+                    SampledAxis::Mass1 => run.m1 = v,
+                    SampledAxis::Period1 => run.t1 = v,
+                    SampledAxis::Damping1 => run.xi1 = v,
+                    SampledAxis::Mass2 => run.m2 = v,
+                    SampledAxis::Period2 => run.t2 = v,
+                    SampledAxis::Damping2 => run.xi2 = v,
+                    SampledAxis::Gap => run.gap = v,
+                    SampledAxis::KLinear if !law.is_hertzian() => run.stiffness = v,
+                    SampledAxis::Beta if law.is_hertzian() => run.stiffness = v,
+                    SampledAxis::KLinear | SampledAxis::Beta => {}
+                }
+            }
         }
+        run
     }
 
     pub fn forcing(&self, run: &RunSpec) -> Forcing<'_> {

@@ -181,3 +181,41 @@ pub fn exact_damping(law: LawKind, e: f64) -> Result<f64, RestitutionError> {
     }
     Ok(0.5 * (lo + hi))
 }
+
+/// `zeta(e)` of every printed formula and the exact damping of the seed's law (nonlinear
+/// viscoelastic) over `es`, the seed's Fig. 2: one panel on a linear axis, one on a log axis
+/// (the formulas span four decades at small e).
+pub fn zeta_panels(es: &[f64]) -> Result<Vec<crate::plot::Panel>, RestitutionError> {
+    use crate::plot::{Panel, Series};
+    let mut series = Vec::new();
+    for f in Formula::ALL {
+        let points = es
+            .iter()
+            .map(|&e| {
+                let z = match f.zeta(e)? {
+                    Some(z) => z,
+                    None => exact_damping(LawKind::NonlinearViscoelastic, e)?,
+                };
+                Ok((e, z))
+            })
+            .collect::<Result<Vec<_>, RestitutionError>>()?;
+        let name = match f {
+            Formula::Exact => "exact (nonlinear viscoelastic)".to_string(),
+            _ => f.key().to_string(),
+        };
+        series.push(Series {
+            name,
+            points,
+            scatter: false,
+        });
+    }
+    let panel = |log_y: bool| Panel {
+        title: "impact damping ratio against e".into(),
+        x_label: "e".into(),
+        y_label: "zeta".into(),
+        log_x: false,
+        log_y,
+        series: series.clone(),
+    };
+    Ok(vec![panel(false), panel(true)])
+}

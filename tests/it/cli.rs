@@ -4,14 +4,14 @@ use crate::support::{assert_same_text, records_dir, tempdir};
 use std::path::Path;
 use std::process::Command;
 
-fn pound(args: &[&str]) -> std::process::Output {
+pub fn pound(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_pound"))
         .args(args)
         .output()
         .expect("run pound")
 }
 
-fn ok(out: &std::process::Output) -> String {
+pub fn ok(out: &std::process::Output) -> String {
     assert!(
         out.status.success(),
         "pound failed: {}",

@@ -1,7 +1,7 @@
 //! Integration tests: one binary, one module per area.
 
 mod accuracy;
-mod cli;
+pub mod cli;
 mod config;
 pub mod fast_vs_reference;
 mod fidelity;
@@ -9,4 +9,5 @@ mod gpu;
 mod hard;
 mod oracles;
 mod records;
+mod studies;
 mod support;

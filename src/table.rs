@@ -1,0 +1,221 @@
+//! Reading a results CSV back for studies (`pound plot`, `pound fragility`): named columns,
+//! numeric cells, row filters, and units from the column names. Errors name the file, the line
+//! and the column.
+
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum TableError {
+    #[error("{}: {message}", path.display())]
+    Read { path: PathBuf, message: String },
+    #[error("{}: no column `{column}`; the columns are: {available}", path.display())]
+    NoColumn {
+        path: PathBuf,
+        column: String,
+        available: String,
+    },
+    #[error("{}, line {line}, column `{column}`: `{value}` is not a number", path.display())]
+    NotNumber {
+        path: PathBuf,
+        line: usize,
+        column: String,
+        value: String,
+    },
+    #[error("--where `{text}`: {message}")]
+    Filter { text: String, message: String },
+}
+
+/// A CSV with a header row, held in memory as text.
+#[derive(Debug, Clone)]
+pub struct Table {
+    pub path: PathBuf,
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    pub fn read(path: &Path) -> Result<Table, TableError> {
+        let fail = |message: String| TableError::Read {
+            path: path.into(),
+            message,
+        };
+        let mut r = csv::Reader::from_path(path).map_err(|e| fail(e.to_string()))?;
+        let header = r
+            .headers()
+            .map_err(|e| fail(e.to_string()))?
+            .iter()
+            .map(String::from)
+            .collect();
+        let rows = r
+            .records()
+            .map(|rec| {
+                rec.map(|r| r.iter().map(String::from).collect())
+                    .map_err(|e| fail(e.to_string()))
+            })
+            .collect::<Result<_, _>>()?;
+        Ok(Table {
+            path: path.into(),
+            header,
+            rows,
+        })
+    }
+
+    /// Index of the column `name`.
+    pub fn col(&self, name: &str) -> Result<usize, TableError> {
+        self.header
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| TableError::NoColumn {
+                path: self.path.clone(),
+                column: name.into(),
+                available: self.header.join(", "),
+            })
+    }
+
+    /// The number in row `i` (0-based, after the header), column `c`; None for an empty cell.
+    pub fn num(&self, i: usize, c: usize) -> Result<Option<f64>, TableError> {
+        let v = self.rows[i][c].trim();
+        if v.is_empty() {
+            return Ok(None);
+        }
+        v.parse().map(Some).map_err(|_| TableError::NotNumber {
+            path: self.path.clone(),
+            line: i + 2,
+            column: self.header[c].clone(),
+            value: v.into(),
+        })
+    }
+
+    /// Rows that pass every filter.
+    pub fn select(&self, filters: &[Filter]) -> Result<Vec<usize>, TableError> {
+        let cols: Vec<usize> = filters
+            .iter()
+            .map(|f| self.col(&f.column))
+            .collect::<Result<_, _>>()?;
+        Ok((0..self.rows.len())
+            .filter(|&i| {
+                filters
+                    .iter()
+                    .zip(&cols)
+                    .all(|(f, &c)| f.keeps(&self.rows[i][c]))
+            })
+            .collect())
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Op {
+    Eq,
+    Ne,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+}
+
+/// `column OP value` with OP one of `=`, `!=`, `<`, `<=`, `>`, `>=`. `=` and `!=` compare numbers
+/// as numbers when both sides parse (so `gap_m=0.010` matches `0.01`), else as text.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Filter {
+    pub column: String,
+    pub op: Op,
+    pub value: String,
+}
+
+impl Filter {
+    pub fn parse(text: &str) -> Result<Filter, TableError> {
+        let fail = |message: &str| TableError::Filter {
+            text: text.into(),
+            message: message.into(),
+        };
+        let ops = [
+            ("!=", Op::Ne),
+            ("<=", Op::Le),
+            (">=", Op::Ge),
+            ("=", Op::Eq),
+            ("<", Op::Lt),
+            (">", Op::Gt),
+        ];
+        let (at, len, op) = ops
+            .iter()
+            .filter_map(|(s, op)| text.find(s).map(|i| (i, s.len(), *op)))
+            .min_by_key(|(i, len, _)| (*i, usize::MAX - len))
+            .ok_or_else(|| fail("expected COLUMN=VALUE (or !=, <, <=, >, >=)"))?;
+        let column = text[..at].trim().to_string();
+        let value = text[at + len..].trim().to_string();
+        if column.is_empty() || value.is_empty() {
+            return Err(fail("expected COLUMN=VALUE (or !=, <, <=, >, >=)"));
+        }
+        if !matches!(op, Op::Eq | Op::Ne) && value.parse::<f64>().is_err() {
+            return Err(fail("<, <=, > and >= need a number"));
+        }
+        Ok(Filter { column, op, value })
+    }
+
+    pub fn keeps(&self, cell: &str) -> bool {
+        let num = cell.trim().parse::<f64>().ok();
+        let want = self.value.parse::<f64>().ok();
+        match (self.op, num, want) {
+            (Op::Eq, Some(a), Some(b)) => a == b,
+            (Op::Ne, Some(a), Some(b)) => a != b,
+            (Op::Eq, _, _) => cell.trim() == self.value,
+            (Op::Ne, _, _) => cell.trim() != self.value,
+            (_, None, _) | (_, _, None) => false,
+            (Op::Lt, Some(a), Some(b)) => a < b,
+            (Op::Le, Some(a), Some(b)) => a <= b,
+            (Op::Gt, Some(a), Some(b)) => a > b,
+            (Op::Ge, Some(a), Some(b)) => a >= b,
+        }
+    }
+}
+
+/// An axis label from a column name: the unit suffix becomes a unit in parentheses
+/// (`gap_m` -> `gap (m)`, `peak_force_n` -> `peak force (N)`, `impact_velocity_m_s` ->
+/// `impact velocity (m/s)`).
+pub fn label(column: &str) -> String {
+    const UNITS: [(&str, &str); 10] = [
+        ("_n_per_m1_5", "N/m^1.5"),
+        ("_n_per_m", "N/m"),
+        ("_m_s", "m/s"),
+        ("_kg", "kg"),
+        ("_g", "g"),
+        ("_j", "J"),
+        ("_n", "N"),
+        ("_m", "m"),
+        ("_s", "s"),
+        ("_pct", "%"),
+    ];
+    for (suffix, unit) in UNITS {
+        if let Some(stem) = column.strip_suffix(suffix) {
+            if !stem.is_empty() {
+                return format!("{} ({unit})", stem.replace('_', " "));
+            }
+        }
+    }
+    column.replace('_', " ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn filters_and_labels() {
+        let f = Filter::parse("gap_m<=0.01").unwrap();
+        assert_eq!(
+            (f.column.as_str(), f.op, f.value.as_str()),
+            ("gap_m", Op::Le, "0.01")
+        );
+        assert!(f.keeps("0.010") && f.keeps("0") && !f.keeps("0.02") && !f.keeps(""));
+        let f = Filter::parse("law=hertz").unwrap();
+        assert!(f.keeps("hertz") && !f.keeps("linear"));
+        assert!(Filter::parse("e=0.50").unwrap().keeps("0.5"));
+        assert!(Filter::parse("law!=hertz").unwrap().keeps("linear"));
+        assert!(Filter::parse("gap_m").is_err() && Filter::parse("law<x").is_err());
+        assert_eq!(label("gap_m"), "gap (m)");
+        assert_eq!(label("peak_force_n"), "peak force (N)");
+        assert_eq!(label("impact_velocity_m_s"), "impact velocity (m/s)");
+        assert_eq!(label("beta_n_per_m1_5"), "beta (N/m^1.5)");
+        assert_eq!(label("impacts"), "impacts");
+    }
+}
