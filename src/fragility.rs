@@ -6,7 +6,7 @@
 
 use crate::plot::{Panel, Series};
 use crate::sample::phi;
-use crate::table::{label, Filter, Table, TableError};
+use crate::table::{label, order_key, Filter, Table, TableError};
 use std::collections::BTreeMap;
 
 /// Runs at one intensity level.
@@ -177,12 +177,11 @@ pub fn levels(table: &Table, spec: &FragilitySpec) -> Result<(Vec<Vec<Level>>, u
         // Levels keyed by the IM rounded to 12 significant digits (CSV text round-trips exactly,
         // but scaled PGAs computed per record may differ in the last bits).
         let key = format!("{im:.11e}").parse::<f64>().unwrap_or(im);
-        let k = if key >= 0.0 {
-            key.to_bits() ^ (1 << 63)
-        } else {
-            !key.to_bits()
-        };
-        by_im.entry(k).or_insert((key, Vec::new())).1.push(edp);
+        by_im
+            .entry(order_key(key))
+            .or_insert((key, Vec::new()))
+            .1
+            .push(edp);
     }
     let out = spec
         .thresholds

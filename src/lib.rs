@@ -23,5 +23,6 @@ pub mod record;
 pub mod restitution;
 pub mod sample;
 pub mod sensitivity;
+pub mod shard;
 pub mod sweep;
 pub mod table;

@@ -9,6 +9,9 @@ use pounding::gpu::{GpuContext, GpuOptions, Precision};
 use pounding::output::CsvOut;
 use pounding::record::{read_record, Format, ReadOptions, Units, G};
 use pounding::restitution::{exact_damping, Formula};
+use pounding::shard::{
+    meta_path, progress_path, read_toml, write_toml, Fingerprint, Meta, Progress,
+};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -78,6 +81,19 @@ struct SweepArgs {
     /// as `energy = true` under `[run]`. The reference scheme always writes it.
     #[arg(long)]
     energy: bool,
+    /// Run only shard I of N (0-based, `I/N`): a contiguous, cost-balanced part of the plan, for
+    /// job arrays; combine the outputs with `pound merge`.
+    #[arg(long, value_name = "I/N", value_parser = parse_shard)]
+    shard: Option<pounding::shard::Shard>,
+    /// Continue an interrupted sweep of the same config into the same output: only the runs
+    /// not yet on disk are computed.
+    #[arg(long)]
+    resume: bool,
+}
+
+fn parse_shard(s: &str) -> std::result::Result<pounding::shard::Shard, String> {
+    pounding::shard::Shard::parse(s)
+        .ok_or_else(|| format!("`{s}`: expected I/N with 0 <= I < N, e.g. 3/16"))
 }
 
 #[derive(clap::Args)]
@@ -203,6 +219,15 @@ enum Cmd {
     /// Fragility curves from a results CSV: the share of runs whose EDP exceeds each threshold
     /// at each intensity level, and a lognormal curve fitted by maximum likelihood.
     Fragility(FragilityArgs),
+    /// Combine the outputs of `pound sweep --shard I/N` into one CSV, checking that they come
+    /// from one sweep (same fingerprint) and hold every run exactly once.
+    Merge {
+        /// Shard outputs (CSV files written by `pound sweep --shard`), in any order.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        #[arg(short, long, default_value = "results.csv")]
+        output: PathBuf,
+    },
     /// The seed paper's cheap checks: Table 1 (e from the drop heights) and Fig. 2 (zeta(e) of
     /// every formula). The rest of the reproduction: docs/paper-reproduction.md.
     Paper,
@@ -303,6 +328,15 @@ fn run(cli: Cli) -> Result<()> {
         Cmd::Formulas { e, plot } => formulas(&e, plot.as_deref()),
         Cmd::Plot(a) => plot(a),
         Cmd::Fragility(a) => fragility(a),
+        Cmd::Merge { inputs, output } => {
+            let rows = pounding::shard::merge(&output, &inputs)?;
+            eprintln!(
+                "{rows} runs from {} inputs -> {}",
+                inputs.len(),
+                output.display()
+            );
+            Ok(())
+        }
         Cmd::Paper => {
             print!("{}", pounding::paper::report()?);
             Ok(())
@@ -358,9 +392,11 @@ fn sweep(a: SweepArgs) -> Result<()> {
         precision,
         chunk,
         energy,
+        shard,
+        resume,
     } = a;
     let precision = precision.get();
-    let plan = config::load(&config)?;
+    let mut plan = config::load(&config)?;
     let scheme = match scheme {
         None => plan.spec.scheme,
         Some(SchemeArg::Fast) => Scheme::Fast(match plan.spec.scheme {
@@ -380,6 +416,8 @@ fn sweep(a: SweepArgs) -> Result<()> {
         Scheme::Reference(_) => None,
     };
     let scheme = fast.map_or(scheme, Scheme::Fast);
+    // The fingerprint covers the scheme as run, not as configured.
+    plan.spec.scheme = scheme;
     if backend == BackendArg::Gpu && fast.is_none() {
         bail!("--backend gpu runs the fast scheme only; use --scheme fast or --backend cpu")
     }
@@ -402,10 +440,49 @@ fn sweep(a: SweepArgs) -> Result<()> {
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("starting worker threads")?;
-    let mut out =
-        CsvOut::create(&output).with_context(|| format!("cannot create {}", output.display()))?;
+    let range = match shard {
+        Some(s) => pounding::shard::shard_range(&plan, s),
+        None => 0..plan.len(),
+    };
+    let meta = Meta {
+        fingerprint: Fingerprint::of(&plan),
+        plan_runs: plan.len(),
+        first_run: range.start,
+        end_run: range.end,
+        shard,
+        backend: match &gpu {
+            Some(_) => format!("gpu-{}", precision.key()),
+            None => "cpu".into(),
+        },
+    };
+    let Some((mut out, done)) = open_output(&output, &meta, resume)? else {
+        return Ok(());
+    };
     let partial = out.partial_path().to_path_buf();
-    let total = plan.len();
+    let progress_file = progress_path(&output);
+    let mut progress = Progress {
+        meta: meta.clone(),
+        done,
+        bytes: out
+            .sync()
+            .with_context(|| format!("writing {}", partial.display()))?,
+    };
+    write_toml(&progress_file, &progress)?;
+    let total = range.end - range.start - done;
+    if let Some(s) = shard {
+        eprintln!(
+            "shard {}/{}: runs {}..{} of {}",
+            s.index,
+            s.count,
+            range.start,
+            range.end,
+            plan.len()
+        );
+    }
+    if done > 0 {
+        eprintln!("resuming {}: {done} runs already on disk", output.display());
+    }
+    let todo = range.start + done..range.end;
     let bar = if std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(total);
         b.set_style(
@@ -430,9 +507,14 @@ fn sweep(a: SweepArgs) -> Result<()> {
     );
     let summary = pool
         .install(|| -> Result<_> {
+            // Each chunk's rows go to disk (fsync) before the progress file counts them, so a
+            // crash at any moment leaves a consistent prefix to resume from.
             let mut write = |rows: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
-                out.write(rows.iter().map(|(s, o)| pounding::output::row(&plan, s, o)))
-                    .map_err(anyhow::Error::from)
+                out.write(rows.iter().map(|(s, o)| pounding::output::row(&plan, s, o)))?;
+                progress.bytes = out.sync()?;
+                progress.done += rows.len() as u64;
+                write_toml(&progress_file, &progress)?;
+                Ok::<(), anyhow::Error>(())
             };
             match (&gpu, fast) {
                 (Some(ctx), Some(fast)) => {
@@ -441,8 +523,9 @@ fn sweep(a: SweepArgs) -> Result<()> {
                         fast,
                         ..Default::default()
                     };
-                    let (s, t) = pounding::sweep::run_gpu(
+                    let (s, t) = pounding::sweep::run_gpu_range(
                         &plan,
+                        todo.clone(),
                         ctx,
                         &opts,
                         chunk.unwrap_or(65536),
@@ -462,9 +545,14 @@ fn sweep(a: SweepArgs) -> Result<()> {
                     Ok(s)
                 }
                 _ => {
-                    pounding::sweep::run(&plan, &scheme, chunk.unwrap_or(64), &mut write, |done| {
-                        bar.set_position(done)
-                    })
+                    pounding::sweep::run_range(
+                        &plan,
+                        todo.clone(),
+                        &scheme,
+                        chunk.unwrap_or(64),
+                        &mut write,
+                        |done| bar.set_position(done),
+                    )
                 }
             }
         })
@@ -475,9 +563,13 @@ fn sweep(a: SweepArgs) -> Result<()> {
             )
         })?;
     bar.finish_and_clear();
+    // Sidecar first: a crash between the two leaves a resumable, not an unlabelled, output.
+    write_toml(&meta_path(&output), &meta)?;
     let path = out
         .finish()
         .with_context(|| format!("finishing {}", output.display()))?;
+    std::fs::remove_file(&progress_file)
+        .with_context(|| format!("removing {}", progress_file.display()))?;
     eprintln!(
         "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {}",
         summary.runs,
@@ -489,6 +581,65 @@ fn sweep(a: SweepArgs) -> Result<()> {
         path.display()
     );
     Ok(())
+}
+
+/// The output to write into and the runs of the range already in it: a fresh `.partial`, or
+/// with `resume` the one an interrupted sweep left (after checking it is the same sweep). None
+/// when there is nothing left to do.
+fn open_output(
+    output: &std::path::Path,
+    meta: &Meta,
+    resume: bool,
+) -> Result<Option<(CsvOut, u64)>> {
+    let progress_file = progress_path(output);
+    let cannot = |what: &str| {
+        anyhow::anyhow!(
+            "cannot resume {}: {what} differs from the sweep that wrote it; rerun without --resume after deleting {} to start over",
+            output.display(),
+            progress_file.display()
+        )
+    };
+    if resume {
+        if progress_file.exists() {
+            let p: Progress = read_toml(&progress_file)?;
+            if let Some(what) = p.meta.fingerprint.differs(&meta.fingerprint) {
+                return Err(cannot(what));
+            }
+            if (p.meta.first_run, p.meta.end_run, p.meta.shard)
+                != (meta.first_run, meta.end_run, meta.shard)
+            {
+                return Err(cannot("the shard (--shard)"));
+            }
+            if p.meta.backend != meta.backend {
+                return Err(cannot("the backend (--backend, --precision)"));
+            }
+            let out = CsvOut::resume(output, p.bytes)
+                .with_context(|| format!("resuming {}", output.display()))?;
+            return Ok(Some((out, p.done)));
+        }
+        let meta_file = meta_path(output);
+        if output.exists() && meta_file.exists() {
+            let m: Meta = read_toml(&meta_file)?;
+            if m.fingerprint.differs(&meta.fingerprint).is_none()
+                && (m.first_run, m.end_run) == (meta.first_run, meta.end_run)
+            {
+                eprintln!("{} is already complete", output.display());
+                return Ok(None);
+            }
+        }
+        eprintln!("nothing to resume for {}: starting", output.display());
+    } else if progress_file.exists() {
+        let p: Progress = read_toml(&progress_file)?;
+        bail!(
+            "{}.partial holds {} finished runs of an unfinished sweep: rerun with --resume to continue it, or delete {} to start over",
+            output.display(),
+            p.done,
+            progress_file.display()
+        );
+    }
+    let out =
+        CsvOut::create(output).with_context(|| format!("cannot create {}", output.display()))?;
+    Ok(Some((out, 0)))
 }
 
 fn gpu_info() -> Result<()> {

@@ -149,8 +149,44 @@ impl CsvOut {
         })
     }
 
+    /// Continue `path`'s `.partial` file, whose first `bytes` bytes hold the header and the rows
+    /// of finished chunks: anything after them (a chunk cut off mid-write) is truncated.
+    pub fn resume(path: &Path, bytes: u64) -> std::io::Result<CsvOut> {
+        let mut partial = path.as_os_str().to_owned();
+        partial.push(".partial");
+        let partial = PathBuf::from(partial);
+        let file = std::fs::OpenOptions::new().write(true).open(&partial)?;
+        let len = file.metadata()?.len();
+        if len < bytes {
+            return Err(std::io::Error::other(format!(
+                "{} holds {len} bytes, fewer than the {bytes} its progress file records: it was changed or truncated; delete it and its .progress.toml to start over",
+                partial.display()
+            )));
+        }
+        file.set_len(bytes)?;
+        file.sync_all()?;
+        let mut file = file;
+        std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
+        let w = csv::WriterBuilder::new()
+            .has_headers(false)
+            .from_writer(BufWriter::new(file));
+        Ok(CsvOut {
+            path: path.into(),
+            partial,
+            w,
+        })
+    }
+
     pub fn partial_path(&self) -> &Path {
         &self.partial
+    }
+
+    /// Push everything written to the disk (fsync) and return the file's length.
+    pub fn sync(&mut self) -> std::io::Result<u64> {
+        self.w.flush()?;
+        let f = self.w.get_ref().get_ref();
+        f.sync_data()?;
+        Ok(f.metadata()?.len())
     }
 
     /// Append rows and push them to the OS, so a crash keeps them in the `.partial` file.

@@ -4,7 +4,7 @@
 //! or every row is drawn as a point.
 
 use crate::plot::{Panel, Series};
-use crate::table::{label, Filter, Table, TableError};
+use crate::table::{label, order_key, Filter, Table, TableError};
 use std::collections::BTreeMap;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,13 +98,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<Panel, TableError> {
             } else {
                 let mut at: BTreeMap<u64, (f64, Vec<f64>)> = BTreeMap::new();
                 for &(x, y) in pts {
-                    // Key by the bits of x, ordered like the numbers (all finite here).
-                    let key = if x >= 0.0 {
-                        x.to_bits() ^ (1 << 63)
-                    } else {
-                        !x.to_bits()
-                    };
-                    at.entry(key).or_insert((x, Vec::new())).1.push(y);
+                    at.entry(order_key(x)).or_insert((x, Vec::new())).1.push(y);
                 }
                 at.into_values()
                     .map(|(x, mut ys)| (x, spec.aggregate.apply(&mut ys)))

@@ -47,13 +47,25 @@ pub fn run<E>(
     plan: &Plan,
     scheme: &Scheme,
     chunk: usize,
+    sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<Summary, E> {
+    run_range(plan, 0..plan.len(), scheme, chunk, sink, progress)
+}
+
+/// As [`run`], for the runs `runs` of the plan only (a shard, or what a resumed sweep has left).
+pub fn run_range<E>(
+    plan: &Plan,
+    runs: std::ops::Range<u64>,
+    scheme: &Scheme,
+    chunk: usize,
     mut sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
     mut progress: impl FnMut(u64),
 ) -> Result<Summary, E> {
     let start = Instant::now();
     let chunk = chunk.max(1) as u64;
-    let n = plan.len();
-    let nchunks = n.div_ceil(chunk);
+    let (first, n) = (runs.start, runs.end);
+    let nchunks = (n - first.min(n)).div_ceil(chunk);
     let batch = (rayon::current_num_threads() as u64 * 4).max(1);
     let mut s = Summary::default();
     let mut c0 = 0;
@@ -62,7 +74,7 @@ pub fn run<E>(
         let results: Vec<Vec<(RunSpec, RunOutput)>> = (c0..c1)
             .into_par_iter()
             .map(|c| {
-                (c * chunk..((c + 1) * chunk).min(n))
+                (first + c * chunk..(first + (c + 1) * chunk).min(n))
                     .map(|i| {
                         let spec = plan.run(i);
                         let out = run_one(plan, &spec, scheme);
@@ -109,6 +121,19 @@ pub fn run_gpu<E: From<crate::gpu::GpuError>>(
     ctx: &crate::gpu::GpuContext,
     opts: &crate::gpu::GpuOptions,
     chunk: usize,
+    sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), E> {
+    run_gpu_range(plan, 0..plan.len(), ctx, opts, chunk, sink, progress)
+}
+
+/// As [`run_gpu`], for the runs `runs` of the plan only.
+pub fn run_gpu_range<E: From<crate::gpu::GpuError>>(
+    plan: &Plan,
+    runs: std::ops::Range<u64>,
+    ctx: &crate::gpu::GpuContext,
+    opts: &crate::gpu::GpuOptions,
+    chunk: usize,
     mut sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
     mut progress: impl FnMut(u64),
 ) -> Result<(Summary, GpuTimes), E> {
@@ -118,9 +143,9 @@ pub fn run_gpu<E: From<crate::gpu::GpuError>>(
     let accels: Vec<&[f64]> = plan.spec.records.iter().map(|r| &r.accel[..]).collect();
     let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
     let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
-    let n = plan.len();
+    let n = runs.end;
     let mut s = Summary::default();
-    let mut c0 = 0;
+    let mut c0 = runs.start;
     while c0 < n {
         let c1 = (c0 + chunk).min(n);
         let t = Instant::now();

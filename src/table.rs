@@ -169,6 +169,16 @@ impl Filter {
     }
 }
 
+/// A map key that orders finite numbers like the numbers themselves (for grouping rows by a
+/// numeric column in a `BTreeMap`).
+pub fn order_key(x: f64) -> u64 {
+    if x >= 0.0 {
+        x.to_bits() ^ (1 << 63)
+    } else {
+        !x.to_bits()
+    }
+}
+
 /// An axis label from a column name: the unit suffix becomes a unit in parentheses
 /// (`gap_m` -> `gap (m)`, `peak_force_n` -> `peak force (N)`, `impact_velocity_m_s` ->
 /// `impact velocity (m/s)`).

@@ -9,5 +9,6 @@ mod gpu;
 mod hard;
 mod oracles;
 mod records;
+mod scale;
 mod studies;
 mod support;

@@ -1,0 +1,283 @@
+//! Scale and reliability (issue 6): shards merge to the unsharded sweep, a killed sweep resumes
+//! to the same output, and resuming or merging outputs of different sweeps is refused.
+
+use crate::cli::{ok, pound};
+use crate::support::{assert_same_text, tempdir};
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+/// Two records of different lengths, so cost-balanced shards differ in run count.
+const SWEEP: &str = r#"
+[run]
+tail_s = 1.0
+
+[building1]
+mass_kg = 1.0e5
+period_s = [0.3, 0.5, 0.7]
+damping_ratio = 0.05
+
+[building2]
+mass_kg = 1.0e5
+period_s = [0.4, 0.9]
+damping_ratio = 0.05
+
+[contact]
+law = ["nonlinear_viscoelastic", "kelvin_voigt"]
+formula = "exact"
+e = [0.5, 0.8]
+k_n_per_m = 1e9
+beta_n_per_m1_5 = 2.75e9
+gap_m = { from = 0.0, to = 0.03, n = 4 }
+
+[[record]]
+synthetic = { seed = 1, duration_s = 4.0 }
+
+[[record]]
+path = "long.txt"
+format = "values"
+dt_s = 0.01
+units = "g"
+"#;
+
+fn setup(dir: &Path) -> std::path::PathBuf {
+    // A 16 s record: four times the synthetic one's cost per run.
+    let long: Vec<String> = (0..1600)
+        .map(|i| {
+            format!(
+                "{}",
+                0.3 * (i as f64 * 0.05).sin() * (i as f64 * 0.0021).cos()
+            )
+        })
+        .collect();
+    std::fs::write(dir.join("long.txt"), long.join("\n")).unwrap();
+    let cfg = dir.join("sweep.toml");
+    std::fs::write(&cfg, SWEEP).unwrap();
+    cfg
+}
+
+fn sweep(cfg: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "sweep",
+        cfg.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--backend",
+        "cpu",
+    ];
+    args.extend_from_slice(extra);
+    pound(&args)
+}
+
+/// `pound sweep` on the CPU, started in the background (to be killed).
+fn spawn(cfg: &Path, out: &Path, extra: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_pound"))
+        .args(["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .args(["--backend", "cpu", "--threads", "1"])
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
+#[test]
+fn shards_merge_to_the_unsharded_sweep() {
+    let d = tempdir();
+    let cfg = setup(d.path());
+    let all = d.path().join("all.csv");
+    ok(&sweep(&cfg, &all, &[]));
+    let mut shards = Vec::new();
+    let mut counts = Vec::new();
+    for i in 0..3 {
+        let out = d.path().join(format!("shard{i}.csv"));
+        ok(&sweep(&cfg, &out, &["--shard", &format!("{i}/3")]));
+        counts.push(std::fs::read_to_string(&out).unwrap().lines().count() - 1);
+        shards.push(out);
+    }
+    // 192 runs: record 1 (4 s) and record 2 (16 s) alternate in blocks, so equal cost is not
+    // equal count.
+    assert_eq!(counts.iter().sum::<usize>(), 192, "{counts:?}");
+    assert!(counts.iter().any(|&c| c != 64), "{counts:?}");
+    let merged = d.path().join("merged.csv");
+    let args: Vec<&str> = ["merge", "-o", merged.to_str().unwrap()]
+        .into_iter()
+        .chain([2, 0, 1].map(|i| shards[i].to_str().unwrap()))
+        .collect();
+    ok(&pound(&args));
+    assert_same_text(
+        "merged shards vs one sweep",
+        &std::fs::read_to_string(&merged).unwrap(),
+        &std::fs::read_to_string(&all).unwrap(),
+    );
+    // A missing shard, a repeated one, and a shard of another sweep are refused.
+    let missing = pound(&[
+        "merge",
+        "-o",
+        "x.csv",
+        shards[0].to_str().unwrap(),
+        shards[2].to_str().unwrap(),
+    ]);
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("are in no input"));
+    let twice = pound(&[
+        "merge",
+        "-o",
+        "x.csv",
+        shards[0].to_str().unwrap(),
+        shards[1].to_str().unwrap(),
+        shards[1].to_str().unwrap(),
+        shards[2].to_str().unwrap(),
+    ]);
+    assert!(String::from_utf8_lossy(&twice.stderr).contains("also in another input"));
+    std::fs::write(&cfg, SWEEP.replace("e = [0.5, 0.8]", "e = [0.5, 0.7]")).unwrap();
+    let other = d.path().join("other.csv");
+    ok(&sweep(&cfg, &other, &["--shard", "1/3"]));
+    let mixed = pound(&[
+        "merge",
+        "-o",
+        "x.csv",
+        shards[0].to_str().unwrap(),
+        other.to_str().unwrap(),
+        shards[2].to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&mixed.stderr);
+    assert!(
+        err.contains("the config (the validated plan) differs"),
+        "{err}"
+    );
+    assert!(!d.path().join("x.csv").exists());
+}
+
+/// Kill a real sweep (SIGKILL) at several moments, resume each time, and end with exactly the
+/// output of an uninterrupted sweep; each resume computes only what is not on disk.
+#[test]
+fn killed_sweep_resumes_to_identical_output() {
+    let d = tempdir();
+    let cfg = setup(d.path());
+    // Four times the runs of the other tests, so there is time to kill it.
+    std::fs::write(&cfg, SWEEP.replace("to = 0.03, n = 4", "to = 0.03, n = 16")).unwrap();
+    let whole = d.path().join("whole.csv");
+    let t = std::time::Instant::now();
+    ok(&sweep(&cfg, &whole, &["--threads", "1"]));
+    let full = t.elapsed().as_secs_f64();
+    let out = d.path().join("killed.csv");
+    let progress = d.path().join("killed.csv.progress.toml");
+    let mut kills = 0;
+    // Kill points as fractions of an uninterrupted sweep's time, so they land inside the sweep
+    // on a fast machine or a slow one.
+    for (k, f) in [0.1, 0.3, 0.2, 0.35, 0.15, 0.25].into_iter().enumerate() {
+        let ms = (f * full * 1000.0) as u64;
+        let extra: &[&str] = if k > 0 {
+            &["--chunk", "2", "--resume"]
+        } else {
+            &["--chunk", "2"]
+        };
+        let mut child = spawn(&cfg, &out, extra);
+        std::thread::sleep(Duration::from_millis(ms));
+        if child.try_wait().unwrap().is_none() {
+            child.kill().unwrap();
+            kills += 1;
+        }
+        child.wait().unwrap();
+        if out.exists() {
+            break;
+        }
+    }
+    assert!(
+        kills >= 2,
+        "the sweep finished before it could be killed twice"
+    );
+    let done_before = std::fs::read_to_string(&progress).ok().and_then(|t| {
+        t.lines()
+            .find(|l| l.starts_with("done = "))
+            .map(String::from)
+    });
+    let r = sweep(&cfg, &out, &["--resume"]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    ok(&r);
+    if let Some(line) = done_before {
+        let n: u64 = line["done = ".len()..].parse().unwrap();
+        if n > 0 {
+            assert!(err.contains(&format!("{n} runs already on disk")), "{err}");
+        }
+    }
+    assert_same_text(
+        "resumed vs uninterrupted",
+        &std::fs::read_to_string(&out).unwrap(),
+        &std::fs::read_to_string(&whole).unwrap(),
+    );
+    assert!(!progress.exists());
+    let again = sweep(&cfg, &out, &["--resume"]);
+    assert!(String::from_utf8_lossy(&again.stderr).contains("already complete"));
+}
+
+/// Resuming after the config or a record changed is refused and names what changed; a sweep
+/// that is not resumed does not overwrite finished work.
+#[test]
+fn resume_refuses_a_different_sweep() {
+    let d = tempdir();
+    let cfg = setup(d.path());
+    let out = d.path().join("r.csv");
+    // Leave an unfinished output: kill the sweep early.
+    let mut child = spawn(&cfg, &out, &["--chunk", "1"]);
+    std::thread::sleep(Duration::from_millis(150));
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(d.path().join("r.csv.progress.toml").exists() && !out.exists());
+    let fresh = sweep(&cfg, &out, &[]);
+    assert!(!fresh.status.success());
+    assert!(String::from_utf8_lossy(&fresh.stderr).contains("rerun with --resume"));
+    std::fs::write(
+        &cfg,
+        SWEEP.replace(
+            "gap_m = { from = 0.0, to = 0.03, n = 4 }",
+            "gap_m = [0.0, 0.01, 0.02, 0.035]",
+        ),
+    )
+    .unwrap();
+    let e = sweep(&cfg, &out, &["--resume"]);
+    let err = String::from_utf8_lossy(&e.stderr);
+    assert!(
+        !e.status.success() && err.contains("the config (the validated plan) differs"),
+        "{err}"
+    );
+    std::fs::write(&cfg, SWEEP).unwrap();
+    let long = std::fs::read_to_string(d.path().join("long.txt")).unwrap();
+    std::fs::write(d.path().join("long.txt"), long.replacen('0', "1", 1)).unwrap();
+    let e = sweep(&cfg, &out, &["--resume"]);
+    let err = String::from_utf8_lossy(&e.stderr);
+    assert!(
+        !e.status.success() && err.contains("the records (their content) differs"),
+        "{err}"
+    );
+    std::fs::write(d.path().join("long.txt"), long).unwrap();
+    let e = sweep(&cfg, &out, &["--resume", "--shard", "0/2"]);
+    assert!(String::from_utf8_lossy(&e.stderr).contains("the shard"));
+    ok(&sweep(&cfg, &out, &["--resume"]));
+}
+
+/// The Slurm example, run as local processes (`examples/slurm/local.sh`: the array tasks, then
+/// the merge job), gives the unsharded sweep row for row.
+#[test]
+fn slurm_example_runs_locally() {
+    let d = tempdir();
+    let cfg = setup(d.path());
+    let prefix = d.path().join("out").join("sweep");
+    let r = Command::new("bash")
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/examples/slurm/local.sh"
+        ))
+        .args([cfg.to_str().unwrap(), prefix.to_str().unwrap(), "3"])
+        .env("POUND", env!("CARGO_BIN_EXE_pound"))
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let all = d.path().join("all.csv");
+    ok(&sweep(&cfg, &all, &[]));
+    assert_same_text(
+        "slurm example vs one sweep",
+        &std::fs::read_to_string(d.path().join("out").join("sweep.csv")).unwrap(),
+        &std::fs::read_to_string(&all).unwrap(),
+    );
+}
