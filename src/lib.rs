@@ -6,6 +6,7 @@
 //! execution and streaming output).
 
 pub mod accuracy;
+pub mod aggregate;
 pub mod bench;
 pub mod config;
 pub mod contact;

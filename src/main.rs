@@ -89,6 +89,58 @@ struct SweepArgs {
     /// not yet on disk are computed.
     #[arg(long)]
     resume: bool,
+    /// Write, instead of a row per run, one row per group of these swept columns (e.g.
+    /// record,pga_g): runs, failures, --exceed counts, and max, mean, p50, p90, p99 of each output.
+    #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
+    aggregate: Option<Vec<String>>,
+    /// With --aggregate: count runs with COLUMN > THRESHOLD (e.g. peak_force_n=1e6); repeatable.
+    #[arg(long, value_name = "COLUMN=THRESHOLD", requires = "aggregate")]
+    exceed: Vec<String>,
+}
+
+/// Where a sweep's rows go: a CSV row per run (journaled for --resume), or folded into a
+/// summary per group (--aggregate).
+enum Rows {
+    Csv {
+        out: Box<CsvOut>,
+        progress: Progress,
+        progress_file: PathBuf,
+    },
+    Summary {
+        agg: pounding::aggregate::Aggregator,
+        seen: pounding::aggregate::FirstSeen,
+    },
+}
+
+impl Rows {
+    fn take(
+        &mut self,
+        plan: &pounding::plan::Plan,
+        rows: &[(pounding::plan::RunSpec, pounding::model::RunOutput)],
+    ) -> Result<()> {
+        match self {
+            // Each chunk's rows go to disk (fsync) before the progress file counts them, so a
+            // crash at any moment leaves a consistent prefix to resume from.
+            Rows::Csv {
+                out,
+                progress,
+                progress_file,
+            } => {
+                out.write(rows.iter().map(|(s, o)| pounding::output::row(plan, s, o)))?;
+                progress.bytes = out.sync()?;
+                progress.done += rows.len() as u64;
+                write_toml(progress_file, progress)?;
+            }
+            Rows::Summary { agg, seen } => {
+                for (s, o) in rows {
+                    let r = pounding::output::row(plan, s, o);
+                    seen.note(agg.key(&r));
+                    agg.add(&r);
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 fn parse_shard(s: &str) -> std::result::Result<pounding::shard::Shard, String> {
@@ -394,7 +446,12 @@ fn sweep(a: SweepArgs) -> Result<()> {
         energy,
         shard,
         resume,
+        aggregate,
+        exceed,
     } = a;
+    if aggregate.is_some() && (resume || shard.is_some()) {
+        bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
+    }
     let precision = precision.get();
     let mut plan = config::load(&config)?;
     let scheme = match scheme {
@@ -455,19 +512,40 @@ fn sweep(a: SweepArgs) -> Result<()> {
             None => "cpu".into(),
         },
     };
-    let Some((mut out, done)) = open_output(&output, &meta, resume)? else {
-        return Ok(());
+    let (mut rows, done, partial) = match &aggregate {
+        Some(by) => (
+            Rows::Summary {
+                agg: pounding::aggregate::Aggregator::new(by, &exceed)?,
+                seen: Default::default(),
+            },
+            0,
+            output.clone(),
+        ),
+        None => {
+            let Some((mut out, done)) = open_output(&output, &meta, resume)? else {
+                return Ok(());
+            };
+            let partial = out.partial_path().to_path_buf();
+            let progress_file = progress_path(&output);
+            let progress = Progress {
+                meta: meta.clone(),
+                done,
+                bytes: out
+                    .sync()
+                    .with_context(|| format!("writing {}", partial.display()))?,
+            };
+            write_toml(&progress_file, &progress)?;
+            (
+                Rows::Csv {
+                    out: Box::new(out),
+                    progress,
+                    progress_file,
+                },
+                done,
+                partial,
+            )
+        }
     };
-    let partial = out.partial_path().to_path_buf();
-    let progress_file = progress_path(&output);
-    let mut progress = Progress {
-        meta: meta.clone(),
-        done,
-        bytes: out
-            .sync()
-            .with_context(|| format!("writing {}", partial.display()))?,
-    };
-    write_toml(&progress_file, &progress)?;
     let total = range.end - range.start - done;
     if let Some(s) = shard {
         eprintln!(
@@ -507,14 +585,8 @@ fn sweep(a: SweepArgs) -> Result<()> {
     );
     let summary = pool
         .install(|| -> Result<_> {
-            // Each chunk's rows go to disk (fsync) before the progress file counts them, so a
-            // crash at any moment leaves a consistent prefix to resume from.
-            let mut write = |rows: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
-                out.write(rows.iter().map(|(s, o)| pounding::output::row(&plan, s, o)))?;
-                progress.bytes = out.sync()?;
-                progress.done += rows.len() as u64;
-                write_toml(&progress_file, &progress)?;
-                Ok::<(), anyhow::Error>(())
+            let mut write = |chunk: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
+                rows.take(&plan, chunk)
             };
             match (&gpu, fast) {
                 (Some(ctx), Some(fast)) => {
@@ -565,11 +637,24 @@ fn sweep(a: SweepArgs) -> Result<()> {
     bar.finish_and_clear();
     // Sidecar first: a crash between the two leaves a resumable, not an unlabelled, output.
     write_toml(&meta_path(&output), &meta)?;
-    let path = out
-        .finish()
-        .with_context(|| format!("finishing {}", output.display()))?;
-    std::fs::remove_file(&progress_file)
-        .with_context(|| format!("removing {}", progress_file.display()))?;
+    let path = match rows {
+        Rows::Csv {
+            out, progress_file, ..
+        } => {
+            let path = out
+                .finish()
+                .with_context(|| format!("finishing {}", output.display()))?;
+            std::fs::remove_file(&progress_file)
+                .with_context(|| format!("removing {}", progress_file.display()))?;
+            path
+        }
+        Rows::Summary { agg, seen } => {
+            pounding::output::write_atomic(&output, agg.csv(&seen.order).as_bytes())
+                .with_context(|| format!("writing {}", output.display()))?;
+            eprintln!("{} groups", agg.groups());
+            output.clone()
+        }
+    };
     eprintln!(
         "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {}",
         summary.runs,

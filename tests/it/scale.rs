@@ -281,3 +281,68 @@ fn slurm_example_runs_locally() {
         &std::fs::read_to_string(&all).unwrap(),
     );
 }
+
+/// `--aggregate` writes one row per group, and its counts, maxima and means equal those of the
+/// per-run CSV of the same sweep; quantiles are within the sketch's 1 %.
+#[test]
+fn aggregate_matches_the_per_run_output() {
+    let d = tempdir();
+    let cfg = setup(d.path());
+    let runs = d.path().join("runs.csv");
+    ok(&sweep(&cfg, &runs, &[]));
+    let agg = d.path().join("agg.csv");
+    ok(&sweep(
+        &cfg,
+        &agg,
+        &[
+            "--aggregate",
+            "record,law",
+            "--exceed",
+            "peak_force_n=1e6",
+            "--exceed",
+            "impacts=0",
+        ],
+    ));
+    let mut r = csv::Reader::from_path(&runs).unwrap();
+    let h = r.headers().unwrap().clone();
+    let col = |n: &str| h.iter().position(|c| c == n).unwrap();
+    let all: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
+    let mut a = csv::Reader::from_path(&agg).unwrap();
+    let ah = a.headers().unwrap().clone();
+    let groups: Vec<csv::StringRecord> = a.records().map(|x| x.unwrap()).collect();
+    assert_eq!(groups.len(), 4, "2 records x 2 laws");
+    for g in &groups {
+        let get = |n: &str| -> f64 { g[ah.iter().position(|c| c == n).unwrap()].parse().unwrap() };
+        let rows: Vec<&csv::StringRecord> = all
+            .iter()
+            .filter(|x| x[col("record")] == g[0] && x[col("law")] == g[1])
+            .collect();
+        let f: Vec<f64> = rows
+            .iter()
+            .map(|x| x[col("peak_force_n")].parse().unwrap())
+            .collect();
+        assert_eq!(get("runs") as usize, rows.len());
+        assert_eq!(
+            get("exceed_peak_force_n>1000000") as usize,
+            f.iter().filter(|&&x| x > 1e6).count()
+        );
+        let pounded = rows
+            .iter()
+            .filter(|x| x[col("impacts")].parse::<u32>().unwrap() > 0)
+            .count();
+        assert_eq!(get("exceed_impacts>0") as usize, pounded);
+        assert_eq!(
+            get("peak_force_n_max"),
+            f.iter().cloned().fold(0.0, f64::max)
+        );
+        let mean = f.iter().sum::<f64>() / f.len() as f64;
+        assert!((get("peak_force_n_mean") - mean).abs() <= 1e-12 * mean);
+        let mut s = f.clone();
+        s.sort_by(f64::total_cmp);
+        let p90 = s[(0.9 * (s.len() - 1) as f64).round() as usize];
+        assert!((get("peak_force_n_p90") - p90).abs() <= 0.01 * p90, "{g:?}");
+    }
+    assert!(std::fs::metadata(&agg).unwrap().len() < 10_000);
+    let bad = sweep(&cfg, &agg, &["--aggregate", "gap"]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("`gap` is not a column"));
+}
