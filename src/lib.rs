@@ -17,6 +17,7 @@ pub mod gpu;
 pub mod model;
 pub mod output;
 pub mod paper;
+pub mod parquet_out;
 pub mod plan;
 pub mod plot;
 pub mod propagator;

@@ -96,6 +96,19 @@ struct SweepArgs {
     /// With --aggregate: count runs with COLUMN > THRESHOLD (e.g. peak_force_n=1e6); repeatable.
     #[arg(long, value_name = "COLUMN=THRESHOLD", requires = "aggregate")]
     exceed: Vec<String>,
+    /// Output format: csv (journaled, resumable) or parquet (typed columns, the plan
+    /// fingerprint in its metadata).
+    #[arg(long, value_enum, default_value = "csv")]
+    format: FormatArg,
+    /// Write only these columns (comma-separated; `run` is always kept, first).
+    #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
+    columns: Option<Vec<String>>,
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum FormatArg {
+    Csv,
+    Parquet,
 }
 
 /// Where a sweep's rows go: a CSV row per run (journaled for --resume), or folded into a
@@ -105,6 +118,11 @@ enum Rows {
         out: Box<CsvOut>,
         progress: Progress,
         progress_file: PathBuf,
+        columns: Option<Vec<usize>>,
+    },
+    Parquet {
+        out: Box<pounding::parquet_out::ParquetOut>,
+        columns: Option<Vec<usize>>,
     },
     Summary {
         agg: pounding::aggregate::Aggregator,
@@ -125,11 +143,22 @@ impl Rows {
                 out,
                 progress,
                 progress_file,
+                columns,
             } => {
-                out.write(rows.iter().map(|(s, o)| pounding::output::row(plan, s, o)))?;
+                out.write(
+                    rows.iter()
+                        .map(|(s, o)| pick(pounding::output::row(plan, s, o), columns)),
+                )?;
                 progress.bytes = out.sync()?;
                 progress.done += rows.len() as u64;
                 write_toml(progress_file, progress)?;
+            }
+            Rows::Parquet { out, columns } => {
+                let cells: Vec<Vec<String>> = rows
+                    .iter()
+                    .map(|(s, o)| pick(pounding::output::row(plan, s, o), columns))
+                    .collect();
+                out.write(&cells)?;
             }
             Rows::Summary { agg, seen } => {
                 for (s, o) in rows {
@@ -140,6 +169,14 @@ impl Rows {
             }
         }
         Ok(())
+    }
+}
+
+/// The cells of `columns` (all of them without).
+fn pick(row: Vec<String>, columns: &Option<Vec<usize>>) -> Vec<String> {
+    match columns {
+        Some(c) => c.iter().map(|&i| row[i].clone()).collect(),
+        None => row,
     }
 }
 
@@ -448,7 +485,29 @@ fn sweep(a: SweepArgs) -> Result<()> {
         resume,
         aggregate,
         exceed,
+        format,
+        columns,
     } = a;
+    if format == FormatArg::Parquet && resume {
+        bail!("--resume continues CSV output only: a Parquet file is readable only once its footer is written at the end");
+    }
+    if aggregate.is_some() && (format == FormatArg::Parquet || columns.is_some()) {
+        bail!("--aggregate writes its own summary columns: --format and --columns do not apply");
+    }
+    let picked = columns
+        .as_ref()
+        .map(|c| pounding::output::select(c))
+        .transpose()
+        .map_err(|bad| {
+            anyhow::anyhow!(
+                "--columns: `{bad}` is not a column; the columns are: {}",
+                pounding::output::header().join(", ")
+            )
+        })?;
+    let picked_names: Option<Vec<String>> = picked.as_ref().map(|ix| {
+        let h = pounding::output::header();
+        ix.iter().map(|&i| h[i].to_string()).collect()
+    });
     if aggregate.is_some() && (resume || shard.is_some()) {
         bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
     }
@@ -511,6 +570,7 @@ fn sweep(a: SweepArgs) -> Result<()> {
             Some(_) => format!("gpu-{}", precision.key()),
             None => "cpu".into(),
         },
+        columns: picked_names.clone(),
     };
     let (mut rows, done, partial) = match &aggregate {
         Some(by) => (
@@ -521,6 +581,24 @@ fn sweep(a: SweepArgs) -> Result<()> {
             0,
             output.clone(),
         ),
+        None if format == FormatArg::Parquet => {
+            let names: Vec<&str> = match &picked_names {
+                Some(n) => n.iter().map(String::as_str).collect(),
+                None => pounding::output::header(),
+            };
+            let out = pounding::parquet_out::ParquetOut::create(&output, &names, &meta)
+                .with_context(|| format!("cannot create {}", output.display()))?;
+            let mut partial = output.clone().into_os_string();
+            partial.push(".partial");
+            (
+                Rows::Parquet {
+                    out: Box::new(out),
+                    columns: picked.clone(),
+                },
+                0,
+                PathBuf::from(partial),
+            )
+        }
         None => {
             let Some((mut out, done)) = open_output(&output, &meta, resume)? else {
                 return Ok(());
@@ -540,6 +618,7 @@ fn sweep(a: SweepArgs) -> Result<()> {
                     out: Box::new(out),
                     progress,
                     progress_file,
+                    columns: picked.clone(),
                 },
                 done,
                 partial,
@@ -638,6 +717,9 @@ fn sweep(a: SweepArgs) -> Result<()> {
     // Sidecar first: a crash between the two leaves a resumable, not an unlabelled, output.
     write_toml(&meta_path(&output), &meta)?;
     let path = match rows {
+        Rows::Parquet { out, .. } => out
+            .finish()
+            .with_context(|| format!("finishing {}", output.display()))?,
         Rows::Csv {
             out, progress_file, ..
         } => {
@@ -698,6 +780,9 @@ fn open_output(
             if p.meta.backend != meta.backend {
                 return Err(cannot("the backend (--backend, --precision)"));
             }
+            if p.meta.columns != meta.columns {
+                return Err(cannot("the columns (--columns)"));
+            }
             let out = CsvOut::resume(output, p.bytes)
                 .with_context(|| format!("resuming {}", output.display()))?;
             return Ok(Some((out, p.done)));
@@ -722,8 +807,12 @@ fn open_output(
             progress_file.display()
         );
     }
-    let out =
-        CsvOut::create(output).with_context(|| format!("cannot create {}", output.display()))?;
+    let names: Vec<&str> = match &meta.columns {
+        Some(c) => c.iter().map(String::as_str).collect(),
+        None => pounding::output::header(),
+    };
+    let out = CsvOut::create_with(output, &names)
+        .with_context(|| format!("cannot create {}", output.display()))?;
     Ok(Some((out, 0)))
 }
 

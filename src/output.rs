@@ -118,6 +118,20 @@ pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
     ]
 }
 
+/// Indices into [`header`] of `names` (`run` first, added if missing), or the first name that is
+/// not a column.
+pub fn select(names: &[String]) -> Result<Vec<usize>, String> {
+    let h = header();
+    let mut idx = vec![0];
+    for n in names {
+        let i = h.iter().position(|c| c == n).ok_or_else(|| n.clone())?;
+        if !idx.contains(&i) {
+            idx.push(i);
+        }
+    }
+    Ok(idx)
+}
+
 /// All column names.
 pub fn header() -> Vec<&'static str> {
     COLUMNS
@@ -136,12 +150,17 @@ pub struct CsvOut {
 
 impl CsvOut {
     pub fn create(path: &Path) -> std::io::Result<CsvOut> {
+        CsvOut::create_with(path, &header())
+    }
+
+    /// As [`CsvOut::create`], with the header `columns`.
+    pub fn create_with(path: &Path, columns: &[&str]) -> std::io::Result<CsvOut> {
         let mut partial = path.as_os_str().to_owned();
         partial.push(".partial");
         let partial = PathBuf::from(partial);
         let file = File::create(&partial)?;
         let mut w = csv::Writer::from_writer(BufWriter::new(file));
-        w.write_record(header()).map_err(std::io::Error::other)?;
+        w.write_record(columns).map_err(std::io::Error::other)?;
         Ok(CsvOut {
             path: path.into(),
             partial,

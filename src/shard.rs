@@ -139,6 +139,9 @@ pub struct Meta {
     /// Where the runs were integrated: `cpu`, `gpu-f32` or `gpu-f64` (a resumed sweep must keep
     /// it; merged shards may mix them).
     pub backend: String,
+    /// The columns written, when `--columns` chose them (all otherwise).
+    #[serde(default)]
+    pub columns: Option<Vec<String>>,
 }
 
 /// `OUT.meta.toml` for the output `OUT`.
@@ -265,8 +268,22 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
             ),
         ));
     }
-    let mut w = crate::output::CsvOut::create(out).map_err(|e| fail(out, e.to_string()))?;
-    let header = crate::output::header();
+    let header: Vec<String> = match &first.columns {
+        Some(c) => c.clone(),
+        None => crate::output::header()
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+    };
+    if parts.iter().any(|(_, m)| m.columns != first.columns) {
+        return Err(fail(
+            out,
+            "the inputs hold different columns (--columns)".into(),
+        ));
+    }
+    let names: Vec<&str> = header.iter().map(String::as_str).collect();
+    let mut w =
+        crate::output::CsvOut::create_with(out, &names).map_err(|e| fail(out, e.to_string()))?;
     let mut rows = 0u64;
     for (p, m) in &parts {
         let mut r = csv::Reader::from_path(p).map_err(|e| fail(p, e.to_string()))?;
@@ -277,7 +294,10 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
             .map(String::from)
             .collect();
         if h != header {
-            return Err(fail(p, "its columns differ from this engine's".into()));
+            return Err(fail(
+                p,
+                "its columns differ from its sidecar's (not a `pound sweep` CSV?)".into(),
+            ));
         }
         let mut expect = m.first_run;
         for (line, rec) in r.records().enumerate() {
@@ -315,6 +335,7 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
         end_run: first.plan_runs,
         shard: None,
         backend: backends.join("+"),
+        columns: first.columns.clone(),
     };
     write_toml(&meta_path(out), &merged)?;
     w.finish().map_err(|e| fail(out, e.to_string()))?;

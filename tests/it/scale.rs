@@ -346,3 +346,60 @@ fn aggregate_matches_the_per_run_output() {
     let bad = sweep(&cfg, &agg, &["--aggregate", "gap"]);
     assert!(String::from_utf8_lossy(&bad.stderr).contains("`gap` is not a column"));
 }
+
+/// `--format parquet` holds the CSV's values, typed (an empty cell is a null), with the plan
+/// fingerprint in its metadata; `--columns` keeps `run` and the named columns, in CSV and
+/// Parquet alike.
+#[test]
+fn parquet_and_columns_hold_the_csv_values() {
+    use parquet::file::reader::{FileReader, SerializedFileReader};
+    let d = tempdir();
+    let cfg = setup(d.path());
+    let csv_out = d.path().join("runs.csv");
+    ok(&sweep(&cfg, &csv_out, &[]));
+    let pq = d.path().join("runs.parquet");
+    ok(&sweep(&cfg, &pq, &["--format", "parquet"]));
+    let reader = SerializedFileReader::new(std::fs::File::open(&pq).unwrap()).unwrap();
+    let md = reader.metadata().file_metadata();
+    let kv = md.key_value_metadata().unwrap();
+    let plan_fp = kv
+        .iter()
+        .find(|k| k.key == "pound.fingerprint.plan")
+        .and_then(|k| k.value.clone())
+        .unwrap();
+    let sidecar = std::fs::read_to_string(d.path().join("runs.parquet.meta.toml")).unwrap();
+    assert!(
+        sidecar.contains(&format!("plan = \"{plan_fp}\"")),
+        "{sidecar}"
+    );
+    let mut r = csv::Reader::from_path(&csv_out).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();
+    assert_eq!(md.num_rows() as usize, rows.len());
+    for (row, rec) in reader.get_row_iter(None).unwrap().zip(&rows) {
+        let row = row.unwrap();
+        for ((name, field), cell) in row.get_column_iter().zip(rec.iter()) {
+            let i = header.iter().position(|h| h == name).unwrap();
+            assert_eq!(&header[i], name);
+            let text = match field {
+                parquet::record::Field::Null => String::new(),
+                parquet::record::Field::Str(s) => s.clone(),
+                parquet::record::Field::Long(v) => v.to_string(),
+                parquet::record::Field::Double(v) => v.to_string(),
+                other => panic!("{name}: unexpected {other:?}"),
+            };
+            if let (Ok(a), Ok(b)) = (text.parse::<f64>(), cell.parse::<f64>()) {
+                assert_eq!(a, b, "{name}");
+            } else {
+                assert_eq!(text, cell, "{name}");
+            }
+        }
+    }
+    let some = d.path().join("some.csv");
+    ok(&sweep(&cfg, &some, &["--columns", "gap_m,peak_force_n"]));
+    let text = std::fs::read_to_string(&some).unwrap();
+    assert_eq!(text.lines().next().unwrap(), "run,gap_m,peak_force_n");
+    assert_eq!(text.lines().count(), rows.len() + 1);
+    let bad = sweep(&cfg, &some, &["--columns", "gap"]);
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("`gap` is not a column"));
+}
