@@ -403,3 +403,19 @@ fn parquet_and_columns_hold_the_csv_values() {
     let bad = sweep(&cfg, &some, &["--columns", "gap"]);
     assert!(String::from_utf8_lossy(&bad.stderr).contains("`gap` is not a column"));
 }
+
+/// An output that cannot be created is a clear error naming it, and leaves nothing behind.
+#[test]
+fn unwritable_output_is_a_clear_error() {
+    let d = tempdir();
+    let cfg = setup(d.path());
+    let out = d.path().join("no-such-dir").join("runs.csv");
+    let r = sweep(&cfg, &out, &[]);
+    assert!(!r.status.success());
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("cannot create") && err.contains("no-such-dir"),
+        "{err}"
+    );
+    assert!(!d.path().join("no-such-dir").exists());
+}
