@@ -20,7 +20,7 @@ fn sweeps(c: &mut Criterion) {
                     precision,
                     ..Default::default()
                 };
-                ctx.kernel(precision).expect("kernel compiles");
+                ctx.kernel(precision, false).expect("kernel compiles");
                 g.bench_function(format!("gpu_{}", precision.key()), |b| {
                     b.iter(|| pounding::bench::gpu(&plan, &ctx, &opts, 65536).expect("gpu sweep"))
                 });

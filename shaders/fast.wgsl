@@ -111,8 +111,8 @@ const LOCATE_ITER: u32 = 16u;
 @group(0) @binding(6) var<storage, read_write> active_runs: atomic<u32>;
 @group(0) @binding(7) var<storage, read> run_ids: array<u32>;
 @group(0) @binding(8) var<storage, read_write> next_ids: array<u32>;
-// Exact free-step energy integrals, FORMS reals per run (layout::forms); read only when
-// `disp.energy` is 1 (otherwise a one-element placeholder).
+// Exact free-step energy integrals, FORMS reals per run (layout::forms); read only in the ENERGY
+// variant (otherwise a one-element placeholder).
 @group(0) @binding(9) var<storage, read> forms: array<real>;
 
 // This invocation's run.
@@ -245,8 +245,8 @@ fn rhs(mode: u32, v0: real, ag: real, z: Z) -> Z {
         z.v2,
         (-P.c2 * z.v2 - P.k2 * z.u2 + f) / P.m2 - ag,
         f * ddelta(z),
-        -ag * (P.m1 * z.v1 + P.m2 * z.v2),
-        P.c1 * z.v1 * z.v1 + P.c2 * z.v2 * z.v2,
+        select(0.0, -ag * (P.m1 * z.v1 + P.m2 * z.v2), ENERGY),
+        select(0.0, P.c1 * z.v1 * z.v1 + P.c2 * z.v2 * z.v2, ENERGY),
     );
 }
 
@@ -542,7 +542,9 @@ fn track_free_step(seg: Seg, z0: Z, z1: Z) {
     let a20 = (-P.c2 * z0.v2 - P.k2 * z0.u2) / P.m2 - seg.a0;
     let a21 = (-P.c2 * z1.v2 - P.k2 * z1.u2) / P.m2 - seg.a1;
     S.peak_u2 = max(S.peak_u2, quintic_peak_abs(z0.u2, z1.u2, z0.v2, z1.v2, a20, a21, seg.dt));
-    S.e_peak = max(S.e_peak, z1.ein);
+    if (ENERGY) {
+        S.e_peak = max(S.e_peak, z1.ein);
+    }
 }
 
 fn track_step(mode: u32, tau0: real, h: real, z0: Z, z1: Z) {
@@ -550,7 +552,9 @@ fn track_step(mode: u32, tau0: real, h: real, z0: Z, z1: Z) {
     S.peak_u1 = max(max(S.peak_u1, abs(r1.hi)), abs(r1.lo));
     let r2 = hermite_range(z0.u2, z0.v2, z1.u2, z1.v2, h);
     S.peak_u2 = max(max(S.peak_u2, abs(r2.hi)), abs(r2.lo));
-    S.e_peak = max(S.e_peak, z1.ein);
+    if (ENERGY) {
+        S.e_peak = max(S.e_peak, z1.ein);
+    }
     if (mode != MODE_FREE) {
         S.contact_time = S.contact_time + h;
         let rd = hermite_range(delta(z0), ddelta(z0), delta(z1), ddelta(z1), h);
@@ -646,7 +650,7 @@ fn accept(tau: real, h_in: real, trial_in: Z, seg: Seg, z0: Z, out: ptr<function
 fn finite(z: Z) -> bool {
     // abs(x) <= BIG is false for NaN and for +-inf.
     return abs(z.u1) <= BIG && abs(z.v1) <= BIG && abs(z.u2) <= BIG && abs(z.v2) <= BIG
-        && abs(z.w) <= BIG && abs(z.ein) <= BIG && abs(z.ed) <= BIG;
+        && abs(z.w) <= BIG && (!ENERGY || (abs(z.ein) <= BIG && abs(z.ed) <= BIG));
 }
 
 // propagator::quadratic: y^T form y for y = [u, v, a0, a1], the form's 10 upper-triangle
@@ -675,7 +679,7 @@ fn begin_interval(seg: Seg) {
         let v2 = P.p2_vu * z0.u2 + P.p2_vv * z0.v2 + P.p2_va0 * seg.a0 + P.p2_va1 * seg.a1;
         var z1 = Z(u1, v1, u2, v2, z0.w, z0.ein, z0.ed);
         if (!may_touch(seg, z0, z1, dt, S.v0)) {
-            if (disp.energy == 1u) {
+            if (ENERGY) {
                 // fast.rs: the exact free-step input and damping work (EnergyForms::integrals).
                 let b = R * FORMS;
                 let vv1 = quadratic(b, z0.u1, z0.v1, seg.a0, seg.a1);

@@ -393,6 +393,14 @@ enum RecordCmd {
 }
 
 fn main() -> std::process::ExitCode {
+    // Like other command-line tools, end quietly when a reader such as `head` closes the pipe
+    // (Rust ignores SIGPIPE, and printing to a closed pipe then panics). An interrupted sweep
+    // keeps its finished chunks for --resume.
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of one signal before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     match run(Cli::parse()) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
@@ -862,7 +870,7 @@ fn bench(
                 ..Default::default()
             };
             // The first call compiles the kernel; keep that out of the figures.
-            ctx.kernel(precision)?;
+            ctx.kernel(precision, false)?;
             let r = pounding::bench::gpu(&plan, ctx, &opts, chunk)?;
             eprintln!("{} runs on GPU: {:.0} runs/s", r.runs, r.runs_per_second());
             rows.push(r);

@@ -64,6 +64,9 @@ pub struct Kernel {
     pub layout: wgpu::BindGroupLayout,
 }
 
+/// A compiled variant: precision, and whether it integrates the energy balance.
+type KernelKey = (Precision, bool);
+
 /// Device, queue and compiled kernels, created once per process (or per test).
 pub struct GpuContext {
     pub device: wgpu::Device,
@@ -71,7 +74,7 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// Errors reported outside an explicit check (validation, out of memory, device loss).
     errors: Arc<Mutex<Option<GpuError>>>,
-    kernels: Mutex<Vec<(Precision, Arc<Kernel>)>>,
+    kernels: Mutex<Vec<(KernelKey, Arc<Kernel>)>>,
 }
 
 impl GpuContext {
@@ -150,10 +153,11 @@ impl GpuContext {
         self.errors.lock().unwrap().take()
     }
 
-    /// The fast-scheme kernel in `precision`, compiled on first use.
-    pub fn kernel(&self, precision: Precision) -> Result<Arc<Kernel>, GpuError> {
+    /// The fast-scheme kernel in `precision`, with or without the energy balance, compiled on
+    /// first use.
+    pub fn kernel(&self, precision: Precision, energy: bool) -> Result<Arc<Kernel>, GpuError> {
         let mut ks = self.kernels.lock().unwrap();
-        if let Some((_, k)) = ks.iter().find(|(p, _)| *p == precision) {
+        if let Some((_, k)) = ks.iter().find(|(p, _)| *p == (precision, energy)) {
             return Ok(k.clone());
         }
         if precision == Precision::F64 && !self.supports_f64() {
@@ -161,12 +165,12 @@ impl GpuContext {
                 adapter: self.info.name.clone(),
             });
         }
-        let k = Arc::new(self.compile(precision)?);
-        ks.push((precision, k.clone()));
+        let k = Arc::new(self.compile(precision, energy)?);
+        ks.push(((precision, energy), k.clone()));
         Ok(k)
     }
 
-    fn compile(&self, precision: Precision) -> Result<Kernel, GpuError> {
+    fn compile(&self, precision: Precision, energy: bool) -> Result<Kernel, GpuError> {
         let d = &self.device;
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
         let desc = wgpu::ShaderModuleDescriptor {
@@ -174,7 +178,7 @@ impl GpuContext {
                 Precision::F32 => "fast.wgsl f32",
                 Precision::F64 => "fast.wgsl f64",
             }),
-            source: wgpu::ShaderSource::Wgsl(fast_source(precision).into()),
+            source: wgpu::ShaderSource::Wgsl(fast_source(precision, energy).into()),
         };
         let module = d.create_shader_module(desc);
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {

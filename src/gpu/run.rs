@@ -319,7 +319,7 @@ pub fn run_chunk(
     if runs.is_empty() {
         return Ok((Vec::new(), times));
     }
-    let kernel = ctx.kernel(opts.precision)?;
+    let kernel = ctx.kernel(opts.precision, opts.fast.energy)?;
     let n = runs.len();
     let t = Instant::now();
     let params: Vec<u8> = match opts.precision {

@@ -253,3 +253,21 @@ fn accuracy_writes_table_csv_and_plot() {
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(err.contains("--settings: 0.5 is out of range"), "{err}");
 }
+
+/// A reader that closes the pipe early (`| head`) ends `pound` quietly, not with a panic.
+#[test]
+fn closed_pipe_ends_quietly() {
+    let r = std::process::Command::new("bash")
+        .args([
+            "-c",
+            &format!(
+                "'{}' formulas --e 0.1:1:0.001 | head -1",
+                env!("CARGO_BIN_EXE_pound")
+            ),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(String::from_utf8_lossy(&r.stdout).lines().count(), 1);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+}

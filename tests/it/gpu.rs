@@ -4,7 +4,7 @@ use pounding::gpu::layout::{self, Layout};
 use pounding::gpu::shader::{fast_source, Precision};
 
 fn parse(precision: Precision) -> naga::Module {
-    let src = fast_source(precision);
+    let src = fast_source(precision, true);
     let module =
         naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
     let mut v = naga::valid::Validator::new(
