@@ -71,7 +71,7 @@ struct Dispatch {
     max_substeps_per_step: u32,
     max_substeps: u32,
     handoff_substeps_per_step: u32,
-    energy: u32,
+    _pad1: u32,
     _pad2: u32,
     _pad3: u32,
 }

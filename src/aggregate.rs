@@ -6,6 +6,7 @@
 //! `g = 1.02`); max and mean are exact.
 
 use crate::output::header;
+use std::collections::hash_map::Entry;
 use std::collections::{BTreeMap, HashMap};
 
 /// Outputs summarised per group.
@@ -101,6 +102,8 @@ pub struct Aggregator {
     outputs: Vec<usize>,
     status: usize,
     groups: HashMap<Vec<String>, Group>,
+    /// Group keys in the order of their first run (the summary's row order).
+    order: Vec<Vec<String>>,
 }
 
 impl Aggregator {
@@ -137,6 +140,7 @@ impl Aggregator {
                 .collect(),
             status: col("status").expect("status column"),
             groups: HashMap::new(),
+            order: Vec::new(),
         })
     }
 
@@ -144,11 +148,17 @@ impl Aggregator {
     pub fn add(&mut self, row: &[String]) {
         let key: Vec<String> = self.by.iter().map(|(_, i)| row[*i].clone()).collect();
         let (ne, no) = (self.exceed.len(), self.outputs.len());
-        let g = self.groups.entry(key).or_insert_with(|| Group {
-            exceed: vec![0; ne],
-            stats: vec![Sketch::default(); no],
-            ..Default::default()
-        });
+        let g = match self.groups.entry(key) {
+            Entry::Occupied(e) => e.into_mut(),
+            Entry::Vacant(e) => {
+                self.order.push(e.key().clone());
+                e.insert(Group {
+                    exceed: vec![0; ne],
+                    stats: vec![Sketch::default(); no],
+                    ..Default::default()
+                })
+            }
+        };
         g.runs += 1;
         if row[self.status] != "ok" {
             g.failures += 1;
@@ -168,7 +178,7 @@ impl Aggregator {
     }
 
     /// The summary as CSV, groups in the order of their first run.
-    pub fn csv(&self, order: &[Vec<String>]) -> String {
+    pub fn csv(&self) -> String {
         let mut head: Vec<String> = self.by.iter().map(|(b, _)| b.clone()).collect();
         head.push("runs".into());
         head.push("failures".into());
@@ -184,7 +194,7 @@ impl Aggregator {
         }
         let mut w = csv::Writer::from_writer(Vec::new());
         w.write_record(&head).expect("in memory");
-        for key in order {
+        for key in &self.order {
             let g = &self.groups[key];
             let mut r = key.clone();
             r.push(g.runs.to_string());
@@ -200,28 +210,6 @@ impl Aggregator {
             w.write_record(&r).expect("in memory");
         }
         String::from_utf8(w.into_inner().expect("in memory")).expect("utf-8")
-    }
-}
-
-/// Remembers the order in which group keys first appear (so the summary follows run order).
-#[derive(Debug, Default)]
-pub struct FirstSeen {
-    seen: std::collections::HashSet<Vec<String>>,
-    pub order: Vec<Vec<String>>,
-}
-
-impl FirstSeen {
-    pub fn note(&mut self, key: Vec<String>) {
-        if self.seen.insert(key.clone()) {
-            self.order.push(key);
-        }
-    }
-}
-
-impl Aggregator {
-    /// The group key of a row.
-    pub fn key(&self, row: &[String]) -> Vec<String> {
-        self.by.iter().map(|(_, i)| row[*i].clone()).collect()
     }
 }
 

@@ -124,10 +124,7 @@ enum Rows {
         out: Box<pounding::parquet_out::ParquetOut>,
         columns: Option<Vec<usize>>,
     },
-    Summary {
-        agg: pounding::aggregate::Aggregator,
-        seen: pounding::aggregate::FirstSeen,
-    },
+    Summary(pounding::aggregate::Aggregator),
 }
 
 impl Rows {
@@ -160,11 +157,9 @@ impl Rows {
                     .collect();
                 out.write(&cells)?;
             }
-            Rows::Summary { agg, seen } => {
+            Rows::Summary(agg) => {
                 for (s, o) in rows {
-                    let r = pounding::output::row(plan, s, o);
-                    seen.note(agg.key(&r));
-                    agg.add(&r);
+                    agg.add(&pounding::output::row(plan, s, o));
                 }
             }
         }
@@ -582,29 +577,22 @@ fn sweep(a: SweepArgs) -> Result<()> {
     };
     let (mut rows, done, partial) = match &aggregate {
         Some(by) => (
-            Rows::Summary {
-                agg: pounding::aggregate::Aggregator::new(by, &exceed)?,
-                seen: Default::default(),
-            },
+            Rows::Summary(pounding::aggregate::Aggregator::new(by, &exceed)?),
             0,
             output.clone(),
         ),
         None if format == FormatArg::Parquet => {
-            let names: Vec<&str> = match &picked_names {
-                Some(n) => n.iter().map(String::as_str).collect(),
-                None => pounding::output::header(),
-            };
+            let names = pounding::output::header_for(meta.columns.as_deref());
             let out = pounding::parquet_out::ParquetOut::create(&output, &names, &meta)
                 .with_context(|| format!("cannot create {}", output.display()))?;
-            let mut partial = output.clone().into_os_string();
-            partial.push(".partial");
+            let partial = out.partial_path().to_path_buf();
             (
                 Rows::Parquet {
                     out: Box::new(out),
                     columns: picked.clone(),
                 },
                 0,
-                PathBuf::from(partial),
+                partial,
             )
         }
         None => {
@@ -738,8 +726,8 @@ fn sweep(a: SweepArgs) -> Result<()> {
                 .with_context(|| format!("removing {}", progress_file.display()))?;
             path
         }
-        Rows::Summary { agg, seen } => {
-            pounding::output::write_atomic(&output, agg.csv(&seen.order).as_bytes())
+        Rows::Summary(agg) => {
+            pounding::output::write_atomic(&output, agg.csv().as_bytes())
                 .with_context(|| format!("writing {}", output.display()))?;
             eprintln!("{} groups", agg.groups());
             output.clone()
@@ -815,12 +803,11 @@ fn open_output(
             progress_file.display()
         );
     }
-    let names: Vec<&str> = match &meta.columns {
-        Some(c) => c.iter().map(String::as_str).collect(),
-        None => pounding::output::header(),
-    };
-    let out = CsvOut::create_with(output, &names)
-        .with_context(|| format!("cannot create {}", output.display()))?;
+    let out = CsvOut::create_with(
+        output,
+        &pounding::output::header_for(meta.columns.as_deref()),
+    )
+    .with_context(|| format!("cannot create {}", output.display()))?;
     Ok(Some((out, 0)))
 }
 
@@ -942,11 +929,7 @@ fn fragility(a: FragilityArgs) -> Result<()> {
         im: a.im,
         edp: a.edp,
         thresholds: a.threshold,
-        filters: a
-            .filters
-            .iter()
-            .map(|f| pounding::table::Filter::parse(f))
-            .collect::<Result<Vec<_>, _>>()?,
+        filters: pounding::table::Filter::parse_all(&a.filters)?,
     };
     let (lv, skipped) = levels(&table, &spec)?;
     let runs: u64 = lv.first().map_or(0, |l| l.iter().map(|x| x.n).sum());
@@ -988,11 +971,7 @@ fn fragility(a: FragilityArgs) -> Result<()> {
 fn plot(a: PlotArgs) -> Result<()> {
     use pounding::sensitivity::{panel, Aggregate, PlotSpec};
     let table = pounding::table::Table::read(&a.results)?;
-    let filters = a
-        .filters
-        .iter()
-        .map(|f| pounding::table::Filter::parse(f))
-        .collect::<Result<Vec<_>, _>>()?;
+    let filters = pounding::table::Filter::parse_all(&a.filters)?;
     let spec = PlotSpec {
         x: a.x,
         y: a.y,

@@ -31,6 +31,11 @@ impl Oscillator {
         }
     }
 
+    /// Kinetic plus strain energy at displacement `u` and velocity `v`, J.
+    pub fn energy(&self, u: f64, v: f64) -> f64 {
+        0.5 * (self.m * v * v + self.k * u * u)
+    }
+
     /// A free mass (no spring, no dashpot): for isolated-collision problems.
     pub fn free(m: f64) -> Oscillator {
         Oscillator { m, k: 0.0, c: 0.0 }
@@ -158,4 +163,26 @@ pub struct EnergyBalance {
     /// `(initial + input - kinetic - strain - damping - contact work) / scale`, where the scale
     /// is the largest `initial + input` reached during the run (0 for a run that never moves).
     pub residual: f64,
+}
+
+impl EnergyBalance {
+    /// The balance of a run that started with `initial` J, took `input` from the ground, spent
+    /// `damping` in the dampers and `contact_work` in the contact, and holds `held` (kinetic plus
+    /// strain) at the end; `peak` is the largest `initial + input` seen.
+    pub fn close(
+        initial: f64,
+        input: f64,
+        damping: f64,
+        contact_work: f64,
+        held: f64,
+        peak: f64,
+    ) -> EnergyBalance {
+        let scale = peak.max(initial);
+        let r = initial + input - held - damping - contact_work;
+        EnergyBalance {
+            input,
+            damping,
+            residual: if scale > 0.0 { r / scale } else { 0.0 },
+        }
+    }
 }

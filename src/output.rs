@@ -155,9 +155,7 @@ impl CsvOut {
 
     /// As [`CsvOut::create`], with the header `columns`.
     pub fn create_with(path: &Path, columns: &[&str]) -> std::io::Result<CsvOut> {
-        let mut partial = path.as_os_str().to_owned();
-        partial.push(".partial");
-        let partial = PathBuf::from(partial);
+        let partial = sibling(path, ".partial");
         let file = File::create(&partial)?;
         let mut w = csv::Writer::from_writer(BufWriter::new(file));
         w.write_record(columns).map_err(std::io::Error::other)?;
@@ -171,9 +169,7 @@ impl CsvOut {
     /// Continue `path`'s `.partial` file, whose first `bytes` bytes hold the header and the rows
     /// of finished chunks: anything after them (a chunk cut off mid-write) is truncated.
     pub fn resume(path: &Path, bytes: u64) -> std::io::Result<CsvOut> {
-        let mut partial = path.as_os_str().to_owned();
-        partial.push(".partial");
-        let partial = PathBuf::from(partial);
+        let partial = sibling(path, ".partial");
         let file = std::fs::OpenOptions::new().write(true).open(&partial)?;
         let len = file.metadata()?.len();
         if len < bytes {
@@ -230,11 +226,25 @@ impl CsvOut {
     }
 }
 
+/// `path` with `suffix` appended to its name (`OUT` -> `OUT.partial`): the unfinished file and
+/// the sidecars of an output.
+pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
+    let mut p = path.as_os_str().to_owned();
+    p.push(suffix);
+    PathBuf::from(p)
+}
+
+/// The column names of an output: those `--columns` chose, or all of [`header`].
+pub fn header_for(columns: Option<&[String]>) -> Vec<&str> {
+    match columns {
+        Some(c) => c.iter().map(String::as_str).collect(),
+        None => header(),
+    }
+}
+
 /// Write `bytes` to `path` atomically (temporary file, fsync, rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".partial");
-    let tmp = PathBuf::from(tmp);
+    let tmp = sibling(path, ".partial");
     let mut f = File::create(&tmp)?;
     f.write_all(bytes)?;
     f.sync_all()?;

@@ -46,9 +46,7 @@ impl ParquetOut {
     /// Columns `columns` (names of `output::header`), and `meta` as key-value metadata
     /// (`pound.fingerprint.plan`, `.records`, `.engine`, `pound.runs`, `pound.backend`).
     pub fn create(path: &Path, columns: &[&str], meta: &Meta) -> std::io::Result<ParquetOut> {
-        let mut partial = path.as_os_str().to_owned();
-        partial.push(".partial");
-        let partial = PathBuf::from(partial);
+        let partial = crate::output::sibling(path, ".partial");
         let kinds: Vec<Kind> = columns.iter().map(|c| kind(c)).collect();
         let fields = columns
             .iter()
@@ -95,6 +93,10 @@ impl ParquetOut {
             kinds,
             writer,
         })
+    }
+
+    pub fn partial_path(&self) -> &Path {
+        &self.partial
     }
 
     /// One row group of `rows` (cells as in the CSV, in the columns given to `create`).

@@ -33,16 +33,21 @@ fn mul<const N: usize>(a: &[[f64; N]; N], b: &[[f64; N]; N]) -> [[f64; N]; N] {
     r
 }
 
-fn expm<const N: usize>(a: &[[f64; N]; N]) -> [[f64; N]; N] {
+/// Halvings that bring the row-sum norm of `a` to at most `limit` (scaling and squaring).
+fn halvings<const N: usize>(a: &[[f64; N]; N], limit: f64) -> i32 {
     let norm = a
         .iter()
         .map(|r| r.iter().map(|x| x.abs()).sum::<f64>())
         .fold(0.0, f64::max);
-    let s = if norm > 0.5 {
-        (norm / 0.5).log2().ceil() as i32
+    if norm > limit {
+        (norm / limit).log2().ceil() as i32
     } else {
         0
-    };
+    }
+}
+
+fn expm<const N: usize>(a: &[[f64; N]; N]) -> [[f64; N]; N] {
+    let s = halvings(a, 0.5);
     let f = 0.5f64.powi(s);
     let a = a.map(|r| r.map(|x| x * f));
     let mut result = [[0.0; N]; N];
@@ -133,15 +138,7 @@ impl EnergyForms {
     /// enough for no growth and the doubling `W(2h) = W(h) + E(h)^T W(h) E(h)` does the rest.
     pub fn new(o: &Oscillator, h: f64) -> EnergyForms {
         let a = augmented(o, h);
-        let norm = a
-            .iter()
-            .map(|r| r.iter().map(|x| x.abs()).sum::<f64>())
-            .fold(0.0, f64::max);
-        let s = if norm > 0.25 {
-            (norm / 0.25).log2().ceil() as i32
-        } else {
-            0
-        };
+        let s = halvings(&a, 0.25);
         let a = a.map(|r| r.map(|x| x * 0.5f64.powi(s)));
         let hs = h * 0.5f64.powi(s);
         // x = [u, v, f, g] with f = ag, g = (a1 - a0) / h: x0 = T y.

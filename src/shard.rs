@@ -105,25 +105,28 @@ pub fn shard_range(plan: &Plan, shard: Shard) -> Range<u64> {
         .iter()
         .map(|r| r.forcing(1.0, plan.spec.tail).intervals().max(1) as f64)
         .collect();
-    let total: f64 = (0..n).map(|i| costs[plan.run(i).record]).sum();
-    let cut = |k: u64| -> u64 {
-        if k == 0 {
-            return 0;
+    let cost = |i: u64| costs[plan.run(i).record];
+    let total: f64 = (0..n).map(cost).sum();
+    // Cut k is the first run at which the cost so far reaches k / N of the total; both cuts of
+    // this shard come from one pass.
+    let target = |k: u64| total * k as f64 / shard.count as f64;
+    let (lo, hi) = (shard.index, shard.index + 1);
+    let mut start = (lo == 0).then_some(0);
+    let mut end = (hi >= shard.count).then_some(n);
+    let mut acc = 0.0;
+    for i in 0..n {
+        if start.is_none() && acc >= target(lo) {
+            start = Some(i);
         }
-        if k >= shard.count {
-            return n;
+        if end.is_none() && acc >= target(hi) {
+            end = Some(i);
         }
-        let target = total * k as f64 / shard.count as f64;
-        let mut acc = 0.0;
-        for i in 0..n {
-            if acc >= target {
-                return i;
-            }
-            acc += costs[plan.run(i).record];
+        if start.is_some() && end.is_some() {
+            break;
         }
-        n
-    };
-    cut(shard.index)..cut(shard.index + 1)
+        acc += cost(i);
+    }
+    start.unwrap_or(n)..end.unwrap_or(n)
 }
 
 /// The sidecar of a finished output (`OUT.meta.toml`): what it was computed from and which runs
@@ -146,9 +149,7 @@ pub struct Meta {
 
 /// `OUT.meta.toml` for the output `OUT`.
 pub fn meta_path(out: &Path) -> PathBuf {
-    let mut p = out.as_os_str().to_owned();
-    p.push(".meta.toml");
-    PathBuf::from(p)
+    crate::output::sibling(out, ".meta.toml")
 }
 
 /// Progress of an unfinished output (`OUT.progress.toml`), rewritten atomically after each
@@ -162,9 +163,7 @@ pub struct Progress {
 }
 
 pub fn progress_path(out: &Path) -> PathBuf {
-    let mut p = out.as_os_str().to_owned();
-    p.push(".progress.toml");
-    PathBuf::from(p)
+    crate::output::sibling(out, ".progress.toml")
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -268,22 +267,15 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
             ),
         ));
     }
-    let header: Vec<String> = match &first.columns {
-        Some(c) => c.clone(),
-        None => crate::output::header()
-            .iter()
-            .map(|s| s.to_string())
-            .collect(),
-    };
     if parts.iter().any(|(_, m)| m.columns != first.columns) {
         return Err(fail(
             out,
             "the inputs hold different columns (--columns)".into(),
         ));
     }
-    let names: Vec<&str> = header.iter().map(String::as_str).collect();
+    let header = crate::output::header_for(first.columns.as_deref());
     let mut w =
-        crate::output::CsvOut::create_with(out, &names).map_err(|e| fail(out, e.to_string()))?;
+        crate::output::CsvOut::create_with(out, &header).map_err(|e| fail(out, e.to_string()))?;
     let mut rows = 0u64;
     for (p, m) in &parts {
         let mut r = csv::Reader::from_path(p).map_err(|e| fail(p, e.to_string()))?;

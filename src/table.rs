@@ -152,6 +152,11 @@ impl Filter {
         Ok(Filter { column, op, value })
     }
 
+    /// Every `--where` text, parsed.
+    pub fn parse_all(texts: &[String]) -> Result<Vec<Filter>, TableError> {
+        texts.iter().map(|t| Filter::parse(t)).collect()
+    }
+
     pub fn keeps(&self, cell: &str) -> bool {
         let num = cell.trim().parse::<f64>().ok();
         let want = self.value.parse::<f64>().ok();

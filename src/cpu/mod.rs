@@ -590,20 +590,13 @@ impl Tracker {
     /// The energy balance at state `z`.
     pub fn energy(&self, p: &Pair, z: &State) -> EnergyBalance {
         let held = mechanical_energy(p, z);
-        let scale = self.e_peak.max(self.e_initial);
-        let r = self.e_initial + z[5] - held - z[6] - z[4];
-        EnergyBalance {
-            input: z[5],
-            damping: z[6],
-            residual: if scale > 0.0 { r / scale } else { 0.0 },
-        }
+        EnergyBalance::close(self.e_initial, z[5], z[6], z[4], held, self.e_peak)
     }
 }
 
 /// Kinetic plus strain energy of both buildings, J.
 pub(crate) fn mechanical_energy(p: &Pair, z: &State) -> f64 {
-    let (b1, b2) = (&p.b1, &p.b2);
-    0.5 * (b1.m * z[1] * z[1] + b1.k * z[0] * z[0] + b2.m * z[3] * z[3] + b2.k * z[2] * z[2])
+    p.b1.energy(z[0], z[1]) + p.b2.energy(z[2], z[3])
 }
 
 /// The state of one run being integrated, shared by both schemes: they decide step lengths and

@@ -161,8 +161,7 @@ pub struct Dispatch {
     pub max_substeps: u32,
     /// A record step needing more substeps ends the run with `STATUS_HANDOFF`.
     pub handoff_substeps_per_step: u32,
-    /// 1: add the free steps' input and damping work from the `forms` buffer.
-    pub energy: u32,
+    pub _pad1: u32,
     pub _pad2: u32,
     pub _pad3: u32,
 }
@@ -217,7 +216,7 @@ impl Layout for Dispatch {
                 "handoff_substeps_per_step",
                 offset_of!(Dispatch, handoff_substeps_per_step),
             ),
-            ("energy", offset_of!(Dispatch, energy)),
+            ("_pad1", offset_of!(Dispatch, _pad1)),
             ("_pad2", offset_of!(Dispatch, _pad2)),
             ("_pad3", offset_of!(Dispatch, _pad3)),
         ]

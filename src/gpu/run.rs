@@ -9,7 +9,7 @@ use super::layout::{
 use super::shader::Precision;
 use crate::contact::LawKind;
 use crate::cpu::FastOptions;
-use crate::model::{EnergyBalance, Forcing, Pair, RunOutput, Status};
+use crate::model::{EnergyBalance, Forcing, Oscillator, Pair, RunOutput, Status};
 use crate::propagator::{EnergyForms, Propagator};
 use std::time::{Duration, Instant};
 
@@ -215,17 +215,18 @@ pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<R
         dissipated_energy: s.dissipated,
         substeps: c.substeps as u64,
         energy: energy.then(|| {
-            let held = 0.5
-                * (p.m1 * s.v1 * s.v1
-                    + p.k1 * s.u1 * s.u1
-                    + p.m2 * s.v2 * s.v2
-                    + p.k2 * s.u2 * s.u2);
-            let r = s.e_in - held - s.e_damp - s.w;
-            EnergyBalance {
-                input: s.e_in,
-                damping: s.e_damp,
-                residual: if s.e_peak > 0.0 { r / s.e_peak } else { 0.0 },
-            }
+            let b1 = Oscillator {
+                m: p.m1,
+                k: p.k1,
+                c: p.c1,
+            };
+            let b2 = Oscillator {
+                m: p.m2,
+                k: p.k2,
+                c: p.c2,
+            };
+            let held = b1.energy(s.u1, s.v1) + b2.energy(s.u2, s.v2);
+            EnergyBalance::close(0.0, s.e_in, s.e_damp, s.w, held, s.e_peak)
         }),
     })
 }
@@ -439,7 +440,6 @@ pub fn run_chunk(
         max_substeps_per_step: opts.fast.max_substeps_per_step,
         max_substeps: opts.fast.max_substeps,
         handoff_substeps_per_step: opts.handoff(),
-        energy: energy as u32,
         ..Default::default()
     };
     let active_staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
