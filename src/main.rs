@@ -204,7 +204,7 @@ struct PlotArgs {
     log_x: bool,
     #[arg(long)]
     log_y: bool,
-    /// Output: .svg, or .png (needs a TrueType font, see README).
+    /// Output: .svg, or .png (text in a font built into the binary).
     #[arg(short, long, default_value = "plot.svg")]
     output: PathBuf,
 }
