@@ -11,60 +11,8 @@
 // lavapipe's f64 pow/exp/sin are wrong, so every transcendental coefficient comes precomputed in
 // `Params`, and the one fifth root is an f32 seed refined by Newton steps in `real`.
 
+// Params, State, Meta, Counters and the MODE_/STATUS_ codes are in types.wgsl.
 // Keep in sync with src/gpu/layout.rs (the layout test checks sizes and offsets).
-struct Params {
-    m1: real, c1: real, k1: real, m2: real, c2: real, k2: real,
-    gap: real,
-    stiffness: real,
-    damping: real,
-    damping_ratio: real,
-    m_eff: real,
-    tc_coef: real,
-    dt: real, t0: real, scale: real,
-    substeps_per_contact: real,
-    p1_uu: real, p1_uv: real, p1_ua0: real, p1_ua1: real,
-    p1_vu: real, p1_vv: real, p1_va0: real, p1_va1: real,
-    p2_uu: real, p2_uv: real, p2_ua0: real, p2_ua1: real,
-    p2_vu: real, p2_vv: real, p2_va0: real, p2_va1: real,
-}
-
-struct State {
-    u1: real, v1: real, u2: real, v2: real,
-    w: real,
-    v0: real,
-    imp_peak: real,
-    h_t0: real, h_f0: real, h_t1: real, h_f1: real,
-    tau_onset: real,
-    tau: real,
-    peak_force: real, impact_velocity: real, peak_penetration: real, peak_u1: real, peak_u2: real,
-    first_impact: real,
-    contact_time: real,
-    dissipated: real,
-    e_in: real, e_damp: real, e_peak: real,
-}
-
-struct Meta {
-    law: u32,
-    rec_offset: u32,
-    rec_len: u32,
-    intervals: u32,
-}
-
-struct Counters {
-    mode: u32,
-    nhist: u32,
-    impacts: u32,
-    status: u32,
-    substeps: u32,
-    i_onset: u32,
-    i: u32,
-    j: u32,
-    m: u32,
-    pieces: u32,
-    _pad0: u32,
-    _pad1: u32,
-}
-
 struct Dispatch {
     budget: u32,
     nactive: u32,
@@ -76,7 +24,7 @@ struct Dispatch {
     _pad3: u32,
 }
 
-// Codes (keep in sync with LawKind::ALL order and the MODE_/STATUS_ constants in layout.rs).
+// Law codes (keep in sync with LawKind::ALL order).
 const LAW_LINEAR: u32 = 0u;
 const LAW_KELVIN_VOIGT: u32 = 1u;
 const LAW_KELVIN_VOIGT_NO_TENSION: u32 = 2u;
@@ -84,13 +32,6 @@ const LAW_MODIFIED_LINEAR: u32 = 3u;
 const LAW_HERTZ: u32 = 4u;
 const LAW_NONLINEAR_VISCOELASTIC: u32 = 5u;
 // 6..9: the Hunt-Crossley family.
-const MODE_FREE: u32 = 0u;
-const MODE_APPROACH: u32 = 1u;
-const MODE_RESTITUTION: u32 = 2u;
-const STATUS_OK: u32 = 0u;
-const STATUS_NON_FINITE: u32 = 1u;
-const STATUS_STEP_LIMIT: u32 = 2u;
-const STATUS_HANDOFF: u32 = 3u;
 // contact::HC_V0_MIN, contact::HERTZ floor on v, fast::MAX_PIECES_PER_SUBSTEP, fast::SUSTAINED.
 const HC_V0_MIN: real = 1e-3;
 const V_MIN: real = 1e-6;

@@ -1,16 +1,21 @@
-//! In-engine aggregation for sweeps too large to store run by run (`pound sweep --aggregate`):
-//! per group of swept parameters, run counts, exceedance counts for given thresholds, and the
-//! max, mean and quantiles of each output. Rows are folded in as chunks finish, so memory is
-//! bounded by the number of groups, not of runs. Quantiles come from a log-bucket sketch with a
-//! relative error of at most 1 % (DDSketch-style: a value's bucket is `ceil(log_g |x|)`,
-//! `g = 1.02`); max and mean are exact.
+//! In-engine aggregation for sweeps too large to store per run (`pound sweep --aggregate`): per
+//! group of swept parameters, run counts, exceedance counts for given thresholds, and the max,
+//! mean and quantiles of each output. Memory is bounded by the number of groups, not of runs.
+//!
+//! Quantiles come from a log-bucket histogram with a relative error of at most 1 % (a value's
+//! bucket is `ceil(log_g x)`, `g = 1.02`, DDSketch-style), over a fixed range
+//! [`SKETCH_MIN`, `SKETCH_MAX`] so that the GPU can keep it as a dense array of counters (see
+//! `shaders/aggregate.wgsl`, whose per-run body [`Group::add`] is the CPU twin of). Values below
+//! the range count as zero; values above it land in the top bucket, whose quantile is the exact
+//! max. Max and mean are exact.
 
-use crate::output::header;
-use std::collections::hash_map::Entry;
+use crate::model::{RunOutput, Status};
+use crate::output::{header, row};
+use crate::plan::{Intensity, Plan, RunSpec};
 use std::collections::{BTreeMap, HashMap};
 
 /// Outputs summarised per group.
-pub const OUTPUTS: [&str; 8] = [
+pub const OUTPUTS: [&str; NOUT] = [
     "impacts",
     "peak_force_n",
     "peak_penetration_m",
@@ -20,17 +25,62 @@ pub const OUTPUTS: [&str; 8] = [
     "contact_time_s",
     "dissipated_energy_j",
 ];
+pub const NOUT: usize = 8;
 
 /// Quantiles reported for each output.
 pub const QUANTILES: [f64; 3] = [0.5, 0.9, 0.99];
 
-const GAMMA: f64 = 1.02;
+/// Bucket growth factor: a bucket's midpoint is within 1 % of every value in it.
+pub const GAMMA: f64 = 1.02;
+/// Values below this (in the output's SI unit) count as zero.
+pub const SKETCH_MIN: f64 = 1e-12;
+/// Values above this share the top bucket.
+pub const SKETCH_MAX: f64 = 1e12;
+/// `ceil(log_g SKETCH_MIN)` and `ceil(log_g SKETCH_MAX)` (checked by a test).
+pub const KMIN: i32 = -1395;
+pub const KMAX: i32 = 1396;
+/// Buckets per output: the zero bucket, then `KMIN..=KMAX`.
+pub const BUCKETS: usize = (KMAX - KMIN + 2) as usize;
+/// Most `--exceed` thresholds one sweep may count.
+pub const MAX_EXCEED: usize = 8;
 
-/// Quantile sketch of non-negative values (outputs are magnitudes).
+/// The bucket of a non-negative value (0 for zero, tiny values and NaN).
+pub fn bucket(x: f64) -> usize {
+    if x.is_nan() || x < SKETCH_MIN {
+        return 0;
+    }
+    let k = (x.min(SKETCH_MAX).ln() / GAMMA.ln()).ceil() as i32;
+    (k.clamp(KMIN, KMAX) - KMIN + 1) as usize
+}
+
+/// The value a bucket stands for: its midpoint in the sense of relative error.
+pub fn bucket_value(b: usize) -> f64 {
+    if b == 0 {
+        return 0.0;
+    }
+    let k = b as i32 - 1 + KMIN;
+    2.0 * GAMMA.powi(k) / (1.0 + GAMMA)
+}
+
+/// The summarised outputs of a run, in [`OUTPUTS`] order, as magnitudes.
+pub fn outputs(o: &RunOutput) -> [f64; NOUT] {
+    [
+        o.impacts as f64,
+        o.peak_force,
+        o.peak_penetration,
+        o.peak_u1,
+        o.peak_u2,
+        o.impact_velocity,
+        o.contact_time,
+        o.dissipated_energy,
+    ]
+    .map(f64::abs)
+}
+
+/// Histogram, count, sum and max of one output's values in one group.
 #[derive(Debug, Clone, Default)]
 pub struct Sketch {
-    zeros: u64,
-    buckets: BTreeMap<i32, u64>,
+    buckets: BTreeMap<u32, u64>,
     count: u64,
     sum: f64,
     max: f64,
@@ -38,39 +88,54 @@ pub struct Sketch {
 
 impl Sketch {
     pub fn add(&mut self, x: f64) {
-        let x = x.abs();
         self.count += 1;
         self.sum += x;
         self.max = self.max.max(x);
-        if x < 1e-300 {
-            self.zeros += 1;
-        } else {
-            *self
-                .buckets
-                .entry((x.ln() / GAMMA.ln()).ceil() as i32)
-                .or_default() += 1;
+        *self.buckets.entry(bucket(x) as u32).or_default() += 1;
+    }
+
+    /// Fold in values summarised elsewhere (a device partial); their buckets come separately,
+    /// through [`Sketch::add_bucket`].
+    pub fn add_moments(&mut self, count: u64, sum: f64, max: f64) {
+        self.count += count;
+        self.sum += sum;
+        self.max = self.max.max(max);
+    }
+
+    pub fn add_bucket(&mut self, b: usize, n: u64) {
+        if n > 0 {
+            *self.buckets.entry(b as u32).or_default() += n;
         }
+    }
+
+    pub fn count(&self) -> u64 {
+        self.count
+    }
+
+    pub fn max(&self) -> f64 {
+        self.max
     }
 
     pub fn mean(&self) -> f64 {
         self.sum / self.count.max(1) as f64
     }
 
-    /// The `q` quantile, within 1 % of a value of the data at that rank.
+    /// The `q` quantile, within 1 % of a value of the data at that rank (for values inside the
+    /// sketch's range).
     pub fn quantile(&self, q: f64) -> f64 {
         if self.count == 0 {
             return f64::NAN;
         }
         let rank = (q * (self.count - 1) as f64).round() as u64;
-        if rank < self.zeros {
-            return 0.0;
-        }
-        let mut seen = self.zeros;
-        for (&k, &n) in &self.buckets {
+        let mut seen = 0;
+        for (&b, &n) in &self.buckets {
             seen += n;
             if seen > rank {
-                // The bucket's midpoint in the sense of relative error.
-                return 2.0 * GAMMA.powi(k) / (1.0 + GAMMA);
+                return if b as usize == BUCKETS - 1 {
+                    self.max
+                } else {
+                    bucket_value(b as usize).min(self.max)
+                };
             }
         }
         self.max
@@ -82,50 +147,211 @@ impl Sketch {
 pub struct Group {
     pub runs: u64,
     pub failures: u64,
+    /// Runs with at least one impact.
+    pub pounded: u64,
+    pub impacts: u64,
     pub exceed: Vec<u64>,
     pub stats: Vec<Sketch>,
 }
 
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum AggregateError {
-    #[error("--aggregate: `{0}` is not a column; group by swept parameters such as record, pga_g, gap_m, t1_s, law, e")]
-    NoColumn(String),
-    #[error("--exceed `{0}`: expected COLUMN=THRESHOLD with a numeric output column, e.g. peak_force_n=1e6")]
-    BadExceed(String),
+impl Group {
+    fn new(nexceed: usize) -> Group {
+        Group {
+            exceed: vec![0; nexceed],
+            stats: vec![Sketch::default(); NOUT],
+            ..Default::default()
+        }
+    }
+
+    /// Fold in one run: `exceed` holds (output index, threshold) pairs. Failed runs are
+    /// counted, not summarised. The per-run body of `shaders/aggregate.wgsl`, line for line.
+    pub fn add(&mut self, o: &RunOutput, exceed: &[(usize, f64)]) {
+        self.runs += 1;
+        if o.status != Status::Ok {
+            self.failures += 1;
+            return;
+        }
+        let x = outputs(o);
+        self.pounded += (o.impacts > 0) as u64;
+        self.impacts += o.impacts as u64;
+        for (k, &(i, t)) in exceed.iter().enumerate() {
+            self.exceed[k] += (x[i] > t) as u64;
+        }
+        for (s, &v) in self.stats.iter_mut().zip(&x) {
+            s.add(v);
+        }
+    }
+
+    /// Fold in a device partial (its histogram counts come through [`Group::add_histogram`]).
+    pub fn add_partial(&mut self, p: &Partial) {
+        self.runs += p.runs;
+        self.failures += p.failures;
+        self.pounded += p.pounded;
+        self.impacts += p.impacts;
+        for (e, n) in self.exceed.iter_mut().zip(&p.exceed) {
+            *e += n;
+        }
+        let ok = p.runs - p.failures;
+        for (o, s) in self.stats.iter_mut().enumerate() {
+            s.add_moments(ok, p.sum[o], p.max[o]);
+        }
+    }
+
+    /// Fold in bucket counts: [`NOUT`] outputs of [`BUCKETS`] counters each.
+    pub fn add_histogram(&mut self, counts: &[u32]) {
+        for (s, c) in self.stats.iter_mut().zip(counts.chunks_exact(BUCKETS)) {
+            for (b, &n) in c.iter().enumerate() {
+                s.add_bucket(b, n as u64);
+            }
+        }
+    }
 }
 
-/// Folds rows into groups.
+/// What the device folded for one segment of runs of one group (histograms aside); runs handed
+/// back to the CPU are not in it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Partial {
+    pub runs: u64,
+    pub failures: u64,
+    pub handoffs: u64,
+    pub pounded: u64,
+    pub impacts: u64,
+    pub exceed: [u64; MAX_EXCEED],
+    pub max: [f64; NOUT],
+    pub sum: [f64; NOUT],
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AggregateError {
+    #[error("--aggregate: `{0}` is not a swept-parameter column; group by columns such as record, pga_g, gap_m, t1_s, law, e")]
+    NoColumn(String),
+    #[error("--exceed `{0}`: expected COLUMN=THRESHOLD with an output column ({cols}), e.g. peak_force_n=1e6", cols = OUTPUTS.join(", "))]
+    BadExceed(String),
+    #[error("--exceed: at most {MAX_EXCEED} thresholds, {0} given")]
+    TooManyExceed(usize),
+}
+
+/// A swept-parameter column, as a key (floats by their bits; an absent value is `u64::MAX`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Param {
+    Run,
+    Law,
+    Formula,
+    E,
+    Damping,
+    K,
+    Beta,
+    Record,
+    TargetPga,
+    Scale,
+    Pga,
+    M1,
+    T1,
+    Xi1,
+    M2,
+    T2,
+    Xi2,
+    Gap,
+    Sample,
+}
+
+impl Param {
+    fn from_column(c: &str) -> Option<Param> {
+        use Param::*;
+        Some(match c {
+            "run" => Run,
+            "law" => Law,
+            "formula" => Formula,
+            "e" => E,
+            "impact_damping" => Damping,
+            "k_n_per_m" => K,
+            "beta_n_per_m1_5" => Beta,
+            "record" => Record,
+            "target_pga_g" => TargetPga,
+            "scale_factor" => Scale,
+            "pga_g" => Pga,
+            "m1_kg" => M1,
+            "t1_s" => T1,
+            "xi1" => Xi1,
+            "m2_kg" => M2,
+            "t2_s" => T2,
+            "xi2" => Xi2,
+            "gap_m" => Gap,
+            "sample" => Sample,
+            _ => return None,
+        })
+    }
+
+    fn key(self, s: &RunSpec) -> u64 {
+        const NONE: u64 = u64::MAX;
+        let bits = |x: Option<f64>| x.map_or(NONE, f64::to_bits);
+        let hertz = s.law.is_hertzian();
+        match self {
+            Param::Run => s.index,
+            Param::Law => s.law as u64,
+            Param::Formula => s.formula.map_or(NONE, |f| f as u64),
+            Param::E => bits(s.e),
+            Param::Damping => bits(s.law.is_damped().then_some(s.damping)),
+            Param::K => bits((!hertz).then_some(s.stiffness)),
+            Param::Beta => bits(hertz.then_some(s.stiffness)),
+            Param::Record => s.record as u64,
+            Param::TargetPga => bits(match s.intensity {
+                Intensity::PgaG(g) => Some(g),
+                Intensity::Scale(_) => None,
+            }),
+            Param::Scale => s.scale.to_bits(),
+            Param::Pga => s.pga_g.to_bits(),
+            Param::M1 => s.m1.to_bits(),
+            Param::T1 => s.t1.to_bits(),
+            Param::Xi1 => s.xi1.to_bits(),
+            Param::M2 => s.m2.to_bits(),
+            Param::T2 => s.t2.to_bits(),
+            Param::Xi2 => s.xi2.to_bits(),
+            Param::Gap => s.gap.to_bits(),
+            Param::Sample => s.sample.map_or(NONE, |i| i as u64),
+        }
+    }
+}
+
+/// Groups runs and folds their outputs in.
 #[derive(Debug, Clone)]
 pub struct Aggregator {
-    by: Vec<(String, usize)>,
+    /// Column name, its index in the CSV header, its key.
+    by: Vec<(String, usize, Param)>,
+    /// Column name, output index, threshold.
     exceed: Vec<(String, usize, f64)>,
-    outputs: Vec<usize>,
-    status: usize,
-    groups: HashMap<Vec<String>, Group>,
-    /// Group keys in the order of their first run (the summary's row order).
-    order: Vec<Vec<String>>,
+    ids: HashMap<Vec<u64>, u32>,
+    /// In the order of each group's first run (the summary's row order), with its labels.
+    groups: Vec<(Vec<String>, Group)>,
 }
 
 impl Aggregator {
     /// Group by the columns `by`; count runs whose `column > threshold` for each `exceed`.
     pub fn new(by: &[String], exceed: &[String]) -> Result<Aggregator, AggregateError> {
         let h = header();
-        let col = |name: &str| h.iter().position(|c| *c == name);
         let by = by
             .iter()
             .map(|b| {
-                col(b)
-                    .map(|i| (b.clone(), i))
-                    .ok_or_else(|| AggregateError::NoColumn(b.clone()))
+                let b = b.trim();
+                Param::from_column(b)
+                    .map(|p| {
+                        let i = h.iter().position(|c| *c == b).expect("parameter column");
+                        (b.to_string(), i, p)
+                    })
+                    .ok_or_else(|| AggregateError::NoColumn(b.to_string()))
             })
             .collect::<Result<_, _>>()?;
+        if exceed.len() > MAX_EXCEED {
+            return Err(AggregateError::TooManyExceed(exceed.len()));
+        }
         let exceed = exceed
             .iter()
             .map(|e| {
                 let bad = || AggregateError::BadExceed(e.clone());
                 let (c, t) = e.split_once('=').ok_or_else(bad)?;
-                let i = col(c.trim())
-                    .filter(|_| OUTPUTS.contains(&c.trim()))
+                let i = OUTPUTS
+                    .iter()
+                    .position(|o| *o == c.trim())
                     .ok_or_else(bad)?;
                 let t: f64 = t.trim().parse().map_err(|_| bad())?;
                 Ok((c.trim().to_string(), i, t))
@@ -134,43 +360,37 @@ impl Aggregator {
         Ok(Aggregator {
             by,
             exceed,
-            outputs: OUTPUTS
-                .iter()
-                .map(|o| col(o).expect("output column"))
-                .collect(),
-            status: col("status").expect("status column"),
-            groups: HashMap::new(),
-            order: Vec::new(),
+            ids: HashMap::new(),
+            groups: Vec::new(),
         })
     }
 
-    /// Fold in one run's row (`output::row`). Failed runs are counted, not summarised.
-    pub fn add(&mut self, row: &[String]) {
-        let key: Vec<String> = self.by.iter().map(|(_, i)| row[*i].clone()).collect();
-        let (ne, no) = (self.exceed.len(), self.outputs.len());
-        let g = match self.groups.entry(key) {
-            Entry::Occupied(e) => e.into_mut(),
-            Entry::Vacant(e) => {
-                self.order.push(e.key().clone());
-                e.insert(Group {
-                    exceed: vec![0; ne],
-                    stats: vec![Sketch::default(); no],
-                    ..Default::default()
-                })
-            }
-        };
-        g.runs += 1;
-        if row[self.status] != "ok" {
-            g.failures += 1;
-            return;
+    /// The (output index, threshold) pairs of `--exceed`.
+    pub fn thresholds(&self) -> Vec<(usize, f64)> {
+        self.exceed.iter().map(|&(_, i, t)| (i, t)).collect()
+    }
+
+    /// The group of a run (numbered in the order of first appearance).
+    pub fn group_of(&mut self, plan: &Plan, spec: &RunSpec) -> u32 {
+        let key: Vec<u64> = self.by.iter().map(|(_, _, p)| p.key(spec)).collect();
+        let next = self.groups.len() as u32;
+        let id = *self.ids.entry(key).or_insert(next);
+        if id == next {
+            let r = row(plan, spec, &RunOutput::default());
+            let label = self.by.iter().map(|(_, i, _)| r[*i].clone()).collect();
+            self.groups.push((label, Group::new(self.exceed.len())));
         }
-        let num = |i: usize| row[i].parse::<f64>().unwrap_or(0.0);
-        for (k, (_, i, t)) in self.exceed.iter().enumerate() {
-            g.exceed[k] += (num(*i) > *t) as u64;
-        }
-        for (k, &i) in self.outputs.iter().enumerate() {
-            g.stats[k].add(num(i));
-        }
+        id
+    }
+
+    pub fn group(&mut self, id: u32) -> &mut Group {
+        &mut self.groups[id as usize].1
+    }
+
+    /// Fold in one run of group `id`.
+    pub fn add(&mut self, id: u32, o: &RunOutput) {
+        let t = self.thresholds();
+        self.group(id).add(o, &t);
     }
 
     pub fn groups(&self) -> usize {
@@ -179,7 +399,7 @@ impl Aggregator {
 
     /// The summary as CSV, groups in the order of their first run.
     pub fn csv(&self) -> String {
-        let mut head: Vec<String> = self.by.iter().map(|(b, _)| b.clone()).collect();
+        let mut head: Vec<String> = self.by.iter().map(|(b, _, _)| b.clone()).collect();
         head.push("runs".into());
         head.push("failures".into());
         for (c, _, t) in &self.exceed {
@@ -194,9 +414,8 @@ impl Aggregator {
         }
         let mut w = csv::Writer::from_writer(Vec::new());
         w.write_record(&head).expect("in memory");
-        for key in &self.order {
-            let g = &self.groups[key];
-            let mut r = key.clone();
+        for (label, g) in &self.groups {
+            let mut r = label.clone();
             r.push(g.runs.to_string());
             r.push(g.failures.to_string());
             r.extend(g.exceed.iter().map(|n| n.to_string()));
@@ -218,6 +437,21 @@ mod tests {
     use super::*;
 
     #[test]
+    fn bucket_range_constants() {
+        assert_eq!((SKETCH_MIN.ln() / GAMMA.ln()).ceil() as i32, KMIN);
+        assert_eq!((SKETCH_MAX.ln() / GAMMA.ln()).ceil() as i32, KMAX);
+        assert_eq!(bucket(0.0), 0);
+        assert_eq!(bucket(f64::NAN), 0);
+        assert_eq!(bucket(1e-13), 0);
+        assert_eq!(bucket(SKETCH_MIN), 1);
+        assert_eq!(bucket(1e30), BUCKETS - 1);
+        for x in [1e-11, 3e-5, 1.0, 7.5, 2e6, 9e11] {
+            let v = bucket_value(bucket(x));
+            assert!((v - x).abs() <= 0.01 * x, "{x}: {v}");
+        }
+    }
+
+    #[test]
     fn sketch_quantiles_within_one_percent() {
         let mut s = Sketch::default();
         let xs: Vec<f64> = (0..10_000).map(|i| 1.0 + (i as f64).powf(1.7)).collect();
@@ -237,5 +471,24 @@ mod tests {
             );
         }
         assert_eq!(s.max, *sorted.last().unwrap());
+    }
+
+    #[test]
+    fn moments_and_buckets_merge_like_values() {
+        let xs = [0.0, 2.5, 3.0, 1e13, 4e-3];
+        let mut a = Sketch::default();
+        for x in xs {
+            a.add(x);
+        }
+        let mut b = Sketch::default();
+        b.add_moments(xs.len() as u64, xs.iter().sum(), 1e13);
+        for x in xs {
+            b.add_bucket(bucket(x), 1);
+        }
+        for q in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            assert_eq!(a.quantile(q), b.quantile(q));
+        }
+        assert_eq!(a.mean(), b.mean());
+        assert_eq!(a.quantile(1.0), 1e13, "the top bucket reports the max");
     }
 }

@@ -76,18 +76,18 @@ impl Row {
 /// Formats each chunk's rows as CSV into a sink, timing it (the cost a real sweep pays).
 struct CsvSink<'a> {
     plan: &'a Plan,
-    w: csv::Writer<std::io::Sink>,
+    w: std::io::Sink,
     seconds: f64,
 }
 
 impl CsvSink<'_> {
     fn write(&mut self, rows: &[(RunSpec, RunOutput)]) {
+        use std::io::Write;
         let t = Instant::now();
-        for (s, o) in rows {
-            self.w
-                .write_record(crate::output::row(self.plan, s, o))
-                .expect("writing to a sink cannot fail");
-        }
+        let lines = crate::output::encode_csv(self.plan, rows, None);
+        self.w
+            .write_all(&lines)
+            .expect("writing to a sink cannot fail");
         self.seconds += t.elapsed().as_secs_f64();
     }
 }
@@ -96,7 +96,7 @@ impl CsvSink<'_> {
 pub fn cpu(plan: &Plan) -> Row {
     let mut sink = CsvSink {
         plan,
-        w: csv::Writer::from_writer(std::io::sink()),
+        w: std::io::sink(),
         seconds: 0.0,
     };
     let s = crate::sweep::run(
@@ -134,7 +134,7 @@ pub fn gpu(
 ) -> Result<Row, GpuError> {
     let mut sink = CsvSink {
         plan,
-        w: csv::Writer::from_writer(std::io::sink()),
+        w: std::io::sink(),
         seconds: 0.0,
     };
     let (s, t) = crate::sweep::run_gpu(
@@ -158,6 +158,53 @@ pub fn gpu(
         readback: t.readback,
         handoff: t.handoff,
         csv: sink.seconds,
+        impacts: s.impacts,
+        handed_off: t.handed_off,
+    })
+}
+
+/// The GPU path with `--aggregate by` folded on the device: `readback` is the fold and its
+/// partials' readback, `csv` writing the summary.
+pub fn gpu_aggregate(
+    plan: &Plan,
+    ctx: &GpuContext,
+    opts: &GpuOptions,
+    chunk: usize,
+    by: &[String],
+) -> Result<Row, GpuError> {
+    let mut agg = crate::aggregate::Aggregator::new(by, &[]).map_err(|e| GpuError::Other {
+        message: e.to_string(),
+    })?;
+    let (s, t) = crate::sweep::run_gpu_aggregate(
+        plan,
+        0..plan.len(),
+        ctx,
+        opts,
+        chunk,
+        crate::gpu::reduce::DEFAULT_SLOTS,
+        &mut agg,
+        |_| {},
+    )?;
+    let c = Instant::now();
+    let summary = agg.csv();
+    let csv = c.elapsed().as_secs_f64();
+    Ok(Row {
+        runs: s.runs,
+        backend: format!(
+            "gpu {} ({}), --aggregate {} ({} groups, {} bytes)",
+            opts.precision.key(),
+            ctx.info.name,
+            by.join(","),
+            agg.groups(),
+            summary.len()
+        ),
+        seconds: s.seconds + csv,
+        pack: t.pack,
+        upload: t.upload,
+        kernel: t.kernel,
+        readback: t.aggregate,
+        handoff: t.handoff,
+        csv,
         impacts: s.impacts,
         handed_off: t.handed_off,
     })

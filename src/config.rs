@@ -326,12 +326,36 @@ pub struct RawConfig {
 
 /// Read and validate a config file.
 pub fn load(path: &Path) -> Result<Plan, ConfigError> {
+    load_with_text(path).map(|(plan, _)| plan)
+}
+
+/// [`load`], also returning the config's text (for [`changed_records`]).
+pub fn load_with_text(path: &Path) -> Result<(Plan, String), ConfigError> {
     let text = std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
         path: path.into(),
         error,
     })?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    parse(&text, path, &base, &records_dir())
+    let plan = parse(&text, path, &base, &records_dir())?;
+    Ok((plan, text))
+}
+
+/// The records of `plan` (from the config `text` at `path`) whose files no longer hold what was
+/// read, by name; or why they cannot be read again. A sweep reads its records once, so this
+/// finds files changed while it ran.
+pub fn changed_records(text: &str, path: &Path, plan: &Plan) -> Vec<String> {
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    match parse(text, path, &base, &records_dir()) {
+        Err(e) => vec![format!("the records can no longer be read ({e})")],
+        Ok(now) => plan
+            .spec
+            .records
+            .iter()
+            .zip(&now.spec.records)
+            .filter(|(a, b)| a != b)
+            .map(|(a, _)| format!("record `{}`", a.name))
+            .collect(),
+    }
 }
 
 /// Parse and validate config text. `path` names the file in errors; `base` resolves `path =`

@@ -142,36 +142,27 @@ impl Rows {
                 progress_file,
                 columns,
             } => {
-                out.write(
-                    rows.iter()
-                        .map(|(s, o)| pick(pounding::output::row(plan, s, o), columns)),
-                )?;
+                out.write_encoded(&pounding::output::encode_csv(
+                    plan,
+                    rows,
+                    columns.as_deref(),
+                ))?;
                 progress.bytes = out.sync()?;
                 progress.done += rows.len() as u64;
                 write_toml(progress_file, progress)?;
             }
             Rows::Parquet { out, columns } => {
-                let cells: Vec<Vec<String>> = rows
-                    .iter()
-                    .map(|(s, o)| pick(pounding::output::row(plan, s, o), columns))
-                    .collect();
+                let cells = pounding::output::cells(plan, rows, columns.as_deref());
                 out.write(&cells)?;
             }
             Rows::Summary(agg) => {
                 for (s, o) in rows {
-                    agg.add(&pounding::output::row(plan, s, o));
+                    let g = agg.group_of(plan, s);
+                    agg.add(g, o);
                 }
             }
         }
         Ok(())
-    }
-}
-
-/// The cells of `columns` (all of them without).
-fn pick(row: Vec<String>, columns: &Option<Vec<usize>>) -> Vec<String> {
-    match columns {
-        Some(c) => c.iter().map(|&i| row[i].clone()).collect(),
-        None => row,
     }
 }
 
@@ -267,6 +258,9 @@ enum Cmd {
         /// Also write the table to this file.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// Also time each GPU sweep with `--aggregate COLUMNS` folded on the device (e.g. gap_m).
+        #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
+        aggregate: Option<Vec<String>>,
     },
     /// Speed against error of every path and accuracy setting on a benchmark sweep, against the
     /// reference solved once.
@@ -416,7 +410,15 @@ fn run(cli: Cli) -> Result<()> {
             precision,
             chunk,
             output,
-        } => bench(&sizes, max_cpu_runs, precision.get(), chunk, output),
+            aggregate,
+        } => bench(
+            &sizes,
+            max_cpu_runs,
+            precision.get(),
+            chunk,
+            output,
+            aggregate.as_deref(),
+        ),
         Cmd::Formulas { e, plot } => formulas(&e, plot.as_deref()),
         Cmd::Plot(a) => plot(a),
         Cmd::Fragility(a) => fragility(a),
@@ -515,7 +517,7 @@ fn sweep(a: SweepArgs) -> Result<()> {
         bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
     }
     let precision = precision.get();
-    let mut plan = config::load(&config)?;
+    let (mut plan, config_text) = config::load_with_text(&config)?;
     let scheme = match scheme {
         None => plan.spec.scheme,
         Some(SchemeArg::Fast) => Scheme::Fast(match plan.spec.scheme {
@@ -660,9 +662,6 @@ fn sweep(a: SweepArgs) -> Result<()> {
     );
     let summary = pool
         .install(|| -> Result<_> {
-            let mut write = |chunk: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
-                rows.take(&plan, chunk)
-            };
             match (&gpu, fast) {
                 (Some(ctx), Some(fast)) => {
                     let opts = GpuOptions {
@@ -670,15 +669,41 @@ fn sweep(a: SweepArgs) -> Result<()> {
                         fast,
                         ..Default::default()
                     };
-                    let (s, t) = pounding::sweep::run_gpu_range(
-                        &plan,
-                        todo.clone(),
-                        ctx,
-                        &opts,
-                        chunk.unwrap_or(65536),
-                        &mut write,
-                        |done| bar.set_position(done),
-                    )?;
+                    let (s, t) = match &mut rows {
+                        Rows::Summary(agg) => {
+                            let (s, t) = pounding::sweep::run_gpu_aggregate(
+                                &plan,
+                                todo.clone(),
+                                ctx,
+                                &opts,
+                                chunk.unwrap_or(65536),
+                                pounding::gpu::reduce::DEFAULT_SLOTS,
+                                agg,
+                                |done| bar.set_position(done),
+                            )?;
+                            bar.suspend(|| {
+                                eprintln!(
+                                    "aggregated on the device: {:.2} s folding; {} chunks with more than {} groups folded on the host; histograms flushed {} times",
+                                    t.aggregate,
+                                    t.host_folded_chunks,
+                                    pounding::gpu::reduce::DEFAULT_SLOTS,
+                                    t.slot_flushes
+                                )
+                            });
+                            (s, t)
+                        }
+                        _ => pounding::sweep::run_gpu_range(
+                            &plan,
+                            todo.clone(),
+                            ctx,
+                            &opts,
+                            chunk.unwrap_or(65536),
+                            |c: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
+                                rows.take(&plan, c)
+                            },
+                            |done| bar.set_position(done),
+                        )?,
+                    };
                     if t.handed_off > 0 {
                         bar.suspend(|| {
                             eprintln!(
@@ -697,7 +722,9 @@ fn sweep(a: SweepArgs) -> Result<()> {
                         todo.clone(),
                         &scheme,
                         chunk.unwrap_or(64),
-                        &mut write,
+                        |c: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
+                            rows.take(&plan, c)
+                        },
                         |done| bar.set_position(done),
                     )
                 }
@@ -710,29 +737,55 @@ fn sweep(a: SweepArgs) -> Result<()> {
             )
         })?;
     bar.finish_and_clear();
-    // Sidecar first: a crash between the two leaves a resumable, not an unlabelled, output.
-    write_toml(&meta_path(&output), &meta)?;
-    let path = match rows {
-        Rows::Parquet { out, .. } => out
-            .finish()
-            .with_context(|| format!("finishing {}", output.display()))?,
-        Rows::Csv {
-            out, progress_file, ..
-        } => {
-            let path = out
-                .finish()
-                .with_context(|| format!("finishing {}", output.display()))?;
-            std::fs::remove_file(&progress_file)
-                .with_context(|| format!("removing {}", progress_file.display()))?;
-            path
-        }
-        Rows::Summary(agg) => {
-            pounding::output::write_atomic(&output, agg.csv().as_bytes())
-                .with_context(|| format!("writing {}", output.display()))?;
-            eprintln!("{} groups", agg.groups());
-            output.clone()
-        }
-    };
+    // Records are read once, at the start: a file changed since then no longer matches the rows
+    // (or the fingerprint), so the output is not put in place.
+    let changed = config::changed_records(&config_text, &config, &plan);
+    if !changed.is_empty() {
+        bail!(
+            "{} changed on disk during the sweep; the runs were computed from the content read at the start ({}); rerun the sweep (without --resume) to use the new content",
+            changed.join(", "),
+            match rows {
+                Rows::Summary(_) => "no summary was written".to_string(),
+                _ => format!("their rows are left in {}", partial.display()),
+            }
+        );
+    }
+    let meta_file = meta_path(&output);
+    let finished = (|| -> Result<PathBuf> {
+        Ok(match rows {
+            // A summary is written whole (nothing to resume), then labelled.
+            Rows::Summary(agg) => {
+                pounding::output::write_atomic(&output, agg.csv().as_bytes())
+                    .with_context(|| format!("writing {}", output.display()))?;
+                write_toml(&meta_file, &meta)?;
+                eprintln!("{} groups", agg.groups());
+                output.clone()
+            }
+            // Sidecar first: a crash between the two leaves a resumable, not an unlabelled,
+            // output.
+            Rows::Parquet { out, .. } => {
+                write_toml(&meta_file, &meta)?;
+                out.finish()
+                    .with_context(|| format!("finishing {}", output.display()))?
+            }
+            Rows::Csv {
+                out, progress_file, ..
+            } => {
+                write_toml(&meta_file, &meta)?;
+                let path = out
+                    .finish()
+                    .with_context(|| format!("finishing {}", output.display()))?;
+                std::fs::remove_file(&progress_file)
+                    .with_context(|| format!("removing {}", progress_file.display()))?;
+                path
+            }
+        })
+    })();
+    if finished.is_err() && !output.exists() {
+        // No sidecar for an output that is not there (disk full, say).
+        let _ = std::fs::remove_file(&meta_file);
+    }
+    let path = finished?;
     eprintln!(
         "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {}",
         summary.runs,
@@ -840,6 +893,7 @@ fn bench(
     precision: Precision,
     chunk: usize,
     output: Option<PathBuf>,
+    aggregate: Option<&[String]>,
 ) -> Result<()> {
     let ctx = match GpuContext::new() {
         Ok(c) => Some(c),
@@ -861,6 +915,16 @@ fn bench(
             let r = pounding::bench::gpu(&plan, ctx, &opts, chunk)?;
             eprintln!("{} runs on GPU: {:.0} runs/s", r.runs, r.runs_per_second());
             rows.push(r);
+            if let Some(by) = aggregate {
+                ctx.aggregator(precision)?;
+                let r = pounding::bench::gpu_aggregate(&plan, ctx, &opts, chunk, by)?;
+                eprintln!(
+                    "{} runs on GPU, aggregated: {:.0} runs/s",
+                    r.runs,
+                    r.runs_per_second()
+                );
+                rows.push(r);
+            }
         }
         if plan.len() <= max_cpu_runs {
             let r = pounding::bench::cpu(&plan);

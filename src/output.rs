@@ -145,7 +145,23 @@ pub fn header() -> Vec<&'static str> {
 pub struct CsvOut {
     path: PathBuf,
     partial: PathBuf,
-    w: csv::Writer<BufWriter<File>>,
+    w: BufWriter<File>,
+}
+
+/// CSV lines of records (quoted as the `csv` crate quotes them).
+fn lines<I, R>(records: I) -> Vec<u8>
+where
+    I: IntoIterator<Item = R>,
+    R: IntoIterator,
+    R::Item: AsRef<[u8]>,
+{
+    let mut w = csv::WriterBuilder::new()
+        .has_headers(false)
+        .from_writer(Vec::new());
+    for r in records {
+        w.write_record(r).expect("writing to memory");
+    }
+    w.into_inner().expect("writing to memory")
 }
 
 impl CsvOut {
@@ -157,8 +173,8 @@ impl CsvOut {
     pub fn create_with(path: &Path, columns: &[&str]) -> std::io::Result<CsvOut> {
         let partial = sibling(path, ".partial");
         let file = File::create(&partial)?;
-        let mut w = csv::Writer::from_writer(BufWriter::new(file));
-        w.write_record(columns).map_err(std::io::Error::other)?;
+        let mut w = BufWriter::new(file);
+        w.write_all(&lines([columns]))?;
         Ok(CsvOut {
             path: path.into(),
             partial,
@@ -182,9 +198,7 @@ impl CsvOut {
         file.sync_all()?;
         let mut file = file;
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
-        let w = csv::WriterBuilder::new()
-            .has_headers(false)
-            .from_writer(BufWriter::new(file));
+        let w = BufWriter::new(file);
         Ok(CsvOut {
             path: path.into(),
             partial,
@@ -199,31 +213,66 @@ impl CsvOut {
     /// Push everything written to the disk (fsync) and return the file's length.
     pub fn sync(&mut self) -> std::io::Result<u64> {
         self.w.flush()?;
-        let f = self.w.get_ref().get_ref();
+        let f = self.w.get_ref();
         f.sync_data()?;
         Ok(f.metadata()?.len())
     }
 
     /// Append rows and push them to the OS, so a crash keeps them in the `.partial` file.
     pub fn write(&mut self, rows: impl IntoIterator<Item = Vec<String>>) -> std::io::Result<()> {
-        for r in rows {
-            self.w.write_record(&r).map_err(std::io::Error::other)?;
-        }
+        self.write_encoded(&lines(rows))
+    }
+
+    /// Append rows already encoded as CSV lines ([`encode_csv`]).
+    pub fn write_encoded(&mut self, lines: &[u8]) -> std::io::Result<()> {
+        self.w.write_all(lines)?;
         self.w.flush()
     }
 
     /// Flush, fsync and rename to the final name.
     pub fn finish(self) -> std::io::Result<PathBuf> {
-        let buf = self
-            .w
-            .into_inner()
-            .map_err(|e| std::io::Error::other(e.to_string()))?;
-        let file = buf.into_inner().map_err(|e| e.into_error())?;
+        let file = self.w.into_inner().map_err(|e| e.into_error())?;
         file.sync_all()?;
         drop(file);
         std::fs::rename(&self.partial, &self.path)?;
         Ok(self.path)
     }
+}
+
+/// The cells of `columns` (all of them without).
+pub fn pick(row: Vec<String>, columns: Option<&[usize]>) -> Vec<String> {
+    match columns {
+        Some(c) => c.iter().map(|&i| row[i].clone()).collect(),
+        None => row,
+    }
+}
+
+/// The cells of each run's row (`columns` as in [`pick`]), formatted in parallel.
+pub fn cells(
+    plan: &Plan,
+    rows: &[(RunSpec, RunOutput)],
+    columns: Option<&[usize]>,
+) -> Vec<Vec<String>> {
+    use rayon::prelude::*;
+    rows.par_iter()
+        .map(|(s, o)| pick(row(plan, s, o), columns))
+        .collect()
+}
+
+/// Rows as CSV lines (`columns` as in [`pick`]): formatted in parallel blocks, the same bytes
+/// as writing them one by one. Formatting, not the GPU, limited a 1e6-run sweep on an H100
+/// (BENCHMARKS.md).
+pub fn encode_csv(
+    plan: &Plan,
+    rows: &[(RunSpec, RunOutput)],
+    columns: Option<&[usize]>,
+) -> Vec<u8> {
+    use rayon::prelude::*;
+    let blocks: Vec<Vec<u8>> = rows
+        .par_chunks(512)
+        .map(|block| lines(block.iter().map(|(s, o)| pick(row(plan, s, o), columns))))
+        .collect();
+    blocks.concat()
 }
 
 /// `path` with `suffix` appended to its name (`OUT` -> `OUT.partial`): the unfinished file and
@@ -245,8 +294,16 @@ pub fn header_for(columns: Option<&[String]>) -> Vec<&str> {
 /// Write `bytes` to `path` atomically (temporary file, fsync, rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let tmp = sibling(path, ".partial");
-    let mut f = File::create(&tmp)?;
-    f.write_all(bytes)?;
-    f.sync_all()?;
-    std::fs::rename(&tmp, path)
+    let written = File::create(&tmp).and_then(|mut f| {
+        f.write_all(bytes)?;
+        f.sync_all()
+    });
+    match written {
+        Ok(()) => std::fs::rename(&tmp, path),
+        Err(e) => {
+            // Nothing half-written stays behind (a full disk, say).
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
 }

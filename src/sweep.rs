@@ -26,6 +26,14 @@ impl Summary {
         self.failures += (o.status != Status::Ok) as u64;
     }
 
+    /// Count the runs of a device partial (handed-back runs are counted when finished).
+    fn count_partial(&mut self, p: &crate::aggregate::Partial) {
+        self.runs += p.runs;
+        self.impacts += p.impacts;
+        self.runs_with_impacts += p.pounded;
+        self.failures += p.failures;
+    }
+
     pub fn runs_per_second(&self) -> f64 {
         self.runs as f64 / self.seconds.max(1e-9)
     }
@@ -109,6 +117,12 @@ pub struct GpuTimes {
     pub sink: f64,
     /// Runs handed back by the kernel and finished on the CPU in f64.
     pub handed_off: u64,
+    /// `--aggregate`: folding on the device and reading the partials back, s.
+    pub aggregate: f64,
+    /// `--aggregate`: chunks with more groups than the device's histogram slots (read back and
+    /// folded on the host), and times the slots were flushed to the host before the end.
+    pub host_folded_chunks: u64,
+    pub slot_flushes: u64,
 }
 
 /// Run every run of `plan` on the GPU, `chunk` runs per chunk (capped by the device's limits);
@@ -189,6 +203,134 @@ pub fn run_gpu_range<E: From<crate::gpu::GpuError>>(
         progress(s.runs);
         c0 = c1;
     }
+    s.seconds = start.elapsed().as_secs_f64();
+    Ok((s, times))
+}
+
+/// As [`run_gpu_range`] with `--aggregate`: each chunk is packed sorted by group, integrated,
+/// and folded into `agg` on the device (`shaders/aggregate.wgsl`), so only the groups' partials
+/// come back per chunk and the histograms at the end, not a state per run. Runs the kernel hands
+/// back are finished on the CPU and folded on the host. A chunk with more groups than
+/// `max_slots` (or than one buffer holds) is read back and folded on the host instead.
+#[allow(clippy::too_many_arguments)]
+pub fn run_gpu_aggregate(
+    plan: &Plan,
+    runs: std::ops::Range<u64>,
+    ctx: &crate::gpu::GpuContext,
+    opts: &crate::gpu::GpuOptions,
+    chunk: usize,
+    max_slots: u32,
+    agg: &mut crate::aggregate::Aggregator,
+    mut progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), crate::gpu::GpuError> {
+    use crate::gpu::layout::{Segment, MAX_SEGMENT};
+    use crate::gpu::reduce::{reduce, Slots};
+    use crate::gpu::{integrate, pack, run_chunk, GpuRecords};
+    let start = Instant::now();
+    let mut times = GpuTimes::default();
+    let accels: Vec<&[f64]> = plan.spec.records.iter().map(|r| &r.accel[..]).collect();
+    let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
+    let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
+    let mut slots = Slots::new(ctx, max_slots);
+    let thresholds = agg.thresholds();
+    let cpu = Scheme::Fast(opts.fast);
+    let mut s = Summary::default();
+    let mut c0 = runs.start;
+    while c0 < runs.end {
+        let c1 = (c0 + chunk).min(runs.end);
+        let t = Instant::now();
+        let specs: Vec<RunSpec> = (c0..c1).into_par_iter().map(|i| plan.run(i)).collect();
+        let gids: Vec<u32> = specs.iter().map(|r| agg.group_of(plan, r)).collect();
+        // Pack sorted by group (stable), so each group is a run of consecutive runs.
+        let mut order: Vec<usize> = (0..specs.len()).collect();
+        order.sort_by_key(|&i| gids[i]);
+        let packed: Vec<_> = order
+            .par_iter()
+            .map(|&i| {
+                let r = &specs[i];
+                pack(&r.pair(), &plan.forcing(r), r.record, &recs, &opts.fast)
+            })
+            .collect();
+        let mut segments: Vec<(u32, Segment)> = Vec::new();
+        for (k, &i) in order.iter().enumerate() {
+            match segments.last_mut() {
+                Some((g, seg)) if *g == gids[i] && seg.len < MAX_SEGMENT => seg.len += 1,
+                _ => segments.push((
+                    gids[i],
+                    Segment {
+                        start: k as u32,
+                        len: 1,
+                        ..Default::default()
+                    },
+                )),
+            }
+        }
+        let mut groups: Vec<u32> = segments.iter().map(|(g, _)| *g).collect();
+        groups.dedup();
+        times.pack += t.elapsed().as_secs_f64();
+        let Some(slot) = slots.assign(ctx, &groups, agg)? else {
+            // More groups than slots: read every run back and fold here.
+            let (outs, ct) = run_chunk(ctx, &recs, &packed, opts)?;
+            times.upload += ct.upload.as_secs_f64();
+            times.kernel += ct.kernel.as_secs_f64();
+            times.readback += ct.readback.as_secs_f64();
+            times.host_folded_chunks += 1;
+            let t = Instant::now();
+            times.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
+            let outs: Vec<RunOutput> = order
+                .par_iter()
+                .zip(outs)
+                .map(|(&i, o)| o.unwrap_or_else(|| run_one(plan, &specs[i], &cpu)))
+                .collect();
+            for (&i, o) in order.iter().zip(&outs) {
+                agg.add(gids[i], o);
+                s.count(o);
+            }
+            times.handoff += t.elapsed().as_secs_f64();
+            progress(s.runs);
+            c0 = c1;
+            continue;
+        };
+        let slot_of: std::collections::HashMap<u32, u32> =
+            groups.iter().copied().zip(slot).collect();
+        let segs: Vec<Segment> = segments
+            .iter()
+            .map(|(g, seg)| Segment {
+                slot: slot_of[g],
+                ..*seg
+            })
+            .collect();
+        let (done, ct) = integrate(ctx, &recs, &packed, opts)?;
+        times.upload += ct.upload.as_secs_f64();
+        times.kernel += ct.kernel.as_secs_f64();
+        let t = Instant::now();
+        let (partials, handed) = reduce(ctx, &done, opts.precision, &segs, &thresholds, &slots)?;
+        for ((g, _), p) in segments.iter().zip(&partials) {
+            agg.group(*g).add_partial(p);
+            s.count_partial(p);
+        }
+        times.aggregate += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        times.handed_off += handed.len() as u64;
+        let finished: Vec<(usize, RunOutput)> = handed
+            .par_iter()
+            .map(|&k| {
+                let i = order[k as usize];
+                (i, run_one(plan, &specs[i], &cpu))
+            })
+            .collect();
+        for (i, o) in &finished {
+            agg.add(gids[*i], o);
+            s.count(o);
+        }
+        times.handoff += t.elapsed().as_secs_f64();
+        progress(s.runs);
+        c0 = c1;
+    }
+    let t = Instant::now();
+    slots.flush(ctx, agg)?;
+    times.aggregate += t.elapsed().as_secs_f64();
+    times.slot_flushes = slots.flushes.saturating_sub(1) as u64;
     s.seconds = start.elapsed().as_secs_f64();
     Ok((s, times))
 }

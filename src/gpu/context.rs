@@ -2,7 +2,7 @@
 //! the work functions so tests can bring their own device.
 
 use super::layout::{Counters, Dispatch, Meta};
-use super::shader::{fast_source, Precision};
+use super::shader::{aggregate_source, fast_source, Precision};
 use std::sync::{Arc, Mutex};
 
 /// What went wrong on the GPU path; each message says what to do next.
@@ -64,8 +64,16 @@ pub struct Kernel {
     pub layout: wgpu::BindGroupLayout,
 }
 
-/// A compiled variant: precision, and whether it integrates the energy balance.
-type KernelKey = (Precision, bool);
+/// A compiled stage and variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    /// `fast.wgsl`, with or without the energy balance.
+    Fast { energy: bool },
+    /// `aggregate.wgsl`.
+    Aggregate,
+}
+
+type KernelKey = (Stage, Precision);
 
 /// Device, queue and compiled kernels, created once per process (or per test).
 pub struct GpuContext {
@@ -156,8 +164,17 @@ impl GpuContext {
     /// The fast-scheme kernel in `precision`, with or without the energy balance, compiled on
     /// first use.
     pub fn kernel(&self, precision: Precision, energy: bool) -> Result<Arc<Kernel>, GpuError> {
+        self.stage(Stage::Fast { energy }, precision)
+    }
+
+    /// The aggregation stage in `precision`, compiled on first use.
+    pub fn aggregator(&self, precision: Precision) -> Result<Arc<Kernel>, GpuError> {
+        self.stage(Stage::Aggregate, precision)
+    }
+
+    fn stage(&self, stage: Stage, precision: Precision) -> Result<Arc<Kernel>, GpuError> {
         let mut ks = self.kernels.lock().unwrap();
-        if let Some((_, k)) = ks.iter().find(|(p, _)| *p == (precision, energy)) {
+        if let Some((_, k)) = ks.iter().find(|(p, _)| *p == (stage, precision)) {
             return Ok(k.clone());
         }
         if precision == Precision::F64 && !self.supports_f64() {
@@ -165,20 +182,22 @@ impl GpuContext {
                 adapter: self.info.name.clone(),
             });
         }
-        let k = Arc::new(self.compile(precision, energy)?);
-        ks.push(((precision, energy), k.clone()));
+        let k = Arc::new(self.compile(stage, precision)?);
+        ks.push(((stage, precision), k.clone()));
         Ok(k)
     }
 
-    fn compile(&self, precision: Precision, energy: bool) -> Result<Kernel, GpuError> {
+    fn compile(&self, stage: Stage, precision: Precision) -> Result<Kernel, GpuError> {
         let d = &self.device;
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+        let (name, source) = match stage {
+            Stage::Fast { energy } => ("fast", fast_source(precision, energy)),
+            Stage::Aggregate => ("aggregate", aggregate_source(precision)),
+        };
+        let label = format!("{name}.wgsl {}", precision.key());
         let desc = wgpu::ShaderModuleDescriptor {
-            label: Some(match precision {
-                Precision::F32 => "fast.wgsl f32",
-                Precision::F64 => "fast.wgsl f64",
-            }),
-            source: wgpu::ShaderSource::Wgsl(fast_source(precision, energy).into()),
+            label: Some(&label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
         };
         let module = d.create_shader_module(desc);
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
@@ -192,9 +211,9 @@ impl GpuContext {
             has_dynamic_offset: false,
             min_binding_size: None,
         };
-        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("fast bind group layout"),
-            entries: &[
+        // Binding order as declared in each shader.
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = match stage {
+            Stage::Fast { .. } => vec![
                 entry(
                     0,
                     wgpu::BindingType::Buffer {
@@ -213,14 +232,19 @@ impl GpuContext {
                 entry(8, storage(false)),
                 entry(9, storage(true)),
             ],
+            Stage::Aggregate => (0..9).map(|b| entry(b, storage(b < 5))).collect(),
+        };
+        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(&format!("{name} bind group layout")),
+            entries: &entries,
         });
         let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("fast pipeline layout"),
+            label: Some(&format!("{name} pipeline layout")),
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
         let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("fast pipeline"),
+            label: Some(&format!("{name} pipeline")),
             layout: Some(&pl),
             module: &module,
             entry_point: Some("main"),

@@ -265,3 +265,103 @@ pub fn params_bytes(precision: super::Precision) -> usize {
 pub fn state_bytes(precision: super::Precision) -> usize {
     core::mem::size_of::<State64>() / 8 * precision.bytes()
 }
+
+/// Settings of the aggregation stage (`shaders/aggregate.wgsl`), in a read-only storage buffer
+/// (a uniform array would need 16-byte strides).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct AggConfig {
+    /// Segments in this dispatch.
+    pub nseg: u32,
+    /// `--exceed` thresholds in use (their values are in the `thresholds` buffer).
+    pub nexceed: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    /// Output index (`aggregate::OUTPUTS`) of each threshold.
+    pub exceed_output: [u32; crate::aggregate::MAX_EXCEED],
+}
+
+/// Consecutive runs of a chunk (in the order they were packed) that belong to one group; the
+/// stage folds each segment in one workgroup.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Segment {
+    /// First run (index into the chunk's buffers) and run count.
+    pub start: u32,
+    pub len: u32,
+    /// The group's histogram slot in the `hist` buffer.
+    pub slot: u32,
+    pub _pad: u32,
+}
+
+impl Layout for AggConfig {
+    const NAME: &'static str = "AggConfig";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("nseg", offset_of!(AggConfig, nseg)),
+            ("nexceed", offset_of!(AggConfig, nexceed)),
+            ("_pad0", offset_of!(AggConfig, _pad0)),
+            ("_pad1", offset_of!(AggConfig, _pad1)),
+            ("exceed_output", offset_of!(AggConfig, exceed_output)),
+        ]
+    }
+}
+
+impl Layout for Segment {
+    const NAME: &'static str = "Segment";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("start", offset_of!(Segment, start)),
+            ("len", offset_of!(Segment, len)),
+            ("slot", offset_of!(Segment, slot)),
+            ("_pad", offset_of!(Segment, _pad)),
+        ]
+    }
+}
+
+// A segment's partial counts: `PART_U` u32 words at these offsets (keep in sync with
+// aggregate.wgsl, which gets PART_U and the P_* offsets from `shader::aggregate_source`).
+pub const PART_U: usize = 16;
+pub const P_RUNS: usize = 0;
+pub const P_FAILURES: usize = 1;
+pub const P_HANDOFFS: usize = 2;
+pub const P_POUNDED: usize = 3;
+pub const P_IMPACTS: usize = 4;
+/// `MAX_EXCEED` exceedance counts from here.
+pub const P_EXCEED: usize = 5;
+/// A segment's reals: the max of each output, then the sum of each.
+pub const PART_R: usize = 2 * crate::aggregate::NOUT;
+/// Longest segment: keeps each invocation's loop at `MAX_SEGMENT / WORKGROUP_SIZE` iterations,
+/// far below lavapipe's loop limit (longer runs of one group are cut into several segments).
+pub const MAX_SEGMENT: u32 = 1 << 16;
+/// Histogram counters of one slot (one group): `NOUT` outputs of `BUCKETS` each.
+pub const SLOT_WORDS: usize = crate::aggregate::NOUT * crate::aggregate::BUCKETS;
+
+/// The partial of segment `k` from the read-back `part_u` words and `part_r` reals.
+pub fn partial(part_u: &[u32], part_r: &[f64], k: usize) -> crate::aggregate::Partial {
+    use crate::aggregate::{MAX_EXCEED, NOUT};
+    let u = &part_u[k * PART_U..(k + 1) * PART_U];
+    let r = &part_r[k * PART_R..(k + 1) * PART_R];
+    let mut p = crate::aggregate::Partial {
+        runs: u[P_RUNS] as u64,
+        failures: u[P_FAILURES] as u64,
+        handoffs: u[P_HANDOFFS] as u64,
+        pounded: u[P_POUNDED] as u64,
+        impacts: u[P_IMPACTS] as u64,
+        ..Default::default()
+    };
+    for e in 0..MAX_EXCEED {
+        p.exceed[e] = u[P_EXCEED + e] as u64;
+    }
+    p.max.copy_from_slice(&r[..NOUT]);
+    p.sum.copy_from_slice(&r[NOUT..]);
+    p
+}
+
+/// Workgroups for `n` segments, one each, as an `(x, y)` grid within `max_per_dim`.
+pub fn segment_grid(n: u32, max_per_dim: u32) -> (u32, u32) {
+    let x = n.clamp(1, max_per_dim);
+    (x, n.div_ceil(x))
+}

@@ -3,9 +3,13 @@
 
 pub mod context;
 pub mod layout;
+pub mod reduce;
 pub mod run;
 pub mod shader;
 
 pub use context::{GpuContext, GpuError};
-pub use run::{output, pack, run_chunk, ChunkTimes, GpuOptions, GpuRecords};
+pub use run::{
+    integrate, output, pack, read_outputs, run_chunk, ChunkTimes, GpuOptions, GpuRecords,
+    Integrated,
+};
 pub use shader::Precision;

@@ -231,7 +231,7 @@ pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<R
     })
 }
 
-fn storage(
+pub(super) fn storage(
     ctx: &GpuContext,
     label: &str,
     bytes: &[u8],
@@ -256,7 +256,29 @@ fn storage(
     Ok(buffer)
 }
 
-fn wait(ctx: &GpuContext) -> Result<(), GpuError> {
+/// A bind group of whole buffers, bound in order (binding `i` is `buffers[i]`).
+pub(super) fn bind_group(
+    ctx: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    label: &str,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+pub(super) fn wait(ctx: &GpuContext) -> Result<(), GpuError> {
     ctx.device
         .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| GpuError::Other {
@@ -269,7 +291,7 @@ fn wait(ctx: &GpuContext) -> Result<(), GpuError> {
 }
 
 /// Map a MAP_READ buffer whose copy has been submitted, wait, and return its bytes.
-fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+pub(super) fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
     let failed = |e: String| GpuError::Other {
         message: format!("reading results back: {e}"),
     };
@@ -290,8 +312,16 @@ fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, GpuErro
     Ok(data)
 }
 
-fn read(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
-    let size = src.size();
+pub(super) fn read(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    read_prefix(ctx, src, src.size())
+}
+
+/// The first `size` bytes of a buffer (a multiple of 4).
+pub(super) fn read_prefix(
+    ctx: &GpuContext,
+    src: &wgpu::Buffer,
+    size: u64,
+) -> Result<Vec<u8>, GpuError> {
     let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size,
@@ -316,10 +346,32 @@ pub fn run_chunk(
     runs: &[Packed],
     opts: &GpuOptions,
 ) -> Result<(Vec<Option<RunOutput>>, ChunkTimes), GpuError> {
-    let mut times = ChunkTimes::default();
     if runs.is_empty() {
-        return Ok((Vec::new(), times));
+        return Ok((Vec::new(), ChunkTimes::default()));
     }
+    let (done, mut times) = integrate(ctx, recs, runs, opts)?;
+    let t = Instant::now();
+    let out = read_outputs(ctx, &done, runs, opts)?;
+    times.readback = t.elapsed();
+    Ok((out, times))
+}
+
+/// A chunk's final states and counters, still on the device.
+pub struct Integrated {
+    pub states: wgpu::Buffer,
+    pub counters: wgpu::Buffer,
+    pub runs: u32,
+}
+
+/// Integrate packed runs (at least one) from rest over their whole records, leaving the final
+/// states on the device.
+pub fn integrate(
+    ctx: &GpuContext,
+    recs: &GpuRecords,
+    runs: &[Packed],
+    opts: &GpuOptions,
+) -> Result<(Integrated, ChunkTimes), GpuError> {
+    let mut times = ChunkTimes::default();
     let kernel = ctx.kernel(opts.precision, opts.fast.energy)?;
     let n = runs.len();
     let t = Instant::now();
@@ -408,19 +460,7 @@ pub fn run_chunk(
             to,
             &forms,
         ];
-        let entries: Vec<wgpu::BindGroupEntry> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(label),
-            layout: &kernel.layout,
-            entries: &entries,
-        })
+        bind_group(ctx, &kernel.layout, label, &buffers)
     };
     let binds = [
         bind(&ids[0], &ids[1], "fast bind group a->b"),
@@ -474,10 +514,26 @@ pub fn run_chunk(
         }
     }
     times.kernel = t.elapsed();
+    Ok((
+        Integrated {
+            states,
+            counters,
+            runs: n as u32,
+        },
+        times,
+    ))
+}
 
-    let t = Instant::now();
-    let sbytes = read(ctx, &states)?;
-    let cbytes = read(ctx, &counters)?;
+/// Each run's results from its final state, in input order (None: handed back).
+pub fn read_outputs(
+    ctx: &GpuContext,
+    done: &Integrated,
+    runs: &[Packed],
+    opts: &GpuOptions,
+) -> Result<Vec<Option<RunOutput>>, GpuError> {
+    let energy = opts.fast.energy;
+    let sbytes = read(ctx, &done.states)?;
+    let cbytes = read(ctx, &done.counters)?;
     let cs: &[Counters] = bytemuck::cast_slice(&cbytes);
     let out: Vec<Option<RunOutput>> = match opts.precision {
         Precision::F64 => {
@@ -497,6 +553,5 @@ pub fn run_chunk(
                 .collect()
         }
     };
-    times.readback = t.elapsed();
-    Ok((out, times))
+    Ok(out)
 }

@@ -1,18 +1,21 @@
 //! GPU path: shader layout against the Rust structs, GPU against the CPU twin.
 
 use pounding::gpu::layout::{self, Layout};
-use pounding::gpu::shader::{fast_source, Precision};
+use pounding::gpu::shader::{aggregate_source, fast_source, Precision};
 
 fn parse(precision: Precision) -> naga::Module {
-    let src = fast_source(precision, true);
+    parse_source(&fast_source(precision, true))
+}
+
+fn parse_source(src: &str) -> naga::Module {
     let module =
-        naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&src)));
+        naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(src)));
     let mut v = naga::valid::Validator::new(
         naga::valid::ValidationFlags::all(),
         naga::valid::Capabilities::FLOAT64,
     );
     if let Err(e) = v.validate(&module) {
-        panic!("{}", e.emit_to_string(&src));
+        panic!("{}", e.emit_to_string(src));
     }
     module
 }
@@ -50,6 +53,15 @@ fn shared_structs_match_the_shader_in_both_precisions() {
     check::<layout::Params32>(&m, size_of::<layout::Params32>());
     check::<layout::State32>(&m, size_of::<layout::State32>());
     check::<layout::Meta>(&m, size_of::<layout::Meta>());
+    // The aggregation stage shares types.wgsl and has its own two structs.
+    for p in [Precision::F64, Precision::F32] {
+        let m = parse_source(&aggregate_source(p));
+        check::<layout::AggConfig>(&m, size_of::<layout::AggConfig>());
+        check::<layout::Segment>(&m, size_of::<layout::Segment>());
+        check::<layout::Counters>(&m, size_of::<layout::Counters>());
+    }
+    let m = parse_source(&aggregate_source(Precision::F64));
+    check::<layout::State64>(&m, size_of::<layout::State64>());
 }
 
 /// The value of the shader's `const name` (a literal).
@@ -215,11 +227,15 @@ pub fn peak_diff(a: &RunOutput, b: &RunOutput) -> f64 {
 
 /// f64 on the GPU runs the CPU fast path's arithmetic, so the two agree to rounding: measured
 /// on the 2,352 wide-grid runs (`cargo test --release gpu_f64 -- --nocapture`), median 0 and max
-/// 1.8e-9 over nine laws (the largest on long pressed Kelvin-Voigt contacts at gap 0, where
+/// 1.8e-9 over nine laws on lavapipe (median 1.8e-14, max 5.2e-9 on an H100) (the largest on long pressed Kelvin-Voigt contacts at gap 0, where
 /// rounding differences grow over hundreds of substeps). The nonlinear viscoelastic law differs
 /// by up to 7.7e-6: its `delta^(1/4)` damping is singular at first touch, and on the CPU alone
 /// moving the damping by 4 ulps changes some of those runs by as much, but not all of them, so
 /// the cause is not pinned down: it gets 3x its measured maximum, every other law 1e-8.
+/// Energy residuals (a fraction of the largest input) differ by at most 3.9e-9 on lavapipe,
+/// 1.26e-8 on an H100 (its compiler fuses multiply-adds, which lavapipe does not).
+const RESIDUAL_BOUND: f64 = 4e-8;
+
 #[test]
 fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
     let Some(ctx) = ctx() else { return };
@@ -235,17 +251,22 @@ fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
     let mut worst = std::collections::BTreeMap::new();
     let mut worst_residual = 0.0f64;
     let mut all = Vec::new();
+    // Every difference is measured before any is judged, so a failure reports the whole picture.
+    let mut bad = Vec::new();
     for ((s, c), (_, g)) in cpu.iter().zip(&gpu) {
-        assert_eq!(c.status, g.status, "run {}", s.index);
-        assert_eq!(c.impacts, g.impacts, "run {}", s.index);
-        assert_eq!(c.peak_force == 0.0, g.peak_force == 0.0, "run {}", s.index);
+        if (c.status, c.impacts, c.peak_force == 0.0) != (g.status, g.impacts, g.peak_force == 0.0)
+        {
+            bad.push(format!("run {}: CPU {c:?}, GPU {g:?}", s.index));
+            continue;
+        }
         let (rg, rc) = (g.energy.unwrap().residual, c.energy.unwrap().residual);
         worst_residual = worst_residual.max((rg - rc).abs());
-        assert!(
-            (rg - rc).abs() < 1e-8,
-            "run {}: energy residual {rg:e} on the GPU, {rc:e} on the CPU",
-            s.index
-        );
+        if (rg - rc).abs() >= RESIDUAL_BOUND {
+            bad.push(format!(
+                "run {}: energy residual {rg:e} on the GPU, {rc:e} on the CPU",
+                s.index
+            ));
+        }
         let e = peak_diff(g, c);
         let w = worst.entry(s.law.key()).or_insert(0.0f64);
         *w = w.max(e);
@@ -255,18 +276,26 @@ fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
         } else {
             1e-9 + 1e-14 * c.substeps as f64
         };
-        assert!(
-            e <= bound,
-            "run {} ({}): GPU-CPU difference {e:e}",
-            s.index,
-            s.law.key()
-        );
+        if e > bound {
+            bad.push(format!(
+                "run {} ({}): GPU-CPU difference {e:e}",
+                s.index,
+                s.law.key()
+            ));
+        }
     }
     all.sort_by(f64::total_cmp);
     eprintln!(
-        "f64 GPU vs CPU on {} runs: median {:e}; max by law {worst:?}; energy residuals differ by at most {worst_residual:e}",
+        "f64 GPU vs CPU on {} runs ({}): median {:e}; max by law {worst:?}; energy residuals differ by at most {worst_residual:e}",
         all.len(),
+        ctx.info.name,
         all[all.len() / 2]
+    );
+    assert!(
+        bad.is_empty(),
+        "{} runs out of bounds:\n{}",
+        bad.len(),
+        bad.join("\n")
     );
 }
 
@@ -523,4 +552,126 @@ fn gpu_device_loss_keeps_finished_chunks() {
         assert_eq!(o.status, pounding::model::Status::Ok, "run {i}");
     }
     assert!(rows.iter().any(|(_, o)| o.impacts > 0));
+}
+
+/// `--aggregate` folded on the device (`shaders/aggregate.wgsl`) against the host's fold of the
+/// same GPU runs read back one by one: run, failure and exceedance counts equal, maxima equal,
+/// means to the precision's rounding, quantiles at most one 2 % bucket apart (the device takes
+/// the bucket's log in f32). Cases: every group in every chunk with runs handed back to the CPU;
+/// f32; more groups over the sweep than histogram slots (flushed to the host); more groups in a
+/// chunk than slots (that chunk folded on the host).
+#[test]
+fn gpu_aggregate_on_device_matches_the_host_fold() {
+    use pounding::aggregate::Aggregator;
+    let Some(ctx) = ctx() else { return };
+    let plan = pounding::bench::plan(200);
+    let exceed = ["peak_force_n=1e6".to_string(), "impacts=2".to_string()];
+    struct Case {
+        precision: Precision,
+        by: &'static str,
+        chunk: usize,
+        slots: u32,
+        handoff: Option<u32>,
+        mean_tol: f64,
+    }
+    let cases = [
+        Case {
+            precision: Precision::F64,
+            by: "gap_m",
+            chunk: 64,
+            slots: 1024,
+            handoff: Some(16),
+            mean_tol: 1e-12,
+        },
+        Case {
+            precision: Precision::F32,
+            by: "t1_s",
+            chunk: 64,
+            slots: 1024,
+            handoff: None,
+            mean_tol: 1e-5,
+        },
+        Case {
+            precision: Precision::F64,
+            by: "t1_s,gap_m",
+            chunk: 40,
+            slots: 12,
+            handoff: None,
+            mean_tol: 1e-12,
+        },
+        Case {
+            precision: Precision::F64,
+            by: "t1_s,gap_m",
+            chunk: 40,
+            slots: 8,
+            handoff: None,
+            mean_tol: 1e-12,
+        },
+    ];
+    for (n, c) in cases.iter().enumerate() {
+        let by: Vec<String> = c.by.split(',').map(String::from).collect();
+        let opts = GpuOptions {
+            precision: c.precision,
+            handoff_substeps_per_step: c.handoff,
+            ..Default::default()
+        };
+        let mut host = Aggregator::new(&by, &exceed).unwrap();
+        for (s, o) in gpu_collect(&plan, &opts, c.chunk) {
+            let g = host.group_of(&plan, &s);
+            host.add(g, &o);
+        }
+        let mut dev = Aggregator::new(&by, &exceed).unwrap();
+        let (summary, t) = pounding::sweep::run_gpu_aggregate(
+            &plan,
+            0..plan.len(),
+            ctx,
+            &opts,
+            c.chunk,
+            c.slots,
+            &mut dev,
+            |_| {},
+        )
+        .unwrap();
+        eprintln!(
+            "case {n}: {} groups, {} handed off, {} chunks folded on the host, {} flushes",
+            dev.groups(),
+            t.handed_off,
+            t.host_folded_chunks,
+            t.slot_flushes
+        );
+        assert_eq!(summary.runs, plan.len());
+        match n {
+            0 => assert!(t.handed_off > 0),
+            2 => assert!(t.slot_flushes > 0 && t.host_folded_chunks == 0),
+            3 => assert!(t.host_folded_chunks == 5),
+            _ => assert!(t.host_folded_chunks == 0 && t.slot_flushes == 0),
+        }
+        let (d, h) = (dev.csv(), host.csv());
+        let mut dr = csv::Reader::from_reader(d.as_bytes());
+        let mut hr = csv::Reader::from_reader(h.as_bytes());
+        let head = hr.headers().unwrap().clone();
+        assert_eq!(dr.headers().unwrap(), &head);
+        let drows: Vec<csv::StringRecord> = dr.records().map(|r| r.unwrap()).collect();
+        let hrows: Vec<csv::StringRecord> = hr.records().map(|r| r.unwrap()).collect();
+        assert_eq!(drows.len(), hrows.len());
+        let mut moved = 0;
+        for (a, b) in drows.iter().zip(&hrows) {
+            for ((col, x), y) in head.iter().zip(a).zip(b) {
+                let (fx, fy) = (x.parse::<f64>(), y.parse::<f64>());
+                let (Ok(fx), Ok(fy)) = (fx, fy) else {
+                    assert_eq!(x, y, "case {n} {col}");
+                    continue;
+                };
+                if col.ends_with("_mean") {
+                    assert!(rel(fx, fy) <= c.mean_tol, "case {n} {col}: {fx} vs {fy}");
+                } else if col.contains("_p") && fx != fy {
+                    moved += 1;
+                    assert!(rel(fx, fy) <= 0.021, "case {n} {col}: {fx} vs {fy}");
+                } else if !col.contains("_p") {
+                    assert_eq!(fx, fy, "case {n} {col}");
+                }
+            }
+        }
+        eprintln!("case {n}: {moved} quantiles one bucket apart");
+    }
 }

@@ -343,8 +343,44 @@ fn aggregate_matches_the_per_run_output() {
         assert!((get("peak_force_n_p90") - p90).abs() <= 0.01 * p90, "{g:?}");
     }
     assert!(std::fs::metadata(&agg).unwrap().len() < 10_000);
-    let bad = sweep(&cfg, &agg, &["--aggregate", "gap"]);
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("`gap` is not a column"));
+    // On the GPU the fold runs on the device: the same groups and counts.
+    if crate::gpu::ctx().is_some() {
+        let gagg = d.path().join("gpu-agg.csv");
+        let out = pound(&[
+            "sweep",
+            cfg.to_str().unwrap(),
+            "-o",
+            gagg.to_str().unwrap(),
+            "--backend",
+            "gpu",
+            "--precision",
+            "f64",
+            "--aggregate",
+            "record,law",
+        ]);
+        ok(&out);
+        assert!(String::from_utf8_lossy(&out.stderr).contains("aggregated on the device"));
+        let mut g = csv::Reader::from_path(&gagg).unwrap();
+        let gh = g.headers().unwrap().clone();
+        let grows: Vec<csv::StringRecord> = g.records().map(|x| x.unwrap()).collect();
+        assert_eq!(grows.len(), groups.len());
+        for (a, b) in grows.iter().zip(&groups) {
+            let at = |r: &csv::StringRecord, h: &csv::StringRecord, n: &str| {
+                r[h.iter().position(|c| c == n).unwrap()].to_string()
+            };
+            for n in ["record", "law", "runs", "failures"] {
+                assert_eq!(at(a, &gh, n), at(b, &ah, n), "{n}");
+            }
+        }
+    }
+    for (by, what) in [("gap", "`gap`"), ("impacts", "`impacts`")] {
+        let bad = sweep(&cfg, &agg, &["--aggregate", by]);
+        let err = String::from_utf8_lossy(&bad.stderr);
+        assert!(
+            err.contains(&format!("{what} is not a swept-parameter column")),
+            "{err}"
+        );
+    }
 }
 
 /// `--format parquet` holds the CSV's values, typed (an empty cell is a null), with the plan
@@ -418,4 +454,127 @@ fn unwritable_output_is_a_clear_error() {
         "{err}"
     );
     assert!(!d.path().join("no-such-dir").exists());
+}
+
+/// A record file that changes while a sweep runs ends the sweep with an error naming the
+/// record; the output does not appear under its final name (the rows computed from the content
+/// read at the start stay in the `.partial` file).
+#[test]
+fn record_changed_during_a_sweep_is_an_error() {
+    let d = tempdir();
+    let cfg = setup(d.path());
+    std::fs::write(&cfg, SWEEP.replace("to = 0.03, n = 4", "to = 0.03, n = 64")).unwrap();
+    let out = d.path().join("o.csv");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pound"))
+        .args(["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .args(["--backend", "cpu", "--threads", "1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Change the record once the first rows are on disk, i.e. mid-sweep.
+    let progress = d.path().join("o.csv.progress.toml");
+    while !std::fs::read_to_string(&progress).is_ok_and(|t| !t.contains("done = 0\n")) {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let long = d.path().join("long.txt");
+    let mut text = std::fs::read_to_string(&long).unwrap();
+    text.push_str("\n0.5");
+    std::fs::write(&long, text).unwrap();
+    let r = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        !r.status.success(),
+        "the sweep ended before the record changed: {err}"
+    );
+    assert!(
+        err.contains("record `long` changed on disk during the sweep"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    assert!(d.path().join("o.csv.partial").exists());
+}
+
+/// A full disk (`OUT.partial` pointing at `/dev/full`, where every write fails with ENOSPC) is a
+/// clear error for every output kind, and nothing is left under the final name, not even the
+/// sidecar.
+#[test]
+fn full_disk_is_a_clear_error_with_nothing_left_behind() {
+    assert!(Path::new("/dev/full").exists(), "/dev/full is needed");
+    let d = tempdir();
+    let cfg = setup(d.path());
+    for (name, extra) in [
+        ("runs.csv", &[][..]),
+        ("runs.parquet", &["--format", "parquet"][..]),
+        ("summary.csv", &["--aggregate", "record"][..]),
+    ] {
+        let out = d.path().join(name);
+        std::os::unix::fs::symlink("/dev/full", d.path().join(format!("{name}.partial"))).unwrap();
+        let r = sweep(&cfg, &out, extra);
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(!r.status.success(), "{name}");
+        assert!(err.contains("No space left on device"), "{name}: {err}");
+        assert!(
+            err.contains(name),
+            "{name}: the error names the file: {err}"
+        );
+        assert!(!out.exists(), "{name}");
+        assert!(
+            !d.path().join(format!("{name}.meta.toml")).exists(),
+            "{name}"
+        );
+    }
+}
+
+/// A disk that fills in the middle of a sweep (a file-size limit, so writes past it fail) keeps
+/// every finished chunk; once there is room again, `--resume` completes the output, identical to
+/// an uninterrupted sweep.
+#[test]
+fn disk_filling_mid_sweep_keeps_finished_rows_and_resumes() {
+    use std::os::unix::process::CommandExt;
+    let d = tempdir();
+    let cfg = setup(d.path());
+    let whole = d.path().join("whole.csv");
+    ok(&sweep(&cfg, &whole, &[]));
+    let size = std::fs::metadata(&whole).unwrap().len();
+    let out = d.path().join("out.csv");
+    let limit = size / 3;
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_pound"));
+    cmd.args(["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .args(["--backend", "cpu", "--chunk", "4"]);
+    // SAFETY: only async-signal-safe calls between fork and exec.
+    unsafe {
+        cmd.pre_exec(move || {
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            let r = libc::rlimit {
+                rlim_cur: limit,
+                rlim_max: limit,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &r) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let r = cmd.output().unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success());
+    assert!(err.contains("out.csv.partial"), "{err}");
+    assert!(err.contains("File too large"), "{err}");
+    assert!(!out.exists());
+    // What is on disk is a prefix of the full output, cut at the last finished chunk.
+    let partial = std::fs::read_to_string(d.path().join("out.csv.partial")).unwrap();
+    let full = std::fs::read_to_string(&whole).unwrap();
+    assert!(partial.len() as u64 <= limit && partial.len() > 100);
+    assert!(full.starts_with(&partial));
+    let resumed = sweep(&cfg, &out, &["--resume"]);
+    ok(&resumed);
+    assert_same_text(
+        "resumed after a full disk",
+        &std::fs::read_to_string(&out).unwrap(),
+        &full,
+    );
 }
