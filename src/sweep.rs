@@ -159,11 +159,10 @@ pub fn run_gpu_range<E: From<crate::gpu::GpuError>>(
     let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
     let n = runs.end;
     let mut s = Summary::default();
-    let mut c0 = runs.start;
-    while c0 < n {
-        let c1 = (c0 + chunk).min(n);
+    // Packing is host work: the next chunk is packed while the device integrates this one.
+    let prep = |c0: u64| {
         let t = Instant::now();
-        let (specs, packed): (Vec<RunSpec>, Vec<_>) = (c0..c1)
+        let (specs, packed): (Vec<RunSpec>, Vec<_>) = (c0..(c0 + chunk).min(n))
             .into_par_iter()
             .map(|i| {
                 let spec = plan.run(i);
@@ -177,8 +176,19 @@ pub fn run_gpu_range<E: From<crate::gpu::GpuError>>(
                 (spec, p)
             })
             .unzip();
-        times.pack += t.elapsed().as_secs_f64();
-        let (outs, ct) = run_chunk(ctx, &recs, &packed, opts)?;
+        (specs, packed, t.elapsed().as_secs_f64())
+    };
+    let mut c0 = runs.start;
+    let mut next = (c0 < n).then(|| prep(c0));
+    while let Some((specs, packed, pack_s)) = next.take() {
+        let c1 = (c0 + chunk).min(n);
+        times.pack += pack_s;
+        let (done, upcoming) = rayon::join(
+            || run_chunk(ctx, &recs, &packed, opts),
+            || (c1 < n).then(|| prep(c1)),
+        );
+        next = upcoming;
+        let (outs, ct) = done?;
         times.upload += ct.upload.as_secs_f64();
         times.kernel += ct.kernel.as_secs_f64();
         times.readback += ct.readback.as_secs_f64();
@@ -235,11 +245,15 @@ pub fn run_gpu_aggregate(
     let thresholds = agg.thresholds();
     let cpu = Scheme::Fast(opts.fast);
     let mut s = Summary::default();
-    let mut c0 = runs.start;
-    while c0 < runs.end {
-        let c1 = (c0 + chunk).min(runs.end);
+    let end = runs.end;
+    // Host work for a chunk: decode, group, order by group, pack, cut into segments. It runs
+    // for the next chunk while the device integrates this one.
+    let prep = |c0: u64, agg: &mut crate::aggregate::Aggregator| {
         let t = Instant::now();
-        let specs: Vec<RunSpec> = (c0..c1).into_par_iter().map(|i| plan.run(i)).collect();
+        let specs: Vec<RunSpec> = (c0..(c0 + chunk).min(end))
+            .into_par_iter()
+            .map(|i| plan.run(i))
+            .collect();
         let gids: Vec<u32> = specs.iter().map(|r| agg.group_of(plan, r)).collect();
         // Pack sorted by group (stable), so each group is a run of consecutive runs.
         let mut order: Vec<usize> = (0..specs.len()).collect();
@@ -267,23 +281,43 @@ pub fn run_gpu_aggregate(
         }
         let mut groups: Vec<u32> = segments.iter().map(|(g, _)| *g).collect();
         groups.dedup();
-        times.pack += t.elapsed().as_secs_f64();
-        let Some(slot) = slots.assign(ctx, &groups, agg)? else {
+        Prepared {
+            specs,
+            gids,
+            order,
+            packed,
+            segments,
+            groups,
+            seconds: t.elapsed().as_secs_f64(),
+        }
+    };
+    let mut c0 = runs.start;
+    let mut next = (c0 < end).then(|| prep(c0, agg));
+    while let Some(p) = next.take() {
+        let c1 = (c0 + chunk).min(end);
+        times.pack += p.seconds;
+        let Some(slot) = slots.assign(ctx, &p.groups, agg)? else {
             // More groups than slots: read every run back and fold here.
-            let (outs, ct) = run_chunk(ctx, &recs, &packed, opts)?;
+            let (done, upcoming) = rayon::join(
+                || run_chunk(ctx, &recs, &p.packed, opts),
+                || (c1 < end).then(|| prep(c1, &mut *agg)),
+            );
+            next = upcoming;
+            let (outs, ct) = done?;
             times.upload += ct.upload.as_secs_f64();
             times.kernel += ct.kernel.as_secs_f64();
             times.readback += ct.readback.as_secs_f64();
             times.host_folded_chunks += 1;
             let t = Instant::now();
             times.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
-            let outs: Vec<RunOutput> = order
+            let outs: Vec<RunOutput> = p
+                .order
                 .par_iter()
                 .zip(outs)
-                .map(|(&i, o)| o.unwrap_or_else(|| run_one(plan, &specs[i], &cpu)))
+                .map(|(&i, o)| o.unwrap_or_else(|| run_one(plan, &p.specs[i], &cpu)))
                 .collect();
-            for (&i, o) in order.iter().zip(&outs) {
-                agg.add(gids[i], o);
+            for (&i, o) in p.order.iter().zip(&outs) {
+                agg.add(p.gids[i], o);
                 s.count(o);
             }
             times.handoff += t.elapsed().as_secs_f64();
@@ -292,35 +326,44 @@ pub fn run_gpu_aggregate(
             continue;
         };
         let slot_of: std::collections::HashMap<u32, u32> =
-            groups.iter().copied().zip(slot).collect();
-        let segs: Vec<Segment> = segments
+            p.groups.iter().copied().zip(slot).collect();
+        let segs: Vec<Segment> = p
+            .segments
             .iter()
             .map(|(g, seg)| Segment {
                 slot: slot_of[g],
                 ..*seg
             })
             .collect();
-        let (done, ct) = integrate(ctx, &recs, &packed, opts)?;
+        let (done, upcoming) = rayon::join(
+            || -> Result<_, crate::gpu::GpuError> {
+                let (done, ct) = integrate(ctx, &recs, &p.packed, opts)?;
+                let t = Instant::now();
+                let folded = reduce(ctx, &done, opts.precision, &segs, &thresholds, &slots)?;
+                Ok((ct, folded, t.elapsed().as_secs_f64()))
+            },
+            || (c1 < end).then(|| prep(c1, &mut *agg)),
+        );
+        next = upcoming;
+        let (ct, (partials, handed), fold_s) = done?;
         times.upload += ct.upload.as_secs_f64();
         times.kernel += ct.kernel.as_secs_f64();
-        let t = Instant::now();
-        let (partials, handed) = reduce(ctx, &done, opts.precision, &segs, &thresholds, &slots)?;
-        for ((g, _), p) in segments.iter().zip(&partials) {
-            agg.group(*g).add_partial(p);
-            s.count_partial(p);
+        times.aggregate += fold_s;
+        for ((g, _), part) in p.segments.iter().zip(&partials) {
+            agg.group(*g).add_partial(part);
+            s.count_partial(part);
         }
-        times.aggregate += t.elapsed().as_secs_f64();
         let t = Instant::now();
         times.handed_off += handed.len() as u64;
         let finished: Vec<(usize, RunOutput)> = handed
             .par_iter()
             .map(|&k| {
-                let i = order[k as usize];
-                (i, run_one(plan, &specs[i], &cpu))
+                let i = p.order[k as usize];
+                (i, run_one(plan, &p.specs[i], &cpu))
             })
             .collect();
         for (i, o) in &finished {
-            agg.add(gids[*i], o);
+            agg.add(p.gids[*i], o);
             s.count(o);
         }
         times.handoff += t.elapsed().as_secs_f64();
@@ -333,4 +376,19 @@ pub fn run_gpu_aggregate(
     times.slot_flushes = slots.flushes.saturating_sub(1) as u64;
     s.seconds = start.elapsed().as_secs_f64();
     Ok((s, times))
+}
+
+/// One chunk's host work for [`run_gpu_aggregate`].
+struct Prepared {
+    specs: Vec<RunSpec>,
+    /// Group of each run (in run order).
+    gids: Vec<u32>,
+    /// Runs sorted by group: `packed[k]` is run `specs[order[k]]`.
+    order: Vec<usize>,
+    packed: Vec<crate::gpu::run::Packed>,
+    /// Each segment's group, and the segment (slot not yet assigned).
+    segments: Vec<(u32, crate::gpu::layout::Segment)>,
+    /// The distinct groups, in segment order.
+    groups: Vec<u32>,
+    seconds: f64,
 }

@@ -4,7 +4,7 @@
 
 use super::context::{GpuContext, GpuError};
 use super::layout::{self, AggConfig, Segment, PART_R, PART_U, SLOT_WORDS};
-use super::run::{bind_group, read, read_prefix, storage, Integrated};
+use super::run::{bind_group, read, read_prefix, storage, zeroed, Integrated};
 use super::shader::Precision;
 use crate::aggregate::{Aggregator, Partial, MAX_EXCEED};
 use std::collections::HashMap;
@@ -184,19 +184,14 @@ pub fn reduce(
     let cfg_buf = storage(ctx, "aggregate config", bytemuck::bytes_of(&cfg), none)?;
     let limits = storage(ctx, "aggregate thresholds", &reals(&limits), none)?;
     let segs = storage(ctx, "segments", bytemuck::cast_slice(segments), none)?;
-    let part_u = storage(ctx, "partial counts", &vec![0; nseg * PART_U * 4], src)?;
-    let part_r = storage(
+    let part_u = zeroed(ctx, "partial counts", (nseg * PART_U * 4) as u64, src)?;
+    let part_r = zeroed(
         ctx,
         "partial reals",
-        &vec![0; nseg * PART_R * precision.bytes()],
+        (nseg * PART_R * precision.bytes()) as u64,
         src,
     )?;
-    let handoffs = storage(
-        ctx,
-        "handed-back runs",
-        &vec![0; (done.runs as usize + 1) * 4],
-        src,
-    )?;
+    let handoffs = zeroed(ctx, "handed-back runs", (done.runs as u64 + 1) * 4, src)?;
     let buffers = [
         &cfg_buf,
         &limits,

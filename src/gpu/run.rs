@@ -231,6 +231,29 @@ pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<R
     })
 }
 
+/// A storage buffer of `size` bytes left as wgpu creates it: zeroed (no upload).
+pub(super) fn zeroed(
+    ctx: &GpuContext,
+    label: &str,
+    size: u64,
+    extra: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer, GpuError> {
+    let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(4).next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+        mapped_at_creation: false,
+    });
+    if pollster::block_on(scope.pop()).is_some() {
+        return Err(GpuError::OutOfMemory {
+            what: label.to_string(),
+            bytes: size,
+        });
+    }
+    Ok(buffer)
+}
+
 pub(super) fn storage(
     ctx: &GpuContext,
     label: &str,
@@ -376,14 +399,14 @@ pub fn integrate(
     let n = runs.len();
     let t = Instant::now();
     let params: Vec<u8> = match opts.precision {
-        Precision::F64 => runs
-            .iter()
-            .flat_map(|r| bytemuck::bytes_of(&r.params).to_vec())
-            .collect(),
-        Precision::F32 => runs
-            .iter()
-            .flat_map(|r| bytemuck::bytes_of(&Params32::from_f64(&r.params)).to_vec())
-            .collect(),
+        Precision::F64 => {
+            let v: Vec<Params64> = runs.iter().map(|r| r.params).collect();
+            bytemuck::cast_slice(&v).to_vec()
+        }
+        Precision::F32 => {
+            let v: Vec<Params32> = runs.iter().map(|r| Params32::from_f64(&r.params)).collect();
+            bytemuck::cast_slice(&v).to_vec()
+        }
     };
     let metas: Vec<Meta> = runs.iter().map(|r| r.meta).collect();
     let energy = opts.fast.energy;
@@ -402,8 +425,6 @@ pub fn integrate(
         }
     };
     let forms = storage(ctx, "energy forms", &forms, wgpu::BufferUsages::empty())?;
-    let states = vec![0u8; n * layout::state_bytes(opts.precision)];
-    let counters = vec![Counters::default(); n];
     let params = storage(ctx, "params", &params, wgpu::BufferUsages::empty())?;
     let metas_buf = storage(
         ctx,
@@ -411,11 +432,17 @@ pub fn integrate(
         bytemuck::cast_slice(&metas),
         wgpu::BufferUsages::empty(),
     )?;
-    let states = storage(ctx, "states", &states, wgpu::BufferUsages::COPY_SRC)?;
-    let counters = storage(
+    // Runs start from rest: a new buffer is zeroed, which is the zero state and `Counters`.
+    let states = zeroed(
+        ctx,
+        "states",
+        (n * layout::state_bytes(opts.precision)) as u64,
+        wgpu::BufferUsages::COPY_SRC,
+    )?;
+    let counters = zeroed(
         ctx,
         "counters",
-        bytemuck::cast_slice(&counters),
+        (n * size_of::<Counters>()) as u64,
         wgpu::BufferUsages::COPY_SRC,
     )?;
     let active = storage(
@@ -434,10 +461,11 @@ pub fn integrate(
             bytemuck::cast_slice(&all),
             wgpu::BufferUsages::empty(),
         )?,
-        storage(
+        // Written by the first dispatch before any dispatch reads it.
+        zeroed(
             ctx,
             "run ids b",
-            bytemuck::cast_slice(&all),
+            (n * 4) as u64,
             wgpu::BufferUsages::empty(),
         )?,
     ];
