@@ -89,7 +89,6 @@ fn main(
         let i = seg.start + k;
         let c = counters[i];
         if (c.status == STATUS_HANDOFF) {
-            atomicAdd(&w_count[P_HANDOFFS], 1u);
             let at = atomicAdd(&handoffs[0], 1u);
             atomicStore(&handoffs[1u + at], i);
             continue;

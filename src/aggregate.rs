@@ -108,14 +108,6 @@ impl Sketch {
         }
     }
 
-    pub fn count(&self) -> u64 {
-        self.count
-    }
-
-    pub fn max(&self) -> f64 {
-        self.max
-    }
-
     pub fn mean(&self) -> f64 {
         self.sum / self.count.max(1) as f64
     }
@@ -147,9 +139,6 @@ impl Sketch {
 pub struct Group {
     pub runs: u64,
     pub failures: u64,
-    /// Runs with at least one impact.
-    pub pounded: u64,
-    pub impacts: u64,
     pub exceed: Vec<u64>,
     pub stats: Vec<Sketch>,
 }
@@ -172,8 +161,6 @@ impl Group {
             return;
         }
         let x = outputs(o);
-        self.pounded += (o.impacts > 0) as u64;
-        self.impacts += o.impacts as u64;
         for (k, &(i, t)) in exceed.iter().enumerate() {
             self.exceed[k] += (x[i] > t) as u64;
         }
@@ -186,8 +173,6 @@ impl Group {
     pub fn add_partial(&mut self, p: &Partial) {
         self.runs += p.runs;
         self.failures += p.failures;
-        self.pounded += p.pounded;
-        self.impacts += p.impacts;
         for (e, n) in self.exceed.iter_mut().zip(&p.exceed) {
             *e += n;
         }
@@ -213,7 +198,7 @@ impl Group {
 pub struct Partial {
     pub runs: u64,
     pub failures: u64,
-    pub handoffs: u64,
+    /// Runs with at least one impact, and their impacts (for the sweep's totals).
     pub pounded: u64,
     pub impacts: u64,
     pub exceed: [u64; MAX_EXCEED],
@@ -318,8 +303,10 @@ impl Param {
 pub struct Aggregator {
     /// Column name, its index in the CSV header, its key.
     by: Vec<(String, usize, Param)>,
-    /// Column name, output index, threshold.
-    exceed: Vec<(String, usize, f64)>,
+    /// Column name of each `--exceed`.
+    exceed_names: Vec<String>,
+    /// Output index and threshold of each `--exceed`.
+    exceed: Vec<(usize, f64)>,
     ids: HashMap<Vec<u64>, u32>,
     /// In the order of each group's first run (the summary's row order), with its labels.
     groups: Vec<(Vec<String>, Group)>,
@@ -344,7 +331,7 @@ impl Aggregator {
         if exceed.len() > MAX_EXCEED {
             return Err(AggregateError::TooManyExceed(exceed.len()));
         }
-        let exceed = exceed
+        let parsed: Vec<(String, usize, f64)> = exceed
             .iter()
             .map(|e| {
                 let bad = || AggregateError::BadExceed(e.clone());
@@ -359,15 +346,16 @@ impl Aggregator {
             .collect::<Result<_, _>>()?;
         Ok(Aggregator {
             by,
-            exceed,
+            exceed: parsed.iter().map(|&(_, i, t)| (i, t)).collect(),
+            exceed_names: parsed.into_iter().map(|(c, _, _)| c).collect(),
             ids: HashMap::new(),
             groups: Vec::new(),
         })
     }
 
     /// The (output index, threshold) pairs of `--exceed`.
-    pub fn thresholds(&self) -> Vec<(usize, f64)> {
-        self.exceed.iter().map(|&(_, i, t)| (i, t)).collect()
+    pub fn thresholds(&self) -> &[(usize, f64)] {
+        &self.exceed
     }
 
     /// The group of a run (numbered in the order of first appearance).
@@ -389,8 +377,7 @@ impl Aggregator {
 
     /// Fold in one run of group `id`.
     pub fn add(&mut self, id: u32, o: &RunOutput) {
-        let t = self.thresholds();
-        self.group(id).add(o, &t);
+        self.groups[id as usize].1.add(o, &self.exceed);
     }
 
     pub fn groups(&self) -> usize {
@@ -402,7 +389,7 @@ impl Aggregator {
         let mut head: Vec<String> = self.by.iter().map(|(b, _, _)| b.clone()).collect();
         head.push("runs".into());
         head.push("failures".into());
-        for (c, _, t) in &self.exceed {
+        for (c, (_, t)) in self.exceed_names.iter().zip(&self.exceed) {
             head.push(format!("exceed_{c}>{t}"));
         }
         for o in OUTPUTS {

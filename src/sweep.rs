@@ -125,6 +125,36 @@ pub struct GpuTimes {
     pub slot_flushes: u64,
 }
 
+impl GpuTimes {
+    /// Add a chunk's device times.
+    fn add_chunk(&mut self, ct: &crate::gpu::ChunkTimes) {
+        self.upload += ct.upload.as_secs_f64();
+        self.kernel += ct.kernel.as_secs_f64();
+        self.readback += ct.readback.as_secs_f64();
+    }
+
+    /// A chunk's outputs as read back, with the runs the kernel handed back finished on the CPU
+    /// in f64 (`spec(k)` is the run of `outs[k]`).
+    fn finish<'a>(
+        &mut self,
+        plan: &Plan,
+        fast: &crate::cpu::FastOptions,
+        outs: Vec<Option<RunOutput>>,
+        spec: impl Fn(usize) -> &'a RunSpec + Sync,
+    ) -> Vec<RunOutput> {
+        let t = Instant::now();
+        let cpu = Scheme::Fast(*fast);
+        self.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
+        let done = outs
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, o)| o.unwrap_or_else(|| run_one(plan, spec(k), &cpu)))
+            .collect();
+        self.handoff += t.elapsed().as_secs_f64();
+        done
+    }
+}
+
 /// Run every run of `plan` on the GPU, `chunk` runs per chunk (capped by the device's limits);
 /// `sink` gets each chunk's results in run order as it finishes. Runs the kernel hands back
 /// (more substeps per record step than its precision resolves) are finished on the CPU's fast
@@ -189,21 +219,9 @@ pub fn run_gpu_range<E: From<crate::gpu::GpuError>>(
         );
         next = upcoming;
         let (outs, ct) = done?;
-        times.upload += ct.upload.as_secs_f64();
-        times.kernel += ct.kernel.as_secs_f64();
-        times.readback += ct.readback.as_secs_f64();
-        let t = Instant::now();
-        let cpu = Scheme::Fast(opts.fast);
-        times.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
-        let rows: Vec<(RunSpec, RunOutput)> = specs
-            .into_par_iter()
-            .zip(outs)
-            .map(|(spec, o)| {
-                let o = o.unwrap_or_else(|| run_one(plan, &spec, &cpu));
-                (spec, o)
-            })
-            .collect();
-        times.handoff += t.elapsed().as_secs_f64();
+        times.add_chunk(&ct);
+        let outs = times.finish(plan, &opts.fast, outs, |k| &specs[k]);
+        let rows: Vec<(RunSpec, RunOutput)> = specs.into_iter().zip(outs).collect();
         let t = Instant::now();
         for (_, o) in &rows {
             s.count(o);
@@ -242,8 +260,7 @@ pub fn run_gpu_aggregate(
     let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
     let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
     let mut slots = Slots::new(ctx, max_slots);
-    let thresholds = agg.thresholds();
-    let cpu = Scheme::Fast(opts.fast);
+    let thresholds = agg.thresholds().to_vec();
     let mut s = Summary::default();
     let end = runs.end;
     // Host work for a chunk: decode, group, order by group, pack, cut into segments. It runs
@@ -304,23 +321,13 @@ pub fn run_gpu_aggregate(
             );
             next = upcoming;
             let (outs, ct) = done?;
-            times.upload += ct.upload.as_secs_f64();
-            times.kernel += ct.kernel.as_secs_f64();
-            times.readback += ct.readback.as_secs_f64();
+            times.add_chunk(&ct);
             times.host_folded_chunks += 1;
-            let t = Instant::now();
-            times.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
-            let outs: Vec<RunOutput> = p
-                .order
-                .par_iter()
-                .zip(outs)
-                .map(|(&i, o)| o.unwrap_or_else(|| run_one(plan, &p.specs[i], &cpu)))
-                .collect();
+            let outs = times.finish(plan, &opts.fast, outs, |k| &p.specs[p.order[k]]);
             for (&i, o) in p.order.iter().zip(&outs) {
                 agg.add(p.gids[i], o);
                 s.count(o);
             }
-            times.handoff += t.elapsed().as_secs_f64();
             progress(s.runs);
             c0 = c1;
             continue;
@@ -346,27 +353,21 @@ pub fn run_gpu_aggregate(
         );
         next = upcoming;
         let (ct, (partials, handed), fold_s) = done?;
-        times.upload += ct.upload.as_secs_f64();
-        times.kernel += ct.kernel.as_secs_f64();
+        times.add_chunk(&ct);
         times.aggregate += fold_s;
         for ((g, _), part) in p.segments.iter().zip(&partials) {
             agg.group(*g).add_partial(part);
             s.count_partial(part);
         }
-        let t = Instant::now();
-        times.handed_off += handed.len() as u64;
-        let finished: Vec<(usize, RunOutput)> = handed
-            .par_iter()
-            .map(|&k| {
-                let i = p.order[k as usize];
-                (i, run_one(plan, &p.specs[i], &cpu))
-            })
-            .collect();
-        for (i, o) in &finished {
-            agg.add(p.gids[*i], o);
+        // Runs handed back: `handed` holds their places in the packed (sorted) chunk.
+        let run = |k: usize| p.order[handed[k] as usize];
+        let outs = times.finish(plan, &opts.fast, vec![None; handed.len()], |k| {
+            &p.specs[run(k)]
+        });
+        for (k, o) in outs.iter().enumerate() {
+            agg.add(p.gids[run(k)], o);
             s.count(o);
         }
-        times.handoff += t.elapsed().as_secs_f64();
         progress(s.runs);
         c0 = c1;
     }

@@ -324,13 +324,14 @@ impl Layout for Segment {
 // A segment's partial counts: `PART_U` u32 words at these offsets (keep in sync with
 // aggregate.wgsl, which gets PART_U and the P_* offsets from `shader::aggregate_source`).
 pub const PART_U: usize = 16;
+/// Runs folded (handed-back runs are not), of which failed.
 pub const P_RUNS: usize = 0;
 pub const P_FAILURES: usize = 1;
-pub const P_HANDOFFS: usize = 2;
-pub const P_POUNDED: usize = 3;
-pub const P_IMPACTS: usize = 4;
+/// Runs with at least one impact, and their impacts.
+pub const P_POUNDED: usize = 2;
+pub const P_IMPACTS: usize = 3;
 /// `MAX_EXCEED` exceedance counts from here.
-pub const P_EXCEED: usize = 5;
+pub const P_EXCEED: usize = 4;
 /// A segment's reals: the max of each output, then the sum of each.
 pub const PART_R: usize = 2 * crate::aggregate::NOUT;
 /// Longest segment: keeps each invocation's loop at `MAX_SEGMENT / WORKGROUP_SIZE` iterations,
@@ -347,7 +348,6 @@ pub fn partial(part_u: &[u32], part_r: &[f64], k: usize) -> crate::aggregate::Pa
     let mut p = crate::aggregate::Partial {
         runs: u[P_RUNS] as u64,
         failures: u[P_FAILURES] as u64,
-        handoffs: u[P_HANDOFFS] as u64,
         pounded: u[P_POUNDED] as u64,
         impacts: u[P_IMPACTS] as u64,
         ..Default::default()

@@ -84,22 +84,12 @@ impl Slots {
     fn grow(&mut self, ctx: &GpuContext, need: u32) -> Result<(), GpuError> {
         let capacity = need.max(2 * self.capacity).max(16).min(self.max);
         let bytes = capacity as u64 * SLOT_BYTES;
-        let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        // New buffers are zeroed.
-        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("aggregate histograms"),
-            size: bytes,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        if pollster::block_on(scope.pop()).is_some() {
-            return Err(GpuError::OutOfMemory {
-                what: "aggregate histograms".into(),
-                bytes,
-            });
-        }
+        let buffer = zeroed(
+            ctx,
+            "aggregate histograms",
+            bytes,
+            wgpu::BufferUsages::COPY_SRC,
+        )?;
         if let (Some(old), used) = (&self.buffer, self.owner.len() as u64 * SLOT_BYTES) {
             if used > 0 {
                 let mut enc = ctx
@@ -170,19 +160,10 @@ pub fn reduce(
         cfg.exceed_output[k] = o as u32;
         limits[k] = t;
     }
-    let reals = |x: &[f64]| -> Vec<u8> {
-        match precision {
-            Precision::F64 => bytemuck::cast_slice(x).to_vec(),
-            Precision::F32 => {
-                let v: Vec<f32> = x.iter().map(|&y| y as f32).collect();
-                bytemuck::cast_slice(&v).to_vec()
-            }
-        }
-    };
     let none = wgpu::BufferUsages::empty();
     let src = wgpu::BufferUsages::COPY_SRC;
     let cfg_buf = storage(ctx, "aggregate config", bytemuck::bytes_of(&cfg), none)?;
-    let limits = storage(ctx, "aggregate thresholds", &reals(&limits), none)?;
+    let limits = storage(ctx, "aggregate thresholds", &precision.reals(&limits), none)?;
     let segs = storage(ctx, "segments", bytemuck::cast_slice(segments), none)?;
     let part_u = zeroed(ctx, "partial counts", (nseg * PART_U * 4) as u64, src)?;
     let part_r = zeroed(

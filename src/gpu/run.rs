@@ -91,14 +91,12 @@ impl GpuRecords {
         if all.is_empty() {
             all.push(0.0);
         }
-        let bytes = match precision {
-            Precision::F64 => bytemuck::cast_slice(&all).to_vec(),
-            Precision::F32 => {
-                let v: Vec<f32> = all.iter().map(|&x| x as f32).collect();
-                bytemuck::cast_slice(&v).to_vec()
-            }
-        };
-        let buffer = storage(ctx, "records", &bytes, wgpu::BufferUsages::empty())?;
+        let buffer = storage(
+            ctx,
+            "records",
+            &precision.reals(&all),
+            wgpu::BufferUsages::empty(),
+        )?;
         Ok(GpuRecords {
             buffer,
             offsets,
@@ -238,20 +236,7 @@ pub(super) fn zeroed(
     size: u64,
     extra: wgpu::BufferUsages,
 ) -> Result<wgpu::Buffer, GpuError> {
-    let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: size.max(4).next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
-        mapped_at_creation: false,
-    });
-    if pollster::block_on(scope.pop()).is_some() {
-        return Err(GpuError::OutOfMemory {
-            what: label.to_string(),
-            bytes: size,
-        });
-    }
-    Ok(buffer)
+    buffer(ctx, label, size.max(4), extra, &[])
 }
 
 pub(super) fn storage(
@@ -260,20 +245,34 @@ pub(super) fn storage(
     bytes: &[u8],
     extra: wgpu::BufferUsages,
 ) -> Result<wgpu::Buffer, GpuError> {
+    buffer(ctx, label, bytes.len() as u64, extra, bytes)
+}
+
+/// A storage buffer of `size` bytes holding `contents` (its first bytes; the rest zero), out of
+/// memory reported as an error.
+fn buffer(
+    ctx: &GpuContext,
+    label: &str,
+    size: u64,
+    extra: wgpu::BufferUsages,
+    contents: &[u8],
+) -> Result<wgpu::Buffer, GpuError> {
     let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
     // Not `create_buffer_init`: a buffer mapped at creation panics on a lost device, and a
     // lost device must come back as an error.
     let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
-        size: (bytes.len() as u64).next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
+        size: size.next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
         mapped_at_creation: false,
     });
-    ctx.queue.write_buffer(&buffer, 0, bytes);
+    if !contents.is_empty() {
+        ctx.queue.write_buffer(&buffer, 0, contents);
+    }
     if pollster::block_on(scope.pop()).is_some() {
         return Err(GpuError::OutOfMemory {
             what: label.to_string(),
-            bytes: bytes.len() as u64,
+            bytes: size,
         });
     }
     Ok(buffer)
@@ -417,14 +416,12 @@ pub fn integrate(
     } else {
         vec![0.0]
     };
-    let forms = match opts.precision {
-        Precision::F64 => bytemuck::cast_slice(&forms).to_vec(),
-        Precision::F32 => {
-            let v: Vec<f32> = forms.iter().map(|&x| x as f32).collect();
-            bytemuck::cast_slice(&v).to_vec()
-        }
-    };
-    let forms = storage(ctx, "energy forms", &forms, wgpu::BufferUsages::empty())?;
+    let forms = storage(
+        ctx,
+        "energy forms",
+        &opts.precision.reals(&forms),
+        wgpu::BufferUsages::empty(),
+    )?;
     let params = storage(ctx, "params", &params, wgpu::BufferUsages::empty())?;
     let metas_buf = storage(
         ctx,

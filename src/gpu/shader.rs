@@ -25,6 +25,17 @@ impl Precision {
         }
     }
 
+    /// `x` as this precision's reals, in bytes (as the shaders' `array<real>` reads them).
+    pub fn reals(self, x: &[f64]) -> Vec<u8> {
+        match self {
+            Precision::F64 => bytemuck::cast_slice(x).to_vec(),
+            Precision::F32 => {
+                let v: Vec<f32> = x.iter().map(|&y| y as f32).collect();
+                bytemuck::cast_slice(&v).to_vec()
+            }
+        }
+    }
+
     /// Bytes per real.
     pub fn bytes(self) -> usize {
         match self {
@@ -63,16 +74,14 @@ pub fn fast_source(precision: Precision, energy: bool) -> String {
 /// `shaders/aggregate.wgsl` for `precision`, after the prelude: with the sketch's bucket range
 /// and the partials' layout, all from `aggregate` and `layout` (one source of truth).
 pub fn aggregate_source(precision: Precision) -> String {
-    use super::layout::{
-        PART_R, PART_U, P_EXCEED, P_FAILURES, P_HANDOFFS, P_IMPACTS, P_POUNDED, P_RUNS,
-    };
+    use super::layout::{PART_R, PART_U, P_EXCEED, P_FAILURES, P_IMPACTS, P_POUNDED, P_RUNS};
     use crate::aggregate::{BUCKETS, GAMMA, KMAX, KMIN, MAX_EXCEED, NOUT, SKETCH_MAX, SKETCH_MIN};
     let inv_ln_g = 1.0 / GAMMA.ln();
     format!(
         "{}const NOUT: u32 = {NOUT}u;\nconst BUCKETS: u32 = {BUCKETS}u;\nconst KMIN: i32 = {KMIN}i;\nconst KMAX: i32 = {KMAX}i;\n\
          const SKETCH_MIN: real = {SKETCH_MIN:e};\nconst SKETCH_MAX: real = {SKETCH_MAX:e};\nconst INV_LN_G: f32 = {inv_ln_g:?};\n\
          const MAX_EXCEED: u32 = {MAX_EXCEED}u;\nconst PART_U: u32 = {PART_U}u;\nconst PART_R: u32 = {PART_R}u;\n\
-         const P_RUNS: u32 = {P_RUNS}u;\nconst P_FAILURES: u32 = {P_FAILURES}u;\nconst P_HANDOFFS: u32 = {P_HANDOFFS}u;\n\
+         const P_RUNS: u32 = {P_RUNS}u;\nconst P_FAILURES: u32 = {P_FAILURES}u;\n\
          const P_POUNDED: u32 = {P_POUNDED}u;\nconst P_IMPACTS: u32 = {P_IMPACTS}u;\nconst P_EXCEED: u32 = {P_EXCEED}u;\n{AGGREGATE_WGSL}",
         prelude(precision)
     )
