@@ -145,6 +145,11 @@ fn local_rate(delta: real, v0: real) -> real {
 }
 
 // Two Newton steps, unrolled (every loop iteration counts against lavapipe's limiter).
+// model.rs Pair::structural_rate: the faster oscillator's sqrt(k/m) + c/m.
+fn structural_rate() -> real {
+    return max(sqrt(P.k1 / P.m1) + P.c1 / P.m1, sqrt(P.k2 / P.m2) + P.c2 / P.m2);
+}
+
 fn inv_fifth_root(v: real) -> real {
     var y = real(pow(f32(v), -0.2));
     var y2 = y * y;
@@ -650,7 +655,8 @@ fn begin_interval(seg: Seg) {
     }
     if (substep) {
         // Resolve an impact at v_est, and stay stable at twice the current penetration.
-        let h_rate = 6.283185307179586 / P.substeps_per_contact / local_rate(2.0 * d_est, S.v0);
+        let h_rate = 6.283185307179586 / P.substeps_per_contact
+            / max(local_rate(2.0 * d_est, S.v0), structural_rate());
         // fast.rs: a contact that has lasted SUSTAINED contact durations needs only h_rate.
         var h0 = h_rate;
         if (!(C.mode != MODE_FREE && since_onset(0.0) > SUSTAINED * duration_estimate(S.v0))) {

@@ -384,6 +384,11 @@ impl Aggregator {
         self.groups.len()
     }
 
+    /// Runs folded in so far, over all groups.
+    pub fn runs(&self) -> u64 {
+        self.groups.iter().map(|(_, g)| g.runs).sum()
+    }
+
     /// The summary as CSV, groups in the order of their first run.
     pub fn csv(&self) -> String {
         let mut head: Vec<String> = self.by.iter().map(|(b, _, _)| b.clone()).collect();
@@ -407,6 +412,11 @@ impl Aggregator {
             r.push(g.failures.to_string());
             r.extend(g.exceed.iter().map(|n| n.to_string()));
             for s in &g.stats {
+                // A group with no `ok` run has no statistics: empty cells, not zeros.
+                if s.count == 0 {
+                    r.extend(std::iter::repeat_n(String::new(), 2 + QUANTILES.len()));
+                    continue;
+                }
                 r.push(format!("{}", s.max));
                 r.push(format!("{}", s.mean()));
                 for q in QUANTILES {

@@ -137,15 +137,57 @@ impl Axis {
         }
     }
 
-    fn range_values(r: &RangeSpec) -> Result<Vec<f64>, String> {
+    /// The number of values, without computing them (so a sweep too large to run is refused
+    /// before gigabytes of axes are built).
+    pub fn count(&self) -> Result<usize, String> {
+        match self {
+            Axis::List(v) => Ok(v.len()),
+            Axis::Range(r) => Self::range_count(r),
+        }
+    }
+
+    fn range_count(r: &RangeSpec) -> Result<usize, String> {
+        let max = crate::limits::MAX_AXIS_POINTS;
         if !(r.from.is_finite() && r.to.is_finite()) {
             return Err("range ends must be finite".into());
         }
         match (r.n, r.step) {
             (Some(n), None) => {
-                if n == 0 || n > 10_000_000 {
+                if n == 0 || n > max {
                     return Err(format!("n = {n}: expected 1 to 1e7 points"));
                 }
+                if n == 1 && r.to != r.from {
+                    return Err(format!(
+                        "n = 1 gives the single value from = {}, and to = {} would be ignored: give one value, or n >= 2",
+                        r.from, r.to
+                    ));
+                }
+                Ok(n)
+            }
+            (None, Some(step)) if !r.log => {
+                if !(step.is_finite() && step != 0.0) || (r.to - r.from) * step < 0.0 {
+                    return Err(format!(
+                        "step = {step:?} does not lead from {:?} to {:?}",
+                        r.from, r.to
+                    ));
+                }
+                let count = ((r.to - r.from) / step + 1e-9).floor() + 1.0;
+                if count.is_nan() || count > max as f64 {
+                    return Err(format!(
+                        "step = {step:?} gives {count:.3e} points from {:?} to {:?}: expected at most 1e7",
+                        r.from, r.to
+                    ));
+                }
+                Ok(count as usize)
+            }
+            _ => Err("give exactly one of n or step (log ranges take n)".into()),
+        }
+    }
+
+    fn range_values(r: &RangeSpec) -> Result<Vec<f64>, String> {
+        let count = Self::range_count(r)?;
+        match (r.n, r.step) {
+            (Some(n), None) => {
                 if n == 1 {
                     return Ok(vec![r.from]);
                 }
@@ -175,19 +217,7 @@ impl Axis {
                         .collect())
                 }
             }
-            (None, Some(step)) if !r.log => {
-                if !(step.is_finite() && step != 0.0) || (r.to - r.from) * step < 0.0 {
-                    return Err(format!(
-                        "step = {step} does not lead from {} to {}",
-                        r.from, r.to
-                    ));
-                }
-                let count = ((r.to - r.from) / step + 1e-9).floor() as usize + 1;
-                if count > 10_000_000 {
-                    return Err(format!("{count} points: expected at most 1e7"));
-                }
-                Ok((0..count).map(|i| r.from + step * i as f64).collect())
-            }
+            (None, Some(step)) => Ok((0..count).map(|i| r.from + step * i as f64).collect()),
             _ => Err("give exactly one of n or step (log ranges take n)".into()),
         }
     }
@@ -340,6 +370,30 @@ pub fn load_with_text(path: &Path) -> Result<(Plan, String), ConfigError> {
     Ok((plan, text))
 }
 
+/// The record files a config reads (`file =` and `path =` records, resolved), so a command can
+/// refuse to write over one of them. A config that does not parse lists none (loading it then
+/// reports the error).
+pub fn input_files(path: &Path) -> Result<Vec<PathBuf>, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
+        path: path.into(),
+        error,
+    })?;
+    let Ok(raw) = toml::from_str::<RawConfig>(&text) else {
+        return Ok(Vec::new());
+    };
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let records = records_dir();
+    Ok(raw
+        .records
+        .iter()
+        .filter_map(|r| match (&r.file, &r.path) {
+            (Some(f), _) => Some(records.join(f)),
+            (_, Some(p)) => Some(base.join(p)),
+            _ => None,
+        })
+        .collect())
+}
+
 /// The records of `plan` (from the config `text` at `path`) whose files no longer hold what was
 /// read, by name; or why they cannot be read again. A sweep reads its records once, so this
 /// finds files changed while it ran.
@@ -378,10 +432,15 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
         "fast" => {
             let mut o = FastOptions::default();
             if let Some(n) = raw.run.substeps_per_contact {
-                if !(n.is_finite() && n >= 1.0) {
+                if !(n.is_finite() && (1.0..=crate::limits::MAX_SUBSTEPS_PER_CONTACT).contains(&n))
+                {
                     return Err(invalid(
                         "run.substeps_per_contact",
-                        format!("{n}: expected a number >= 1"),
+                        format!(
+                            "{n}: expected 1 to {} ({})",
+                            crate::limits::MAX_SUBSTEPS_PER_CONTACT,
+                            crate::limits::WHY_SUBSTEPS
+                        ),
                     ));
                 }
                 o.substeps_per_contact = n;
@@ -434,6 +493,7 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
         })?);
     }
 
+    check_size(&raw, &laws, &invalid)?;
     let samples = raw
         .sample
         .as_ref()
@@ -512,6 +572,42 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
     Plan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
 }
 
+/// Refuse a sweep of more than [`crate::limits::MAX_RUNS`] runs from the axes' sizes alone,
+/// before any axis is built or sample drawn.
+fn check_size(
+    raw: &RawConfig,
+    laws: &[LawKind],
+    invalid: &dyn Fn(&str, String) -> ConfigError,
+) -> Result<(), ConfigError> {
+    let count = |key: &str, a: &Option<Axis>| -> Result<usize, ConfigError> {
+        a.as_ref()
+            .map_or(Ok(1), |a| a.count().map_err(|m| invalid(key, m)))
+    };
+    let b = |name: &str, r: &RawBuilding| -> Result<[usize; 3], ConfigError> {
+        Ok([
+            count(&format!("{name}.mass_kg"), &r.mass_kg)?,
+            count(&format!("{name}.period_s"), &r.period_s)?,
+            count(&format!("{name}.damping_ratio"), &r.damping_ratio)?,
+        ])
+    };
+    let counts = crate::plan::AxisCounts {
+        formulas: raw.contact.formula.as_ref().map_or(0, |f| f.list().len()),
+        e: count("contact.e", &raw.contact.e)?,
+        k_linear: count("contact.k_n_per_m", &raw.contact.k_n_per_m)?,
+        beta: count("contact.beta_n_per_m1_5", &raw.contact.beta_n_per_m1_5)?,
+        records: raw.records.len(),
+        intensities: count("intensity.pga_g", &raw.intensity.pga_g)?
+            * count("intensity.scale", &raw.intensity.scale)?,
+        samples: raw.sample.as_ref().map_or(1, |s| s.n.max(1)),
+        building1: b("building1", &raw.building1)?,
+        building2: b("building2", &raw.building2)?,
+        gaps: count("contact.gap_m", &raw.contact.gap_m)?,
+    };
+    crate::plan::check_run_count(laws, &counts)
+        .map(|_| ())
+        .map_err(|e| invalid(&e.key, e.message))
+}
+
 /// Stage 2 of `[sample]`: distributions checked, points drawn.
 fn samples(
     s: &RawSample,
@@ -531,6 +627,17 @@ fn samples(
         return Err(invalid(
             "sample.n",
             "is 0: expected at least one sample".into(),
+        ));
+    }
+    if s.n > crate::limits::MAX_SAMPLES {
+        return Err(invalid(
+            "sample.n",
+            format!(
+                "{}: expected at most {} ({})",
+                s.n,
+                crate::limits::MAX_SAMPLES,
+                crate::limits::WHY_SAMPLES
+            ),
         ));
     }
     if s.axes.is_empty() {

@@ -14,6 +14,8 @@ pub mod cpu;
 pub mod fidelity;
 pub mod fragility;
 pub mod gpu;
+pub mod journal;
+pub mod limits;
 pub mod model;
 pub mod output;
 pub mod paper;
@@ -27,4 +29,13 @@ pub mod sample;
 pub mod sensitivity;
 pub mod shard;
 pub mod sweep;
+pub mod sweep_output;
 pub mod table;
+pub mod target;
+
+/// Print a line to standard error. A failed write (stderr closed, or on a full device) is
+/// ignored, never a panic: diagnostics must not turn a good run into a crash.
+pub fn note(line: impl std::fmt::Display) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "{line}");
+}

@@ -6,13 +6,24 @@ use pounding::config;
 use pounding::contact::LawKind;
 use pounding::cpu::{FastOptions, ReferenceOptions, Scheme};
 use pounding::gpu::{GpuContext, GpuOptions, Precision};
-use pounding::output::CsvOut;
 use pounding::record::{read_record, Format, ReadOptions, Units, G};
 use pounding::restitution::{exact_damping, Formula};
-use pounding::shard::{
-    meta_path, progress_path, read_toml, write_toml, Fingerprint, Meta, Progress,
-};
+use pounding::shard::{meta_path, progress_path, Fingerprint, Meta};
 use std::io::IsTerminal;
+use std::io::Write as _;
+
+/// A line on standard error that never panics (stderr may be closed or full).
+macro_rules! note {
+    ($($t:tt)*) => { pounding::note(format_args!($($t)*)) };
+}
+
+/// A line on standard output; a failed write is an error, not a panic.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout(), $($t)*).context("writing to standard output")?
+    }};
+}
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -34,7 +45,8 @@ enum SchemeArg {
 
 #[derive(Clone, Copy, PartialEq, ValueEnum)]
 enum BackendArg {
-    /// The GPU if an adapter is found, else the CPU (with a one-line notice).
+    /// A hardware GPU if one is found, else the CPU (with a one-line notice saying why); a
+    /// software adapter (lavapipe) is slower than the CPU path, so only `gpu` uses it.
     Auto,
     Gpu,
     Cpu,
@@ -109,61 +121,6 @@ struct SweepArgs {
 enum FormatArg {
     Csv,
     Parquet,
-}
-
-/// Where a sweep's rows go: a CSV row per run (journaled for --resume), or folded into a
-/// summary per group (--aggregate).
-enum Rows {
-    Csv {
-        out: Box<CsvOut>,
-        progress: Progress,
-        progress_file: PathBuf,
-        columns: Option<Vec<usize>>,
-    },
-    Parquet {
-        out: Box<pounding::parquet_out::ParquetOut>,
-        columns: Option<Vec<usize>>,
-    },
-    Summary(pounding::aggregate::Aggregator),
-}
-
-impl Rows {
-    fn take(
-        &mut self,
-        plan: &pounding::plan::Plan,
-        rows: &[(pounding::plan::RunSpec, pounding::model::RunOutput)],
-    ) -> Result<()> {
-        match self {
-            // Each chunk's rows go to disk (fsync) before the progress file counts them, so a
-            // crash at any moment leaves a consistent prefix to resume from.
-            Rows::Csv {
-                out,
-                progress,
-                progress_file,
-                columns,
-            } => {
-                out.write_encoded(&pounding::output::encode_csv(
-                    plan,
-                    rows,
-                    columns.as_deref(),
-                ))?;
-                progress.bytes = out.sync()?;
-                progress.done += rows.len() as u64;
-                write_toml(progress_file, progress)?;
-            }
-            Rows::Parquet { out, columns } => {
-                let cells = pounding::output::cells(plan, rows, columns.as_deref());
-                out.write(&cells)?;
-            }
-            Rows::Summary(agg) => {
-                for (s, o) in rows {
-                    let g = agg.group_of(plan, s);
-                    agg.add(g, o);
-                }
-            }
-        }
-        Ok(())
-    }
 }
 
 fn parse_shard(s: &str) -> std::result::Result<pounding::shard::Shard, String> {
@@ -273,7 +230,8 @@ enum Cmd {
         /// Stated relative accuracy of the reference.
         #[arg(long, default_value_t = 1e-8)]
         tol: f64,
-        /// `auto` adds the GPU paths when an adapter is found; `cpu` leaves them out.
+        /// `auto` adds the GPU paths when a hardware adapter is found; `gpu` also on a software
+        /// one; `cpu` leaves them out.
         #[arg(long, value_enum, default_value = "auto")]
         backend: BackendArg,
         #[arg(short, long, default_value = "accuracy.csv")]
@@ -390,11 +348,20 @@ fn main() -> std::process::ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    // Mesa's software Vulkan driver probes for a Wayland display and prints "XDG_RUNTIME_DIR is
+    // invalid" twice when there is none. Without XDG_RUNTIME_DIR no Wayland display can be
+    // reached anyway; an absolute WAYLAND_DISPLAY that does not exist makes the probe fail
+    // quietly. Set here, before any thread starts.
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none()
+        && std::env::var_os("WAYLAND_DISPLAY").is_none()
+    {
+        std::env::set_var("WAYLAND_DISPLAY", "/nonexistent/pound-compute-only");
+    }
     match run(Cli::parse()) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             // The cause chain on one line; no backtrace, whatever RUST_BACKTRACE says.
-            eprintln!("error: {e:#}");
+            note!("error: {e:#}");
             std::process::ExitCode::FAILURE
         }
     }
@@ -424,7 +391,7 @@ fn run(cli: Cli) -> Result<()> {
         Cmd::Fragility(a) => fragility(a),
         Cmd::Merge { inputs, output } => {
             let rows = pounding::shard::merge(&output, &inputs)?;
-            eprintln!(
+            note!(
                 "{rows} runs from {} inputs -> {}",
                 inputs.len(),
                 output.display()
@@ -432,7 +399,11 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Cmd::Paper => {
-            print!("{}", pounding::paper::report()?);
+            {
+                use std::io::Write as _;
+                write!(std::io::stdout(), "{}", pounding::paper::report()?)
+                    .context("writing to standard output")?;
+            }
             Ok(())
         }
         Cmd::Accuracy {
@@ -477,6 +448,8 @@ fn run(cli: Cli) -> Result<()> {
 }
 
 fn sweep(a: SweepArgs) -> Result<()> {
+    use pounding::sweep_output::{Format, Opened, SweepOutput};
+    use pounding::target::Target;
     let SweepArgs {
         config,
         output,
@@ -499,6 +472,10 @@ fn sweep(a: SweepArgs) -> Result<()> {
     if aggregate.is_some() && (format == FormatArg::Parquet || columns.is_some()) {
         bail!("--aggregate writes its own summary columns: --format and --columns do not apply");
     }
+    if aggregate.is_some() && (resume || shard.is_some()) {
+        bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
+    }
+    let threads = threads.map(check_threads).transpose()?;
     let picked = columns
         .as_ref()
         .map(|c| pounding::output::select(c))
@@ -513,11 +490,37 @@ fn sweep(a: SweepArgs) -> Result<()> {
         let h = pounding::output::header();
         ix.iter().map(|&i| h[i].to_string()).collect()
     });
-    if aggregate.is_some() && (resume || shard.is_some()) {
-        bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
+    // The output is checked before anything runs: not a directory, not one of the inputs, and
+    // writable.
+    let target = Target::resolve("-o", &output)?;
+    let inputs = config::input_files(&config)?;
+    {
+        let mut ins: Vec<(&str, &std::path::Path)> = vec![("the config", &config)];
+        ins.extend(inputs.iter().map(|p| ("the record", p.as_path())));
+        let t = target.path();
+        let (partial, meta_file, progress_file) = (
+            pounding::output::sibling(t, ".partial"),
+            meta_path(t),
+            progress_path(t),
+        );
+        let outs: Vec<(&str, &std::path::Path)> = if target.is_file() {
+            vec![
+                ("-o", t),
+                ("-o's partial file", &partial),
+                ("-o's sidecar", &meta_file),
+                ("-o's journal", &progress_file),
+            ]
+        } else {
+            vec![("-o", t)]
+        };
+        pounding::target::check_distinct(&ins, &outs)?;
+        target.probe("-o")?;
     }
     let precision = precision.get();
     let (mut plan, config_text) = config::load_with_text(&config)?;
+    for w in plan.warnings() {
+        note!("warning: {}: {w}", config.display());
+    }
     let scheme = match scheme {
         None => plan.spec.scheme,
         Some(SchemeArg::Fast) => Scheme::Fast(match plan.spec.scheme {
@@ -553,11 +556,9 @@ fn sweep(a: SweepArgs) -> Result<()> {
             });
         }
     }
+    let chunk = check_chunk(chunk, gpu.is_some())?;
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = threads {
-        if t == 0 {
-            bail!("--threads must be at least 1");
-        }
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("starting worker threads")?;
@@ -576,56 +577,23 @@ fn sweep(a: SweepArgs) -> Result<()> {
             None => "cpu".into(),
         },
         columns: picked_names.clone(),
+        content: None,
     };
-    let (mut rows, done, partial) = match &aggregate {
-        Some(by) => (
-            Rows::Summary(pounding::aggregate::Aggregator::new(by, &exceed)?),
-            0,
-            output.clone(),
-        ),
-        None if format == FormatArg::Parquet => {
-            let names = pounding::output::header_for(meta.columns.as_deref());
-            let out = pounding::parquet_out::ParquetOut::create(&output, &names, &meta)
-                .with_context(|| format!("cannot create {}", output.display()))?;
-            let partial = out.partial_path().to_path_buf();
-            (
-                Rows::Parquet {
-                    out: Box::new(out),
-                    columns: picked.clone(),
-                },
-                0,
-                partial,
-            )
-        }
-        None => {
-            let Some((mut out, done)) = open_output(&output, &meta, resume)? else {
-                return Ok(());
-            };
-            let partial = out.partial_path().to_path_buf();
-            let progress_file = progress_path(&output);
-            let progress = Progress {
-                meta: meta.clone(),
-                done,
-                bytes: out
-                    .sync()
-                    .with_context(|| format!("writing {}", partial.display()))?,
-            };
-            write_toml(&progress_file, &progress)?;
-            (
-                Rows::Csv {
-                    out: Box::new(out),
-                    progress,
-                    progress_file,
-                    columns: picked.clone(),
-                },
-                done,
-                partial,
-            )
-        }
+    let fmt = match &aggregate {
+        Some(by) => Format::Summary(Box::new(pounding::aggregate::Aggregator::new(by, &exceed)?)),
+        None if format == FormatArg::Parquet => Format::Parquet,
+        None => Format::Csv,
     };
-    let total = range.end - range.start - done;
+    let mut out = match SweepOutput::open(target, meta, fmt, picked, resume, &mut |l| note!("{l}"))?
+    {
+        Opened::Ready(o) => o,
+        Opened::Complete(_) => return Ok(()),
+    };
+    let todo = out.todo();
+    let done = out.done();
+    let partial = out.partial_path();
     if let Some(s) = shard {
-        eprintln!(
+        note!(
             "shard {}/{}: runs {}..{} of {}",
             s.index,
             s.count,
@@ -635,11 +603,10 @@ fn sweep(a: SweepArgs) -> Result<()> {
         );
     }
     if done > 0 {
-        eprintln!("resuming {}: {done} runs already on disk", output.display());
+        note!("resuming {}: {done} runs already on disk", output.display());
     }
-    let todo = range.start + done..range.end;
     let bar = if std::io::stderr().is_terminal() {
-        let b = indicatif::ProgressBar::new(total);
+        let b = indicatif::ProgressBar::new(todo.end - todo.start);
         b.set_style(
             indicatif::ProgressStyle::with_template(
                 "{bar:40} {pos}/{len} runs  {per_sec}  eta {eta}",
@@ -654,12 +621,13 @@ fn sweep(a: SweepArgs) -> Result<()> {
         Some(ctx) => format!("GPU {} in {}", ctx.describe(), precision.key()),
         None => format!("CPU, {} threads", pool.current_num_threads()),
     };
-    eprintln!(
+    note!(
         "{}: {} runs, {} scheme, {on}",
         config.display(),
-        total,
+        todo.end - todo.start,
         scheme.key(),
     );
+    let mut absurd = 0u64;
     let summary = pool
         .install(|| -> Result<_> {
             match (&gpu, fast) {
@@ -669,20 +637,20 @@ fn sweep(a: SweepArgs) -> Result<()> {
                         fast,
                         ..Default::default()
                     };
-                    let (s, t) = match &mut rows {
-                        Rows::Summary(agg) => {
+                    let (s, t) = match out.aggregator() {
+                        Some(agg) => {
                             let (s, t) = pounding::sweep::run_gpu_aggregate(
                                 &plan,
                                 todo.clone(),
                                 ctx,
                                 &opts,
-                                chunk.unwrap_or(65536),
+                                chunk,
                                 pounding::gpu::reduce::DEFAULT_SLOTS,
                                 agg,
                                 |done| bar.set_position(done),
                             )?;
                             bar.suspend(|| {
-                                eprintln!(
+                                note!(
                                     "aggregated on the device: {:.2} s folding; {} chunks with more than {} groups folded on the host; histograms flushed {} times",
                                     t.aggregate,
                                     t.host_folded_chunks,
@@ -692,21 +660,22 @@ fn sweep(a: SweepArgs) -> Result<()> {
                             });
                             (s, t)
                         }
-                        _ => pounding::sweep::run_gpu_range(
+                        None => pounding::sweep::run_gpu_range(
                             &plan,
                             todo.clone(),
                             ctx,
                             &opts,
-                            chunk.unwrap_or(65536),
+                            chunk,
                             |c: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
-                                rows.take(&plan, c)
+                                absurd += absurd_drifts(c);
+                                out.take(&plan, c).map_err(anyhow::Error::from)
                             },
                             |done| bar.set_position(done),
                         )?,
                     };
                     if t.handed_off > 0 {
                         bar.suspend(|| {
-                            eprintln!(
+                            note!(
                                 "{} runs needed more than {} RK4 substeps per record step, past what {} resolves: finished on the CPU in f64",
                                 t.handed_off,
                                 opts.handoff(),
@@ -716,18 +685,17 @@ fn sweep(a: SweepArgs) -> Result<()> {
                     }
                     Ok(s)
                 }
-                _ => {
-                    pounding::sweep::run_range(
-                        &plan,
-                        todo.clone(),
-                        &scheme,
-                        chunk.unwrap_or(64),
-                        |c: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
-                            rows.take(&plan, c)
-                        },
-                        |done| bar.set_position(done),
-                    )
-                }
+                _ => Ok(pounding::sweep::run_range(
+                    &plan,
+                    todo.clone(),
+                    &scheme,
+                    chunk,
+                    |c: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]| {
+                        absurd += absurd_drifts(c);
+                        out.take(&plan, c).map_err(anyhow::Error::from)
+                    },
+                    |done| bar.set_position(done),
+                )?),
             }
         })
         .with_context(|| {
@@ -741,53 +709,27 @@ fn sweep(a: SweepArgs) -> Result<()> {
     // (or the fingerprint), so the output is not put in place.
     let changed = config::changed_records(&config_text, &config, &plan);
     if !changed.is_empty() {
+        let summary_only = out.aggregator().is_some();
+        drop(out);
         bail!(
             "{} changed on disk during the sweep; the runs were computed from the content read at the start ({}); rerun the sweep (without --resume) to use the new content",
             changed.join(", "),
-            match rows {
-                Rows::Summary(_) => "no summary was written".to_string(),
-                _ => format!("their rows are left in {}", partial.display()),
+            if summary_only {
+                "no summary was written".to_string()
+            } else {
+                format!("their rows are left in {}", partial.display())
             }
         );
     }
-    let meta_file = meta_path(&output);
-    let finished = (|| -> Result<PathBuf> {
-        Ok(match rows {
-            // A summary is written whole (nothing to resume), then labelled.
-            Rows::Summary(agg) => {
-                pounding::output::write_atomic(&output, agg.csv().as_bytes())
-                    .with_context(|| format!("writing {}", output.display()))?;
-                write_toml(&meta_file, &meta)?;
-                eprintln!("{} groups", agg.groups());
-                output.clone()
-            }
-            // Sidecar first: a crash between the two leaves a resumable, not an unlabelled,
-            // output.
-            Rows::Parquet { out, .. } => {
-                write_toml(&meta_file, &meta)?;
-                out.finish()
-                    .with_context(|| format!("finishing {}", output.display()))?
-            }
-            Rows::Csv {
-                out, progress_file, ..
-            } => {
-                write_toml(&meta_file, &meta)?;
-                let path = out
-                    .finish()
-                    .with_context(|| format!("finishing {}", output.display()))?;
-                std::fs::remove_file(&progress_file)
-                    .with_context(|| format!("removing {}", progress_file.display()))?;
-                path
-            }
-        })
-    })();
-    if finished.is_err() && !output.exists() {
-        // No sidecar for an output that is not there (disk full, say).
-        let _ = std::fs::remove_file(&meta_file);
+    let (path, what) = out.finish()?;
+    if absurd > 0 {
+        note!(
+            "warning: {absurd} runs have a peak displacement above the building's height estimated from its period ({} m per s: T ~ 0.1 s per 3 m storey): check the record's units and the intensity",
+            pounding::limits::HEIGHT_PER_PERIOD_M
+        );
     }
-    let path = finished?;
-    eprintln!(
-        "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {}",
+    note!(
+        "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {} ({what})",
         summary.runs,
         summary.seconds,
         summary.runs_per_second(),
@@ -799,69 +741,78 @@ fn sweep(a: SweepArgs) -> Result<()> {
     Ok(())
 }
 
-/// The output to write into and the runs of the range already in it: a fresh `.partial`, or
-/// with `resume` the one an interrupted sweep left (after checking it is the same sweep). None
-/// when there is nothing left to do.
-fn open_output(
-    output: &std::path::Path,
-    meta: &Meta,
-    resume: bool,
-) -> Result<Option<(CsvOut, u64)>> {
-    let progress_file = progress_path(output);
-    let cannot = |what: &str| {
-        anyhow::anyhow!(
-            "cannot resume {}: {what} differs from the sweep that wrote it; rerun without --resume after deleting {} to start over",
-            output.display(),
-            progress_file.display()
-        )
-    };
-    if resume {
-        if progress_file.exists() {
-            let p: Progress = read_toml(&progress_file)?;
-            if let Some(what) = p.meta.fingerprint.differs(&meta.fingerprint) {
-                return Err(cannot(what));
-            }
-            if (p.meta.first_run, p.meta.end_run, p.meta.shard)
-                != (meta.first_run, meta.end_run, meta.shard)
-            {
-                return Err(cannot("the shard (--shard)"));
-            }
-            if p.meta.backend != meta.backend {
-                return Err(cannot("the backend (--backend, --precision)"));
-            }
-            if p.meta.columns != meta.columns {
-                return Err(cannot("the columns (--columns)"));
-            }
-            let out = CsvOut::resume(output, p.bytes)
-                .with_context(|| format!("resuming {}", output.display()))?;
-            return Ok(Some((out, p.done)));
+/// Runs whose peak displacement exceeds the building's height estimated from its period.
+fn absurd_drifts(rows: &[(pounding::plan::RunSpec, pounding::model::RunOutput)]) -> u64 {
+    let h = pounding::limits::HEIGHT_PER_PERIOD_M;
+    rows.iter()
+        .filter(|(s, o)| o.peak_u1 > h * s.t1 || o.peak_u2 > h * s.t2)
+        .count() as u64
+}
+
+/// Check a command's outputs before it does any work: each resolves (not a directory, its
+/// folder exists), can be written, is none of `inputs` and is not written twice (each file's
+/// `.partial` counts).
+fn check_outputs(
+    inputs: &[(&str, &std::path::Path)],
+    outputs: &[(&str, Option<&std::path::Path>)],
+) -> Result<()> {
+    use pounding::target::Target;
+    let mut outs: Vec<(String, PathBuf)> = Vec::new();
+    for (what, p) in outputs {
+        let Some(p) = p else { continue };
+        let t = Target::resolve(what, p)?;
+        t.probe(what)?;
+        outs.push((what.to_string(), t.path().to_path_buf()));
+        if t.is_file() {
+            outs.push((
+                format!("{what}'s partial file"),
+                pounding::output::sibling(t.path(), ".partial"),
+            ));
         }
-        let meta_file = meta_path(output);
-        if output.exists() && meta_file.exists() {
-            let m: Meta = read_toml(&meta_file)?;
-            if m.fingerprint.differs(&meta.fingerprint).is_none()
-                && (m.first_run, m.end_run) == (meta.first_run, meta.end_run)
-            {
-                eprintln!("{} is already complete", output.display());
-                return Ok(None);
-            }
-        }
-        eprintln!("nothing to resume for {}: starting", output.display());
-    } else if progress_file.exists() {
-        let p: Progress = read_toml(&progress_file)?;
+    }
+    let outs: Vec<(&str, &std::path::Path)> = outs
+        .iter()
+        .map(|(w, p)| (w.as_str(), p.as_path()))
+        .collect();
+    pounding::target::check_distinct(inputs, &outs)?;
+    Ok(())
+}
+
+/// Warn when a results file is not vouched for by its sweep's sidecar.
+fn warn_provenance(results: &std::path::Path) {
+    if let Some(w) = pounding::journal::provenance_warning(results) {
+        note!("warning: {w}");
+    }
+}
+
+fn check_threads(t: usize) -> Result<usize> {
+    if t == 0 || t > pounding::limits::MAX_THREADS {
         bail!(
-            "{}.partial holds {} finished runs of an unfinished sweep: rerun with --resume to continue it, or delete {} to start over",
-            output.display(),
-            p.done,
-            progress_file.display()
+            "--threads {t}: expected 1 to {} ({}; this machine has {})",
+            pounding::limits::MAX_THREADS,
+            pounding::limits::WHY_THREADS,
+            std::thread::available_parallelism().map_or(1, |n| n.get())
         );
     }
-    let out = CsvOut::create_with(
-        output,
-        &pounding::output::header_for(meta.columns.as_deref()),
-    )
-    .with_context(|| format!("cannot create {}", output.display()))?;
-    Ok(Some((out, 0)))
+    Ok(t)
+}
+
+/// `--chunk`, or the default for the path (64 runs per CPU task, 65,536 per GPU chunk).
+fn check_chunk(chunk: Option<usize>, gpu: bool) -> Result<usize> {
+    let (default, max) = if gpu {
+        (65536, pounding::limits::MAX_GPU_CHUNK)
+    } else {
+        (64, pounding::limits::MAX_CPU_CHUNK)
+    };
+    let c = chunk.unwrap_or(default);
+    if c == 0 || c > max {
+        bail!(
+            "--chunk {c}: expected 1 to {max} on the {} ({})",
+            if gpu { "GPU" } else { "CPU" },
+            pounding::limits::WHY_CHUNK
+        );
+    }
+    Ok(c)
 }
 
 fn gpu_info() -> Result<()> {
@@ -871,7 +822,7 @@ fn gpu_info() -> Result<()> {
     }
     for a in all {
         let l = &a.limits;
-        println!(
+        say!(
             "{} | backend {:?} | type {:?} | driver {} {} | f64 {} | max storage binding {} MiB | max buffer {} MiB | workgroups/dim {}",
             a.info.name,
             a.info.backend,
@@ -895,10 +846,27 @@ fn bench(
     output: Option<PathBuf>,
     aggregate: Option<&[String]>,
 ) -> Result<()> {
+    if let Some(n) = sizes
+        .iter()
+        .find(|&&n| n == 0 || n > pounding::limits::MAX_BENCH_RUNS)
+    {
+        bail!(
+            "--sizes: {n} runs is out of range: expected 1 to {}",
+            pounding::limits::MAX_BENCH_RUNS
+        );
+    }
+    if chunk == 0 || chunk > pounding::limits::MAX_GPU_CHUNK {
+        bail!(
+            "--chunk {chunk}: expected 1 to {} ({})",
+            pounding::limits::MAX_GPU_CHUNK,
+            pounding::limits::WHY_CHUNK
+        );
+    }
+    check_outputs(&[], &[("-o", output.as_deref())])?;
     let ctx = match GpuContext::new() {
         Ok(c) => Some(c),
         Err(e) => {
-            eprintln!("notice: CPU only: {e}");
+            note!("notice: CPU only: {e}");
             None
         }
     };
@@ -913,12 +881,12 @@ fn bench(
             // The first call compiles the kernel; keep that out of the figures.
             ctx.kernel(precision, false)?;
             let r = pounding::bench::gpu(&plan, ctx, &opts, chunk)?;
-            eprintln!("{} runs on GPU: {:.0} runs/s", r.runs, r.runs_per_second());
+            note!("{} runs on GPU: {:.0} runs/s", r.runs, r.runs_per_second());
             rows.push(r);
             if let Some(by) = aggregate {
                 ctx.aggregator(precision)?;
                 let r = pounding::bench::gpu_aggregate(&plan, ctx, &opts, chunk, by)?;
-                eprintln!(
+                note!(
                     "{} runs on GPU, aggregated: {:.0} runs/s",
                     r.runs,
                     r.runs_per_second()
@@ -928,12 +896,12 @@ fn bench(
         }
         if plan.len() <= max_cpu_runs {
             let r = pounding::bench::cpu(&plan);
-            eprintln!("{} runs on CPU: {:.0} runs/s", r.runs, r.runs_per_second());
+            note!("{} runs on CPU: {:.0} runs/s", r.runs, r.runs_per_second());
             rows.push(r);
         }
     }
     let table = pounding::bench::table(&rows);
-    print!("{table}");
+    write!(std::io::stdout(), "{table}").context("writing to standard output")?;
     if let Some(p) = output {
         pounding::output::write_atomic(&p, table.as_bytes())
             .with_context(|| format!("writing {}", p.display()))?;
@@ -943,10 +911,11 @@ fn bench(
 
 fn formulas(e: &str, plot: Option<&std::path::Path>) -> Result<()> {
     let es = e_values(e)?;
+    check_outputs(&[], &[("--plot", plot)])?;
     if let Some(path) = plot {
         let panels = pounding::restitution::zeta_panels(&es)?;
         pounding::plot::save(path, &panels, 2)?;
-        eprintln!(
+        note!(
             "zeta(e) of {} formulas -> {}",
             Formula::ALL.len(),
             path.display()
@@ -967,7 +936,7 @@ fn formulas(e: &str, plot: Option<&std::path::Path>) -> Result<()> {
     );
     head.extend(exact_laws.iter().map(|l| format!("exact:{}", l.key())));
     head.push("exact_a:hunt_crossley".into());
-    println!("{}", head.join(","));
+    say!("{}", head.join(","));
     for &e in &es {
         let mut row = vec![format!("{e}")];
         for f in Formula::ALL.iter().filter(|f| **f != Formula::Exact) {
@@ -981,13 +950,18 @@ fn formulas(e: &str, plot: Option<&std::path::Path>) -> Result<()> {
         {
             row.push(format!("{:.6}", exact_damping(l, e)?));
         }
-        println!("{}", row.join(","));
+        say!("{}", row.join(","));
     }
     Ok(())
 }
 
 fn fragility(a: FragilityArgs) -> Result<()> {
     use pounding::fragility::{csv, fit, levels, panel, FragilitySpec};
+    check_outputs(
+        &[("the results", &a.results)],
+        &[("-o", Some(&a.output)), ("--plot", a.plot.as_deref())],
+    )?;
+    warn_provenance(&a.results);
     let table = pounding::table::Table::read(&a.results)?;
     let spec = FragilitySpec {
         im: a.im,
@@ -1004,7 +978,7 @@ fn fragility(a: FragilityArgs) -> Result<()> {
         );
     }
     let fits: Vec<_> = lv.iter().map(|l| fit(l)).collect();
-    println!(
+    say!(
         "{runs} runs at {} levels of {}{}",
         lv[0].len(),
         spec.im,
@@ -1014,14 +988,18 @@ fn fragility(a: FragilityArgs) -> Result<()> {
             String::new()
         }
     );
-    println!("\n| {} > | median {} | beta | se(ln median) | se(beta) | log-likelihood |\n|---:|---:|---:|---:|---:|---:|", spec.edp, spec.im);
+    say!("\n| {} > | median {} | beta | se(ln median) | se(beta) | log-likelihood |\n|---:|---:|---:|---:|---:|---:|", spec.edp, spec.im);
     for (t, f) in spec.thresholds.iter().zip(&fits) {
         match f {
-            Ok(f) => println!(
+            Ok(f) => say!(
                 "| {t} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} |",
-                f.median, f.beta, f.se_ln_median, f.se_beta, f.log_likelihood
+                f.median,
+                f.beta,
+                f.se_ln_median,
+                f.se_beta,
+                f.log_likelihood
             ),
-            Err(e) => println!("| {t} | no fit: {e} | | | | |"),
+            Err(e) => say!("| {t} | no fit: {e} | | | | |"),
         }
     }
     pounding::output::write_atomic(&a.output, csv(&spec, &lv).as_bytes())
@@ -1034,6 +1012,8 @@ fn fragility(a: FragilityArgs) -> Result<()> {
 
 fn plot(a: PlotArgs) -> Result<()> {
     use pounding::sensitivity::{panel, Aggregate, PlotSpec};
+    check_outputs(&[("the results", &a.results)], &[("-o", Some(&a.output))])?;
+    warn_provenance(&a.results);
     let table = pounding::table::Table::read(&a.results)?;
     let filters = pounding::table::Filter::parse_all(&a.filters)?;
     let spec = PlotSpec {
@@ -1051,7 +1031,13 @@ fn plot(a: PlotArgs) -> Result<()> {
         log_x: a.log_x,
         log_y: a.log_y,
     };
-    let p = panel(&table, &spec)?;
+    let (p, failed) = panel(&table, &spec)?;
+    if failed > 0 {
+        note!(
+            "{}: {failed} rows left out: runs whose status is not ok, or values that are not finite",
+            a.results.display()
+        );
+    }
     let points: usize = p.series.iter().map(|s| s.points.len()).sum();
     if points == 0 {
         bail!(
@@ -1062,7 +1048,7 @@ fn plot(a: PlotArgs) -> Result<()> {
         );
     }
     pounding::plot::save(&a.output, std::slice::from_ref(&p), 1)?;
-    eprintln!(
+    note!(
         "{} series, {points} points -> {}",
         p.series.len(),
         a.output.display()
@@ -1077,9 +1063,16 @@ fn gpu_context(backend: BackendArg, fallback: &str) -> Result<Option<GpuContext>
         BackendArg::Cpu => None,
         BackendArg::Gpu => Some(GpuContext::new()?),
         BackendArg::Auto => match GpuContext::new() {
+            Ok(c) if c.is_software() => {
+                note!(
+                    "notice: {fallback}: the adapter found, {}, is a software one (slower than the CPU path on the same cores); --backend gpu uses it",
+                    c.info.name
+                );
+                None
+            }
             Ok(c) => Some(c),
             Err(e) => {
-                eprintln!("notice: {fallback}: {e}");
+                note!("notice: {fallback}: {e}");
                 None
             }
         },
@@ -1095,24 +1088,35 @@ fn accuracy(
     plot: Option<&std::path::Path>,
 ) -> Result<()> {
     use pounding::accuracy;
-    if let Some(bad) = settings.iter().find(|s| !(**s >= 1.0 && s.is_finite())) {
-        bail!("--settings: {bad} is out of range: expected substeps per contact >= 1");
+    let most = pounding::limits::MAX_SUBSTEPS_PER_CONTACT;
+    if let Some(bad) = settings.iter().find(|s| !(**s >= 1.0 && **s <= most)) {
+        bail!(
+            "--settings: {bad} is out of range: expected substeps per contact from 1 to {most} ({})",
+            pounding::limits::WHY_SUBSTEPS
+        );
     }
     if !(tol > 0.0 && tol < 1e-3) {
         bail!("--tol: {tol} is out of range: expected 0 < tol < 1e-3");
     }
+    let records = config::input_files(config)?;
+    let mut ins: Vec<(&str, &std::path::Path)> = vec![("the config", config)];
+    ins.extend(records.iter().map(|p| ("the record", p.as_path())));
+    check_outputs(&ins, &[("-o", Some(output)), ("--plot", plot)])?;
     let plan = config::load(config)?;
+    for w in plan.warnings() {
+        note!("warning: {}: {w}", config.display());
+    }
     let ctx = gpu_context(backend, "CPU path only")?;
-    eprintln!(
+    note!(
         "{}: {} runs; reference at tol {tol:e}, then {} settings on {} paths",
         config.display(),
         plan.len(),
         settings.len(),
         if ctx.is_some() { 3 } else { 1 }
     );
-    println!("{}", accuracy::MARKDOWN_HEADER);
+    say!("{}", accuracy::MARKDOWN_HEADER);
     let points = accuracy::study(&plan, ctx.as_ref(), settings, tol, |p| {
-        println!("{}", accuracy::markdown_row(p))
+        let _ = writeln!(std::io::stdout(), "{}", accuracy::markdown_row(p));
     })?;
     pounding::output::write_atomic(output, accuracy::csv(&points).as_bytes())
         .with_context(|| format!("writing {}", output.display()))?;
@@ -1129,6 +1133,13 @@ fn e_values(e: &str) -> Result<Vec<f64>> {
         config::parse_colon_range(e)
     }
     .with_context(|| format!("--e `{e}`: expected start:stop:step, a list a,b,c or one value"))?;
+    if es.len() > pounding::limits::MAX_E_VALUES {
+        bail!(
+            "--e `{e}` gives {} values: expected at most {} (each is a root-found collision)",
+            es.len(),
+            pounding::limits::MAX_E_VALUES
+        );
+    }
     let es: Vec<f64> = es.iter().map(|e| (e * 1e12).round() / 1e12).collect();
     if let Some(bad) = es.iter().find(|e| !(**e > 0.0 && **e <= 1.0)) {
         bail!("--e: e = {bad} is out of range: expected 0 < e <= 1");
@@ -1138,15 +1149,20 @@ fn e_values(e: &str) -> Result<Vec<f64>> {
 
 fn restitution(e: &str, output: &std::path::Path, plot: Option<&std::path::Path>) -> Result<()> {
     use pounding::fidelity;
+    check_outputs(&[], &[("-o", Some(output)), ("--plot", plot)])?;
     let rows = fidelity::table(&e_values(e)?)?;
     pounding::output::write_atomic(output, fidelity::csv(&rows).as_bytes())
         .with_context(|| format!("writing {}", output.display()))?;
-    println!("max |achieved e - asked e| per law and formula (`own`: the law's own chi(e)):\n");
-    print!("{}", fidelity::summary(&rows));
+    say!("max |achieved e - asked e| per law and formula (`own`: the law's own chi(e)):\n");
+    {
+        use std::io::Write as _;
+        write!(std::io::stdout(), "{}", fidelity::summary(&rows))
+            .context("writing to standard output")?;
+    }
     if let Some(p) = plot {
         pounding::plot::svg(p, &fidelity::panels(&rows), 4)?;
     }
-    eprintln!("{} collisions -> {}", rows.len(), output.display());
+    note!("{} collisions -> {}", rows.len(), output.display());
     Ok(())
 }
 
@@ -1178,16 +1194,17 @@ fn hysteresis(
             bail!("{name}: {x} is out of range: expected a positive number");
         }
     }
+    check_outputs(&[], &[("-o", Some(output)), ("--plot", plot)])?;
     let mut csv = String::from("e,delta_m,force_n\n");
     let mut series = Vec::new();
-    println!("| e | damping | achieved e | loop area J | 0.5 m_eff (1-e^2) v0^2 J |\n|---:|---:|---:|---:|---:|");
+    say!("| e | damping | achieved e | loop area J | 0.5 m_eff (1-e^2) v0^2 J |\n|---:|---:|---:|---:|---:|");
     for e in e_values(e)? {
         let d = pounding::restitution::damping_for(law, formula, e)?;
         let l = pounding::fidelity::hysteresis(&Contact::new(law, stiffness, d, m_eff), v0);
         for (x, f) in &l.points {
             csv.push_str(&format!("{e},{x},{f}\n"));
         }
-        println!(
+        say!(
             "| {e} | {d:.6} | {:.6} | {:.6e} | {:.6e} |",
             l.achieved_e,
             l.area,
@@ -1239,18 +1256,18 @@ fn record_info(
         },
     )?;
     let pga = rec.pga();
-    println!("file      {}", file.display());
-    println!("npts      {}", rec.npts());
-    println!("dt        {} s", rec.dt);
-    println!("t0        {} s", rec.t0);
-    println!("duration  {:.3} s", rec.duration());
-    println!(
+    say!("file      {}", file.display());
+    say!("npts      {}", rec.npts());
+    say!("dt        {} s", rec.dt);
+    say!("t0        {} s", rec.t0);
+    say!("duration  {:.3} s", rec.duration());
+    say!(
         "pga       {:.4} g  ({:.4} m/s^2, {:.1} cm/s^2)",
         pga.value / G,
         pga.value,
         pga.value * 100.0
     );
-    println!(
+    say!(
         "pga at    t = {:.3} s (sample {}, value {:+.4} g)",
         pga.time,
         pga.index,

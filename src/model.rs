@@ -36,6 +36,12 @@ impl Oscillator {
         0.5 * (self.m * v * v + self.k * u * u)
     }
 
+    /// Bound on the oscillator's fastest rate (1/s): `sqrt(k/m) + c/m`, as
+    /// [`crate::contact::Contact::local_rate`] bounds the contact's.
+    pub fn rate(&self) -> f64 {
+        (self.k / self.m).sqrt() + self.c / self.m
+    }
+
     /// A free mass (no spring, no dashpot): for isolated-collision problems.
     pub fn free(m: f64) -> Oscillator {
         Oscillator { m, k: 0.0, c: 0.0 }
@@ -53,6 +59,13 @@ pub struct Pair {
 }
 
 impl Pair {
+    /// The fastest rate of the two structures (1/s). Substeps in contact resolve it as well as
+    /// the contact's: a very stiff building (T = 1e-4 s) made RK4 unstable at steps sized by
+    /// the contact alone.
+    pub fn structural_rate(&self) -> f64 {
+        self.b1.rate().max(self.b2.rate())
+    }
+
     pub fn m_eff(b1: &Oscillator, b2: &Oscillator) -> f64 {
         b1.m * b2.m / (b1.m + b2.m)
     }

@@ -2,8 +2,10 @@
 //! when the sweep is complete (after flush and fsync). A failed sweep leaves the `.partial`
 //! file with every finished row.
 
+use crate::journal::{Content, ContentHasher};
 use crate::model::RunOutput;
 use crate::plan::{Intensity, Plan, RunSpec};
+use crate::target::{PartialLock, Target};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -141,11 +143,27 @@ pub fn header() -> Vec<&'static str> {
         .collect()
 }
 
-/// A CSV file that appears under its final name only when complete.
+/// Where a CSV's bytes go: a locked `.partial` file renamed when complete, or a stream written
+/// in place (standard output, a character device, a FIFO).
+enum Dest {
+    File {
+        path: PathBuf,
+        partial: PathBuf,
+        w: BufWriter<File>,
+    },
+    Stream {
+        name: PathBuf,
+        w: BufWriter<Box<dyn Write + Send>>,
+    },
+}
+
+/// A CSV output that appears under its final name only when complete, with its rows hashed and
+/// their run numbers checked as they are written ([`ContentHasher`]).
 pub struct CsvOut {
-    path: PathBuf,
-    partial: PathBuf,
-    w: BufWriter<File>,
+    dest: Dest,
+    header: Vec<u8>,
+    first_run: Option<u64>,
+    hasher: ContentHasher,
 }
 
 /// CSV lines of records (quoted as the `csv` crate quotes them).
@@ -164,58 +182,124 @@ where
     w.into_inner().expect("writing to memory")
 }
 
+/// The header line of `columns`, as written.
+pub fn header_line(columns: &[&str]) -> Vec<u8> {
+    lines([columns])
+}
+
+/// Open a stream target for writing in place.
+pub fn open_stream(target: &Target) -> std::io::Result<Box<dyn Write + Send>> {
+    Ok(match target {
+        Target::Stdout => Box::new(std::io::stdout()),
+        Target::Stream(p) => Box::new(std::fs::OpenOptions::new().write(true).open(p)?),
+        Target::File(p) => Box::new(File::create(p)?),
+    })
+}
+
+/// Empty a `.partial` left by an earlier attempt (a zero-length or non-regular one, such as a
+/// device, is left as it is).
+pub fn empty(file: &File) -> std::io::Result<()> {
+    if file.metadata()?.len() > 0 {
+        file.set_len(0)?;
+    }
+    Ok(())
+}
+
+fn invalid(e: impl std::fmt::Display) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidData, e.to_string())
+}
+
 impl CsvOut {
-    pub fn create(path: &Path) -> std::io::Result<CsvOut> {
-        CsvOut::create_with(path, &header())
-    }
-
-    /// As [`CsvOut::create`], with the header `columns`.
-    pub fn create_with(path: &Path, columns: &[&str]) -> std::io::Result<CsvOut> {
-        let partial = sibling(path, ".partial");
-        let file = File::create(&partial)?;
-        let mut w = BufWriter::new(file);
-        w.write_all(&lines([columns]))?;
-        Ok(CsvOut {
-            path: path.into(),
-            partial,
-            w,
-        })
-    }
-
-    /// Continue `path`'s `.partial` file, whose first `bytes` bytes hold the header and the rows
-    /// of finished chunks: anything after them (a chunk cut off mid-write) is truncated.
-    pub fn resume(path: &Path, bytes: u64) -> std::io::Result<CsvOut> {
-        let partial = sibling(path, ".partial");
-        let file = std::fs::OpenOptions::new().write(true).open(&partial)?;
-        let len = file.metadata()?.len();
-        if len < bytes {
-            return Err(std::io::Error::other(format!(
-                "{} holds {len} bytes, fewer than the {bytes} its progress file records: it was changed or truncated; delete it and its .progress.toml to start over",
-                partial.display()
-            )));
+    /// A new output with the header `columns`. A file target is written into the `.partial`
+    /// that `lock` holds (emptied first); rows must hold runs from `first_run` on, in order.
+    pub fn create(
+        target: &Target,
+        lock: Option<&PartialLock>,
+        columns: &[&str],
+        first_run: Option<u64>,
+    ) -> std::io::Result<CsvOut> {
+        let header = header_line(columns);
+        let mut dest = match (target, lock) {
+            (Target::File(path), Some(lock)) => {
+                let mut file = lock.file().map_err(std::io::Error::other)?;
+                empty(&file)?;
+                std::io::Seek::seek(&mut file, std::io::SeekFrom::Start(0))?;
+                Dest::File {
+                    path: path.clone(),
+                    partial: lock.path().to_path_buf(),
+                    w: BufWriter::new(file),
+                }
+            }
+            (Target::File(_), None) => {
+                return Err(std::io::Error::other("a file output needs its lock"))
+            }
+            _ => Dest::Stream {
+                name: target.path().to_path_buf(),
+                w: BufWriter::new(open_stream(target)?),
+            },
+        };
+        match &mut dest {
+            Dest::File { w, .. } => w.write_all(&header)?,
+            Dest::Stream { w, .. } => w.write_all(&header)?,
         }
-        file.set_len(bytes)?;
-        file.sync_all()?;
-        let mut file = file;
-        std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
-        let w = BufWriter::new(file);
         Ok(CsvOut {
-            path: path.into(),
-            partial,
-            w,
+            dest,
+            hasher: ContentHasher::new(&header, first_run),
+            header,
+            first_run,
         })
     }
 
-    pub fn partial_path(&self) -> &Path {
-        &self.partial
+    /// Continue the locked `.partial` of `path`, whose first `hasher.bytes()` bytes were
+    /// verified ([`crate::journal::verify_prefix`]): anything after them (a chunk cut off
+    /// mid-write) is truncated.
+    pub fn resume(
+        path: &Path,
+        lock: &PartialLock,
+        columns: &[&str],
+        first_run: u64,
+        hasher: ContentHasher,
+    ) -> std::io::Result<CsvOut> {
+        let mut file = lock.file().map_err(std::io::Error::other)?;
+        file.set_len(hasher.bytes())?;
+        file.sync_all()?;
+        std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
+        Ok(CsvOut {
+            dest: Dest::File {
+                path: path.into(),
+                partial: lock.path().to_path_buf(),
+                w: BufWriter::new(file),
+            },
+            header: header_line(columns),
+            first_run: Some(first_run),
+            hasher,
+        })
     }
 
-    /// Push everything written to the disk (fsync) and return the file's length.
-    pub fn sync(&mut self) -> std::io::Result<u64> {
-        self.w.flush()?;
-        let f = self.w.get_ref();
-        f.sync_data()?;
-        Ok(f.metadata()?.len())
+    /// Where the rows are being written (the `.partial` of a file).
+    pub fn partial_path(&self) -> &Path {
+        match &self.dest {
+            Dest::File { partial, .. } => partial,
+            Dest::Stream { name, .. } => name,
+        }
+    }
+
+    /// Push everything written to the disk (fsync for a file) and return the bytes written
+    /// and their hash (what the journal vouches for).
+    pub fn sync(&mut self) -> std::io::Result<(u64, String)> {
+        match &mut self.dest {
+            Dest::File { w, .. } => {
+                w.flush()?;
+                w.get_ref().sync_data()?;
+            }
+            Dest::Stream { w, .. } => w.flush()?,
+        }
+        Ok((self.hasher.bytes(), self.hasher.digest()))
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> u64 {
+        self.hasher.rows_seen()
     }
 
     /// Append rows and push them to the OS, so a crash keeps them in the `.partial` file.
@@ -223,19 +307,53 @@ impl CsvOut {
         self.write_encoded(&lines(rows))
     }
 
-    /// Append rows already encoded as CSV lines ([`encode_csv`]).
+    /// Append rows already encoded as CSV lines ([`encode_csv`]); refused if they do not hold
+    /// the next runs in order.
     pub fn write_encoded(&mut self, lines: &[u8]) -> std::io::Result<()> {
-        self.w.write_all(lines)?;
-        self.w.flush()
+        self.hasher.rows(lines).map_err(invalid)?;
+        match &mut self.dest {
+            Dest::File { w, .. } => {
+                w.write_all(lines)?;
+                w.flush()
+            }
+            Dest::Stream { w, .. } => w.write_all(lines),
+        }
     }
 
-    /// Flush, fsync and rename to the final name.
-    pub fn finish(self) -> std::io::Result<PathBuf> {
-        let file = self.w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-        drop(file);
-        std::fs::rename(&self.partial, &self.path)?;
-        Ok(self.path)
+    /// Flush and fsync; for a file, re-read it and check it holds exactly what was written
+    /// (rows, run order, hash) and `expect_rows` rows, call `label` with its content (to write
+    /// the sidecar first: a crash before the rename leaves a labelled, resumable `.partial`),
+    /// then rename it to its final name. Returns the final path and the content.
+    pub fn finish(
+        self,
+        expect_rows: Option<u64>,
+        label: impl FnOnce(&Content) -> std::io::Result<()>,
+    ) -> std::io::Result<(PathBuf, Content)> {
+        if let Some(n) = expect_rows {
+            if self.hasher.rows_seen() != n {
+                return Err(invalid(format!(
+                    "{} rows were written where {n} were expected: the output is incomplete",
+                    self.hasher.rows_seen()
+                )));
+            }
+        }
+        let content = self.hasher.finish();
+        match self.dest {
+            Dest::File { path, partial, w } => {
+                let file = w.into_inner().map_err(|e| e.into_error())?;
+                file.sync_all()?;
+                crate::journal::verify_file(&partial, &self.header, self.first_run, &content)
+                    .map_err(invalid)?;
+                label(&content)?;
+                std::fs::rename(&partial, &path)?;
+                drop(file);
+                Ok((path, content))
+            }
+            Dest::Stream { name, mut w } => {
+                w.flush()?;
+                Ok((name, content))
+            }
+        }
     }
 }
 
@@ -291,8 +409,16 @@ pub fn header_for(columns: Option<&[String]>) -> Vec<&str> {
     }
 }
 
-/// Write `bytes` to `path` atomically (temporary file, fsync, rename).
+/// Write `bytes` to `path` atomically (temporary file, fsync, rename); standard output (`-`), a
+/// character device or a FIFO is written in place.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let target = Target::resolve("the output", path).map_err(std::io::Error::other)?;
+    if !target.is_file() {
+        let mut w = open_stream(&target)?;
+        w.write_all(bytes)?;
+        return w.flush();
+    }
+    let path = target.path();
     let tmp = sibling(path, ".partial");
     let written = File::create(&tmp).and_then(|mut f| {
         f.write_all(bytes)?;

@@ -4,7 +4,9 @@
 //! `OUT.partial` and renamed when complete (Parquet's footer comes last, so an unfinished file is
 //! not readable; `--resume` is CSV only).
 
+use crate::journal::{Content, HashingWriter};
 use crate::shard::Meta;
+use crate::target::{PartialLock, Target};
 use parquet::basic::{ConvertedType, Repetition, Type as Physical};
 use parquet::data_type::{ByteArray, ByteArrayType, DoubleType, Int64Type};
 use parquet::file::metadata::KeyValue;
@@ -12,6 +14,7 @@ use parquet::file::properties::WriterProperties;
 use parquet::file::writer::SerializedFileWriter;
 use parquet::schema::types::Type;
 use std::fs::File;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -30,12 +33,16 @@ fn kind(column: &str) -> Kind {
     }
 }
 
-/// A Parquet file that appears under its final name only when complete.
+/// A Parquet file that appears under its final name only when complete (or a stream written in
+/// place), hashed as it is written.
 pub struct ParquetOut {
-    path: PathBuf,
+    /// The final name of a file target; None for a stream.
+    path: Option<PathBuf>,
     partial: PathBuf,
     kinds: Vec<Kind>,
-    writer: SerializedFileWriter<File>,
+    rows: u64,
+    writer: SerializedFileWriter<HashingWriter<Box<dyn Write + Send>>>,
+    file: Option<File>,
 }
 
 fn err(e: impl std::fmt::Display) -> std::io::Error {
@@ -45,8 +52,12 @@ fn err(e: impl std::fmt::Display) -> std::io::Error {
 impl ParquetOut {
     /// Columns `columns` (names of `output::header`), and `meta` as key-value metadata
     /// (`pound.fingerprint.plan`, `.records`, `.engine`, `pound.runs`, `pound.backend`).
-    pub fn create(path: &Path, columns: &[&str], meta: &Meta) -> std::io::Result<ParquetOut> {
-        let partial = crate::output::sibling(path, ".partial");
+    pub fn create(
+        target: &Target,
+        lock: Option<&PartialLock>,
+        columns: &[&str],
+        meta: &Meta,
+    ) -> std::io::Result<ParquetOut> {
         let kinds: Vec<Kind> = columns.iter().map(|c| kind(c)).collect();
         let fields = columns
             .iter()
@@ -84,14 +95,35 @@ impl ParquetOut {
                 kv("pound.backend", meta.backend.clone()),
             ]))
             .build();
-        let file = File::create(&partial)?;
+        let (path, partial, file, sink): (_, _, _, Box<dyn Write + Send>) = match (target, lock) {
+            (Target::File(p), Some(lock)) => {
+                let f = lock.file().map_err(err)?;
+                crate::output::empty(&f)?;
+                (
+                    Some(p.clone()),
+                    lock.path().to_path_buf(),
+                    Some(f.try_clone()?),
+                    Box::new(f),
+                )
+            }
+            (Target::File(_), None) => return Err(err("a file output needs its lock")),
+            _ => (
+                None,
+                target.path().to_path_buf(),
+                None,
+                crate::output::open_stream(target)?,
+            ),
+        };
         let writer =
-            SerializedFileWriter::new(file, Arc::new(schema), Arc::new(props)).map_err(err)?;
+            SerializedFileWriter::new(HashingWriter::new(sink), Arc::new(schema), Arc::new(props))
+                .map_err(err)?;
         Ok(ParquetOut {
-            path: path.into(),
+            path,
             partial,
             kinds,
+            rows: 0,
             writer,
+            file,
         })
     }
 
@@ -131,15 +163,39 @@ impl ParquetOut {
             c += 1;
         }
         rg.close().map_err(err)?;
+        self.rows += rows.len() as u64;
         Ok(())
     }
 
-    /// Write the footer, fsync, rename to the final name.
-    pub fn finish(self) -> std::io::Result<PathBuf> {
-        let file = self.writer.into_inner().map_err(err)?;
-        file.sync_all()?;
-        drop(file);
-        std::fs::rename(&self.partial, &self.path)?;
-        Ok(self.path)
+    /// Write the footer and fsync; for a file, check the row count against `expect_rows`, call
+    /// `label` with the content (the sidecar goes first) and rename to the final name.
+    pub fn finish(
+        self,
+        expect_rows: u64,
+        label: impl FnOnce(&Content) -> std::io::Result<()>,
+    ) -> std::io::Result<(PathBuf, Content)> {
+        if self.rows != expect_rows {
+            return Err(err(format!(
+                "{} rows were written where {expect_rows} were expected: the output is incomplete",
+                self.rows
+            )));
+        }
+        let hashing = self.writer.into_inner().map_err(err)?;
+        let (mut sink, sha256) = hashing.into_parts();
+        sink.flush()?;
+        let content = Content {
+            rows: self.rows,
+            sha256,
+            blocks: Vec::new(),
+        };
+        match (self.path, self.file) {
+            (Some(path), Some(file)) => {
+                file.sync_all()?;
+                label(&content)?;
+                std::fs::rename(&self.partial, &path)?;
+                Ok((path, content))
+            }
+            _ => Ok((self.partial, content)),
+        }
     }
 }

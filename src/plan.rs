@@ -130,6 +130,71 @@ fn err(key: impl Into<String>, message: impl Into<String>) -> PlanError {
 
 const NAXES: usize = 13;
 
+/// The size of each axis of a sweep (before its values are built).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AxisCounts {
+    pub formulas: usize,
+    pub e: usize,
+    pub k_linear: usize,
+    pub beta: usize,
+    pub records: usize,
+    pub intensities: usize,
+    pub samples: usize,
+    /// mass, period, damping
+    pub building1: [usize; 3],
+    pub building2: [usize; 3],
+    pub gaps: usize,
+}
+
+/// The sizes of the 13 axes below `law`, outermost first: only the axes the law uses vary.
+fn block_dims(law: LawKind, c: &AxisCounts) -> [usize; NAXES] {
+    [
+        if law.uses_zeta() { c.formulas } else { 1 },
+        if law.is_damped() { c.e } else { 1 },
+        if law.is_hertzian() {
+            c.beta
+        } else {
+            c.k_linear
+        },
+        c.records,
+        c.intensities,
+        c.samples,
+        c.building1[0],
+        c.building1[1],
+        c.building1[2],
+        c.building2[0],
+        c.building2[1],
+        c.building2[2],
+        c.gaps,
+    ]
+}
+
+/// Runs of a sweep of these laws and axis sizes; None past 2^64.
+pub fn count_runs(laws: &[LawKind], c: &AxisCounts) -> Option<u64> {
+    laws.iter().try_fold(0u64, |total, &law| {
+        let len = block_dims(law, c)
+            .iter()
+            .try_fold(1u64, |acc, &d| acc.checked_mul(d as u64))?;
+        total.checked_add(len)
+    })
+}
+
+/// Refuse a sweep of more than [`crate::limits::MAX_RUNS`] runs (key `contact`, as the laws
+/// are where the blocks of runs start), from the axis sizes alone.
+pub fn check_run_count(laws: &[LawKind], c: &AxisCounts) -> Result<u64, PlanError> {
+    match count_runs(laws, c) {
+        Some(n) if n <= crate::limits::MAX_RUNS => Ok(n),
+        n => Err(err(
+            "contact",
+            format!(
+                "the sweep has {} runs: expected at most 2^53 ({})",
+                n.map_or("more than 2^64".to_string(), |n| n.to_string()),
+                crate::limits::WHY_RUNS
+            ),
+        )),
+    }
+}
+
 #[derive(Debug, Clone)]
 struct Block {
     law: LawKind,
@@ -299,11 +364,31 @@ impl Plan {
                 _ => {}
             }
         }
-        if !(spec.tail.is_finite() && spec.tail >= 0.0) {
+        if !(spec.tail.is_finite() && (0.0..=crate::limits::MAX_TAIL_S).contains(&spec.tail)) {
             return Err(err(
                 "run.tail_s",
-                format!("{} is out of range: expected >= 0 s", spec.tail),
+                format!(
+                    "{} is out of range: expected 0 to {} s ({})",
+                    spec.tail,
+                    crate::limits::MAX_TAIL_S,
+                    crate::limits::WHY_TAIL
+                ),
             ));
+        }
+        for (r, rec) in spec.records.iter().enumerate() {
+            let n = rec.forcing(1.0, spec.tail).intervals() as u64;
+            if n > crate::limits::MAX_INTERVALS {
+                return Err(err(
+                    format!("record[{r}]"),
+                    format!(
+                        "`{}` with a tail of {} s is {n} steps of {} s: expected at most 1e8 per run ({})",
+                        rec.name,
+                        spec.tail,
+                        rec.dt,
+                        crate::limits::WHY_INTERVALS
+                    ),
+                ));
+            }
         }
         let damped = spec.laws.iter().any(|l| l.is_damped());
         let uses_formula = spec.laws.iter().any(|l| l.uses_zeta());
@@ -372,40 +457,32 @@ impl Plan {
                 }
             }
         }
+        let counts = AxisCounts {
+            formulas: spec.formulas.len(),
+            e: spec.e.len(),
+            k_linear: spec.k_linear.len(),
+            beta: spec.beta.len(),
+            records: spec.records.len(),
+            intensities: spec.intensities.len(),
+            samples: spec.samples.as_ref().map_or(1, |s| s.points.len()),
+            building1: [
+                spec.building1.mass.len(),
+                spec.building1.period.len(),
+                spec.building1.damping.len(),
+            ],
+            building2: [
+                spec.building2.mass.len(),
+                spec.building2.period.len(),
+                spec.building2.damping.len(),
+            ],
+            gaps: spec.gaps.len(),
+        };
+        check_run_count(&spec.laws, &counts)?;
         let mut blocks = Vec::with_capacity(spec.laws.len());
         let mut total: u64 = 0;
         for &law in &spec.laws {
-            let b1 = &spec.building1;
-            let b2 = &spec.building2;
-            let dims = [
-                if law.uses_zeta() {
-                    spec.formulas.len()
-                } else {
-                    1
-                },
-                if law.is_damped() { spec.e.len() } else { 1 },
-                if law.is_hertzian() {
-                    spec.beta.len()
-                } else {
-                    spec.k_linear.len()
-                },
-                spec.records.len(),
-                spec.intensities.len(),
-                spec.samples.as_ref().map_or(1, |s| s.points.len()),
-                b1.mass.len(),
-                b1.period.len(),
-                b1.damping.len(),
-                b2.mass.len(),
-                b2.period.len(),
-                b2.damping.len(),
-                spec.gaps.len(),
-            ];
-            let len = dims
-                .iter()
-                .try_fold(1u64, |acc, &d| acc.checked_mul(d as u64));
-            let Some(len) = len.filter(|l| total.checked_add(*l).is_some()) else {
-                return Err(err("contact", "the sweep has more than 2^64 runs"));
-            };
+            let dims = block_dims(law, &counts);
+            let len = dims.iter().map(|&d| d as u64).product();
             blocks.push(Block {
                 law,
                 start: total,
@@ -421,6 +498,25 @@ impl Plan {
             damping,
             scales,
         })
+    }
+
+    /// Inputs that are valid but physically absurd (a units mix-up?), one line each.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        for (r, rec) in self.spec.records.iter().enumerate() {
+            let pga = self.scales[r]
+                .iter()
+                .map(|s| rec.pga().value * s / G)
+                .fold(0.0, f64::max);
+            if pga > crate::limits::WARN_PGA_G {
+                w.push(format!(
+                    "record `{}` reaches a PGA of {pga:.3} g, above {} g where no recorded earthquake reaches: check its units and the intensity",
+                    rec.name,
+                    crate::limits::WARN_PGA_G
+                ));
+            }
+        }
+        w
     }
 
     /// Number of runs.
@@ -505,6 +601,30 @@ impl Plan {
             }
         }
         run
+    }
+
+    /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`:
+    /// in closed form per law block (the record axis repeats with a fixed stride), so
+    /// O(blocks x records), never O(runs).
+    pub fn cost_before(&self, end: u64, record_cost: &[u64]) -> u128 {
+        let mut acc: u128 = 0;
+        for b in &self.blocks {
+            if end <= b.start {
+                break;
+            }
+            let rem = (end - b.start).min(b.len) as u128;
+            let inner: u128 = b.dims[4..].iter().map(|&d| d as u128).product();
+            let nrec = b.dims[3] as u128;
+            let cost = |r: usize| record_cost[r] as u128;
+            let cycle: u128 = inner * (0..b.dims[3]).map(cost).sum::<u128>();
+            let (q, r_rem) = (rem / (inner * nrec), rem % (inner * nrec));
+            let (full, part) = ((r_rem / inner) as usize, r_rem % inner);
+            acc += q * cycle + inner * (0..full).map(cost).sum::<u128>();
+            if part > 0 {
+                acc += part * cost(full);
+            }
+        }
+        acc
     }
 
     pub fn forcing(&self, run: &RunSpec) -> Forcing<'_> {

@@ -74,17 +74,29 @@ fn sorted_groups(names: Vec<String>) -> Vec<String> {
     v
 }
 
-/// The panel for `spec` over `table`; rows with an empty x or y (a run that did not pound has
-/// no first impact) are left out.
-pub fn panel(table: &Table, spec: &PlotSpec) -> Result<Panel, TableError> {
+/// The panel for `spec` over `table`, and the number of failed runs left out. Rows with an
+/// empty x or y (a run that did not pound has no first impact) are left out, and so are runs
+/// whose `status` is not `ok` (their values are whatever a diverged run held) and non-finite
+/// values.
+pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableError> {
     let (cx, cy) = (table.col(&spec.x)?, table.col(&spec.y)?);
     let cby = spec.by.as_deref().map(|b| table.col(b)).transpose()?;
+    let cstatus = table.col("status").ok();
     let rows = table.select(&spec.filters)?;
     let mut groups: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    let mut failed = 0;
     for i in rows {
+        if cstatus.is_some_and(|c| table.rows[i][c] != "ok") {
+            failed += 1;
+            continue;
+        }
         let (Some(x), Some(y)) = (table.num(i, cx)?, table.num(i, cy)?) else {
             continue;
         };
+        if !(x.is_finite() && y.is_finite()) {
+            failed += 1;
+            continue;
+        }
         let g = cby.map_or(String::new(), |c| table.rows[i][c].clone());
         groups.entry(g).or_default().push((x, y));
     }
@@ -122,12 +134,15 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<Panel, TableError> {
             spec.aggregate.key()
         ));
     }
-    Ok(Panel {
-        title,
-        x_label: label(&spec.x),
-        y_label: label(&spec.y),
-        log_x: spec.log_x,
-        log_y: spec.log_y,
-        series,
-    })
+    Ok((
+        Panel {
+            title,
+            x_label: label(&spec.x),
+            y_label: label(&spec.y),
+            log_x: spec.log_x,
+            log_y: spec.log_y,
+            series,
+        },
+        failed,
+    ))
 }

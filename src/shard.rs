@@ -3,6 +3,7 @@
 //! metadata sidecar `OUT.meta.toml` that `pound merge` and `--resume` check.
 
 use crate::plan::Plan;
+use crate::target::Target;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::ops::Range;
@@ -93,40 +94,41 @@ impl Shard {
     }
 }
 
-/// The runs of shard `shard`: contiguous ranges cut where the cumulative estimated cost crosses
+/// The runs of shard `shard`: contiguous ranges cut where the cumulative estimated cost reaches
 /// `k / N` of the total. A run's cost is its number of record intervals (record plus tail): the
 /// free stepping that every run pays; contact work is not known before the run. Shards of one
-/// plan tile `0..len` exactly.
+/// plan tile `0..len` exactly. Each cut is a binary search over [`Plan::cost_before`], so a
+/// shard of 1e8 runs is planned in microseconds.
 pub fn shard_range(plan: &Plan, shard: Shard) -> Range<u64> {
     let n = plan.len();
-    let costs: Vec<f64> = plan
+    let costs: Vec<u64> = plan
         .spec
         .records
         .iter()
-        .map(|r| r.forcing(1.0, plan.spec.tail).intervals().max(1) as f64)
+        .map(|r| r.forcing(1.0, plan.spec.tail).intervals().max(1) as u64)
         .collect();
-    let cost = |i: u64| costs[plan.run(i).record];
-    let total: f64 = (0..n).map(cost).sum();
-    // Cut k is the first run at which the cost so far reaches k / N of the total; both cuts of
-    // this shard come from one pass.
-    let target = |k: u64| total * k as f64 / shard.count as f64;
-    let (lo, hi) = (shard.index, shard.index + 1);
-    let mut start = (lo == 0).then_some(0);
-    let mut end = (hi >= shard.count).then_some(n);
-    let mut acc = 0.0;
-    for i in 0..n {
-        if start.is_none() && acc >= target(lo) {
-            start = Some(i);
+    let total = plan.cost_before(n, &costs);
+    // Cut k: the first run i whose preceding cost reaches k / N of the total (exact integers).
+    let cut = |k: u64| -> u64 {
+        if k == 0 {
+            return 0;
         }
-        if end.is_none() && acc >= target(hi) {
-            end = Some(i);
+        if k >= shard.count {
+            return n;
         }
-        if start.is_some() && end.is_some() {
-            break;
+        let target = total * k as u128;
+        let (mut lo, mut hi) = (0u64, n);
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if plan.cost_before(mid, &costs) * shard.count as u128 >= target {
+                hi = mid;
+            } else {
+                lo = mid + 1;
+            }
         }
-        acc += cost(i);
-    }
-    start.unwrap_or(n)..end.unwrap_or(n)
+        lo
+    };
+    cut(shard.index)..cut(shard.index + 1)
 }
 
 /// The sidecar of a finished output (`OUT.meta.toml`): what it was computed from and which runs
@@ -145,6 +147,9 @@ pub struct Meta {
     /// The columns written, when `--columns` chose them (all otherwise).
     #[serde(default)]
     pub columns: Option<Vec<String>>,
+    /// What the file holds (rows and hashes): `pound merge` and the studies check it.
+    #[serde(default)]
+    pub content: Option<crate::journal::Content>,
 }
 
 /// `OUT.meta.toml` for the output `OUT`.
@@ -154,12 +159,15 @@ pub fn meta_path(out: &Path) -> PathBuf {
 
 /// Progress of an unfinished output (`OUT.progress.toml`), rewritten atomically after each
 /// chunk's rows are on disk: the first `done` runs of the range are in the first `bytes` bytes of
-/// `OUT.partial`; anything after that is a half-written chunk.
+/// `OUT.partial`, whose SHA-256 is `sha256`; anything after that is a half-written chunk. A hint,
+/// never the truth: `--resume` re-reads and checks those bytes before it continues.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Progress {
     pub meta: Meta,
     pub done: u64,
     pub bytes: u64,
+    #[serde(default)]
+    pub sha256: String,
 }
 
 pub fn progress_path(out: &Path) -> PathBuf {
@@ -170,6 +178,10 @@ pub fn progress_path(out: &Path) -> PathBuf {
 pub enum ShardError {
     #[error("{}: {message}", path.display())]
     Io { path: PathBuf, message: String },
+    #[error(transparent)]
+    Verify(#[from] crate::journal::VerifyError),
+    #[error(transparent)]
+    Target(#[from] crate::target::TargetError),
 }
 
 /// Read a TOML sidecar.
@@ -196,9 +208,10 @@ pub fn write_toml<T: Serialize>(path: &Path, v: &T) -> Result<(), ShardError> {
     })
 }
 
-/// Combine finished shard outputs into `out`: every input must carry the same fingerprint and
-/// the inputs together must hold every run of the plan exactly once (checked row by row). Rows
-/// are streamed in run order; `out` appears only when complete. Returns the number of rows.
+/// Combine finished shard outputs into `out`: every input must carry the same fingerprint, the
+/// inputs together must hold every run of the plan exactly once (checked row by row), and each
+/// input's rows must hash to what its sidecar recorded (the block of rows that differs is named).
+/// Rows are streamed in run order; `out` appears only when complete. Returns the number of rows.
 pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
     let fail = |path: &Path, message: String| ShardError::Io {
         path: path.into(),
@@ -207,6 +220,7 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
     if inputs.is_empty() {
         return Err(fail(out, "nothing to merge: give the shard outputs".into()));
     }
+    let target = Target::resolve("-o", out)?;
     let mut parts = Vec::new();
     for p in inputs {
         let m = meta_path(p);
@@ -220,7 +234,39 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
             ));
         }
         let meta: Meta = read_toml(&m)?;
+        if meta.content.is_none() {
+            return Err(fail(
+                &m,
+                "carries no content hash of its rows (written by an older pound?): rerun that shard"
+                    .into(),
+            ));
+        }
         parts.push((p.clone(), meta));
+    }
+    {
+        let mut ins: Vec<(String, &Path)> = Vec::new();
+        for (p, _) in &parts {
+            ins.push(("the input".into(), p));
+        }
+        let metas: Vec<PathBuf> = parts.iter().map(|(p, _)| meta_path(p)).collect();
+        for m in &metas {
+            ins.push(("the sidecar".into(), m));
+        }
+        let ins: Vec<(&str, &Path)> = ins.iter().map(|(w, p)| (w.as_str(), *p)).collect();
+        let (partial, meta_out) = (
+            crate::output::sibling(target.path(), ".partial"),
+            meta_path(target.path()),
+        );
+        let outs: Vec<(&str, &Path)> = if target.is_file() {
+            vec![
+                ("-o", target.path()),
+                ("-o's partial file", &partial),
+                ("-o's sidecar", &meta_out),
+            ]
+        } else {
+            vec![("-o", target.path())]
+        };
+        crate::target::check_distinct(&ins, &outs)?;
     }
     let (first_path, first) = (&parts[0].0, parts[0].1.clone());
     for (p, m) in &parts[1..] {
@@ -273,63 +319,80 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
             "the inputs hold different columns (--columns)".into(),
         ));
     }
+    // Every shard is checked whole before anything is written.
     let header = crate::output::header_for(first.columns.as_deref());
-    let mut w =
-        crate::output::CsvOut::create_with(out, &header).map_err(|e| fail(out, e.to_string()))?;
-    let mut rows = 0u64;
+    let header_line = crate::output::header_line(&header);
     for (p, m) in &parts {
-        let mut r = csv::Reader::from_path(p).map_err(|e| fail(p, e.to_string()))?;
-        let h: Vec<String> = r
-            .headers()
-            .map_err(|e| fail(p, e.to_string()))?
-            .iter()
-            .map(String::from)
-            .collect();
-        if h != header {
+        let content = m.content.as_ref().expect("checked above");
+        crate::journal::verify_file(p, &header_line, Some(m.first_run), content)?;
+        if content.rows != m.end_run - m.first_run {
             return Err(fail(
                 p,
-                "its columns differ from its sidecar's (not a `pound sweep` CSV?)".into(),
-            ));
-        }
-        let mut expect = m.first_run;
-        for (line, rec) in r.records().enumerate() {
-            let rec = rec.map_err(|e| fail(p, e.to_string()))?;
-            let run: Option<u64> = rec.get(0).and_then(|x| x.parse().ok());
-            if run != Some(expect) || expect >= m.end_run {
-                return Err(fail(
-                    p,
-                    format!(
-                        "line {}: run {} where run {expect} was expected (rows missing, repeated or out of order)",
-                        line + 2,
-                        rec.get(0).unwrap_or("")
-                    ),
-                ));
-            }
-            w.write(std::iter::once(rec.iter().map(String::from).collect()))
-                .map_err(|e| fail(out, e.to_string()))?;
-            expect += 1;
-            rows += 1;
-        }
-        if expect != m.end_run {
-            return Err(fail(
-                p,
-                format!("ends at run {expect}, its sidecar says {}", m.end_run),
+                format!(
+                    "holds {} rows, its sidecar's run range {}..{} needs {}",
+                    content.rows,
+                    m.first_run,
+                    m.end_run,
+                    m.end_run - m.first_run
+                ),
             ));
         }
     }
-    let mut backends: Vec<&str> = parts.iter().map(|(_, m)| m.backend.as_str()).collect();
-    backends.sort();
-    backends.dedup();
-    let merged = Meta {
-        fingerprint: first.fingerprint.clone(),
-        plan_runs: first.plan_runs,
-        first_run: 0,
-        end_run: first.plan_runs,
-        shard: None,
-        backend: backends.join("+"),
-        columns: first.columns.clone(),
+    let lock = if target.is_file() {
+        Some(crate::target::PartialLock::acquire(
+            &crate::output::sibling(target.path(), ".partial"),
+        )?)
+    } else {
+        None
     };
-    write_toml(&meta_path(out), &merged)?;
-    w.finish().map_err(|e| fail(out, e.to_string()))?;
-    Ok(rows)
+    let mut w = crate::output::CsvOut::create(&target, lock.as_ref(), &header, Some(0))
+        .map_err(|e| fail(out, e.to_string()))?;
+    let written = (|| -> Result<crate::journal::Content, ShardError> {
+        for (p, _) in &parts {
+            let f = std::fs::File::open(p).map_err(|e| fail(p, e.to_string()))?;
+            let mut r = crate::journal::RowReader::new(f);
+            let mut row = Vec::new();
+            r.next_row(&mut row).map_err(|e| fail(p, e.to_string()))?;
+            while r.next_row(&mut row).map_err(|e| fail(p, e.to_string()))? {
+                // The shard may have changed since it was checked: the writer checks run order.
+                w.write_encoded(&row).map_err(|e| fail(p, e.to_string()))?;
+            }
+        }
+        let mut backends: Vec<&str> = parts.iter().map(|(_, m)| m.backend.as_str()).collect();
+        backends.sort();
+        backends.dedup();
+        let merged = |content: &crate::journal::Content| Meta {
+            fingerprint: first.fingerprint.clone(),
+            plan_runs: first.plan_runs,
+            first_run: 0,
+            end_run: first.plan_runs,
+            shard: None,
+            backend: backends.join("+"),
+            columns: first.columns.clone(),
+            content: Some(content.clone()),
+        };
+        let is_file = target.is_file();
+        let (_, content) = w
+            .finish(Some(first.plan_runs), |c| {
+                if is_file {
+                    write_toml(&meta_path(target.path()), &merged(c))
+                        .map_err(std::io::Error::other)?;
+                }
+                Ok(())
+            })
+            .map_err(|e| fail(out, e.to_string()))?;
+        Ok(content)
+    })();
+    match written {
+        Ok(c) => Ok(c.rows),
+        Err(e) => {
+            if let Some(l) = &lock {
+                let _ = std::fs::remove_file(l.path());
+                if !target.path().exists() {
+                    let _ = std::fs::remove_file(meta_path(target.path()));
+                }
+            }
+            Err(e)
+        }
+    }
 }

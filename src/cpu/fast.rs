@@ -11,7 +11,8 @@
 //!    shorter of the free-collision duration at the approach speed, estimated from the step's end
 //!    velocities or the current impact's `v0`, and the time the structures take to reverse the
 //!    relative motion), and keeps RK4 stable at the current penetration
-//!    ([`crate::contact::Contact::local_rate`]). A contact that has lasted [`SUSTAINED`] contact
+//!    ([`crate::contact::Contact::local_rate`]) and at the structures' own rate
+//!    ([`crate::model::Pair::structural_rate`]). A contact that has lasted [`SUSTAINED`] contact
 //!    durations is no longer an impact to resolve: only the local-rate bound applies. Inside a
 //!    substep, the instants of first touch, of the turn `delta' = 0` and of separation are
 //!    located by regula falsi on re-taken partial RK4 steps, so no substep integrates across a
@@ -138,7 +139,10 @@ pub(crate) fn run(
         // it may grow within the step).
         let h_rate = 2.0 * std::f64::consts::PI
             / o.substeps_per_contact
-            / pair.contact.local_rate(2.0 * d_est, run.tr.v0);
+            / pair
+                .contact
+                .local_rate(2.0 * d_est, run.tr.v0)
+                .max(pair.structural_rate());
         let sustained = run.mode != Mode::Free
             && seg.t0 - run.tr.onset_time() > SUSTAINED * pair.contact.duration_estimate(run.tr.v0);
         let h = if sustained {

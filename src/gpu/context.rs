@@ -112,6 +112,12 @@ impl GpuContext {
         Ok(GpuContext::from_device(device, queue, info))
     }
 
+    /// A software adapter (Mesa's lavapipe, type Cpu): it runs the shader on the CPU's own
+    /// cores, slower than the CPU path there, so `--backend auto` passes it by.
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
     /// Wrap a device the caller created (tests, embedding applications).
     pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
         let errors: Arc<Mutex<Option<GpuError>>> = Arc::default();

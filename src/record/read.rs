@@ -306,7 +306,8 @@ fn parse_at2(lines: &[(usize, &str)], ctx: &Ctx) -> Result<Parsed, RecordError> 
     } else {
         Some(Units::G)
     };
-    let mut values = Vec::with_capacity(npts);
+    // The header is not trusted with the allocation: NPTS = 1e18 would abort the process.
+    let mut values = Vec::with_capacity(npts.min(1 << 20));
     let mut last_line = lines[hdr].0;
     for &(n, l) in &lines[hdr + 1..] {
         if l.trim().is_empty() {

@@ -7,6 +7,7 @@ pub mod fast_vs_reference;
 mod fidelity;
 mod gpu;
 mod hard;
+mod hostile;
 mod oracles;
 mod records;
 mod scale;

@@ -450,7 +450,7 @@ fn unwritable_output_is_a_clear_error() {
     assert!(!r.status.success());
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(
-        err.contains("cannot create") && err.contains("no-such-dir"),
+        err.contains("cannot be created") && err.contains("no-such-dir"),
         "{err}"
     );
     assert!(!d.path().join("no-such-dir").exists());
@@ -526,6 +526,14 @@ fn full_disk_is_a_clear_error_with_nothing_left_behind() {
             !d.path().join(format!("{name}.meta.toml")).exists(),
             "{name}"
         );
+        // Only CSV keeps its `.partial` (it resumes); an unfinished Parquet file or summary
+        // cannot be continued and is removed.
+        let partial = d.path().join(format!("{name}.partial"));
+        assert_eq!(
+            partial.symlink_metadata().is_ok(),
+            extra.is_empty(),
+            "{name}"
+        );
     }
 }
 
@@ -534,7 +542,6 @@ fn full_disk_is_a_clear_error_with_nothing_left_behind() {
 /// an uninterrupted sweep.
 #[test]
 fn disk_filling_mid_sweep_keeps_finished_rows_and_resumes() {
-    use std::os::unix::process::CommandExt;
     let d = tempdir();
     let cfg = setup(d.path());
     let whole = d.path().join("whole.csv");
@@ -542,24 +549,19 @@ fn disk_filling_mid_sweep_keeps_finished_rows_and_resumes() {
     let size = std::fs::metadata(&whole).unwrap().len();
     let out = d.path().join("out.csv");
     let limit = size / 3;
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_pound"));
-    cmd.args(["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()])
-        .args(["--backend", "cpu", "--chunk", "4"]);
-    // SAFETY: only async-signal-safe calls between fork and exec.
-    unsafe {
-        cmd.pre_exec(move || {
-            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
-            let r = libc::rlimit {
-                rlim_cur: limit,
-                rlim_max: limit,
-            };
-            if libc::setrlimit(libc::RLIMIT_FSIZE, &r) != 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            Ok(())
-        });
-    }
-    let r = cmd.output().unwrap();
+    let r = crate::support::pound_with_file_limit(
+        &[
+            "sweep",
+            cfg.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--backend",
+            "cpu",
+            "--chunk",
+            "4",
+        ],
+        limit,
+    );
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(!r.status.success());
     assert!(err.contains("out.csv.partial"), "{err}");

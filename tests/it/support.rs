@@ -88,3 +88,26 @@ pub fn collect(plan: &Plan, scheme: &Scheme, chunk: usize) -> Vec<(RunSpec, RunO
     pounding::sweep::run(plan, scheme, chunk, sink, |_| {}).unwrap();
     rows
 }
+
+/// Run `pound ARGS` under a file-size limit of `limit` bytes (SIGXFSZ ignored), so a write past
+/// it fails as on a full disk: a sweep stops with its finished chunks in `OUT.partial`.
+pub fn pound_with_file_limit(args: &[&str], limit: u64) -> std::process::Output {
+    use std::os::unix::process::CommandExt;
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_pound"));
+    cmd.args(args);
+    // SAFETY: only async-signal-safe calls between fork and exec.
+    unsafe {
+        cmd.pre_exec(move || {
+            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+            let r = libc::rlimit {
+                rlim_cur: limit,
+                rlim_max: limit,
+            };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &r) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    cmd.output().expect("run pound")
+}

@@ -1,0 +1,54 @@
+//! Bounds on every size a user types, each with the reason an error quotes. They sit far beyond
+//! any real study; they exist so that a typo (`tail_s = 1e12`, `--threads 100000`) is an
+//! immediate, explained error instead of a hang, a crash or gigabytes of allocation.
+
+/// Worker threads (`--threads`).
+pub const MAX_THREADS: usize = 1024;
+pub const WHY_THREADS: &str =
+    "threads beyond the cores only add switching, and 1,024 is past the largest CPU nodes";
+
+/// Runs per CPU task (`--chunk` on the CPU).
+pub const MAX_CPU_CHUNK: usize = 1 << 20;
+/// Runs per GPU chunk (`--chunk` on the GPU): a chunk's buffers are a few hundred bytes a run.
+pub const MAX_GPU_CHUNK: usize = 1 << 22;
+pub const WHY_CHUNK: &str =
+    "a chunk is held in memory whole (CPU: 1,048,576 runs; GPU: 4,194,304 runs, about 2 GB of buffers)";
+
+/// Free vibration after the record (`run.tail_s`).
+pub const MAX_TAIL_S: f64 = 3600.0;
+pub const WHY_TAIL: &str = "an hour of free vibration is far past the decay of any damped building";
+
+/// Record steps one run integrates (record plus tail).
+pub const MAX_INTERVALS: u64 = 100_000_000;
+pub const WHY_INTERVALS: &str =
+    "the GPU counts steps in 32 bits, and 1e8 steps is 11 days of motion at 0.01 s";
+
+/// RK4 substeps per contact duration (`run.substeps_per_contact`, `--settings`).
+pub const MAX_SUBSTEPS_PER_CONTACT: f64 = 4096.0;
+pub const WHY_SUBSTEPS: &str =
+    "the peak-force error falls ~16x per doubling and reaches f64 round-off well before 4,096 (pound accuracy)";
+
+/// Samples of `[sample]` (`sample.n`).
+pub const MAX_SAMPLES: usize = 10_000_000;
+pub const WHY_SAMPLES: &str = "every sample is held in memory and crossed with the whole grid";
+
+/// Runs in one sweep.
+pub const MAX_RUNS: u64 = 1 << 53;
+pub const WHY_RUNS: &str =
+    "run numbers stay exact in the f64 columns of spreadsheet and dataframe readers only up to 2^53";
+
+/// Values of `--e` for the single-collision studies.
+pub const MAX_E_VALUES: usize = 10_000;
+
+/// Runs of one `pound bench` size.
+pub const MAX_BENCH_RUNS: u64 = 1_000_000_000;
+
+/// Above this PGA (g) a sweep warns: no recorded earthquake comes close (a units mix-up?).
+pub const WARN_PGA_G: f64 = 5.0;
+
+/// A building's height estimated from its period (m per s of period: T ~ 0.1 s per storey of
+/// about 3 m). A peak displacement above it is physically absurd, and a sweep warns.
+pub const HEIGHT_PER_PERIOD_M: f64 = 30.0;
+
+/// The runs of a grid axis or range (`{ from, to, n }`).
+pub const MAX_AXIS_POINTS: usize = 10_000_000;
