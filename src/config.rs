@@ -361,37 +361,43 @@ pub fn load(path: &Path) -> Result<Plan, ConfigError> {
 
 /// [`load`], also returning the config's text (for [`changed_records`]).
 pub fn load_with_text(path: &Path) -> Result<(Plan, String), ConfigError> {
-    let text = std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
-        path: path.into(),
-        error,
-    })?;
-    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let plan = parse(&text, path, &base, &records_dir())?;
+    let text = read_text(path)?;
+    let plan = load_text(&text, path)?;
     Ok((plan, text))
 }
 
-/// The record files a config reads (`file =` and `path =` records, resolved), so a command can
-/// refuse to write over one of them. A config that does not parse lists none (loading it then
-/// reports the error).
-pub fn input_files(path: &Path) -> Result<Vec<PathBuf>, ConfigError> {
-    let text = std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
+/// The text of a config file, read once (it may be a pipe: `pound sweep <(make-config)`).
+pub fn read_text(path: &Path) -> Result<String, ConfigError> {
+    std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
         path: path.into(),
         error,
-    })?;
-    let Ok(raw) = toml::from_str::<RawConfig>(&text) else {
-        return Ok(Vec::new());
+    })
+}
+
+/// Validate config `text` read from `path` (records resolved beside it and in
+/// [`records_dir`]).
+pub fn load_text(text: &str, path: &Path) -> Result<Plan, ConfigError> {
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse(text, path, &base, &records_dir())
+}
+
+/// The record files config `text` (read from `path`) reads, `file =` and `path =` records
+/// resolved, so a command can refuse to write over one of them. Text that does not parse lists
+/// none (loading it reports the error).
+pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
+    let Ok(raw) = toml::from_str::<RawConfig>(text) else {
+        return Vec::new();
     };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let records = records_dir();
-    Ok(raw
-        .records
+    raw.records
         .iter()
         .filter_map(|r| match (&r.file, &r.path) {
             (Some(f), _) => Some(records.join(f)),
             (_, Some(p)) => Some(base.join(p)),
             _ => None,
         })
-        .collect())
+        .collect()
 }
 
 /// The records of `plan` (from the config `text` at `path`) whose files no longer hold what was

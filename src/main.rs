@@ -493,7 +493,8 @@ fn sweep(a: SweepArgs) -> Result<()> {
     // The output is checked before anything runs: not a directory, not one of the inputs, and
     // writable.
     let target = Target::resolve("-o", &output)?;
-    let inputs = config::input_files(&config)?;
+    let config_text = config::read_text(&config)?;
+    let inputs = config::input_files(&config_text, &config);
     {
         let mut ins: Vec<(&str, &std::path::Path)> = vec![("the config", &config)];
         ins.extend(inputs.iter().map(|p| ("the record", p.as_path())));
@@ -517,7 +518,7 @@ fn sweep(a: SweepArgs) -> Result<()> {
         target.probe("-o")?;
     }
     let precision = precision.get();
-    let (mut plan, config_text) = config::load_with_text(&config)?;
+    let mut plan = config::load_text(&config_text, &config)?;
     for w in plan.warnings() {
         note!("warning: {}: {w}", config.display());
     }
@@ -957,8 +958,12 @@ fn formulas(e: &str, plot: Option<&std::path::Path>) -> Result<()> {
 
 fn fragility(a: FragilityArgs) -> Result<()> {
     use pounding::fragility::{csv, fit, levels, panel, FragilitySpec};
+    let sidecar = meta_path(&a.results);
     check_outputs(
-        &[("the results", &a.results)],
+        &[
+            ("the results", &a.results),
+            ("the results' sidecar", &sidecar),
+        ],
         &[("-o", Some(&a.output)), ("--plot", a.plot.as_deref())],
     )?;
     warn_provenance(&a.results);
@@ -1012,7 +1017,14 @@ fn fragility(a: FragilityArgs) -> Result<()> {
 
 fn plot(a: PlotArgs) -> Result<()> {
     use pounding::sensitivity::{panel, Aggregate, PlotSpec};
-    check_outputs(&[("the results", &a.results)], &[("-o", Some(&a.output))])?;
+    let sidecar = meta_path(&a.results);
+    check_outputs(
+        &[
+            ("the results", &a.results),
+            ("the results' sidecar", &sidecar),
+        ],
+        &[("-o", Some(&a.output))],
+    )?;
     warn_provenance(&a.results);
     let table = pounding::table::Table::read(&a.results)?;
     let filters = pounding::table::Filter::parse_all(&a.filters)?;
@@ -1098,11 +1110,12 @@ fn accuracy(
     if !(tol > 0.0 && tol < 1e-3) {
         bail!("--tol: {tol} is out of range: expected 0 < tol < 1e-3");
     }
-    let records = config::input_files(config)?;
+    let text = config::read_text(config)?;
+    let records = config::input_files(&text, config);
     let mut ins: Vec<(&str, &std::path::Path)> = vec![("the config", config)];
     ins.extend(records.iter().map(|p| ("the record", p.as_path())));
     check_outputs(&ins, &[("-o", Some(output)), ("--plot", plot)])?;
-    let plan = config::load(config)?;
+    let plan = config::load_text(&text, config)?;
     for w in plan.warnings() {
         note!("warning: {}: {w}", config.display());
     }

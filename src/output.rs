@@ -420,10 +420,23 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     }
     let path = target.path();
     let tmp = sibling(path, ".partial");
-    let written = File::create(&tmp).and_then(|mut f| {
-        f.write_all(bytes)?;
-        f.sync_all()
-    });
+    // `OUT.partial` may be a sweep's: running (locked) or resumable (with its journal).
+    if sibling(path, ".progress.toml").exists() {
+        return Err(std::io::Error::other(format!(
+            "{} holds the rows of an unfinished sweep (see {}): finish it with --resume, or delete both",
+            tmp.display(),
+            sibling(path, ".progress.toml").display()
+        )));
+    }
+    let lock = PartialLock::acquire(&tmp).map_err(std::io::Error::other)?;
+    let written = lock
+        .file()
+        .map_err(std::io::Error::other)
+        .and_then(|mut f| {
+            empty(&f)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        });
     match written {
         Ok(()) => std::fs::rename(&tmp, path),
         Err(e) => {

@@ -138,6 +138,18 @@ impl SweepOutput {
         let path = target.path();
         let lock = lock.as_ref().map(|(l, _)| l);
         let names = header_for(meta.columns.as_deref());
+        if let (Some(l), false) = (lock, matches!(format, Format::Csv)) {
+            let journal = progress_path(path);
+            if journal.exists() {
+                return Err(at(
+                    l.path(),
+                    format!(
+                        "holds the rows of an unfinished CSV sweep (see {}): finish it with --resume, or delete both to start over",
+                        journal.display()
+                    ),
+                ));
+            }
+        }
         match format {
             Format::Summary(agg) => return Ok(Some((Sink::Summary(agg), 0))),
             Format::Parquet => {

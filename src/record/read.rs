@@ -86,12 +86,31 @@ impl Default for ReadOptions {
     }
 }
 
+/// The largest record file read (256 MiB).
+pub const MAX_RECORD_BYTES: u64 = 256 << 20;
+
 /// Read and parse a record file.
 pub fn read_record(path: &Path, opts: &ReadOptions) -> Result<Record, RecordError> {
-    let bytes = std::fs::read(path).map_err(|error| RecordError::Io {
+    let io = |error| RecordError::Io {
         path: path.into(),
         error,
-    })?;
+    };
+    // Bounded, so a path such as /dev/zero is an error, not a machine out of memory.
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(
+        &mut std::io::Read::take(std::fs::File::open(path).map_err(io)?, MAX_RECORD_BYTES + 1),
+        &mut bytes,
+    )
+    .map_err(io)?;
+    if bytes.len() as u64 > MAX_RECORD_BYTES {
+        return Err(RecordError::Invalid {
+            path: path.into(),
+            message: format!(
+                "larger than {} MiB: not a ground-motion record as pound reads one (real records are under 1 MiB)",
+                MAX_RECORD_BYTES >> 20
+            ),
+        });
+    }
     let text = String::from_utf8_lossy(&bytes);
     let name = path
         .file_stem()

@@ -134,7 +134,7 @@ fn bad_configs_name_the_key() {
         (
             "period_s = [0.3, 0.5]",
             "period_s = [0.3, 0.0]",
-            "building1.period_s[1]: 0 is out of range: expected a period > 0 s",
+            "building1.period_s[1]: 0 is out of range: expected a period >= 1e-4 s",
         ),
         ("period_s = 0.8", "period_s = 0.8\n", ""),
         (

@@ -286,6 +286,56 @@ fn outputs_never_replace_inputs() {
     );
     // A directory is refused before any run.
     refused(&sweep(&sc.cfg, sc.dir.path(), &[]), "is a directory", None);
+
+    // An unfinished CSV sweep's rows are not taken over by another format or a study's output.
+    let u = sc.path("u.csv");
+    sc.interrupted(&u, 0.5);
+    let held = std::fs::read(sibling(&u, ".partial")).unwrap();
+    for extra in [&["--format", "parquet"][..], &["--aggregate", "gap_m"][..]] {
+        refused(&sweep(&sc.cfg, &u, extra), "unfinished CSV sweep", None);
+    }
+    refused(
+        &pound(&[
+            "plot",
+            r,
+            "--x",
+            "gap_m",
+            "--y",
+            "peak_force_n",
+            "-o",
+            s(&u),
+        ]),
+        "unfinished sweep",
+        None,
+    );
+    assert_eq!(std::fs::read(sibling(&u, ".partial")).unwrap(), held);
+    ok(&sweep(&sc.cfg, &u, &["--resume"]));
+    assert_same_text(
+        "resumed after the refusals",
+        &std::fs::read_to_string(&u).unwrap(),
+        &sc.whole,
+    );
+
+    // A config read from a pipe is read once (process substitution).
+    let piped = sc.path("piped.toml");
+    let synthetic_only = SWEEP.replace(
+        "[[record]]\npath = \"rec.txt\"\nformat = \"values\"\ndt_s = 0.01\nunits = \"g\"\n",
+        "",
+    );
+    assert_ne!(synthetic_only, SWEEP);
+    std::fs::write(&piped, &synthetic_only).unwrap();
+    let o = Command::new("bash")
+        .args([
+            "-c",
+            &format!(
+                "'{}' sweep <(cat '{}') -o - --backend cpu",
+                env!("CARGO_BIN_EXE_pound"),
+                s(&piped)
+            ),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(ok(&o).lines().count(), 49, "{}", stderr(&o));
 }
 
 /// Class 2: `--resume` checks what the partial holds against its journal (run numbers 0..k in
@@ -647,6 +697,18 @@ fn sizes_are_bounded_and_nothing_panics() {
     );
     let r = pound_within(&["sweep", s(&big), "-o", s(&o)], limit);
     refused(&r, "more than 2^64 runs", Some(&o));
+    // A record path that never ends is an error after a bounded read.
+    let zero = sc.path("zero.toml");
+    std::fs::write(
+        &zero,
+        SWEEP.replace("path = \"rec.txt\"", "path = \"/dev/zero\""),
+    )
+    .unwrap();
+    refused(
+        &pound_within(&["sweep", s(&zero), "-o", s(&o)], limit),
+        "larger than 256 MiB",
+        Some(&o),
+    );
     // Bench and the single-collision studies bound their sizes too.
     refused(
         &pound_within(&["bench", "--sizes", "0"], limit),
@@ -917,6 +979,42 @@ proptest! {
         let text = String::from_utf8_lossy(&text);
         if let Err(e) = pounding::config::parse(&text, Path::new("m.toml"), d.path(), d.path()) {
             prop_assert!(e.to_string().starts_with("m.toml"), "{e}");
+        }
+    }
+
+    /// Configs with nasty values in every key (zero, negative, tiny, huge, NaN, infinite, or
+    /// ordinary) never panic: they are refused with the file and key named, or they give a plan
+    /// whose runs decode, whose warnings and shard cuts compute.
+    #[test]
+    fn nasty_values_never_panic(
+        nasty in prop::collection::vec(prop_oneof![
+            3 => Just(None),
+            1 => prop::sample::select(vec![
+                "0", "-1", "1e-300", "1e300", "nan", "inf", "-inf", "0.5", "1", "2", "1e-4", "3600", "1e7",
+            ]).prop_map(Some),
+        ], 16),
+        law in prop::sample::select(vec!["linear", "kelvin_voigt", "hertz", "nonlinear_viscoelastic", "hunt_crossley", "hunt_crossley_exact"]),
+        formula in prop::sample::select(vec!["ebrahimi", "jankowski", "exact", "anagnostopoulos", "nope"]),
+    ) {
+        // Each key: a sane value three times in four, else a nasty one.
+        let sane = ["1", "64", "1e5", "0.4", "0.05", "1e5", "0.9", "0.05", "0.5", "1e9", "2.75e9", "0", "0.05", "2", "0.3", "1"];
+        let v: Vec<&str> = nasty.iter().zip(sane).map(|(n, s)| n.unwrap_or(s)).collect();
+        let text = format!(
+            "[run]\ntail_s = {}\nsubsteps_per_contact = {}\n\n[building1]\nmass_kg = {}\nperiod_s = {}\ndamping_ratio = {}\n\n[building2]\nmass_kg = {}\nperiod_s = [{}, 0.5]\ndamping_ratio = {}\n\n[contact]\nlaw = \"{law}\"\nformula = \"{formula}\"\ne = {}\nk_n_per_m = {}\nbeta_n_per_m1_5 = {}\ngap_m = {{ from = {}, to = {}, n = 3 }}\n\n[[record]]\nsynthetic = {{ seed = 1, duration_s = {}, dt_s = 0.01, pga_g = {} }}\n\n[intensity]\nscale = {}\n",
+            v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15]
+        );
+        let d = tempdir();
+        match pounding::config::parse(&text, Path::new("n.toml"), d.path(), d.path()) {
+            Err(e) => prop_assert!(e.to_string().starts_with("n.toml"), "{e}"),
+            Ok(plan) => {
+                for i in 0..plan.len().min(50) {
+                    let r = plan.run(i);
+                    prop_assert!(r.t1 >= 1e-4 && r.gap >= 0.0 && r.scale > 0.0);
+                }
+                let _ = plan.warnings();
+                let sh = pounding::shard::shard_range(&plan, pounding::shard::Shard { index: 1, count: 3 });
+                prop_assert!(sh.start <= sh.end && sh.end <= plan.len());
+            }
         }
     }
 
