@@ -483,3 +483,149 @@ fn write_summary(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shard::Fingerprint;
+
+    const CFG: &str = r#"
+[building1]
+mass_kg = 1.0e5
+period_s = [0.3, 0.6]
+damping_ratio = 0.05
+[building2]
+mass_kg = 1.0e5
+period_s = 0.9
+damping_ratio = 0.05
+[contact]
+law = "linear"
+k_n_per_m = 1e9
+gap_m = [0.0, 0.01, 0.02]
+[[record]]
+synthetic = { seed = 2, duration_s = 2.0 }
+"#;
+
+    fn rows(plan: &Plan) -> Vec<(RunSpec, RunOutput)> {
+        let mut all = Vec::new();
+        crate::sweep::run(
+            plan,
+            &plan.spec.scheme,
+            2,
+            |c: &[(RunSpec, RunOutput)]| -> Result<(), ()> {
+                all.extend_from_slice(c);
+                Ok(())
+            },
+            |_| {},
+        )
+        .unwrap();
+        all
+    }
+
+    fn meta(plan: &Plan) -> Meta {
+        Meta {
+            fingerprint: Fingerprint::of(plan),
+            plan_runs: plan.len(),
+            first_run: 0,
+            end_run: plan.len(),
+            shard: None,
+            backend: "cpu".into(),
+            columns: None,
+            content: None,
+        }
+    }
+
+    fn open(out: &Path, plan: &Plan, resume: bool) -> Result<Opened, OutputError> {
+        SweepOutput::open(
+            Target::File(out.into()),
+            meta(plan),
+            Format::Csv,
+            None,
+            resume,
+            &mut |_| {},
+        )
+    }
+
+    fn ready(o: Result<Opened, OutputError>) -> Box<SweepOutput> {
+        match o.unwrap() {
+            Opened::Ready(o) => o,
+            Opened::Complete(p) => panic!("{} already complete", p.display()),
+        }
+    }
+
+    #[test]
+    fn an_interrupted_output_resumes_to_the_whole_and_is_labelled() {
+        let plan =
+            crate::config::parse(CFG, Path::new("t.toml"), Path::new("."), Path::new(".")).unwrap();
+        let all = rows(&plan);
+        assert_eq!(all.len(), 6);
+        let d = tempfile::tempdir().unwrap();
+        let whole = d.path().join("whole.csv");
+        let mut o = ready(open(&whole, &plan, false));
+        o.take(&plan, &all).unwrap();
+        o.finish().unwrap();
+        // Rows out of order are refused.
+        let mut o = ready(open(&d.path().join("order.csv"), &plan, false));
+        let e = o.take(&plan, &all[1..2]).unwrap_err();
+        assert!(
+            e.to_string().contains("run 1 came where run 0 was due"),
+            "{e}"
+        );
+        // Half the runs, then a crash (dropped unfinished): the CSV keeps its journal.
+        let out = d.path().join("o.csv");
+        let mut o = ready(open(&out, &plan, false));
+        o.take(&plan, &all[..3]).unwrap();
+        drop(o);
+        assert!(crate::output::sibling(&out, ".progress.toml").exists());
+        // A plain open refuses to overwrite it; a resume continues at run 3.
+        assert!(open(&out, &plan, false).is_err());
+        let mut o = ready(open(&out, &plan, true));
+        assert_eq!((o.done(), o.todo()), (3, 3..6));
+        o.take(&plan, &all[3..]).unwrap();
+        let (path, _) = o.finish().unwrap();
+        assert_eq!(path, out);
+        assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&whole).unwrap());
+        let m: Meta = read_toml(&meta_path(&out)).unwrap();
+        let c = m.content.unwrap();
+        assert_eq!(c.rows, 6);
+        assert_eq!(c.sha256, crate::journal::file_sha256(&out).unwrap());
+        // Resuming a complete, intact output does nothing.
+        assert!(matches!(
+            open(&out, &plan, true).unwrap(),
+            Opened::Complete(_)
+        ));
+    }
+
+    #[test]
+    fn an_output_missing_runs_is_not_put_in_place() {
+        let plan =
+            crate::config::parse(CFG, Path::new("t.toml"), Path::new("."), Path::new(".")).unwrap();
+        let all = rows(&plan);
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path().join("o.csv");
+        let mut o = ready(open(&out, &plan, false));
+        o.take(&plan, &all[..5]).unwrap();
+        let e = o.finish().unwrap_err();
+        assert!(e.to_string().contains("5 rows were written where 6"), "{e}");
+        assert!(!out.exists() && !meta_path(&out).exists());
+        // A summary that folded fewer runs than the range is not written either.
+        let agg = Aggregator::new(&["gap_m".into()], &[]).unwrap();
+        let sum = d.path().join("s.csv");
+        let mut o = ready(SweepOutput::open(
+            Target::File(sum.clone()),
+            meta(&plan),
+            Format::Summary(Box::new(agg)),
+            None,
+            false,
+            &mut |_| {},
+        ));
+        o.take(&plan, &all[..4]).unwrap();
+        let e = o.finish().unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("folded 4 runs where the sweep has 6"),
+            "{e}"
+        );
+        assert!(!sum.exists() && !crate::output::sibling(&sum, ".partial").exists());
+    }
+}
