@@ -331,6 +331,18 @@ pub struct RawRecord {
     pub window_s: Option<[f64; 2]>,
 }
 
+impl RawRecord {
+    /// The file this record reads: `file =` in the records directory `records`, `path =`
+    /// relative to the config's folder `base`; None for a synthetic record.
+    fn file_path(&self, base: &Path, records: &Path) -> Option<PathBuf> {
+        match (&self.file, &self.path) {
+            (Some(f), _) => Some(records.join(f)),
+            (_, Some(p)) => Some(base.join(p)),
+            _ => None,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawIntensity {
@@ -392,11 +404,7 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
     let records = records_dir();
     raw.records
         .iter()
-        .filter_map(|r| match (&r.file, &r.path) {
-            (Some(f), _) => Some(records.join(f)),
-            (_, Some(p)) => Some(base.join(p)),
-            _ => None,
-        })
+        .filter_map(|r| r.file_path(&base, &records))
         .collect()
 }
 
@@ -783,11 +791,9 @@ fn load_record(r: &RawRecord, base: &Path, records: &Path) -> Result<Record, Loa
         };
         synthetic(&spec).map_err(LoadError::Record)?
     } else {
-        let file = match (&r.file, &r.path) {
-            (Some(f), _) => records.join(f),
-            (_, Some(p)) => base.join(p),
-            _ => unreachable!("one source checked above"),
-        };
+        let file = r
+            .file_path(base, records)
+            .expect("one source checked above");
         let format = match &r.format {
             Some(f) => Format::parse(f).ok_or_else(|| {
                 LoadError::Invalid(format!("format `{f}`: expected {}", Format::KEYS))

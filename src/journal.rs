@@ -234,14 +234,8 @@ pub fn verify_prefix(
             "holds {len} bytes, fewer than the {bytes} its journal vouches for: it was truncated or replaced"
         )));
     }
-    let mut r = RowReader::new(file.take(bytes));
+    let mut r = after_header(partial, file.take(bytes), header)?;
     let mut row = Vec::new();
-    if !r.next_row(&mut row).map_err(io)? || row != header {
-        return Err(bad(
-            "does not start with the header this sweep writes (another sweep's file, or edited)"
-                .into(),
-        ));
-    }
     let mut h = ContentHasher::new(header, Some(first_run));
     while r.next_row(&mut row).map_err(io)? {
         h.row(&row).map_err(|e| bad(e.to_string()))?;
@@ -267,14 +261,46 @@ pub fn verify_prefix(
     Ok(h)
 }
 
+/// A reader of `file` (read as `path`) past its first row, which must be `header`.
+fn after_header<R: Read>(path: &Path, file: R, header: &[u8]) -> Result<RowReader<R>, VerifyError> {
+    let mut r = RowReader::new(file);
+    let mut row = Vec::new();
+    let read = r.next_row(&mut row).map_err(|error| VerifyError::Io {
+        path: path.into(),
+        error,
+    })?;
+    if !read || row != header {
+        return Err(VerifyError::Bad {
+            path: path.into(),
+            message:
+                "does not start with the header this sweep writes (another sweep's file, or edited)"
+                    .into(),
+        });
+    }
+    Ok(r)
+}
+
 /// Re-read a whole CSV and check it against `content` (hash, rows, blocks) and, with
 /// `first_run`, that its rows hold consecutive runs from there. Used before a finished sweep's
-/// `.partial` is renamed into place, and by `pound merge` on each shard.
+/// `.partial` is renamed into place.
 pub fn verify_file(
     path: &Path,
     header: &[u8],
     first_run: Option<u64>,
     content: &Content,
+) -> Result<(), VerifyError> {
+    verify_rows(path, header, first_run, content, |_| Ok(()))
+}
+
+/// [`verify_file`], handing each row to `each` once it is checked (its block's hash is checked
+/// when the block closes): `pound merge` copies a shard in the same pass that verifies it. On
+/// an error, rows already handed on may belong to a block that then fails.
+pub fn verify_rows(
+    path: &Path,
+    header: &[u8],
+    first_run: Option<u64>,
+    content: &Content,
+    mut each: impl FnMut(&[u8]) -> Result<(), VerifyError>,
 ) -> Result<(), VerifyError> {
     let bad = |message: String| VerifyError::Bad {
         path: path.into(),
@@ -284,15 +310,13 @@ pub fn verify_file(
         path: path.into(),
         error,
     };
-    let mut r = RowReader::new(std::fs::File::open(path).map_err(io)?);
+    let mut r = after_header(path, std::fs::File::open(path).map_err(io)?, header)?;
     let mut row = Vec::new();
-    if !r.next_row(&mut row).map_err(io)? || row != header {
-        return Err(bad("its header differs from the one written".into()));
-    }
     let mut h = ContentHasher::new(header, first_run);
     let mut checked = 0;
     while r.next_row(&mut row).map_err(io)? {
         h.row(&row).map_err(|e| bad(e.to_string()))?;
+        each(&row)?;
         // Compare each block as it closes, to name the rows that differ.
         if h.blocks.len() > checked {
             check_block(path, content, &h.blocks, checked, first_run)?;

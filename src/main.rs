@@ -8,7 +8,7 @@ use pounding::cpu::{FastOptions, ReferenceOptions, Scheme};
 use pounding::gpu::{GpuContext, GpuOptions, Precision};
 use pounding::record::{read_record, Format, ReadOptions, Units, G};
 use pounding::restitution::{exact_damping, Formula};
-use pounding::shard::{meta_path, progress_path, Fingerprint, Meta};
+use pounding::shard::{meta_path, Fingerprint, Meta};
 use std::io::IsTerminal;
 use std::io::Write as _;
 
@@ -449,7 +449,6 @@ fn run(cli: Cli) -> Result<()> {
 
 fn sweep(a: SweepArgs) -> Result<()> {
     use pounding::sweep_output::{Format, Opened, SweepOutput};
-    use pounding::target::Target;
     let SweepArgs {
         config,
         output,
@@ -492,31 +491,13 @@ fn sweep(a: SweepArgs) -> Result<()> {
     });
     // The output is checked before anything runs: not a directory, not one of the inputs, and
     // writable.
-    let target = Target::resolve("-o", &output)?;
     let config_text = config::read_text(&config)?;
-    let inputs = config::input_files(&config_text, &config);
-    {
-        let mut ins: Vec<(&str, &std::path::Path)> = vec![("the config", &config)];
-        ins.extend(inputs.iter().map(|p| ("the record", p.as_path())));
-        let t = target.path();
-        let (partial, meta_file, progress_file) = (
-            pounding::output::sibling(t, ".partial"),
-            meta_path(t),
-            progress_path(t),
-        );
-        let outs: Vec<(&str, &std::path::Path)> = if target.is_file() {
-            vec![
-                ("-o", t),
-                ("-o's partial file", &partial),
-                ("-o's sidecar", &meta_file),
-                ("-o's journal", &progress_file),
-            ]
-        } else {
-            vec![("-o", t)]
-        };
-        pounding::target::check_distinct(&ins, &outs)?;
-        target.probe("-o")?;
-    }
+    let records = config::input_files(&config_text, &config);
+    let mut ins: Vec<(&str, &std::path::Path)> = vec![("the config", &config)];
+    ins.extend(records.iter().map(|p| ("the record", p.as_path())));
+    let target = check_outputs(&ins, &[("-o", Some(&output))])?
+        .pop()
+        .expect("one output");
     let precision = precision.get();
     let mut plan = config::load_text(&config_text, &config)?;
     for w in plan.warnings() {
@@ -751,32 +732,23 @@ fn absurd_drifts(rows: &[(pounding::plan::RunSpec, pounding::model::RunOutput)])
 }
 
 /// Check a command's outputs before it does any work: each resolves (not a directory, its
-/// folder exists), can be written, is none of `inputs` and is not written twice (each file's
-/// `.partial` counts).
+/// folder exists), can be written, is none of `inputs` and is not written twice (the files a
+/// pound output writes beside it count). Returns the targets given.
 fn check_outputs(
     inputs: &[(&str, &std::path::Path)],
     outputs: &[(&str, Option<&std::path::Path>)],
-) -> Result<()> {
+) -> Result<Vec<pounding::target::Target>> {
     use pounding::target::Target;
-    let mut outs: Vec<(String, PathBuf)> = Vec::new();
+    let mut targets = Vec::new();
     for (what, p) in outputs {
         let Some(p) = p else { continue };
         let t = Target::resolve(what, p)?;
         t.probe(what)?;
-        outs.push((what.to_string(), t.path().to_path_buf()));
-        if t.is_file() {
-            outs.push((
-                format!("{what}'s partial file"),
-                pounding::output::sibling(t.path(), ".partial"),
-            ));
-        }
+        targets.push((*what, t));
     }
-    let outs: Vec<(&str, &std::path::Path)> = outs
-        .iter()
-        .map(|(w, p)| (w.as_str(), p.as_path()))
-        .collect();
-    pounding::target::check_distinct(inputs, &outs)?;
-    Ok(())
+    let named: Vec<(&str, &Target)> = targets.iter().map(|(w, t)| (*w, t)).collect();
+    pounding::target::check_outputs(inputs, &named)?;
+    Ok(targets.into_iter().map(|(_, t)| t).collect())
 }
 
 /// Warn when a results file is not vouched for by its sweep's sidecar.

@@ -143,24 +143,16 @@ pub fn header() -> Vec<&'static str> {
         .collect()
 }
 
-/// Where a CSV's bytes go: a locked `.partial` file renamed when complete, or a stream written
-/// in place (standard output, a character device, a FIFO).
-enum Dest {
-    File {
-        path: PathBuf,
-        partial: PathBuf,
-        w: BufWriter<File>,
-    },
-    Stream {
-        name: PathBuf,
-        w: BufWriter<Box<dyn Write + Send>>,
-    },
-}
-
 /// A CSV output that appears under its final name only when complete, with its rows hashed and
-/// their run numbers checked as they are written ([`ContentHasher`]).
+/// their run numbers checked as they are written ([`ContentHasher`]). A file target is written
+/// into its locked `.partial` and renamed; a stream (standard output, a character device, a
+/// FIFO) is written in place.
 pub struct CsvOut {
-    dest: Dest,
+    w: BufWriter<Box<dyn Write + Send>>,
+    /// Where the bytes go: the `.partial` of a file, or the stream's name.
+    written: PathBuf,
+    /// A file target: its final name, and a handle to fsync.
+    file: Option<(PathBuf, File)>,
     header: Vec<u8>,
     first_run: Option<u64>,
     hasher: ContentHasher,
@@ -219,35 +211,27 @@ impl CsvOut {
         first_run: Option<u64>,
     ) -> std::io::Result<CsvOut> {
         let header = header_line(columns);
-        let mut dest = match (target, lock) {
+        let mut out = match (target, lock) {
             (Target::File(path), Some(lock)) => {
                 let mut file = lock.file().map_err(std::io::Error::other)?;
                 empty(&file)?;
                 std::io::Seek::seek(&mut file, std::io::SeekFrom::Start(0))?;
-                Dest::File {
-                    path: path.clone(),
-                    partial: lock.path().to_path_buf(),
-                    w: BufWriter::new(file),
-                }
+                CsvOut::in_file(path, lock, file, &header, first_run)?
             }
             (Target::File(_), None) => {
                 return Err(std::io::Error::other("a file output needs its lock"))
             }
-            _ => Dest::Stream {
-                name: target.path().to_path_buf(),
+            _ => CsvOut {
                 w: BufWriter::new(open_stream(target)?),
+                written: target.path().to_path_buf(),
+                file: None,
+                header: header.clone(),
+                first_run,
+                hasher: ContentHasher::new(&header, first_run),
             },
         };
-        match &mut dest {
-            Dest::File { w, .. } => w.write_all(&header)?,
-            Dest::Stream { w, .. } => w.write_all(&header)?,
-        }
-        Ok(CsvOut {
-            dest,
-            hasher: ContentHasher::new(&header, first_run),
-            header,
-            first_run,
-        })
+        out.w.write_all(&header)?;
+        Ok(out)
     }
 
     /// Continue the locked `.partial` of `path`, whose first `hasher.bytes()` bytes were
@@ -264,60 +248,50 @@ impl CsvOut {
         file.set_len(hasher.bytes())?;
         file.sync_all()?;
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
+        let mut out = CsvOut::in_file(path, lock, file, &header_line(columns), Some(first_run))?;
+        out.hasher = hasher;
+        Ok(out)
+    }
+
+    /// Writing into `file`, the locked `.partial` of `path`.
+    fn in_file(
+        path: &Path,
+        lock: &PartialLock,
+        file: File,
+        header: &[u8],
+        first_run: Option<u64>,
+    ) -> std::io::Result<CsvOut> {
         Ok(CsvOut {
-            dest: Dest::File {
-                path: path.into(),
-                partial: lock.path().to_path_buf(),
-                w: BufWriter::new(file),
-            },
-            header: header_line(columns),
-            first_run: Some(first_run),
-            hasher,
+            w: BufWriter::new(Box::new(file.try_clone()?)),
+            written: lock.path().to_path_buf(),
+            file: Some((path.into(), file)),
+            header: header.to_vec(),
+            first_run,
+            hasher: ContentHasher::new(header, first_run),
         })
     }
 
     /// Where the rows are being written (the `.partial` of a file).
     pub fn partial_path(&self) -> &Path {
-        match &self.dest {
-            Dest::File { partial, .. } => partial,
-            Dest::Stream { name, .. } => name,
-        }
+        &self.written
     }
 
     /// Push everything written to the disk (fsync for a file) and return the bytes written
     /// and their hash (what the journal vouches for).
     pub fn sync(&mut self) -> std::io::Result<(u64, String)> {
-        match &mut self.dest {
-            Dest::File { w, .. } => {
-                w.flush()?;
-                w.get_ref().sync_data()?;
-            }
-            Dest::Stream { w, .. } => w.flush()?,
+        self.w.flush()?;
+        if let Some((_, f)) = &self.file {
+            f.sync_data()?;
         }
         Ok((self.hasher.bytes(), self.hasher.digest()))
     }
 
-    /// Rows written so far.
-    pub fn rows(&self) -> u64 {
-        self.hasher.rows_seen()
-    }
-
-    /// Append rows and push them to the OS, so a crash keeps them in the `.partial` file.
-    pub fn write(&mut self, rows: impl IntoIterator<Item = Vec<String>>) -> std::io::Result<()> {
-        self.write_encoded(&lines(rows))
-    }
-
-    /// Append rows already encoded as CSV lines ([`encode_csv`]); refused if they do not hold
-    /// the next runs in order.
+    /// Append rows already encoded as CSV lines ([`encode_csv`]), pushed to the OS so a crash
+    /// keeps them; refused if they do not hold the next runs in order.
     pub fn write_encoded(&mut self, lines: &[u8]) -> std::io::Result<()> {
         self.hasher.rows(lines).map_err(invalid)?;
-        match &mut self.dest {
-            Dest::File { w, .. } => {
-                w.write_all(lines)?;
-                w.flush()
-            }
-            Dest::Stream { w, .. } => w.write_all(lines),
-        }
+        self.w.write_all(lines)?;
+        self.w.flush()
     }
 
     /// Flush and fsync; for a file, re-read it and check it holds exactly what was written
@@ -325,7 +299,7 @@ impl CsvOut {
     /// the sidecar first: a crash before the rename leaves a labelled, resumable `.partial`),
     /// then rename it to its final name. Returns the final path and the content.
     pub fn finish(
-        self,
+        mut self,
         expect_rows: Option<u64>,
         label: impl FnOnce(&Content) -> std::io::Result<()>,
     ) -> std::io::Result<(PathBuf, Content)> {
@@ -337,22 +311,18 @@ impl CsvOut {
                 )));
             }
         }
+        self.w.flush()?;
         let content = self.hasher.finish();
-        match self.dest {
-            Dest::File { path, partial, w } => {
-                let file = w.into_inner().map_err(|e| e.into_error())?;
+        match self.file {
+            Some((path, file)) => {
                 file.sync_all()?;
-                crate::journal::verify_file(&partial, &self.header, self.first_run, &content)
+                crate::journal::verify_file(&self.written, &self.header, self.first_run, &content)
                     .map_err(invalid)?;
                 label(&content)?;
-                std::fs::rename(&partial, &path)?;
-                drop(file);
+                std::fs::rename(&self.written, &path)?;
                 Ok((path, content))
             }
-            Dest::Stream { name, mut w } => {
-                w.flush()?;
-                Ok((name, content))
-            }
+            None => Ok((self.written, content)),
         }
     }
 }
@@ -421,11 +391,12 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let path = target.path();
     let tmp = sibling(path, ".partial");
     // `OUT.partial` may be a sweep's: running (locked) or resumable (with its journal).
-    if sibling(path, ".progress.toml").exists() {
+    let journal = sibling(path, ".progress.toml");
+    if journal.exists() {
         return Err(std::io::Error::other(format!(
             "{} holds the rows of an unfinished sweep (see {}): finish it with --resume, or delete both",
             tmp.display(),
-            sibling(path, ".progress.toml").display()
+            journal.display()
         )));
     }
     let lock = PartialLock::acquire(&tmp).map_err(std::io::Error::other)?;

@@ -36,13 +36,13 @@ fn kind(column: &str) -> Kind {
 /// A Parquet file that appears under its final name only when complete (or a stream written in
 /// place), hashed as it is written.
 pub struct ParquetOut {
-    /// The final name of a file target; None for a stream.
-    path: Option<PathBuf>,
+    /// Where the bytes go: the `.partial` of a file, or the stream's name.
     partial: PathBuf,
+    /// A file target: its final name, and a handle to fsync.
+    file: Option<(PathBuf, File)>,
     kinds: Vec<Kind>,
     rows: u64,
     writer: SerializedFileWriter<HashingWriter<Box<dyn Write + Send>>>,
-    file: Option<File>,
 }
 
 fn err(e: impl std::fmt::Display) -> std::io::Error {
@@ -95,20 +95,18 @@ impl ParquetOut {
                 kv("pound.backend", meta.backend.clone()),
             ]))
             .build();
-        let (path, partial, file, sink): (_, _, _, Box<dyn Write + Send>) = match (target, lock) {
+        let (partial, file, sink): (_, _, Box<dyn Write + Send>) = match (target, lock) {
             (Target::File(p), Some(lock)) => {
                 let f = lock.file().map_err(err)?;
                 crate::output::empty(&f)?;
                 (
-                    Some(p.clone()),
                     lock.path().to_path_buf(),
-                    Some(f.try_clone()?),
+                    Some((p.clone(), f.try_clone()?)),
                     Box::new(f),
                 )
             }
             (Target::File(_), None) => return Err(err("a file output needs its lock")),
             _ => (
-                None,
                 target.path().to_path_buf(),
                 None,
                 crate::output::open_stream(target)?,
@@ -118,12 +116,11 @@ impl ParquetOut {
             SerializedFileWriter::new(HashingWriter::new(sink), Arc::new(schema), Arc::new(props))
                 .map_err(err)?;
         Ok(ParquetOut {
-            path,
             partial,
+            file,
             kinds,
             rows: 0,
             writer,
-            file,
         })
     }
 
@@ -188,14 +185,14 @@ impl ParquetOut {
             sha256,
             blocks: Vec::new(),
         };
-        match (self.path, self.file) {
-            (Some(path), Some(file)) => {
+        match self.file {
+            Some((path, file)) => {
                 file.sync_all()?;
                 label(&content)?;
                 std::fs::rename(&self.partial, &path)?;
                 Ok((path, content))
             }
-            _ => Ok((self.partial, content)),
+            None => Ok((self.partial, content)),
         }
     }
 }

@@ -244,29 +244,13 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
         parts.push((p.clone(), meta));
     }
     {
-        let mut ins: Vec<(String, &Path)> = Vec::new();
-        for (p, _) in &parts {
-            ins.push(("the input".into(), p));
-        }
         let metas: Vec<PathBuf> = parts.iter().map(|(p, _)| meta_path(p)).collect();
-        for m in &metas {
-            ins.push(("the sidecar".into(), m));
-        }
-        let ins: Vec<(&str, &Path)> = ins.iter().map(|(w, p)| (w.as_str(), *p)).collect();
-        let (partial, meta_out) = (
-            crate::output::sibling(target.path(), ".partial"),
-            meta_path(target.path()),
-        );
-        let outs: Vec<(&str, &Path)> = if target.is_file() {
-            vec![
-                ("-o", target.path()),
-                ("-o's partial file", &partial),
-                ("-o's sidecar", &meta_out),
-            ]
-        } else {
-            vec![("-o", target.path())]
-        };
-        crate::target::check_distinct(&ins, &outs)?;
+        let mut ins: Vec<(&str, &Path)> = parts
+            .iter()
+            .map(|(p, _)| ("the input", p.as_path()))
+            .collect();
+        ins.extend(metas.iter().map(|m| ("the sidecar", m.as_path())));
+        crate::target::check_outputs(&ins, &[("-o", &target)])?;
     }
     let (first_path, first) = (&parts[0].0, parts[0].1.clone());
     for (p, m) in &parts[1..] {
@@ -319,12 +303,10 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
             "the inputs hold different columns (--columns)".into(),
         ));
     }
-    // Every shard is checked whole before anything is written.
     let header = crate::output::header_for(first.columns.as_deref());
     let header_line = crate::output::header_line(&header);
     for (p, m) in &parts {
         let content = m.content.as_ref().expect("checked above");
-        crate::journal::verify_file(p, &header_line, Some(m.first_run), content)?;
         if content.rows != m.end_run - m.first_run {
             return Err(fail(
                 p,
@@ -348,15 +330,17 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, ShardError> {
     let mut w = crate::output::CsvOut::create(&target, lock.as_ref(), &header, Some(0))
         .map_err(|e| fail(out, e.to_string()))?;
     let written = (|| -> Result<crate::journal::Content, ShardError> {
-        for (p, _) in &parts {
-            let f = std::fs::File::open(p).map_err(|e| fail(p, e.to_string()))?;
-            let mut r = crate::journal::RowReader::new(f);
-            let mut row = Vec::new();
-            r.next_row(&mut row).map_err(|e| fail(p, e.to_string()))?;
-            while r.next_row(&mut row).map_err(|e| fail(p, e.to_string()))? {
-                // The shard may have changed since it was checked: the writer checks run order.
-                w.write_encoded(&row).map_err(|e| fail(p, e.to_string()))?;
-            }
+        // Each shard is verified against its sidecar in the pass that copies it; the output is
+        // put in place only if every shard passed.
+        for (p, m) in &parts {
+            let content = m.content.as_ref().expect("checked above");
+            crate::journal::verify_rows(p, &header_line, Some(m.first_run), content, |row| {
+                w.write_encoded(row)
+                    .map_err(|error| crate::journal::VerifyError::Io {
+                        path: out.into(),
+                        error,
+                    })
+            })?;
         }
         let mut backends: Vec<&str> = parts.iter().map(|(_, m)| m.backend.as_str()).collect();
         backends.sort();

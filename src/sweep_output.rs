@@ -138,14 +138,21 @@ impl SweepOutput {
         let path = target.path();
         let lock = lock.as_ref().map(|(l, _)| l);
         let names = header_for(meta.columns.as_deref());
-        if let (Some(l), false) = (lock, matches!(format, Format::Csv)) {
-            let journal = progress_path(path);
-            if journal.exists() {
+        let header = header_line(&names);
+        let progress_file = progress_path(path);
+        // An unfinished CSV sweep's rows are only ever continued (CSV, --resume), never
+        // overwritten by a fresh sweep of any format.
+        if let Some(l) = lock {
+            if progress_file.exists() && !(resume && matches!(format, Format::Csv)) {
+                let held = read_toml::<Progress>(&progress_file)
+                    .map(|p| format!("holds {} finished runs of", p.done))
+                    .unwrap_or_else(|_| "belongs to".into());
                 return Err(at(
                     l.path(),
                     format!(
-                        "holds the rows of an unfinished CSV sweep (see {}): finish it with --resume, or delete both to start over",
-                        journal.display()
+                        "{held} an unfinished CSV sweep: rerun with --resume to continue it, or delete {} and {} to start over",
+                        l.path().display(),
+                        progress_file.display()
                     ),
                 ));
             }
@@ -170,7 +177,6 @@ impl SweepOutput {
                 0,
             )));
         };
-        let progress_file = progress_path(path);
         let start_over = format!(
             "delete {} and {} to start over",
             lock.path().display(),
@@ -221,7 +227,7 @@ impl SweepOutput {
             // The journal is a hint: what the `.partial` holds is checked, row by row.
             let hasher = verify_prefix(
                 lock.path(),
-                &header_line(&names),
+                &header,
                 meta.first_run,
                 p.done,
                 p.bytes,
@@ -240,7 +246,7 @@ impl SweepOutput {
                             && (m.first_run, m.end_run, &m.columns)
                                 == (meta.first_run, meta.end_run, &meta.columns);
                         let intact = m.content.as_ref().is_some_and(|c| {
-                            verify_file(path, &header_line(&names), Some(meta.first_run), c).is_ok()
+                            verify_file(path, &header, Some(meta.first_run), c).is_ok()
                         });
                         if same && intact {
                             note(format!("{} is already complete", path.display()));
@@ -251,14 +257,6 @@ impl SweepOutput {
                 note(format!(
                     "nothing to resume for {}: starting",
                     path.display()
-                ));
-            } else if progress_file.exists() {
-                let held = read_toml::<Progress>(&progress_file)
-                    .map(|p| format!("holds {} finished runs of an unfinished sweep", p.done))
-                    .unwrap_or_else(|_| "belongs to an unfinished sweep".into());
-                return Err(at(
-                    lock.path(),
-                    format!("{held}: rerun with --resume to continue it, or {start_over}"),
                 ));
             }
             let out = CsvOut::create(target, Some(lock), &names, Some(meta.first_run))

@@ -134,6 +134,36 @@ impl Target {
     }
 }
 
+/// Refuse `outputs` that are one of `inputs` or write one file twice ([`check_distinct`]),
+/// counting every file a pound output may write beside a file target: its `.partial`, its
+/// sidecar `.meta.toml` and its journal `.progress.toml`.
+pub fn check_outputs(
+    inputs: &[(&str, &Path)],
+    outputs: &[(&str, &Target)],
+) -> Result<(), TargetError> {
+    let mut files: Vec<(String, PathBuf)> = Vec::new();
+    for (what, t) in outputs {
+        files.push((what.to_string(), t.path().to_path_buf()));
+        if t.is_file() {
+            for (suffix, name) in [
+                (".partial", "partial file"),
+                (".meta.toml", "sidecar"),
+                (".progress.toml", "journal"),
+            ] {
+                files.push((
+                    format!("{what}'s {name}"),
+                    crate::output::sibling(t.path(), suffix),
+                ));
+            }
+        }
+    }
+    let files: Vec<(&str, &Path)> = files
+        .iter()
+        .map(|(w, p)| (w.as_str(), p.as_path()))
+        .collect();
+    check_distinct(inputs, &files)
+}
+
 /// The identity of an existing file: device and inode on Unix, the canonical path elsewhere.
 #[derive(Debug, Clone, PartialEq, Eq)]
 enum FileId {

@@ -118,6 +118,20 @@ fn sweep(cfg: &Path, out: &Path, extra: &[&str]) -> Output {
     pound(&args)
 }
 
+/// `pound fragility RESULTS --threshold 0 --edp impacts EXTRA...` ("pounds at all").
+fn fragility(results: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "fragility",
+        s(results),
+        "--threshold",
+        "0",
+        "--edp",
+        "impacts",
+    ];
+    args.extend_from_slice(extra);
+    pound(&args)
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -196,33 +210,13 @@ fn outputs_never_replace_inputs() {
         None,
     );
     refused(
-        &pound(&[
-            "fragility",
-            r,
-            "--threshold",
-            "0",
-            "--edp",
-            "impacts",
-            "-o",
-            r,
-        ]),
+        &fragility(&results, &["-o", r]),
         "same file as the results",
         None,
     );
     let f = sc.path("f.csv");
     refused(
-        &pound(&[
-            "fragility",
-            r,
-            "--threshold",
-            "0",
-            "--edp",
-            "impacts",
-            "-o",
-            s(&f),
-            "--plot",
-            s(&f),
-        ]),
+        &fragility(&results, &["-o", s(&f), "--plot", s(&f)]),
         "also written as -o",
         Some(&f),
     );
@@ -533,29 +527,11 @@ fn merge_checks_content_and_studies_warn() {
     // No sidecar: studies warn.
     let bare = sc.path("bare.csv");
     std::fs::write(&bare, &sc.whole).unwrap();
-    let w = pound(&[
-        "fragility",
-        s(&bare),
-        "--threshold",
-        "0",
-        "--edp",
-        "impacts",
-        "-o",
-        s(&sc.path("f.csv")),
-    ]);
+    let w = fragility(&bare, &["-o", s(&sc.path("f.csv"))]);
     assert!(stderr(&w).contains("has no sidecar"), "{}", stderr(&w));
     ok(&w);
     // A complete output with its sidecar: no warning.
-    let w = pound(&[
-        "fragility",
-        s(&merged),
-        "--threshold",
-        "0",
-        "--edp",
-        "impacts",
-        "-o",
-        s(&sc.path("f.csv")),
-    ]);
+    let w = fragility(&merged, &["-o", s(&sc.path("f.csv"))]);
     assert!(!stderr(&w).contains("warning"), "{}", stderr(&w));
 }
 
