@@ -1,15 +1,21 @@
-//! Criterion benches of whole sweeps on the CPU fast path and the GPU path, on the `pound bench`
-//! model (the same plan builder), so the figures compare with BENCHMARKS.md.
+//! Criterion benches of whole sweeps on every engine, on the `pound bench` model (the same plan
+//! builder and the same `studies::bench::run`), so the figures compare with BENCHMARKS.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use pounding::gpu::{GpuContext, GpuOptions, Precision};
+use pounding::engine::gpu::{GpuContext, GpuOptions, Precision};
+use pounding::engine::Engine;
+use pounding::physics::solver::{FastOptions, Scheme};
+use pounding::studies::bench;
 
 fn sweeps(c: &mut Criterion) {
-    let plan = pounding::bench::plan(1000);
+    let plan = bench::plan(1000);
     let mut g = c.benchmark_group("sweep_1000_runs_20s_record");
     g.sample_size(10);
     g.throughput(Throughput::Elements(plan.len()));
-    g.bench_function("cpu_fast", |b| b.iter(|| pounding::bench::cpu(&plan)));
+    let cpu = Engine::cpu(Scheme::Fast(FastOptions::default()), None).expect("default chunk");
+    g.bench_function("cpu_fast", |b| {
+        b.iter(|| bench::run(&plan, &cpu).expect("cpu sweep"))
+    });
     match GpuContext::new() {
         Ok(ctx) => {
             for precision in [Precision::F32, Precision::F64] {
@@ -20,9 +26,10 @@ fn sweeps(c: &mut Criterion) {
                     precision,
                     ..Default::default()
                 };
+                let gpu = Engine::gpu(&ctx, opts, None).expect("default chunk");
                 ctx.kernel(precision, false).expect("kernel compiles");
                 g.bench_function(format!("gpu_{}", precision.key()), |b| {
-                    b.iter(|| pounding::bench::gpu(&plan, &ctx, &opts, 65536).expect("gpu sweep"))
+                    b.iter(|| bench::run(&plan, &gpu).expect("gpu sweep"))
                 });
             }
         }

@@ -1,20 +1,22 @@
+// Rust twin: src/engine/aggregate.rs (Group::add, the host fold; host side in
+// src/engine/gpu/reduce.rs).
 // `--aggregate` on the device: folds the runs of a finished chunk into per-group summaries, so
 // only kilobytes come back instead of a state per run. One workgroup per segment (consecutive
 // runs of one group: the host packs each chunk sorted by group). Each invocation folds every
 // WG-th run of the segment; counts meet in workgroup atomics, max and sum in a tree reduction,
 // and each output's value bumps its bucket of the group's histogram slot with a global atomic
 // (the slots live across chunks; the host reads them back when the sweep ends or the slots run
-// out). The per-run body is the twin of `Group::add` in src/aggregate.rs; `outputs` is the twin
+// out). The per-run body is the twin of `Group::add` in src/engine/aggregate.rs; `outputs` is the twin
 // of `gpu::output`. Runs the fast stage handed back (STATUS_HANDOFF) are listed, not folded:
 // the host finishes them on the CPU and folds them there.
 //
-// The host prepends the prelude (src/gpu/shader.rs): `real`, WG, types.wgsl, and the sketch
+// The host prepends the prelude (src/engine/gpu/shader.rs): `real`, WG, types.wgsl, and the sketch
 // and partial layout constants (NOUT, BUCKETS, KMIN, KMAX, SKETCH_MIN, SKETCH_MAX, INV_LN_G,
 // MAX_EXCEED, PART_U, PART_R, P_*). The bucket's log is taken in f32 (lavapipe's f64 log is
 // wrong): a value within f32 rounding of a bucket boundary may land one bucket over, which
 // moves a quantile by at most one bucket's 2 %.
 
-// Keep in sync with src/gpu/layout.rs (the layout test checks sizes and offsets).
+// Keep in sync with src/engine/gpu/layout.rs (the layout test checks sizes and offsets).
 struct AggConfig {
     nseg: u32,
     nexceed: u32,

@@ -1,18 +1,19 @@
-// The `fast` scheme, one invocation per run: the GPU twin of src/cpu/fast.rs and the helpers in
-// src/cpu/mod.rs and src/contact.rs, function for function (same names, same operation order).
+// Rust twin: src/physics/solver/fast.rs (with src/physics/solver/{mod,events,tracker}.rs and
+// src/physics/contact.rs), function for function (same names, same operation order).
+// The `fast` scheme, one invocation per run.
 // Each dispatch does at most `disp.budget` units of work per run (a free record interval, or one
 // piece of an RK4 substep) and saves the state, so the host repeats dispatches until no run is
 // active: no dispatch runs long, and lavapipe's loop limiter (about 65,535 loop iterations per
 // invocation; a loop past it silently exits) is never reached. The resumable form changes no
 // arithmetic: the CPU path takes the same steps in one pass.
 //
-// The host prepends a prelude (src/gpu/shader.rs): `alias real = f32;` or `f64;`, the precision
+// The host prepends a prelude (src/engine/gpu/shader.rs): `alias real = f32;` or `f64;`, the precision
 // constants EPS, TINY, BIG, and WG (the workgroup size). Only sqrt, abs, min, max, ceil on reals:
 // lavapipe's f64 pow/exp/sin are wrong, so every transcendental coefficient comes precomputed in
 // `Params`, and the one fifth root is an f32 seed refined by Newton steps in `real`.
 
 // Params, State, Meta, Counters and the MODE_/STATUS_ codes are in types.wgsl.
-// Keep in sync with src/gpu/layout.rs (the layout test checks sizes and offsets).
+// Keep in sync with src/engine/gpu/layout.rs (the layout test checks sizes and offsets).
 struct Dispatch {
     budget: u32,
     nactive: u32,

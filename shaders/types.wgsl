@@ -1,5 +1,6 @@
+// Rust twin: src/engine/gpu/layout.rs (the #[repr(C)] Pod types and codes).
 // Structs and codes shared by every stage (fast.wgsl, aggregate.wgsl); the host prepends this
-// file after the precision prelude (src/gpu/shader.rs). Keep in sync with src/gpu/layout.rs: the
+// file after the precision prelude (src/engine/gpu/shader.rs). Keep in sync with the twin: the
 // layout test parses each stage with naga and checks every size, offset and code against Rust.
 
 struct Params {

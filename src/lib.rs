@@ -1,37 +1,28 @@
 //! pounding: earthquake-induced pounding between adjacent buildings, simulated in large sweeps.
 //!
-//! Layers, bottom up: [`record`] (ground motions), [`contact`] and [`restitution`] (the physics
-//! of an impact), [`model`] and [`propagator`] (the scene and exact linear stepping), [`cpu`]
-//! (integrators), [`plan`] (a validated sweep), [`config`] (TOML to plan), [`sweep`] (parallel
-//! execution and streaming output).
+//! The data path, in the order of the folders:
+//!
+//! ```text
+//! TOML config --plan::config--> Plan --engine::Engine (cpu | gpu)--> (RunSpec, RunOutput) rows
+//!     --io--> CSV / Parquet / summary with sidecar --studies--> tables and plots
+//! ```
+//!
+//! - [`physics`]: one run in f64: buildings, contact laws, restitution, free stepping, solvers;
+//! - [`record`]: ground motions, read from files or synthesised;
+//! - [`plan`]: a validated sweep, its columns, samples, shards and input bounds;
+//! - [`engine`]: the one enum that runs a range of a plan on the CPU or the GPU (`shaders/`);
+//! - [`io`]: outputs that are never destroyed nor called complete when they are not;
+//! - [`studies`]: accuracy, benchmarks, fidelity, fragility, sensitivity, the seed paper, plots.
+//!
+//! Each layer imports only those above it in this list (the command line, `src/cli/`, sits on
+//! top of them all, in the binary).
 
-pub mod accuracy;
-pub mod aggregate;
-pub mod bench;
-pub mod config;
-pub mod contact;
-pub mod cpu;
-pub mod fidelity;
-pub mod fragility;
-pub mod gpu;
-pub mod journal;
-pub mod limits;
-pub mod model;
-pub mod output;
-pub mod paper;
-pub mod parquet_out;
+pub mod engine;
+pub mod io;
+pub mod physics;
 pub mod plan;
-pub mod plot;
-pub mod propagator;
 pub mod record;
-pub mod restitution;
-pub mod sample;
-pub mod sensitivity;
-pub mod shard;
-pub mod sweep;
-pub mod sweep_output;
-pub mod table;
-pub mod target;
+pub mod studies;
 
 /// Print a line to standard error. A failed write (stderr closed, or on a full device) is
 /// ignored, never a panic: diagnostics must not turn a good run into a crash.

@@ -1,5 +1,7 @@
 //! Ground-motion records: the `Record` type, file readers (`read`), and the seeded synthetic
 //! generator (`synthetic`). Accelerations are stored in m/s^2 whatever the file's units.
+//!
+//! May import the physics only (a record makes a `Forcing`); never plans, engines, io or studies.
 
 mod read;
 mod synthetic;
@@ -86,8 +88,8 @@ impl Record {
 
     /// This record as the ground motion of a run: multiplied by `scale`, followed by `tail`
     /// seconds of free vibration.
-    pub fn forcing(&self, scale: f64, tail: f64) -> crate::model::Forcing<'_> {
-        crate::model::Forcing {
+    pub fn forcing(&self, scale: f64, tail: f64) -> crate::physics::model::Forcing<'_> {
+        crate::physics::model::Forcing {
             accel: &self.accel,
             dt: self.dt,
             t0: self.t0,

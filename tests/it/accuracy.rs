@@ -1,13 +1,13 @@
 //! The speed-against-error study: errors against the reference fall as the fast scheme takes
 //! more substeps per contact, on every path, and the outputs are written.
 
-use crate::gpu::ctx;
+use crate::support::ctx;
 use crate::support::tempdir;
-use pounding::accuracy::{csv, panels, study};
+use pounding::studies::accuracy::{csv, panels, study};
 
 #[test]
 fn errors_fall_with_more_substeps_on_every_path() {
-    let plan = pounding::bench::plan(60);
+    let plan = pounding::studies::bench::plan(60);
     let points = study(&plan, ctx(), &[8.0, 64.0], 1e-8, |_| {}).unwrap();
     let paths = if ctx().is_some() { 3 } else { 1 };
     assert_eq!(points.len(), 1 + 2 * paths);
@@ -51,7 +51,7 @@ fn errors_fall_with_more_substeps_on_every_path() {
     }
     let d = tempdir();
     let svg = d.path().join("a.svg");
-    pounding::plot::svg(&svg, &panels(points), 2).unwrap();
+    pounding::studies::plot::svg(&svg, &panels(points), 2).unwrap();
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("\ncpu-fast-f64\n") && text.contains("\n99th percentile error\n"));
     assert_eq!(csv(points).lines().count(), 1 + points.len());

@@ -1,24 +1,6 @@
 //! The `pound` binary end to end.
 
-use crate::support::{assert_same_text, records_dir, tempdir};
-use std::path::Path;
-use std::process::Command;
-
-pub fn pound(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_pound"))
-        .args(args)
-        .output()
-        .expect("run pound")
-}
-
-pub fn ok(out: &std::process::Output) -> String {
-    assert!(
-        out.status.success(),
-        "pound failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout.clone()).unwrap()
-}
+use crate::support::{assert_same_text, ok, pound, records_dir, tempdir};
 
 const SMALL: &str = r#"
 [run]
@@ -85,7 +67,7 @@ fn sweep_writes_complete_csv_atomically() {
     assert!(!d.path().join("one.csv.partial").exists());
     let mut rdr = csv::Reader::from_reader(a.as_bytes());
     let header: Vec<String> = rdr.headers().unwrap().iter().map(String::from).collect();
-    assert_eq!(header, pounding::output::header());
+    assert_eq!(header, pounding::plan::columns::header());
     let rows: Vec<csv::StringRecord> = rdr.records().map(|r| r.unwrap()).collect();
     assert_eq!(rows.len(), 18);
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
@@ -211,7 +193,13 @@ fn record_info_prints_pga() {
         err.contains("bad.AT2:5: expected numbers, found `oops`"),
         "{err}"
     );
-    assert!(!Path::new("results.csv.partial").exists());
+    // `record info` only reads: the file is as it was and nothing appeared beside it.
+    assert_eq!(
+        std::fs::read_to_string(&bad).unwrap(),
+        "a\nb\nc\nNPTS= 3, DT= .01\n1.0 oops 2.0\n"
+    );
+    let beside: Vec<_> = std::fs::read_dir(d.path()).unwrap().collect();
+    assert_eq!(beside.len(), 1, "{beside:?}");
 }
 
 /// `pound accuracy` on a small config: one table row and one CSV row per path and setting, a

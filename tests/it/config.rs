@@ -2,9 +2,9 @@
 //! and plan numbering is a clean mixed-radix decode.
 
 use crate::support::{records_dir, tempdir};
-use pounding::config::{self, ConfigError};
-use pounding::contact::LawKind;
-use pounding::restitution::Formula;
+use pounding::physics::contact::LawKind;
+use pounding::physics::restitution::Formula;
+use pounding::plan::config::{self, ConfigError};
 use std::path::Path;
 
 fn parse(text: &str) -> Result<pounding::plan::Plan, ConfigError> {

@@ -3,9 +3,9 @@
 //! to beyond contact.
 
 use crate::support::{collect, records_dir, rel};
-use pounding::config;
-use pounding::cpu::{FastOptions, ReferenceOptions, Scheme};
-use pounding::model::Status;
+use pounding::physics::model::Status;
+use pounding::physics::solver::{FastOptions, ReferenceOptions, Scheme};
+use pounding::plan::config;
 use std::path::Path;
 
 pub const MIXED: &str = r#"

@@ -3,10 +3,10 @@
 //! energy taken out of a collision is `0.5 m_eff (1 - e^2) v0^2` for the achieved `e`, and a
 //! loop's enclosed area is that energy.
 
-use crate::support::tempdir;
-use pounding::contact::{Contact, LawKind};
-use pounding::fidelity::{hysteresis, table};
-use pounding::restitution::{damping_for, Formula};
+use crate::support::{pound_with_outputs, tempdir};
+use pounding::physics::contact::{Contact, LawKind};
+use pounding::physics::restitution::{damping_for, Formula};
+use pounding::studies::fidelity::{hysteresis, table};
 
 #[test]
 fn exact_damping_and_anagnostopoulos_in_kelvin_voigt_reproduce_e() {
@@ -61,20 +61,6 @@ fn hysteresis_loop_area_is_the_dissipated_energy() {
         );
         assert!(l.points.len() > 50, "{law:?}: {} points", l.points.len());
     }
-}
-
-/// `pound ARGS -o OUT --plot PLOT`; its stdout on success.
-fn pound_with_outputs(args: &[&str], out: &std::path::Path, plot: &std::path::Path) -> String {
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_pound"))
-        .args(args)
-        .arg("-o")
-        .arg(out)
-        .arg("--plot")
-        .arg(plot)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    String::from_utf8(o.stdout).unwrap()
 }
 
 #[test]

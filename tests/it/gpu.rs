@@ -1,7 +1,7 @@
 //! GPU path: shader layout against the Rust structs, GPU against the CPU twin.
 
-use pounding::gpu::layout::{self, Layout};
-use pounding::gpu::shader::{aggregate_source, fast_source, Precision};
+use pounding::engine::gpu::layout::{self, Layout};
+use pounding::engine::gpu::shader::{aggregate_source, fast_source, Precision};
 
 fn parse(precision: Precision) -> naga::Module {
     parse_source(&fast_source(precision, true))
@@ -87,10 +87,10 @@ fn constant(module: &naga::Module, name: &str) -> f64 {
 /// Every constant the shader shares with the Rust side ("keep in sync" on both).
 #[test]
 fn shared_constants_match_the_shader() {
-    use pounding::cpu::fast;
+    use pounding::physics::solver::fast;
     let m = parse(Precision::F64);
     for (name, rust) in [
-        ("HC_V0_MIN", pounding::contact::HC_V0_MIN),
+        ("HC_V0_MIN", pounding::physics::contact::HC_V0_MIN),
         (
             "MAX_PIECES_PER_SUBSTEP",
             fast::MAX_PIECES_PER_SUBSTEP as f64,
@@ -108,47 +108,23 @@ fn shared_constants_match_the_shader() {
     ] {
         assert_eq!(constant(&m, name), rust, "const {name}");
     }
-    for (i, law) in pounding::contact::LawKind::ALL.iter().enumerate().take(6) {
+    for (i, law) in pounding::physics::contact::LawKind::ALL
+        .iter()
+        .enumerate()
+        .take(6)
+    {
         let name = format!("LAW_{}", law.key().to_uppercase());
         assert_eq!(constant(&m, &name), i as f64, "{name}");
     }
 }
 
-use crate::support::{collect, rel};
-use pounding::cpu::{FastOptions, Scheme};
-use pounding::gpu::{GpuContext, GpuOptions};
-use pounding::model::RunOutput;
+use crate::support::{collect, ctx, gpu_collect, grazing_contacts, peak_diff, rel};
+use pounding::engine::gpu::{GpuContext, GpuOptions};
+use pounding::engine::Engine;
+use pounding::physics::model::RunOutput;
+use pounding::physics::solver::{FastOptions, Scheme};
 use pounding::plan::{Plan, RunSpec};
 use std::sync::OnceLock;
-
-/// The shared test device. With `POUND_REQUIRE_GPU=1` (CI) a missing adapter fails the test.
-pub fn ctx() -> Option<&'static GpuContext> {
-    static CTX: OnceLock<Option<GpuContext>> = OnceLock::new();
-    CTX.get_or_init(|| match GpuContext::new() {
-        Ok(c) => {
-            eprintln!("GPU tests on {}", c.describe());
-            Some(c)
-        }
-        Err(e) => {
-            if std::env::var("POUND_REQUIRE_GPU").is_ok_and(|v| v == "1") {
-                panic!("POUND_REQUIRE_GPU=1 but {e}");
-            }
-            eprintln!("skipping GPU test: {e}");
-            None
-        }
-    })
-    .as_ref()
-}
-
-pub fn gpu_collect(plan: &Plan, opts: &GpuOptions, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
-    let mut rows = Vec::new();
-    let sink = |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::gpu::GpuError> {
-        rows.extend_from_slice(c);
-        Ok(())
-    };
-    pounding::sweep::run_gpu(plan, ctx().unwrap(), opts, chunk, sink, |_| {}).unwrap();
-    rows
-}
 
 /// The GPU-vs-CPU grid: every law and every formula, e from 0.1 (overdamped contact) to 1,
 /// periods 0.05 to 3 s (an undamped stiff building beside a flexible one), gaps from 0 (touching
@@ -199,7 +175,7 @@ const WIDE_FAST: FastOptions = FastOptions {
 fn wide() -> &'static (Plan, Vec<(RunSpec, RunOutput)>) {
     static WIDE_CPU: OnceLock<(Plan, Vec<(RunSpec, RunOutput)>)> = OnceLock::new();
     WIDE_CPU.get_or_init(|| {
-        let plan = pounding::config::parse(
+        let plan = pounding::plan::config::parse(
             WIDE,
             std::path::Path::new("wide.toml"),
             std::path::Path::new("."),
@@ -209,20 +185,6 @@ fn wide() -> &'static (Plan, Vec<(RunSpec, RunOutput)>) {
         let cpu = collect(&plan, &Scheme::Fast(WIDE_FAST), 8);
         (plan, cpu)
     })
-}
-
-/// Largest relative difference of the peak outputs of two results of one run.
-pub fn peak_diff(a: &RunOutput, b: &RunOutput) -> f64 {
-    [
-        rel(a.peak_force, b.peak_force),
-        rel(a.peak_u1, b.peak_u1),
-        rel(a.peak_u2, b.peak_u2),
-        rel(a.peak_penetration, b.peak_penetration),
-        rel(a.impact_velocity, b.impact_velocity),
-    ]
-    .into_iter()
-    .filter(|x| x.is_finite())
-    .fold(0.0, f64::max)
 }
 
 /// f64 on the GPU runs the CPU fast path's arithmetic, so the two agree to rounding: measured
@@ -242,7 +204,7 @@ fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
     assert!(ctx.supports_f64(), "{} has no SHADER_F64", ctx.describe());
     let (plan, cpu) = wide();
     let opts = GpuOptions {
-        precision: pounding::gpu::Precision::F64,
+        precision: pounding::engine::gpu::Precision::F64,
         fast: WIDE_FAST,
         ..Default::default()
     };
@@ -271,7 +233,7 @@ fn gpu_f64_matches_cpu_fast_on_a_wide_grid() {
         let w = worst.entry(s.law.key()).or_insert(0.0f64);
         *w = w.max(e);
         all.push(e);
-        let bound = if s.law == pounding::contact::LawKind::NonlinearViscoelastic {
+        let bound = if s.law == pounding::physics::contact::LawKind::NonlinearViscoelastic {
             2.5e-5
         } else {
             1e-9 + 1e-14 * c.substeps as f64
@@ -350,68 +312,6 @@ fn gpu_f32_error_against_cpu_f64() {
     assert!(q(&u, 1.0) < 5e-3, "peak displacement {:e}", q(&u, 1.0));
 }
 
-/// Contacts of a CPU run that a small change of the trajectory can add or remove, for a
-/// distance scale `tau`: an impact whose peak penetration is below `tau`, a separation between
-/// two impacts that opens less than `tau`, and an approach in free flight that comes within `tau`
-/// of touching without touching. Closest approaches are maxima of the Hermite cubic of `delta`
-/// over each step.
-pub fn grazing_contacts(plan: &Plan, spec: &RunSpec, tau: f64) -> usize {
-    use pounding::cpu::{simulate_observed, Mode, Sample};
-    let pair = spec.pair();
-    let delta = |z: &pounding::cpu::State| z[0] - z[2] - pair.gap;
-    let mut prev: Option<Sample> = None;
-    let (mut count, mut impacts, mut pen) = (0usize, 0u32, 0.0f64);
-    // Most open and closest distances of the current free episode; a local max of delta.
-    let (mut opening, mut rising) = (0.0f64, false);
-    let mut obs = |s: &Sample| {
-        if let Some(p) = prev {
-            match (p.mode, s.mode) {
-                (Mode::Free, Mode::Free) => {
-                    let (y0, d0, y1, d1) =
-                        (delta(&p.z), p.z[1] - p.z[3], delta(&s.z), s.z[1] - s.z[3]);
-                    let h = s.t - p.t;
-                    let (m0, m1) = (h * d0, h * d1);
-                    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
-                    let c = 2.0 * (y0 - y1) + m0 + m1;
-                    for k in 0..=64 {
-                        let x = k as f64 / 64.0;
-                        let y = y0 + x * (m0 + x * (b + x * c));
-                        opening = opening.max(-y);
-                        let dy = m0 + x * (2.0 * b + 3.0 * c * x);
-                        if rising && dy < 0.0 && y > -tau {
-                            count += 1; // a near miss
-                        }
-                        rising = dy > 0.0;
-                    }
-                }
-                (Mode::Free, _) => {
-                    if impacts > 0 && opening < tau {
-                        count += 1; // the bodies barely separated before this impact
-                    }
-                    impacts += 1;
-                    pen = delta(&s.z).max(0.0);
-                }
-                (_, Mode::Free) => {
-                    if pen < tau {
-                        count += 1; // a barely touching impact
-                    }
-                    (opening, rising) = (0.0, false);
-                }
-                _ => pen = pen.max(delta(&s.z)),
-            }
-        }
-        prev = Some(*s);
-    };
-    simulate_observed(
-        &pair,
-        &plan.forcing(spec),
-        &pounding::model::Initial::default(),
-        &Scheme::Fast(FastOptions::default()),
-        Some(&mut obs),
-    );
-    count
-}
-
 /// An impact count may differ between f32 and f64 only where a contact is grazing: for every
 /// run of the quickstart sweep and the wide grid whose counts differ, the f64 run must hold at
 /// least as many grazing contacts (see `grazing_contacts`) as the counts differ by, at a distance
@@ -422,7 +322,8 @@ pub fn grazing_contacts(plan: &Plan, spec: &RunSpec, tau: f64) -> usize {
 #[test]
 fn gpu_f32_impact_counts_differ_only_at_grazing_contacts() {
     let Some(_) = ctx() else { return };
-    let quick = pounding::config::load(std::path::Path::new("configs/quickstart.toml")).unwrap();
+    let quick =
+        pounding::plan::config::load(std::path::Path::new("configs/quickstart.toml")).unwrap();
     let quick_cpu = collect(&quick, &Scheme::Fast(FastOptions::default()), 8);
     let (wide_plan, wide_cpu) = wide();
     let mut differ = 0;
@@ -453,7 +354,8 @@ fn gpu_f32_impact_counts_differ_only_at_grazing_contacts() {
 fn csv_text(plan: &Plan, rows: &[(RunSpec, RunOutput)]) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     for (s, o) in rows {
-        w.write_record(pounding::output::row(plan, s, o)).unwrap();
+        w.write_record(pounding::plan::columns::row(plan, s, o))
+            .unwrap();
     }
     String::from_utf8(w.into_inner().unwrap()).unwrap()
 }
@@ -462,7 +364,7 @@ fn csv_text(plan: &Plan, rows: &[(RunSpec, RunOutput)]) -> String {
 #[test]
 fn gpu_chunking_does_not_change_results() {
     let Some(_) = ctx() else { return };
-    let plan = pounding::bench::plan(200);
+    let plan = pounding::studies::bench::plan(200);
     let one = gpu_collect(&plan, &GpuOptions::default(), 1 << 20);
     let small = GpuOptions {
         units_per_dispatch: 37,
@@ -484,25 +386,26 @@ fn gpu_chunking_does_not_change_results() {
 #[test]
 fn gpu_hands_runs_past_its_precision_to_the_cpu() {
     let Some(ctx) = ctx() else { return };
-    let plan = pounding::bench::plan(200);
+    let plan = pounding::studies::bench::plan(200);
     let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
     let opts = GpuOptions {
         handoff_substeps_per_step: Some(16),
         ..Default::default()
     };
     let mut gpu = Vec::new();
-    let (_, t) = pounding::sweep::run_gpu(
-        &plan,
-        ctx,
-        &opts,
-        1000,
-        |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::gpu::GpuError> {
-            gpu.extend_from_slice(c);
-            Ok(())
-        },
-        |_| {},
-    )
-    .unwrap();
+    let t = Engine::gpu(ctx, opts, Some(1000))
+        .unwrap()
+        .run(
+            &plan,
+            0..plan.len(),
+            |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::engine::gpu::GpuError> {
+                gpu.extend_from_slice(c);
+                Ok(())
+            },
+            |_| {},
+        )
+        .unwrap()
+        .gpu;
     let exact = cpu
         .iter()
         .zip(&gpu)
@@ -524,32 +427,32 @@ fn gpu_hands_runs_past_its_precision_to_the_cpu() {
 fn gpu_device_loss_keeps_finished_chunks() {
     let Some(_) = ctx() else { return };
     let own = GpuContext::new().unwrap();
-    let plan = pounding::bench::plan(200);
+    let plan = pounding::studies::bench::plan(200);
     let mut rows = Vec::new();
-    let res = pounding::sweep::run_gpu(
-        &plan,
-        &own,
-        &GpuOptions::default(),
-        50,
-        |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::gpu::GpuError> {
-            rows.extend_from_slice(c);
-            if rows.len() == 50 {
-                own.device.destroy();
-            }
-            Ok(())
-        },
-        |_| {},
-    );
+    let res = Engine::gpu(&own, GpuOptions::default(), Some(50))
+        .unwrap()
+        .run(
+            &plan,
+            0..plan.len(),
+            |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::engine::gpu::GpuError> {
+                rows.extend_from_slice(c);
+                if rows.len() == 50 {
+                    own.device.destroy();
+                }
+                Ok(())
+            },
+            |_| {},
+        );
     let err = res.expect_err("a sweep on a destroyed device must fail");
     assert!(
-        matches!(err, pounding::gpu::GpuError::DeviceLost { .. }),
+        matches!(err, pounding::engine::gpu::GpuError::DeviceLost { .. }),
         "{err:?}"
     );
     assert!(err.to_string().contains("--backend cpu"), "{err}");
     assert_eq!(rows.len(), 50);
     for (i, (s, o)) in rows.iter().enumerate() {
         assert_eq!(s.index, i as u64);
-        assert_eq!(o.status, pounding::model::Status::Ok, "run {i}");
+        assert_eq!(o.status, pounding::physics::model::Status::Ok, "run {i}");
     }
     assert!(rows.iter().any(|(_, o)| o.impacts > 0));
 }
@@ -562,9 +465,9 @@ fn gpu_device_loss_keeps_finished_chunks() {
 /// chunk than slots (that chunk folded on the host).
 #[test]
 fn gpu_aggregate_on_device_matches_the_host_fold() {
-    use pounding::aggregate::Aggregator;
+    use pounding::engine::aggregate::Aggregator;
     let Some(ctx) = ctx() else { return };
-    let plan = pounding::bench::plan(200);
+    let plan = pounding::studies::bench::plan(200);
     let exceed = ["peak_force_n=1e6".to_string(), "impacts=2".to_string()];
     struct Case {
         precision: Precision,
@@ -621,7 +524,7 @@ fn gpu_aggregate_on_device_matches_the_host_fold() {
             host.add(g, &o);
         }
         let mut dev = Aggregator::new(&by, &exceed).unwrap();
-        let (summary, t) = pounding::sweep::run_gpu_aggregate(
+        let (summary, t) = pounding::engine::gpu::fold::fold_range(
             &plan,
             0..plan.len(),
             ctx,
@@ -646,7 +549,10 @@ fn gpu_aggregate_on_device_matches_the_host_fold() {
             3 => assert!(t.host_folded_chunks == 5),
             _ => assert!(t.host_folded_chunks == 0 && t.slot_flushes == 0),
         }
-        let (d, h) = (dev.csv(), host.csv());
+        let (d, h) = (
+            pounding::io::summary::csv(&dev),
+            pounding::io::summary::csv(&host),
+        );
         let mut dr = csv::Reader::from_reader(d.as_bytes());
         let mut hr = csv::Reader::from_reader(h.as_bytes());
         let head = hr.headers().unwrap().clone();

@@ -3,11 +3,11 @@
 //! `ok` with finite outputs; the fast path must agree with the reference (peak force, peak
 //! displacements, impact counts up to grazing contacts); the GPU must agree with its CPU twin.
 
-use crate::gpu::{ctx, gpu_collect, grazing_contacts, peak_diff};
 use crate::support::{collect, records_dir, rel, tempdir};
-use pounding::cpu::{FastOptions, ReferenceOptions, Scheme};
-use pounding::gpu::{GpuOptions, Precision};
-use pounding::model::{RunOutput, Status};
+use crate::support::{ctx, gpu_collect, grazing_contacts, peak_diff};
+use pounding::engine::gpu::{GpuOptions, Precision};
+use pounding::physics::model::{RunOutput, Status};
+use pounding::physics::solver::{FastOptions, ReferenceOptions, Scheme};
 use std::path::Path;
 
 const BASE: &str = r#"
@@ -175,7 +175,7 @@ fn cases() -> Vec<Case> {
 fn run_case(dir: &Path, case: &Case) -> String {
     let start = std::time::Instant::now();
     let text = config(&case.edits);
-    let plan = pounding::config::parse(&text, Path::new("hard.toml"), dir, &records_dir())
+    let plan = pounding::plan::config::parse(&text, Path::new("hard.toml"), dir, &records_dir())
         .unwrap_or_else(|e| panic!("{}: {e}", case.name));
     let fast_opts = FastOptions {
         energy: true,
@@ -259,7 +259,7 @@ fn run_case(dir: &Path, case: &Case) -> String {
                 w = w.max(d);
                 let bound = match precision {
                     Precision::F64
-                        if s.law == pounding::contact::LawKind::NonlinearViscoelastic =>
+                        if s.law == pounding::physics::contact::LawKind::NonlinearViscoelastic =>
                     {
                         2.5e-5
                     }
@@ -317,7 +317,7 @@ fn residual(o: &RunOutput) -> f64 {
 
 fn sane(what: &str, o: &RunOutput) {
     assert_eq!(o.status, Status::Ok, "{what}: {o:?}");
-    for x in pounding::aggregate::outputs(o) {
+    for x in pounding::engine::aggregate::outputs(o) {
         assert!(x.is_finite(), "{what}: {o:?}");
     }
 }

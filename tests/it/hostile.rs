@@ -2,8 +2,8 @@
 //! incomplete or wrong is ever called complete. One test per class of the issue, then property
 //! tests that feed random edits to configs, records, partial outputs, journals and shards.
 
-use crate::cli::{ok, pound};
 use crate::support::{assert_same_text, tempdir};
+use crate::support::{ok, pound};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -109,7 +109,7 @@ fn s(p: &Path) -> &str {
 }
 
 fn sibling(p: &Path, suffix: &str) -> PathBuf {
-    pounding::output::sibling(p, suffix)
+    pounding::io::atomic::sibling(p, suffix)
 }
 
 fn sweep(cfg: &Path, out: &Path, extra: &[&str]) -> Output {
@@ -448,11 +448,11 @@ fn resume_verifies_what_the_journal_vouches_for() {
     );
     assert!(!journal.exists() && !partial.exists());
     // The sidecar's content hash is the file's.
-    let meta: pounding::shard::Meta =
-        pounding::shard::read_toml(&sibling(&out, ".meta.toml")).unwrap();
+    let meta: pounding::io::provenance::Meta =
+        pounding::io::provenance::read_toml(&sibling(&out, ".meta.toml")).unwrap();
     let c = meta.content.unwrap();
     assert_eq!(c.rows, 96);
-    assert_eq!(c.sha256, pounding::journal::file_sha256(&out).unwrap());
+    assert_eq!(c.sha256, pounding::io::journal::file_sha256(&out).unwrap());
 }
 
 /// Class 3: merge verifies each shard's content against its sidecar and names the shard and
@@ -707,7 +707,7 @@ fn sizes_are_bounded_and_nothing_panics() {
 /// is cut at once, and the cuts equal the linear scan's on a small plan.
 #[test]
 fn shard_cuts_are_cheap_and_exact() {
-    use pounding::shard::{shard_range, Shard};
+    use pounding::plan::shard::{shard_range, Shard};
     let d = tempdir();
     let text = SWEEP
         .replace(
@@ -719,7 +719,8 @@ fn shard_cuts_are_cheap_and_exact() {
             "gap_m = { from = 0, to = 0.1, n = 1250 }",
         );
     std::fs::write(d.path().join("rec.txt"), "0.1\n0.2\n0.1\n0.0\n-0.1").unwrap();
-    let p = pounding::config::parse(&text, Path::new("big.toml"), d.path(), d.path()).unwrap();
+    let p =
+        pounding::plan::config::parse(&text, Path::new("big.toml"), d.path(), d.path()).unwrap();
     assert_eq!(p.len(), 200_000_000);
     let t = Instant::now();
     let last = shard_range(
@@ -734,7 +735,8 @@ fn shard_cuts_are_cheap_and_exact() {
     assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
     // Against the linear scan's definition on the small plan: cut k is the first run whose
     // preceding cost reaches k / N of the total.
-    let small = pounding::config::parse(SWEEP, Path::new("s.toml"), d.path(), d.path()).unwrap();
+    let small =
+        pounding::plan::config::parse(SWEEP, Path::new("s.toml"), d.path(), d.path()).unwrap();
     let costs: Vec<u64> = small
         .spec
         .records
@@ -819,7 +821,7 @@ fn stiff_structures_failed_runs_and_absurd_inputs() {
     let row = text.lines().nth(1).unwrap().to_string();
     let bad_row = row.replacen(",ok,", ",non_finite,", 1);
     let cells: Vec<&str> = bad_row.split(',').collect();
-    let force = pounding::output::header()
+    let force = pounding::plan::columns::header()
         .iter()
         .position(|c| *c == "peak_force_n")
         .unwrap();
@@ -828,17 +830,17 @@ fn stiff_structures_failed_runs_and_absurd_inputs() {
     text = text.replacen(&row, &cells.join(","), 1);
     let t = sc.path("t.csv");
     std::fs::write(&t, text).unwrap();
-    let table = pounding::table::Table::read(&t).unwrap();
-    let spec = pounding::sensitivity::PlotSpec {
+    let table = pounding::io::table::Table::read(&t).unwrap();
+    let spec = pounding::studies::sensitivity::PlotSpec {
         x: "gap_m".into(),
         y: "peak_force_n".into(),
         by: None,
         filters: vec![],
-        aggregate: pounding::sensitivity::Aggregate::Max,
+        aggregate: pounding::studies::sensitivity::Aggregate::Max,
         log_x: false,
         log_y: false,
     };
-    let (panel, left_out) = pounding::sensitivity::panel(&table, &spec).unwrap();
+    let (panel, left_out) = pounding::studies::sensitivity::panel(&table, &spec).unwrap();
     assert_eq!(left_out, 1);
     let top = panel.series[0]
         .points
@@ -847,19 +849,19 @@ fn stiff_structures_failed_runs_and_absurd_inputs() {
         .fold(0.0, f64::max);
     assert!(top < 1e10, "{top}");
     // A group with no ok run has empty statistics, not zeros.
-    let plan = pounding::config::parse(SWEEP, &sc.cfg, sc.dir.path(), sc.dir.path()).unwrap();
-    let mut agg = pounding::aggregate::Aggregator::new(&["gap_m".into()], &[]).unwrap();
+    let plan = pounding::plan::config::parse(SWEEP, &sc.cfg, sc.dir.path(), sc.dir.path()).unwrap();
+    let mut agg = pounding::engine::aggregate::Aggregator::new(&["gap_m".into()], &[]).unwrap();
     let spec0 = plan.run(0);
     let g = agg.group_of(&plan, &spec0);
     agg.add(
         g,
-        &pounding::model::RunOutput {
-            status: pounding::model::Status::NonFinite,
+        &pounding::physics::model::RunOutput {
+            status: pounding::physics::model::Status::NonFinite,
             peak_force: 1e205,
             ..Default::default()
         },
     );
-    let csv = agg.csv();
+    let csv = pounding::io::summary::csv(&agg);
     let row: Vec<&str> = csv.lines().nth(1).unwrap().split(',').collect();
     assert_eq!(&row[..3], &["0", "1", "1"], "{csv}");
     assert!(row[3..].iter().all(|c| c.is_empty()), "{csv}");
@@ -897,7 +899,7 @@ fn quiet_starts_and_honest_defaults() {
     ok(&r);
     assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
     // On CI's only adapter (lavapipe, a software one) auto runs on the CPU and says why.
-    let info = pounding::gpu::context::adapters();
+    let info = pounding::engine::gpu::context::adapters();
     if info
         .iter()
         .all(|a| a.info.device_type == wgpu::DeviceType::Cpu)
@@ -953,7 +955,7 @@ proptest! {
             }
         }
         let text = String::from_utf8_lossy(&text);
-        if let Err(e) = pounding::config::parse(&text, Path::new("m.toml"), d.path(), d.path()) {
+        if let Err(e) = pounding::plan::config::parse(&text, Path::new("m.toml"), d.path(), d.path()) {
             prop_assert!(e.to_string().starts_with("m.toml"), "{e}");
         }
     }
@@ -980,7 +982,7 @@ proptest! {
             v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8], v[9], v[10], v[11], v[12], v[13], v[14], v[15]
         );
         let d = tempdir();
-        match pounding::config::parse(&text, Path::new("n.toml"), d.path(), d.path()) {
+        match pounding::plan::config::parse(&text, Path::new("n.toml"), d.path(), d.path()) {
             Err(e) => prop_assert!(e.to_string().starts_with("n.toml"), "{e}"),
             Ok(plan) => {
                 for i in 0..plan.len().min(50) {
@@ -988,7 +990,7 @@ proptest! {
                     prop_assert!(r.t1 >= 1e-4 && r.gap >= 0.0 && r.scale > 0.0);
                 }
                 let _ = plan.warnings();
-                let sh = pounding::shard::shard_range(&plan, pounding::shard::Shard { index: 1, count: 3 });
+                let sh = pounding::plan::shard::shard_range(&plan, pounding::plan::shard::Shard { index: 1, count: 3 });
                 prop_assert!(sh.start <= sh.end && sh.end <= plan.len());
             }
         }

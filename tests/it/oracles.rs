@@ -1,13 +1,13 @@
 //! Analytic oracles: each problem paired with its closed-form answer, checked on both schemes.
 
 use crate::support::{pair, rel};
-use pounding::contact::{Contact, LawKind, HERTZ_TC};
-use pounding::cpu::{
+use pounding::physics::contact::{Contact, LawKind, HERTZ_TC};
+use pounding::physics::model::{Forcing, Initial, Oscillator, Pair, Status};
+use pounding::physics::restitution::{achieved_e, exact_damping, Formula};
+use pounding::physics::solver::{
     simulate, simulate_observed, single_collision, FastOptions, ReferenceOptions, Sample, Scheme,
 };
-use pounding::model::{Forcing, Initial, Oscillator, Pair, Status};
 use pounding::record::{synthetic, SyntheticSpec};
-use pounding::restitution::{achieved_e, exact_damping, Formula};
 use std::f64::consts::PI;
 
 fn schemes() -> [Scheme; 2] {
@@ -424,7 +424,7 @@ fn reference_tolerance_is_converged() {
         (LawKind::HuntCrossley, 2.75e9, 0.5),
     ] {
         let p = pair(law, k, d, (1e5, 0.5, 0.05), (1e5, 1.2, 0.05), 0.002);
-        let tol = pounding::cpu::reference::DEFAULT_TOL;
+        let tol = pounding::physics::solver::reference::DEFAULT_TOL;
         let a = simulate(
             &p,
             &forcing,

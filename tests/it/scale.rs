@@ -1,8 +1,8 @@
 //! Scale and reliability (issue 6): shards merge to the unsharded sweep, a killed sweep resumes
 //! to the same output, and resuming or merging outputs of different sweeps is refused.
 
-use crate::cli::{ok, pound};
 use crate::support::{assert_same_text, tempdir};
+use crate::support::{ok, pound};
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
@@ -344,7 +344,7 @@ fn aggregate_matches_the_per_run_output() {
     }
     assert!(std::fs::metadata(&agg).unwrap().len() < 10_000);
     // On the GPU the fold runs on the device: the same groups and counts.
-    if crate::gpu::ctx().is_some() {
+    if crate::support::ctx().is_some() {
         let gagg = d.path().join("gpu-agg.csv");
         let out = pound(&[
             "sweep",

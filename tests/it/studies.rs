@@ -1,10 +1,10 @@
 //! Studies (issue 5): plots from small sweeps, the lognormal fragility fit against data drawn
 //! from a known curve, sampled sweeps, and the seed paper's cheap numbers.
 
-use crate::cli::{ok, pound};
 use crate::support::tempdir;
-use pounding::fragility::{fit, Level};
-use pounding::sample::{phi, Rng};
+use crate::support::{ok, pound};
+use pounding::plan::sample::{phi, Rng};
+use pounding::studies::fragility::{fit, Level};
 use std::path::Path;
 
 /// A small sweep with a sampled gap and period and an intensity ladder, on a synthetic record.
@@ -173,7 +173,7 @@ fn plots_from_a_small_sweep() {
     let z = d.path().join("zeta.svg");
     ok(&pound(&["formulas", "--plot", z.to_str().unwrap()]));
     let text = std::fs::read_to_string(&z).unwrap();
-    for f in pounding::restitution::Formula::ALL {
+    for f in pounding::physics::restitution::Formula::ALL {
         assert!(text.contains(f.key()), "{} not in the plot", f.key());
     }
 }
@@ -260,8 +260,8 @@ fn fragility_command_counts_and_fits() {
 /// of the stated 7.269 and zeta <= 1 above e = 0.327 (stated: e > 0.33).
 #[test]
 fn paper_table1_and_fig2() {
-    use pounding::paper::{fig2, table1_mean_e, TABLE1};
-    use pounding::restitution::Formula;
+    use pounding::physics::restitution::Formula;
+    use pounding::studies::paper::{fig2, table1_mean_e, TABLE1};
     for d in TABLE1 {
         assert!((d.v_before() - d.v_before_stated).abs() < 0.01, "{d:?}");
         assert!((d.v_after() - d.v_after_stated).abs() < 0.03, "{d:?}");
@@ -281,4 +281,87 @@ fn paper_table1_and_fig2() {
         out.contains("mean e = 0.712") && out.contains("| ebrahimi | 7.248"),
         "{out}"
     );
+}
+
+/// Plotted values are the chosen aggregate of the rows at each x, per series: a hand-made
+/// results file where max, mean, median and min all differ, with a failed run (left out) and a
+/// row without a value (left out, not counted as failed). Through the binary, `--agg` reaches the
+/// plot (its title names the aggregate).
+#[test]
+fn plotted_values_are_the_chosen_aggregate_at_each_x() {
+    use pounding::io::table::Table;
+    use pounding::studies::sensitivity::{panel, Aggregate, PlotSpec};
+    let d = tempdir();
+    let results = d.path().join("hand.csv");
+    std::fs::write(
+        &results,
+        "run,law,gap_m,status,peak_force_n\n\
+         0,a,0.0,ok,1\n1,a,0.0,ok,2\n2,a,0.0,ok,9\n\
+         3,a,0.01,ok,4\n4,a,0.01,ok,6\n5,a,0.01,step_limit,1e30\n\
+         6,b,0.0,ok,5\n7,b,0.01,ok,\n8,b,0.01,ok,7\n",
+    )
+    .unwrap();
+    let table = Table::read(&results).unwrap();
+    let at = |aggregate| {
+        let spec = PlotSpec {
+            x: "gap_m".into(),
+            y: "peak_force_n".into(),
+            by: Some("law".into()),
+            filters: vec![],
+            aggregate,
+            log_x: false,
+            log_y: false,
+        };
+        let (p, failed) = panel(&table, &spec).unwrap();
+        assert_eq!(failed, 1, "the step_limit run is left out");
+        p.series
+            .iter()
+            .map(|s| (s.name.clone(), s.points.clone()))
+            .collect::<Vec<_>>()
+    };
+    let expect = |a0: f64, a1: f64| {
+        vec![
+            ("law = a".to_string(), vec![(0.0, a0), (0.01, a1)]),
+            ("law = b".to_string(), vec![(0.0, 5.0), (0.01, 7.0)]),
+        ]
+    };
+    assert_eq!(at(Aggregate::Max), expect(9.0, 6.0));
+    assert_eq!(at(Aggregate::Mean), expect(4.0, 5.0));
+    assert_eq!(at(Aggregate::Median), expect(2.0, 5.0));
+    assert_eq!(at(Aggregate::Min), expect(1.0, 4.0));
+    let none = at(Aggregate::None);
+    assert_eq!(none[0].1.len(), 5, "every ok row of law a is a point");
+    for (agg, words) in [
+        ("max", "(max over"),
+        ("mean", "(mean over"),
+        ("median", "(median over"),
+        ("min", "(min over"),
+    ] {
+        let svg = d.path().join(format!("{agg}.svg"));
+        let out = pound(&[
+            "plot",
+            results.to_str().unwrap(),
+            "--x",
+            "gap_m",
+            "--y",
+            "peak_force_n",
+            "--by",
+            "law",
+            "--agg",
+            agg,
+            "-o",
+            svg.to_str().unwrap(),
+        ]);
+        ok(&out);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("1 rows left out") && err.contains("2 series, 4 points"),
+            "{err}"
+        );
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(
+            text.contains(words),
+            "--agg {agg}: no `{words}` in the plot"
+        );
+    }
 }

@@ -1,0 +1,79 @@
+//! `pound accuracy`: speed against error of every path against the reference.
+
+use super::{check_outputs, config_inputs, write_file, BackendArg};
+use anyhow::{bail, Result};
+use pounding::plan::config;
+use pounding::plan::limits::{MAX_SUBSTEPS_PER_CONTACT, WHY_SUBSTEPS};
+use pounding::studies::accuracy;
+use std::io::Write as _;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    #[arg(default_value = "configs/accuracy.toml")]
+    config: PathBuf,
+    /// RK4 substeps per contact duration to try.
+    #[arg(long, value_delimiter = ',', default_value = "8,16,32,64,128")]
+    settings: Vec<f64>,
+    /// Stated relative accuracy of the reference.
+    #[arg(long, default_value_t = 1e-8)]
+    tol: f64,
+    /// `auto` adds the GPU paths when a hardware adapter is found; `gpu` also on a software
+    /// one; `cpu` leaves them out.
+    #[arg(long, value_enum, default_value = "auto")]
+    backend: BackendArg,
+    #[arg(short, long, default_value = "accuracy.csv")]
+    output: PathBuf,
+    /// Work-precision plot (SVG).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let Args {
+        config,
+        settings,
+        tol,
+        backend,
+        output,
+        plot,
+    } = a;
+    let most = MAX_SUBSTEPS_PER_CONTACT;
+    if let Some(bad) = settings.iter().find(|s| !(**s >= 1.0 && **s <= most)) {
+        bail!(
+            "--settings: {bad} is out of range: expected substeps per contact from 1 to {most} ({WHY_SUBSTEPS})"
+        );
+    }
+    if !(tol > 0.0 && tol < 1e-3) {
+        bail!("--tol: {tol} is out of range: expected 0 < tol < 1e-3");
+    }
+    let text = config::read_text(&config)?;
+    let records = config::input_files(&text, &config);
+    check_outputs(
+        &config_inputs(&config, &records),
+        &[("-o", Some(&output)), ("--plot", plot.as_deref())],
+    )?;
+    let plan = config::load_text(&text, &config)?;
+    for w in plan.warnings() {
+        note!("warning: {}: {w}", config.display());
+    }
+    let ctx = backend
+        .get()
+        .acquire("CPU path only", &mut |l| note!("{l}"))?;
+    note!(
+        "{}: {} runs; reference at tol {tol:e}, then {} settings on {} paths",
+        config.display(),
+        plan.len(),
+        settings.len(),
+        if ctx.is_some() { 3 } else { 1 }
+    );
+    say!("{}", accuracy::MARKDOWN_HEADER);
+    let points = accuracy::study(&plan, ctx.as_ref(), &settings, tol, |p| {
+        let _ = writeln!(std::io::stdout(), "{}", accuracy::markdown_row(p));
+    })?;
+    write_file(&output, accuracy::csv(&points).as_bytes())?;
+    if let Some(p) = plot {
+        pounding::studies::plot::svg(&p, &accuracy::panels(&points), 2)?;
+    }
+    Ok(())
+}

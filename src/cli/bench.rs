@@ -1,0 +1,96 @@
+//! `pound bench`: the benchmark sweeps on every engine found, as a markdown table.
+
+use super::{check_outputs, write_file, PrecisionArg};
+use anyhow::{bail, Context, Result};
+use pounding::engine::gpu::{GpuContext, GpuOptions};
+use pounding::engine::Engine;
+use pounding::physics::solver::{FastOptions, Scheme};
+use pounding::plan::limits::{MAX_BENCH_RUNS, MAX_GPU_CHUNK, WHY_CHUNK};
+use pounding::studies::bench;
+use std::io::Write as _;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Sweep sizes (runs, approximate).
+    #[arg(long, value_delimiter = ',', default_value = "100,1000,10000,100000")]
+    sizes: Vec<u64>,
+    /// Largest sweep also run on the CPU (it is the slow side).
+    #[arg(long, default_value_t = 10000)]
+    max_cpu_runs: u64,
+    #[arg(long, value_enum, default_value = "f32")]
+    precision: PrecisionArg,
+    /// Runs per GPU chunk.
+    #[arg(long, default_value_t = pounding::engine::GPU_CHUNK)]
+    chunk: usize,
+    /// Also write the table to this file.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Also time each GPU sweep with `--aggregate COLUMNS` folded on the device (e.g. gap_m).
+    #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
+    aggregate: Option<Vec<String>>,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let precision = a.precision.get();
+    if let Some(n) = a.sizes.iter().find(|&&n| n == 0 || n > MAX_BENCH_RUNS) {
+        bail!("--sizes: {n} runs is out of range: expected 1 to {MAX_BENCH_RUNS}");
+    }
+    if a.chunk == 0 || a.chunk > MAX_GPU_CHUNK {
+        bail!(
+            "--chunk {}: expected 1 to {MAX_GPU_CHUNK} ({WHY_CHUNK})",
+            a.chunk
+        );
+    }
+    check_outputs(&[], &[("-o", a.output.as_deref())])?;
+    let ctx = match GpuContext::new() {
+        Ok(c) => Some(c),
+        Err(e) => {
+            note!("notice: CPU only: {e}");
+            None
+        }
+    };
+    let gpu = match &ctx {
+        Some(ctx) => {
+            let opts = GpuOptions {
+                precision,
+                ..Default::default()
+            };
+            Some(Engine::gpu(ctx, opts, Some(a.chunk))?)
+        }
+        None => None,
+    };
+    let cpu = Engine::cpu(Scheme::Fast(FastOptions::default()), None)?;
+    let mut rows = Vec::new();
+    for &n in &a.sizes {
+        let plan = bench::plan(n);
+        if let (Some(ctx), Some(gpu)) = (&ctx, &gpu) {
+            // The first call compiles the kernel; keep that out of the figures.
+            ctx.kernel(precision, false)?;
+            let r = bench::run(&plan, gpu)?;
+            note!("{} runs on GPU: {:.0} runs/s", r.runs, r.runs_per_second());
+            rows.push(r);
+            if let Some(by) = &a.aggregate {
+                ctx.aggregator(precision)?;
+                let r = bench::fold(&plan, gpu, by)?;
+                note!(
+                    "{} runs on GPU, aggregated: {:.0} runs/s",
+                    r.runs,
+                    r.runs_per_second()
+                );
+                rows.push(r);
+            }
+        }
+        if plan.len() <= a.max_cpu_runs {
+            let r = bench::run(&plan, &cpu)?;
+            note!("{} runs on CPU: {:.0} runs/s", r.runs, r.runs_per_second());
+            rows.push(r);
+        }
+    }
+    let table = bench::table(&rows);
+    write!(std::io::stdout(), "{table}").context("writing to standard output")?;
+    if let Some(p) = &a.output {
+        write_file(p, table.as_bytes())?;
+    }
+    Ok(())
+}

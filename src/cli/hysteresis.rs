@@ -1,0 +1,75 @@
+//! `pound hysteresis`: force against penetration through one isolated impact, per e.
+
+use super::{check_outputs, e_values, write_file};
+use anyhow::{bail, Context, Result};
+use pounding::physics::contact::LawKind;
+use pounding::physics::restitution::Formula;
+use pounding::studies::fidelity;
+use std::io::Write as _;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Contact law.
+    law: String,
+    /// Restitution formula (laws that take zeta).
+    #[arg(long, default_value = "ebrahimi")]
+    formula: String,
+    /// Values of e: start:stop:step, a list a,b,c, or one value.
+    #[arg(long, default_value = "0.3:0.9:0.2")]
+    e: String,
+    /// Approach speed, m/s.
+    #[arg(long, default_value_t = 1.0)]
+    v0: f64,
+    /// k (N/m) or beta (N/m^1.5).
+    #[arg(long, default_value_t = 2.75e9)]
+    stiffness: f64,
+    /// Effective mass m1 m2 / (m1 + m2), kg.
+    #[arg(long, default_value_t = 5.0e4)]
+    m_eff: f64,
+    /// Loop points as CSV (e, delta_m, force_n).
+    #[arg(short, long, default_value = "hysteresis.csv")]
+    output: PathBuf,
+    /// The loops as SVG.
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let law = LawKind::from_key(&a.law)
+        .with_context(|| format!("law `{}`: expected one of {}", a.law, LawKind::keys()))?;
+    let formula = Formula::from_key(&a.formula).with_context(|| {
+        format!(
+            "--formula `{}`: expected one of {}",
+            a.formula,
+            Formula::keys()
+        )
+    })?;
+    if !law.is_damped() {
+        bail!(
+            "law `{}` has no damping: its loop encloses no area",
+            law.key()
+        );
+    }
+    for (name, x) in [
+        ("--v0", a.v0),
+        ("--stiffness", a.stiffness),
+        ("--m-eff", a.m_eff),
+    ] {
+        if !(x > 0.0 && x.is_finite()) {
+            bail!("{name}: {x} is out of range: expected a positive number");
+        }
+    }
+    check_outputs(
+        &[],
+        &[("-o", Some(&a.output)), ("--plot", a.plot.as_deref())],
+    )?;
+    let es = e_values(&a.e)?;
+    let loops = fidelity::loops(law, formula, &es, a.v0, a.stiffness, a.m_eff)?;
+    write!(std::io::stdout(), "{}", loops.markdown()).context("writing to standard output")?;
+    write_file(&a.output, loops.csv().as_bytes())?;
+    if let Some(p) = &a.plot {
+        pounding::studies::plot::svg(p, &[loops.panel()], 1)?;
+    }
+    Ok(())
+}

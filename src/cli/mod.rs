@@ -1,0 +1,184 @@
+//! The commands of `pound`, one module each: its flags (clap) turned into ready values, the
+//! library called, the outcome reported. Logic lives in the library; what stays here is
+//! wording, exit paths and the order of checks (every output is checked before any work).
+
+use anyhow::{bail, Context, Result};
+use clap::{Subcommand, ValueEnum};
+use pounding::engine::gpu::Precision;
+use pounding::engine::Backend;
+use std::path::Path;
+
+/// A line on standard error that never panics (stderr may be closed or full).
+macro_rules! note {
+    ($($t:tt)*) => { pounding::note(format_args!($($t)*)) };
+}
+
+/// A line on standard output; a failed write is an error, not a panic.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        anyhow::Context::context(
+            writeln!(std::io::stdout(), $($t)*),
+            "writing to standard output",
+        )?
+    }};
+}
+
+pub mod accuracy;
+pub mod bench;
+pub mod formulas;
+pub mod fragility;
+pub mod gpu;
+pub mod hysteresis;
+pub mod merge;
+pub mod paper;
+pub mod plot;
+pub mod record;
+pub mod restitution;
+pub mod sweep;
+
+#[derive(Subcommand)]
+pub enum Cmd {
+    /// Run every run of a sweep config and write one CSV row per run.
+    Sweep(sweep::Args),
+    /// GPU adapters.
+    Gpu {
+        #[command(subcommand)]
+        cmd: gpu::Cmd,
+    },
+    /// Runs per second of the CPU and GPU paths on the same sweeps, with where time goes.
+    Bench(bench::Args),
+    /// Speed against error of every path and accuracy setting on a benchmark sweep, against the
+    /// reference solved once.
+    Accuracy(accuracy::Args),
+    /// Impact damping zeta(e) of every formula, and `exact` per law.
+    Formulas(formulas::Args),
+    /// Plot an output of a results CSV against a swept parameter, one series per value of a
+    /// grouping column (SVG, or PNG for a .png name).
+    Plot(plot::Args),
+    /// Fragility curves from a results CSV: the share of runs whose EDP exceeds each threshold
+    /// at each intensity level, and a lognormal curve fitted by maximum likelihood.
+    Fragility(fragility::Args),
+    /// Combine the outputs of `pound sweep --shard I/N` into one CSV, checking that they come
+    /// from one sweep (same fingerprint) and hold every run exactly once.
+    Merge(merge::Args),
+    /// The seed paper's cheap checks: Table 1 (e from the drop heights) and Fig. 2 (zeta(e) of
+    /// every formula). The rest of the reproduction: docs/paper-reproduction.md.
+    Paper,
+    /// Restitution fidelity: one isolated collision per damped law, formula and e; the
+    /// achieved e and the energy taken out against 0.5 m_eff (1 - e^2) v0^2.
+    Restitution(restitution::Args),
+    /// Force against penetration through one isolated impact (the seed's Fig. 5), per e.
+    Hysteresis(hysteresis::Args),
+    /// Ground-motion records.
+    Record {
+        #[command(subcommand)]
+        cmd: record::Cmd,
+    },
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+pub enum BackendArg {
+    /// A hardware GPU if one is found, else the CPU (with a one-line notice saying why); a
+    /// software adapter (lavapipe) is slower than the CPU path, so only `gpu` uses it.
+    Auto,
+    Gpu,
+    Cpu,
+}
+
+impl BackendArg {
+    pub fn get(self) -> Backend {
+        match self {
+            BackendArg::Auto => Backend::Auto,
+            BackendArg::Gpu => Backend::Gpu,
+            BackendArg::Cpu => Backend::Cpu,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum PrecisionArg {
+    F32,
+    F64,
+}
+
+impl PrecisionArg {
+    pub fn get(self) -> Precision {
+        match self {
+            PrecisionArg::F32 => Precision::F32,
+            PrecisionArg::F64 => Precision::F64,
+        }
+    }
+}
+
+/// Check a command's outputs before it does any work: each resolves (not a directory, its
+/// folder exists), can be written, is none of `inputs` and is not written twice (the files a
+/// pound output writes beside it count). Returns the targets given.
+pub fn check_outputs(
+    inputs: &[(&str, &Path)],
+    outputs: &[(&str, Option<&Path>)],
+) -> Result<Vec<pounding::io::target::Target>> {
+    use pounding::io::target::Target;
+    let mut targets = Vec::new();
+    for (what, p) in outputs {
+        let Some(p) = p else { continue };
+        let t = Target::resolve(what, p)?;
+        t.probe(what)?;
+        targets.push((*what, t));
+    }
+    let named: Vec<(&str, &Target)> = targets.iter().map(|(w, t)| (*w, t)).collect();
+    pounding::io::target::check_outputs(inputs, &named)?;
+    Ok(targets.into_iter().map(|(_, t)| t).collect())
+}
+
+/// A config and the record files it names, as the inputs its outputs must not replace.
+pub fn config_inputs<'a>(
+    config: &'a Path,
+    records: &'a [std::path::PathBuf],
+) -> Vec<(&'a str, &'a Path)> {
+    let mut ins: Vec<(&str, &Path)> = vec![("the config", config)];
+    ins.extend(records.iter().map(|p| ("the record", p.as_path())));
+    ins
+}
+
+/// Check the outputs of a study of a results file (`plot`, `fragility`) against the file and
+/// its sidecar, then warn when the results are not vouched for by that sidecar.
+pub fn check_study_outputs(results: &Path, outputs: &[(&str, Option<&Path>)]) -> Result<()> {
+    let sidecar = pounding::io::provenance::meta_path(results);
+    check_outputs(
+        &[("the results", results), ("the results' sidecar", &sidecar)],
+        outputs,
+    )?;
+    if let Some(w) = pounding::io::journal::provenance_warning(results) {
+        note!("warning: {w}");
+    }
+    Ok(())
+}
+
+/// Write `bytes` to `path` whole (temporary file, fsync, rename), naming the file on error.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    pounding::io::atomic::write_atomic(path, bytes)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// `--e`: start:stop:step, a list a,b,c, or one value; each in (0, 1].
+pub fn e_values(e: &str) -> Result<Vec<f64>> {
+    let es = if e.contains(',') {
+        e.split(',').map(|x| x.trim().parse::<f64>().ok()).collect()
+    } else {
+        pounding::plan::config::parse_colon_range(e)
+    }
+    .with_context(|| format!("--e `{e}`: expected start:stop:step, a list a,b,c or one value"))?;
+    if es.len() > pounding::plan::limits::MAX_E_VALUES {
+        bail!(
+            "--e `{e}` gives {} values: expected at most {} (each is a root-found collision)",
+            es.len(),
+            pounding::plan::limits::MAX_E_VALUES
+        );
+    }
+    let es: Vec<f64> = es.iter().map(|e| (e * 1e12).round() / 1e12).collect();
+    if let Some(bad) = es.iter().find(|e| !(**e > 0.0 && **e <= 1.0)) {
+        bail!("--e: e = {bad} is out of range: expected 0 < e <= 1");
+    }
+    Ok(es)
+}

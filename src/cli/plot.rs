@@ -1,0 +1,89 @@
+//! `pound plot`: an output of a results CSV against a swept parameter.
+
+use super::check_study_outputs;
+use anyhow::{bail, Result};
+use clap::ValueEnum;
+use pounding::io::table::{Filter, Table};
+use pounding::studies::sensitivity::{panel, Aggregate, PlotSpec};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// A CSV written by `pound sweep` (or any CSV with a header row).
+    results: PathBuf,
+    /// Column on the x axis (a swept parameter, e.g. gap_m, e, t1_s, pga_g).
+    #[arg(long)]
+    x: String,
+    /// Column on the y axis (an output, e.g. peak_force_n).
+    #[arg(long)]
+    y: String,
+    /// One series per value of this column (e.g. record, law).
+    #[arg(long)]
+    by: Option<String>,
+    /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
+    #[arg(long = "where", value_name = "FILTER")]
+    filters: Vec<String>,
+    /// How rows that share x (and series) are combined: the other swept parameters are
+    /// aggregated. `none` draws every row as a point.
+    #[arg(long, value_enum, default_value = "max")]
+    agg: AggArg,
+    #[arg(long)]
+    log_x: bool,
+    #[arg(long)]
+    log_y: bool,
+    /// Output: .svg, or .png (text in a font built into the binary).
+    #[arg(short, long, default_value = "plot.svg")]
+    output: PathBuf,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum AggArg {
+    Max,
+    Mean,
+    Median,
+    Min,
+    None,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    check_study_outputs(&a.results, &[("-o", Some(&a.output))])?;
+    let table = Table::read(&a.results)?;
+    let spec = PlotSpec {
+        x: a.x,
+        y: a.y,
+        by: a.by,
+        filters: Filter::parse_all(&a.filters)?,
+        aggregate: match a.agg {
+            AggArg::Max => Aggregate::Max,
+            AggArg::Mean => Aggregate::Mean,
+            AggArg::Median => Aggregate::Median,
+            AggArg::Min => Aggregate::Min,
+            AggArg::None => Aggregate::None,
+        },
+        log_x: a.log_x,
+        log_y: a.log_y,
+    };
+    let (p, failed) = panel(&table, &spec)?;
+    if failed > 0 {
+        note!(
+            "{}: {failed} rows left out: runs whose status is not ok, or values that are not finite",
+            a.results.display()
+        );
+    }
+    let points: usize = p.series.iter().map(|s| s.points.len()).sum();
+    if points == 0 {
+        bail!(
+            "{}: no rows left to plot (check --where and that {} and {} have values)",
+            a.results.display(),
+            spec.x,
+            spec.y
+        );
+    }
+    pounding::studies::plot::save(&a.output, std::slice::from_ref(&p), 1)?;
+    note!(
+        "{} series, {points} points -> {}",
+        p.series.len(),
+        a.output.display()
+    );
+    Ok(())
+}

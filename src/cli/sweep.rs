@@ -1,0 +1,345 @@
+//! `pound sweep`: settings from flags, the output opened (fresh or resumed), the engine run,
+//! the output put in place.
+
+use super::{check_outputs, config_inputs, BackendArg, PrecisionArg};
+use anyhow::{bail, Context, Result};
+use clap::ValueEnum;
+use pounding::engine::{Backend, Engine, EngineError};
+use pounding::io::provenance::{Fingerprint, Meta};
+use pounding::io::sweep_output::{Format, Opened, SweepOutput};
+use pounding::physics::model::RunOutput;
+use pounding::physics::solver::{FastOptions, ReferenceOptions, Scheme};
+use pounding::plan::shard::Shard;
+use pounding::plan::{config, RunSpec};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    config: PathBuf,
+    /// Output CSV (written as OUT.partial, renamed when complete).
+    #[arg(short, long, default_value = "results.csv")]
+    output: PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Override the config's integration scheme.
+    #[arg(long, value_enum)]
+    scheme: Option<SchemeArg>,
+    /// Where runs are integrated. The GPU runs the `fast` scheme only.
+    #[arg(long, value_enum, default_value = "auto")]
+    backend: BackendArg,
+    /// GPU arithmetic. f32 (default) adds a peak-force error of at most 6.2e-4 to the fast
+    /// scheme's (measured, README); f64 needs an adapter with SHADER_F64.
+    #[arg(long, value_enum, default_value = "f32")]
+    precision: PrecisionArg,
+    /// Runs per parallel task (CPU, default 64) or per GPU chunk (default 65536).
+    #[arg(long)]
+    chunk: Option<usize>,
+    /// Write each run's energy balance (input, damping work, relative residual); the same
+    /// as `energy = true` under `[run]`. The reference scheme always writes it.
+    #[arg(long)]
+    energy: bool,
+    /// Run only shard I of N (0-based, `I/N`): a contiguous, cost-balanced part of the plan, for
+    /// job arrays; combine the outputs with `pound merge`.
+    #[arg(long, value_name = "I/N", value_parser = parse_shard)]
+    shard: Option<Shard>,
+    /// Continue an interrupted sweep of the same config into the same output: only the runs
+    /// not yet on disk are computed.
+    #[arg(long)]
+    resume: bool,
+    /// Write, instead of a row per run, one row per group of these swept columns (e.g.
+    /// record,pga_g): runs, failures, --exceed counts, and max, mean, p50, p90, p99 of each output.
+    #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
+    aggregate: Option<Vec<String>>,
+    /// With --aggregate: count runs with COLUMN > THRESHOLD (e.g. peak_force_n=1e6); repeatable.
+    #[arg(long, value_name = "COLUMN=THRESHOLD", requires = "aggregate")]
+    exceed: Vec<String>,
+    /// Output format: csv (journaled, resumable) or parquet (typed columns, the plan
+    /// fingerprint in its metadata).
+    #[arg(long, value_enum, default_value = "csv")]
+    format: FormatArg,
+    /// Write only these columns (comma-separated; `run` is always kept, first).
+    #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
+    columns: Option<Vec<String>>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum SchemeArg {
+    Fast,
+    Reference,
+}
+
+#[derive(Clone, Copy, PartialEq, ValueEnum)]
+enum FormatArg {
+    Csv,
+    Parquet,
+}
+
+fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
+    Shard::parse(s).ok_or_else(|| format!("`{s}`: expected I/N with 0 <= I < N, e.g. 3/16"))
+}
+
+/// The scheme as run: the config's, or `--scheme` (keeping the config's settings when it names
+/// the same scheme), with `--energy` added to the fast scheme.
+fn scheme_as_run(configured: Scheme, asked: Option<SchemeArg>, energy: bool) -> Scheme {
+    let scheme = match asked {
+        None => configured,
+        Some(SchemeArg::Fast) => Scheme::Fast(match configured {
+            Scheme::Fast(o) => o,
+            _ => FastOptions::default(),
+        }),
+        Some(SchemeArg::Reference) => Scheme::Reference(match configured {
+            Scheme::Reference(o) => o,
+            _ => ReferenceOptions::default(),
+        }),
+    };
+    match scheme {
+        Scheme::Fast(o) => Scheme::Fast(FastOptions {
+            energy: o.energy || energy,
+            ..o
+        }),
+        reference => reference,
+    }
+}
+
+/// `--threads`, checked.
+fn check_threads(t: usize) -> Result<usize> {
+    use pounding::plan::limits::{MAX_THREADS, WHY_THREADS};
+    if t == 0 || t > MAX_THREADS {
+        bail!(
+            "--threads {t}: expected 1 to {MAX_THREADS} ({WHY_THREADS}; this machine has {})",
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        );
+    }
+    Ok(t)
+}
+
+/// Runs whose peak displacement exceeds the building's height estimated from its period.
+fn absurd_drifts(rows: &[(RunSpec, RunOutput)]) -> u64 {
+    let h = pounding::plan::limits::HEIGHT_PER_PERIOD_M;
+    rows.iter()
+        .filter(|(s, o)| o.peak_u1 > h * s.t1 || o.peak_u2 > h * s.t2)
+        .count() as u64
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let Args {
+        config,
+        output,
+        threads,
+        scheme,
+        backend,
+        precision,
+        chunk,
+        energy,
+        shard,
+        resume,
+        aggregate,
+        exceed,
+        format,
+        columns,
+    } = a;
+    if format == FormatArg::Parquet && resume {
+        bail!("--resume continues CSV output only: a Parquet file is readable only once its footer is written at the end");
+    }
+    if aggregate.is_some() && (format == FormatArg::Parquet || columns.is_some()) {
+        bail!("--aggregate writes its own summary columns: --format and --columns do not apply");
+    }
+    if aggregate.is_some() && (resume || shard.is_some()) {
+        bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
+    }
+    let threads = threads.map(check_threads).transpose()?;
+    let picked = columns
+        .as_ref()
+        .map(|c| pounding::plan::columns::select(c))
+        .transpose()
+        .map_err(|bad| {
+            anyhow::anyhow!(
+                "--columns: `{bad}` is not a column; the columns are: {}",
+                pounding::plan::columns::header().join(", ")
+            )
+        })?;
+    let picked_names: Option<Vec<String>> = picked.as_ref().map(|ix| {
+        let h = pounding::plan::columns::header();
+        ix.iter().map(|&i| h[i].to_string()).collect()
+    });
+    // The output is checked before anything runs: not a directory, not one of the inputs, and
+    // writable.
+    let config_text = config::read_text(&config)?;
+    let records = config::input_files(&config_text, &config);
+    let target = check_outputs(&config_inputs(&config, &records), &[("-o", Some(&output))])?
+        .pop()
+        .expect("one output");
+    let precision = precision.get();
+    let mut plan = config::load_text(&config_text, &config)?;
+    for w in plan.warnings() {
+        note!("warning: {}: {w}", config.display());
+    }
+    let scheme = scheme_as_run(plan.spec.scheme, scheme, energy);
+    // The fingerprint covers the scheme as run, not as configured.
+    plan.spec.scheme = scheme;
+    let fast = matches!(scheme, Scheme::Fast(_));
+    let backend = backend.get();
+    if backend == Backend::Gpu && !fast {
+        bail!(EngineError::GpuNeedsFast)
+    }
+    let gpu = match fast {
+        true => backend.acquire("running on the CPU", &mut |l| note!("{l}"))?,
+        false => None,
+    };
+    let engine = Engine::new(scheme, gpu.as_ref(), precision, chunk)?;
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = threads {
+        pool = pool.num_threads(t);
+    }
+    let pool = pool.build().context("starting worker threads")?;
+    let range = match shard {
+        Some(s) => pounding::plan::shard::shard_range(&plan, s),
+        None => 0..plan.len(),
+    };
+    let meta = Meta {
+        fingerprint: Fingerprint::of(&plan),
+        plan_runs: plan.len(),
+        first_run: range.start,
+        end_run: range.end,
+        shard,
+        backend: engine.key(),
+        columns: picked_names.clone(),
+        content: None,
+    };
+    let fmt = match &aggregate {
+        Some(by) => Format::Summary(Box::new(pounding::engine::aggregate::Aggregator::new(
+            by, &exceed,
+        )?)),
+        None if format == FormatArg::Parquet => Format::Parquet,
+        None => Format::Csv,
+    };
+    let mut out = match SweepOutput::open(target, meta, fmt, picked, resume, &mut |l| note!("{l}"))?
+    {
+        Opened::Ready(o) => o,
+        Opened::Complete(_) => return Ok(()),
+    };
+    let todo = out.todo();
+    let done = out.done();
+    let partial = out.partial_path();
+    if let Some(s) = shard {
+        note!(
+            "shard {}/{}: runs {}..{} of {}",
+            s.index,
+            s.count,
+            range.start,
+            range.end,
+            plan.len()
+        );
+    }
+    if done > 0 {
+        note!("resuming {}: {done} runs already on disk", output.display());
+    }
+    let bar = if std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(todo.end - todo.start);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} runs  {per_sec}  eta {eta}",
+            )
+            .expect("valid template"),
+        );
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    note!(
+        "{}: {} runs, {} scheme, {}",
+        config.display(),
+        todo.end - todo.start,
+        scheme.key(),
+        pool.install(|| engine.describe()),
+    );
+    let mut absurd = 0u64;
+    let report = pool
+        .install(|| -> Result<_> {
+            let progress = |done| bar.set_position(done);
+            let report = match out.aggregator() {
+                Some(agg) => {
+                    let r = engine.fold(&plan, todo.clone(), agg, progress)?;
+                    if let Engine::Gpu { .. } = engine {
+                        let t = r.gpu;
+                        bar.suspend(|| {
+                            note!(
+                                "aggregated on the device: {:.2} s folding; {} chunks with more than {} groups folded on the host; histograms flushed {} times",
+                                t.aggregate,
+                                t.host_folded_chunks,
+                                pounding::engine::gpu::reduce::DEFAULT_SLOTS,
+                                t.slot_flushes
+                            )
+                        });
+                    }
+                    r
+                }
+                None => engine.run(
+                    &plan,
+                    todo.clone(),
+                    |c: &[(RunSpec, RunOutput)]| {
+                        absurd += absurd_drifts(c);
+                        out.take(&plan, c).map_err(anyhow::Error::from)
+                    },
+                    progress,
+                )?,
+            };
+            if let Engine::Gpu { opts, .. } = engine {
+                if report.gpu.handed_off > 0 {
+                    bar.suspend(|| {
+                        note!(
+                            "{} runs needed more than {} RK4 substeps per record step, past what {} resolves: finished on the CPU in f64",
+                            report.gpu.handed_off,
+                            opts.handoff(),
+                            precision.key()
+                        )
+                    });
+                }
+            }
+            Ok(report)
+        })
+        .with_context(|| {
+            format!(
+                "writing {} (finished rows are kept there)",
+                partial.display()
+            )
+        })?;
+    let summary = report.summary;
+    bar.finish_and_clear();
+    // Records are read once, at the start: a file changed since then no longer matches the rows
+    // (or the fingerprint), so the output is not put in place.
+    let changed = config::changed_records(&config_text, &config, &plan);
+    if !changed.is_empty() {
+        let summary_only = out.aggregator().is_some();
+        drop(out);
+        bail!(
+            "{} changed on disk during the sweep; the runs were computed from the content read at the start ({}); rerun the sweep (without --resume) to use the new content",
+            changed.join(", "),
+            if summary_only {
+                "no summary was written".to_string()
+            } else {
+                format!("their rows are left in {}", partial.display())
+            }
+        );
+    }
+    let (path, what) = out.finish()?;
+    if absurd > 0 {
+        note!(
+            "warning: {absurd} runs have a peak displacement above the building's height estimated from its period ({} m per s: T ~ 0.1 s per 3 m storey): check the record's units and the intensity",
+            pounding::plan::limits::HEIGHT_PER_PERIOD_M
+        );
+    }
+    note!(
+        "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {} ({what})",
+        summary.runs,
+        summary.seconds,
+        summary.runs_per_second(),
+        summary.runs_with_impacts,
+        summary.impacts,
+        summary.failures,
+        path.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,316 @@
+//! Device acquisition and the long-lived GPU objects (device, queue, pipelines), kept apart from
+//! the work functions so tests can bring their own device.
+
+use super::layout::{Counters, Dispatch, Meta};
+use super::shader::{aggregate_source, fast_source, Precision};
+use std::sync::{Arc, Mutex};
+
+/// What went wrong on the GPU path; each message says what to do next.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error("no GPU adapter found ({detail}); install a Vulkan driver (for a software one: apt-get install mesa-vulkan-drivers libvulkan1) or run with --backend cpu")]
+    NoAdapter { detail: String },
+    #[error("GPU adapter `{adapter}` refused a device: {source}; run with --backend cpu")]
+    RequestDevice {
+        adapter: String,
+        source: wgpu::RequestDeviceError,
+    },
+    #[error("GPU adapter `{adapter}` has no f64 shader support (SHADER_F64); use --precision f32 or --backend cpu")]
+    NoF64 { adapter: String },
+    #[error("the {precision} shader failed to compile on `{adapter}`: {message}; run with --backend cpu and report this")]
+    Shader {
+        adapter: String,
+        precision: &'static str,
+        message: String,
+    },
+    #[error("GPU out of memory allocating {what} ({bytes} bytes); use a smaller --chunk or --backend cpu")]
+    OutOfMemory { what: String, bytes: u64 },
+    #[error("the GPU device was lost ({reason}); rows already written are kept; rerun with --backend cpu or a smaller --chunk")]
+    DeviceLost { reason: String },
+    #[error("GPU error: {message}; run with --backend cpu")]
+    Other { message: String },
+}
+
+/// One adapter as `pound gpu info` lists it.
+#[derive(Debug, Clone)]
+pub struct AdapterSummary {
+    pub info: wgpu::AdapterInfo,
+    pub f64: bool,
+    pub limits: wgpu::Limits,
+}
+
+fn instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+    wgpu::Instance::new(desc)
+}
+
+/// Every adapter the instance finds.
+pub fn adapters() -> Vec<AdapterSummary> {
+    let inst = instance();
+    pollster::block_on(inst.enumerate_adapters(wgpu::Backends::all()))
+        .into_iter()
+        .map(|a| AdapterSummary {
+            info: a.get_info(),
+            f64: a.features().contains(wgpu::Features::SHADER_F64),
+            limits: a.limits(),
+        })
+        .collect()
+}
+
+/// A compiled kernel with its bind-group layout.
+pub struct Kernel {
+    pub pipeline: wgpu::ComputePipeline,
+    pub layout: wgpu::BindGroupLayout,
+}
+
+/// A compiled stage and variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    /// `fast.wgsl`, with or without the energy balance.
+    Fast { energy: bool },
+    /// `aggregate.wgsl`.
+    Aggregate,
+}
+
+type KernelKey = (Stage, Precision);
+
+/// Device, queue and compiled kernels, created once per process (or per test).
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    /// Errors reported outside an explicit check (validation, out of memory, device loss).
+    errors: Arc<Mutex<Option<GpuError>>>,
+    kernels: Mutex<Vec<(KernelKey, Arc<Kernel>)>>,
+}
+
+impl GpuContext {
+    /// The default adapter (high performance), with f64 enabled where it is supported.
+    pub fn new() -> Result<GpuContext, GpuError> {
+        let inst = instance();
+        let adapter = pollster::block_on(inst.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|e| GpuError::NoAdapter {
+            detail: e.to_string(),
+        })?;
+        let info = adapter.get_info();
+        let features = adapter.features() & wgpu::Features::SHADER_F64;
+        let limits = adapter.limits();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("pounding"),
+            required_features: features,
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .map_err(|source| GpuError::RequestDevice {
+            adapter: info.name.clone(),
+            source,
+        })?;
+        Ok(GpuContext::from_device(device, queue, info))
+    }
+
+    /// A software adapter (Mesa's lavapipe, type Cpu): it runs the shader on the CPU's own
+    /// cores, slower than the CPU path there, so `--backend auto` passes it by.
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
+    /// Wrap a device the caller created (tests, embedding applications).
+    pub fn from_device(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
+        let errors: Arc<Mutex<Option<GpuError>>> = Arc::default();
+        let slot = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            let err = match e {
+                wgpu::Error::OutOfMemory { .. } => GpuError::OutOfMemory {
+                    what: "a buffer".into(),
+                    bytes: 0,
+                },
+                other => GpuError::Other {
+                    message: other.to_string(),
+                },
+            };
+            slot.lock().unwrap().get_or_insert(err);
+        }));
+        let slot = errors.clone();
+        // A loss explains any validation errors that follow it, so it replaces them.
+        device.set_device_lost_callback(move |reason, message| {
+            *slot.lock().unwrap() = Some(GpuError::DeviceLost {
+                reason: format!("{reason:?}: {message}"),
+            });
+        });
+        GpuContext {
+            device,
+            queue,
+            info,
+            errors,
+            kernels: Mutex::new(Vec::new()),
+        }
+    }
+
+    pub fn supports_f64(&self) -> bool {
+        self.device.features().contains(wgpu::Features::SHADER_F64)
+    }
+
+    /// A one-line description: name, backend, type.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
+    }
+
+    /// The first error reported since the last check, if any.
+    pub fn take_error(&self) -> Option<GpuError> {
+        self.errors.lock().unwrap().take()
+    }
+
+    /// Record commands into one encoder named `label` and submit them.
+    pub fn submit(&self, label: &str, record: impl FnOnce(&mut wgpu::CommandEncoder)) {
+        let mut enc = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        record(&mut enc);
+        self.queue.submit([enc.finish()]);
+    }
+
+    /// Submit one pass of `kernel` over `groups` workgroups (x, y) with `bind`, followed by
+    /// whatever `then` records (copies of its results).
+    pub fn dispatch(
+        &self,
+        label: &str,
+        kernel: &Kernel,
+        bind: &wgpu::BindGroup,
+        (x, y): (u32, u32),
+        then: impl FnOnce(&mut wgpu::CommandEncoder),
+    ) {
+        self.submit(label, |enc| {
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(label),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&kernel.pipeline);
+                pass.set_bind_group(0, bind, &[]);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            then(enc);
+        });
+    }
+
+    /// The fast-scheme kernel in `precision`, with or without the energy balance, compiled on
+    /// first use.
+    pub fn kernel(&self, precision: Precision, energy: bool) -> Result<Arc<Kernel>, GpuError> {
+        self.stage(Stage::Fast { energy }, precision)
+    }
+
+    /// The aggregation stage in `precision`, compiled on first use.
+    pub fn aggregator(&self, precision: Precision) -> Result<Arc<Kernel>, GpuError> {
+        self.stage(Stage::Aggregate, precision)
+    }
+
+    fn stage(&self, stage: Stage, precision: Precision) -> Result<Arc<Kernel>, GpuError> {
+        let mut ks = self.kernels.lock().unwrap();
+        if let Some((_, k)) = ks.iter().find(|(p, _)| *p == (stage, precision)) {
+            return Ok(k.clone());
+        }
+        if precision == Precision::F64 && !self.supports_f64() {
+            return Err(GpuError::NoF64 {
+                adapter: self.info.name.clone(),
+            });
+        }
+        let k = Arc::new(self.compile(stage, precision)?);
+        ks.push(((stage, precision), k.clone()));
+        Ok(k)
+    }
+
+    fn compile(&self, stage: Stage, precision: Precision) -> Result<Kernel, GpuError> {
+        let d = &self.device;
+        let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+        let (name, source) = match stage {
+            Stage::Fast { energy } => ("fast", fast_source(precision, energy)),
+            Stage::Aggregate => ("aggregate", aggregate_source(precision)),
+        };
+        let label = format!("{name}.wgsl {}", precision.key());
+        let desc = wgpu::ShaderModuleDescriptor {
+            label: Some(&label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        };
+        let module = d.create_shader_module(desc);
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty,
+            count: None,
+        };
+        let storage = |read_only| wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        // Binding order as declared in each shader.
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = match stage {
+            Stage::Fast { .. } => vec![
+                entry(
+                    0,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(size_of::<Dispatch>() as u64),
+                    },
+                ),
+                entry(1, storage(true)),
+                entry(2, storage(true)),
+                entry(3, storage(true)),
+                entry(4, storage(false)),
+                entry(5, storage(false)),
+                entry(6, storage(false)),
+                entry(7, storage(true)),
+                entry(8, storage(false)),
+                entry(9, storage(true)),
+            ],
+            Stage::Aggregate => (0..9).map(|b| entry(b, storage(b < 5))).collect(),
+        };
+        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some(&format!("{name} bind group layout")),
+            entries: &entries,
+        });
+        let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(&format!("{name} pipeline layout")),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(&format!("{name} pipeline")),
+            layout: Some(&pl),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Shader {
+                adapter: self.info.name.clone(),
+                precision: precision.key(),
+                message: e.to_string(),
+            });
+        }
+        Ok(Kernel { pipeline, layout })
+    }
+
+    /// Largest number of runs one chunk may hold on this device at `precision`.
+    pub fn max_runs_per_chunk(&self, precision: Precision) -> u64 {
+        let l = self.device.limits();
+        let binding = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
+        let largest = (super::layout::params_bytes(precision))
+            .max(super::layout::state_bytes(precision))
+            .max(size_of::<Meta>())
+            .max(size_of::<Counters>()) as u64;
+        let by_binding = binding / largest;
+        let by_groups =
+            l.max_compute_workgroups_per_dimension as u64 * super::layout::WORKGROUP_SIZE as u64;
+        by_binding.min(by_groups)
+    }
+}

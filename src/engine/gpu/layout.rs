@@ -1,0 +1,367 @@
+//! Every struct shared with the WGSL shaders, one `#[repr(C)]` Pod type each, and the
+//! workgroup/buffer-size arithmetic. Keep in sync with `shaders/fast.wgsl` (the struct and field
+//! names there are the same; `tests/it/gpu.rs` parses the shader with naga and checks every size
+//! and offset against these types).
+//!
+//! Structs of reals come in two precisions with the same fields (`...64` for f64, `...32` for
+//! f32): the shader is compiled with `alias real = f64;` or `f32;` prepended. Each is all-real so
+//! it has no padding in either precision; integer fields live in separate all-`u32` structs.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Invocations per workgroup (`@workgroup_size` in the shader is substituted from this).
+pub const WORKGROUP_SIZE: u32 = 64;
+
+/// Field names and byte offsets of a shared struct, for the layout test.
+pub trait Layout {
+    const NAME: &'static str;
+    fn fields() -> Vec<(&'static str, usize)>;
+}
+
+macro_rules! real_structs {
+    ($(#[$doc:meta])* $name:literal, $n64:ident, $n32:ident { $($(#[$fdoc:meta])* $f:ident),* $(,)? }) => {
+        $(#[$doc])*
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+        pub struct $n64 { $($(#[$fdoc])* pub $f: f64),* }
+
+        /// f32 twin of the f64 struct of the same name.
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+        pub struct $n32 { $(pub $f: f32),* }
+
+        impl $n32 {
+            pub fn from_f64(x: &$n64) -> Self {
+                $n32 { $($f: x.$f as f32),* }
+            }
+            pub fn to_f64(&self) -> $n64 {
+                $n64 { $($f: self.$f as f64),* }
+            }
+        }
+
+        impl Layout for $n64 {
+            const NAME: &'static str = $name;
+            fn fields() -> Vec<(&'static str, usize)> {
+                vec![$((stringify!($f), core::mem::offset_of!($n64, $f))),*]
+            }
+        }
+
+        impl Layout for $n32 {
+            const NAME: &'static str = $name;
+            fn fields() -> Vec<(&'static str, usize)> {
+                vec![$((stringify!($f), core::mem::offset_of!($n32, $f))),*]
+            }
+        }
+    };
+}
+
+real_structs! {
+    /// Per-run parameters, all precomputed on the host (no transcendentals in the shader).
+    "Params", Params64, Params32 {
+        m1, c1, k1, m2, c2, k2,
+        /// m
+        gap,
+        /// `k` or `beta`
+        stiffness,
+        /// `c`, `c0` or Hunt-Crossley `a` (see `Contact::damping`)
+        damping,
+        damping_ratio,
+        m_eff,
+        /// Contact duration: `t_c = tc_coef` (linear laws) or `tc_coef v^(-1/5)` (Hertz-type).
+        tc_coef,
+        /// Record step and start, s; factor applied to the record's samples.
+        dt, t0, scale,
+        /// RK4 substeps per estimated contact duration.
+        substeps_per_contact,
+        /// Exact propagator of building 1 over `dt` (see `propagator::Propagator`).
+        p1_uu, p1_uv, p1_ua0, p1_ua1, p1_vu, p1_vv, p1_va0, p1_va1,
+        /// Same for building 2.
+        p2_uu, p2_uv, p2_ua0, p2_ua1, p2_vu, p2_vv, p2_va0, p2_va1,
+    }
+}
+
+real_structs! {
+    /// Per-run integration state and running results; carried from one dispatch to the next.
+    "State", State64, State32 {
+        u1, v1, u2, v2,
+        /// Contact work so far, J.
+        w,
+        /// Approach speed of the current impact.
+        v0,
+        /// Peak force of the current impact.
+        imp_peak,
+        /// The last two force samples `(time since onset, force)` of the current impact.
+        h_t0, h_f0, h_t1, h_f1,
+        /// Local time of the current impact's onset within its record interval.
+        tau_onset,
+        /// Local time reached within the current record interval.
+        tau,
+        peak_force, impact_velocity, peak_penetration, peak_u1, peak_u2,
+        /// Valid when `impacts > 0`.
+        first_impact,
+        contact_time,
+        dissipated,
+        /// Input and structural damping work so far, and the largest input reached, J (the
+        /// energy balance: `cpu::State` and `Tracker`).
+        e_in, e_damp, e_peak,
+    }
+}
+
+/// Per-run integers fixed for the sweep.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Meta {
+    /// `LAW_*` code.
+    pub law: u32,
+    /// First sample of the run's record in the records buffer.
+    pub rec_offset: u32,
+    /// Samples in the record.
+    pub rec_len: u32,
+    /// Record intervals to simulate (record plus tail).
+    pub intervals: u32,
+}
+
+/// Per-run integer state, carried between dispatches.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Counters {
+    /// `MODE_*`
+    pub mode: u32,
+    /// Force samples held in `State::h_*` (0, 1 or 2).
+    pub nhist: u32,
+    pub impacts: u32,
+    /// `STATUS_*`; a run that is not `STATUS_OK` is not stepped again.
+    pub status: u32,
+    /// RK4 substeps taken so far.
+    pub substeps: u32,
+    /// Record interval of the current impact's onset.
+    pub i_onset: u32,
+    /// Current record interval.
+    pub i: u32,
+    /// Current RK4 substep of interval `i` (1..=m), 0 before the interval is started.
+    pub j: u32,
+    /// RK4 substeps of interval `i`.
+    pub m: u32,
+    /// Pieces (event cuts) taken in substep `j`.
+    pub pieces: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// Uniforms of one dispatch: at most `budget` units of work (a free interval, or one piece of a
+/// substep) for each of the `nactive` runs listed in the dispatch's run-id buffer.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Dispatch {
+    pub budget: u32,
+    pub nactive: u32,
+    /// A record step needing more substeps ends the run with `STATUS_STEP_LIMIT`.
+    pub max_substeps_per_step: u32,
+    /// Substep budget of one run.
+    pub max_substeps: u32,
+    /// A record step needing more substeps ends the run with `STATUS_HANDOFF`.
+    pub handoff_substeps_per_step: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+    pub _pad3: u32,
+}
+
+impl Layout for Meta {
+    const NAME: &'static str = "Meta";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("law", offset_of!(Meta, law)),
+            ("rec_offset", offset_of!(Meta, rec_offset)),
+            ("rec_len", offset_of!(Meta, rec_len)),
+            ("intervals", offset_of!(Meta, intervals)),
+        ]
+    }
+}
+
+impl Layout for Counters {
+    const NAME: &'static str = "Counters";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("mode", offset_of!(Counters, mode)),
+            ("nhist", offset_of!(Counters, nhist)),
+            ("impacts", offset_of!(Counters, impacts)),
+            ("status", offset_of!(Counters, status)),
+            ("substeps", offset_of!(Counters, substeps)),
+            ("i_onset", offset_of!(Counters, i_onset)),
+            ("i", offset_of!(Counters, i)),
+            ("j", offset_of!(Counters, j)),
+            ("m", offset_of!(Counters, m)),
+            ("pieces", offset_of!(Counters, pieces)),
+            ("_pad0", offset_of!(Counters, _pad0)),
+            ("_pad1", offset_of!(Counters, _pad1)),
+        ]
+    }
+}
+
+impl Layout for Dispatch {
+    const NAME: &'static str = "Dispatch";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("budget", offset_of!(Dispatch, budget)),
+            ("nactive", offset_of!(Dispatch, nactive)),
+            (
+                "max_substeps_per_step",
+                offset_of!(Dispatch, max_substeps_per_step),
+            ),
+            ("max_substeps", offset_of!(Dispatch, max_substeps)),
+            (
+                "handoff_substeps_per_step",
+                offset_of!(Dispatch, handoff_substeps_per_step),
+            ),
+            ("_pad1", offset_of!(Dispatch, _pad1)),
+            ("_pad2", offset_of!(Dispatch, _pad2)),
+            ("_pad3", offset_of!(Dispatch, _pad3)),
+        ]
+    }
+}
+
+// Codes shared with the shader (keep in sync with the `const`s in `shaders/fast.wgsl`).
+pub const MODE_FREE: u32 = 0;
+pub const MODE_APPROACH: u32 = 1;
+pub const MODE_RESTITUTION: u32 = 2;
+pub const STATUS_OK: u32 = 0;
+pub const STATUS_NON_FINITE: u32 = 1;
+pub const STATUS_STEP_LIMIT: u32 = 2;
+/// The run needs more substeps per record step than the kernel's precision resolves; the host
+/// finishes it on the CPU.
+pub const STATUS_HANDOFF: u32 = 3;
+
+/// Reals per run in the `forms` buffer: the exact free-step energy integrals
+/// (`propagator::EnergyForms`) of building 1 (`vv`, then `agv`), then building 2. The shader's
+/// `FORMS` constant comes from here (see `shader::fast_source`).
+pub const FORMS_PER_RUN: usize = 40;
+
+/// A run's `forms` entries.
+pub fn forms(
+    f1: &crate::physics::propagator::EnergyForms,
+    f2: &crate::physics::propagator::EnergyForms,
+) -> [f64; FORMS_PER_RUN] {
+    let mut out = [0.0; FORMS_PER_RUN];
+    for (k, c) in [f1.vv, f1.agv, f2.vv, f2.agv].iter().enumerate() {
+        out[10 * k..10 * k + 10].copy_from_slice(c);
+    }
+    out
+}
+
+/// Workgroups for `n` runs.
+pub fn workgroups(n: u32) -> u32 {
+    n.div_ceil(WORKGROUP_SIZE)
+}
+
+/// Bytes of one `Params` at `precision`.
+pub fn params_bytes(precision: super::Precision) -> usize {
+    core::mem::size_of::<Params64>() / 8 * precision.bytes()
+}
+
+/// Bytes of one `State` at `precision`.
+pub fn state_bytes(precision: super::Precision) -> usize {
+    core::mem::size_of::<State64>() / 8 * precision.bytes()
+}
+
+/// Settings of the aggregation stage (`shaders/aggregate.wgsl`), in a read-only storage buffer
+/// (a uniform array would need 16-byte strides).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct AggConfig {
+    /// Segments in this dispatch.
+    pub nseg: u32,
+    /// `--exceed` thresholds in use (their values are in the `thresholds` buffer).
+    pub nexceed: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    /// Output index (`aggregate::OUTPUTS`) of each threshold.
+    pub exceed_output: [u32; crate::engine::aggregate::MAX_EXCEED],
+}
+
+/// Consecutive runs of a chunk (in the order they were packed) that belong to one group; the
+/// stage folds each segment in one workgroup.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Segment {
+    /// First run (index into the chunk's buffers) and run count.
+    pub start: u32,
+    pub len: u32,
+    /// The group's histogram slot in the `hist` buffer.
+    pub slot: u32,
+    pub _pad: u32,
+}
+
+impl Layout for AggConfig {
+    const NAME: &'static str = "AggConfig";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("nseg", offset_of!(AggConfig, nseg)),
+            ("nexceed", offset_of!(AggConfig, nexceed)),
+            ("_pad0", offset_of!(AggConfig, _pad0)),
+            ("_pad1", offset_of!(AggConfig, _pad1)),
+            ("exceed_output", offset_of!(AggConfig, exceed_output)),
+        ]
+    }
+}
+
+impl Layout for Segment {
+    const NAME: &'static str = "Segment";
+    fn fields() -> Vec<(&'static str, usize)> {
+        use core::mem::offset_of;
+        vec![
+            ("start", offset_of!(Segment, start)),
+            ("len", offset_of!(Segment, len)),
+            ("slot", offset_of!(Segment, slot)),
+            ("_pad", offset_of!(Segment, _pad)),
+        ]
+    }
+}
+
+// A segment's partial counts: `PART_U` u32 words at these offsets (keep in sync with
+// aggregate.wgsl, which gets PART_U and the P_* offsets from `shader::aggregate_source`).
+pub const PART_U: usize = 16;
+/// Runs folded (handed-back runs are not), of which failed.
+pub const P_RUNS: usize = 0;
+pub const P_FAILURES: usize = 1;
+/// Runs with at least one impact, and their impacts.
+pub const P_POUNDED: usize = 2;
+pub const P_IMPACTS: usize = 3;
+/// `MAX_EXCEED` exceedance counts from here.
+pub const P_EXCEED: usize = 4;
+/// A segment's reals: the max of each output, then the sum of each.
+pub const PART_R: usize = 2 * crate::engine::aggregate::NOUT;
+/// Longest segment: keeps each invocation's loop at `MAX_SEGMENT / WORKGROUP_SIZE` iterations,
+/// far below lavapipe's loop limit (longer runs of one group are cut into several segments).
+pub const MAX_SEGMENT: u32 = 1 << 16;
+/// Histogram counters of one slot (one group): `NOUT` outputs of `BUCKETS` each.
+pub const SLOT_WORDS: usize = crate::engine::aggregate::NOUT * crate::engine::aggregate::BUCKETS;
+
+/// The partial of segment `k` from the read-back `part_u` words and `part_r` reals.
+pub fn partial(part_u: &[u32], part_r: &[f64], k: usize) -> crate::engine::aggregate::Partial {
+    use crate::engine::aggregate::{MAX_EXCEED, NOUT};
+    let u = &part_u[k * PART_U..(k + 1) * PART_U];
+    let r = &part_r[k * PART_R..(k + 1) * PART_R];
+    let mut p = crate::engine::aggregate::Partial {
+        runs: u[P_RUNS] as u64,
+        failures: u[P_FAILURES] as u64,
+        pounded: u[P_POUNDED] as u64,
+        impacts: u[P_IMPACTS] as u64,
+        ..Default::default()
+    };
+    for e in 0..MAX_EXCEED {
+        p.exceed[e] = u[P_EXCEED + e] as u64;
+    }
+    p.max.copy_from_slice(&r[..NOUT]);
+    p.sum.copy_from_slice(&r[NOUT..]);
+    p
+}
+
+/// Workgroups for `n` segments, one each, as an `(x, y)` grid within `max_per_dim`.
+pub fn segment_grid(n: u32, max_per_dim: u32) -> (u32, u32) {
+    let x = n.clamp(1, max_per_dim);
+    (x, n.div_ceil(x))
+}

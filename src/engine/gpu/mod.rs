@@ -1,0 +1,26 @@
+//! The GPU engine, host side: the `fast` scheme as a WGSL compute shader (`shaders/fast.wgsl`),
+//! one invocation per run, and the `--aggregate` fold on the device (`shaders/aggregate.wgsl`).
+//!
+//! - [`context`]: adapter, device, queue and compiled pipelines, acquired apart from the work;
+//! - [`layout`]: the `#[repr(C)]` buffer types both sides share (checked against the WGSL by naga);
+//! - [`shader`]: the WGSL text with its constants filled in from Rust;
+//! - [`run`]: packing runs, dispatching, reading back one chunk;
+//! - [`sweep`]: a range of runs chunk after chunk; [`fold`] and [`reduce`]: the device fold.
+//!
+//! May import the physics, the plan and [`crate::engine::aggregate`]; never io or studies.
+
+pub mod context;
+pub mod fold;
+pub mod layout;
+pub mod reduce;
+pub mod run;
+pub mod shader;
+pub mod sweep;
+
+pub use context::{GpuContext, GpuError};
+pub use run::{
+    integrate, output, pack, read_outputs, run_chunk, ChunkTimes, GpuOptions, GpuRecords,
+    Integrated,
+};
+pub use shader::Precision;
+pub use sweep::GpuTimes;

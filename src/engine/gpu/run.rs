@@ -1,0 +1,566 @@
+//! Packing runs into buffers, dispatching the kernel in windows of record intervals, reading
+//! back. The work functions take a [`GpuContext`], so tests can pass their own device.
+
+use super::context::{GpuContext, GpuError};
+use super::layout::{
+    self, Counters, Dispatch, Meta, Params32, Params64, State32, State64, MODE_FREE,
+    STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK,
+};
+use super::shader::Precision;
+use crate::physics::contact::LawKind;
+use crate::physics::model::{EnergyBalance, Forcing, Oscillator, Pair, RunOutput, Status};
+use crate::physics::propagator::{EnergyForms, Propagator};
+use crate::physics::solver::FastOptions;
+use std::time::{Duration, Instant};
+
+/// Settings of the GPU path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GpuOptions {
+    pub precision: Precision,
+    /// The scheme's settings (the same as the CPU `fast` path's).
+    pub fast: FastOptions,
+    /// Units of work (a free record interval, or one piece of an RK4 substep) per run and
+    /// dispatch: keeps each dispatch short (drivers reset a GPU that runs one dispatch for
+    /// about 2 s). Capped at [`CPU_ADAPTER_BUDGET`] on a software adapter.
+    pub units_per_dispatch: u32,
+    /// A run whose record step needs more RK4 substeps than this is handed back and finished
+    /// on the CPU in f64 (None: [`F32_HANDOFF_SUBSTEPS_PER_STEP`] in f32, never in f64).
+    pub handoff_substeps_per_step: Option<u32>,
+}
+
+impl Default for GpuOptions {
+    fn default() -> Self {
+        GpuOptions {
+            precision: Precision::F32,
+            fast: FastOptions::default(),
+            units_per_dispatch: 4096,
+            handoff_substeps_per_step: None,
+        }
+    }
+}
+
+/// In f32, a state updated `m` times within one record step keeps about `m * 6e-8` of relative
+/// rounding per step; past 4,096 substeps per step (stiff, heavily damped contacts such as
+/// `zeta` = 125 at e = 0.1) the measured peak errors grow from 1e-3 to 10 %, so such runs go to
+/// the CPU (see tests/it/gpu.rs).
+pub const F32_HANDOFF_SUBSTEPS_PER_STEP: u32 = 4096;
+
+impl GpuOptions {
+    pub fn handoff(&self) -> u32 {
+        self.handoff_substeps_per_step
+            .unwrap_or(match self.precision {
+                Precision::F32 => F32_HANDOFF_SUBSTEPS_PER_STEP,
+                Precision::F64 => u32::MAX,
+            })
+    }
+}
+
+/// Budget cap on CPU (software) adapters: lavapipe ends any loop after about 65,535
+/// iterations per invocation without an error, and one unit runs at most 17 loop iterations.
+pub const CPU_ADAPTER_BUDGET: u32 = 1024;
+
+/// Where time went in one chunk.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ChunkTimes {
+    pub upload: Duration,
+    pub kernel: Duration,
+    pub readback: Duration,
+}
+
+/// Every record of a sweep in one buffer, converted to the kernel's precision.
+pub struct GpuRecords {
+    buffer: wgpu::Buffer,
+    offsets: Vec<u32>,
+    lens: Vec<u32>,
+}
+
+impl GpuRecords {
+    pub fn upload(
+        ctx: &GpuContext,
+        precision: Precision,
+        records: &[&[f64]],
+    ) -> Result<GpuRecords, GpuError> {
+        let mut offsets = Vec::with_capacity(records.len());
+        let mut lens = Vec::with_capacity(records.len());
+        let mut all: Vec<f64> = Vec::new();
+        for r in records {
+            offsets.push(all.len() as u32);
+            lens.push(r.len() as u32);
+            all.extend_from_slice(r);
+        }
+        if all.is_empty() {
+            all.push(0.0);
+        }
+        let buffer = storage(
+            ctx,
+            "records",
+            &precision.reals(&all),
+            wgpu::BufferUsages::empty(),
+        )?;
+        Ok(GpuRecords {
+            buffer,
+            offsets,
+            lens,
+        })
+    }
+}
+
+fn law_code(l: LawKind) -> u32 {
+    LawKind::ALL.iter().position(|&k| k == l).unwrap() as u32
+}
+
+/// One run, packed for the kernel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Packed {
+    pub params: Params64,
+    pub meta: Meta,
+    /// The free-step energy integrals, when the energy balance is asked for.
+    pub forms: Option<[f64; layout::FORMS_PER_RUN]>,
+}
+
+/// Pack one run: `record` is the index of its record in the [`GpuRecords`] it will run with.
+pub fn pack(
+    pair: &Pair,
+    forcing: &Forcing,
+    record: usize,
+    recs: &GpuRecords,
+    fast: &FastOptions,
+) -> Packed {
+    let (p1, p2) = (
+        Propagator::new(&pair.b1, forcing.dt),
+        Propagator::new(&pair.b2, forcing.dt),
+    );
+    let c = &pair.contact;
+    let params = Params64 {
+        m1: pair.b1.m,
+        c1: pair.b1.c,
+        k1: pair.b1.k,
+        m2: pair.b2.m,
+        c2: pair.b2.c,
+        k2: pair.b2.k,
+        gap: pair.gap,
+        stiffness: c.stiffness,
+        damping: c.damping,
+        damping_ratio: c.damping_ratio,
+        m_eff: c.m_eff,
+        tc_coef: c.tc_coef(),
+        dt: forcing.dt,
+        t0: forcing.t0,
+        scale: forcing.scale,
+        substeps_per_contact: fast.substeps_per_contact,
+        p1_uu: p1.uu,
+        p1_uv: p1.uv,
+        p1_ua0: p1.ua0,
+        p1_ua1: p1.ua1,
+        p1_vu: p1.vu,
+        p1_vv: p1.vv,
+        p1_va0: p1.va0,
+        p1_va1: p1.va1,
+        p2_uu: p2.uu,
+        p2_uv: p2.uv,
+        p2_ua0: p2.ua0,
+        p2_ua1: p2.ua1,
+        p2_vu: p2.vu,
+        p2_vv: p2.vv,
+        p2_va0: p2.va0,
+        p2_va1: p2.va1,
+    };
+    debug_assert_eq!(forcing.accel.len(), recs.lens[record] as usize);
+    let meta = Meta {
+        law: law_code(c.kind),
+        rec_offset: recs.offsets[record],
+        rec_len: recs.lens[record],
+        intervals: forcing.intervals() as u32,
+    };
+    let forms = fast.energy.then(|| {
+        layout::forms(
+            &EnergyForms::new(&pair.b1, forcing.dt),
+            &EnergyForms::new(&pair.b2, forcing.dt),
+        )
+    });
+    Packed {
+        params,
+        meta,
+        forms,
+    }
+}
+
+/// A run's results from its final state (what `Tracker::finish` and `Tracker::energy` do on
+/// the CPU; GPU runs start at rest); None for a run handed back to the host (`STATUS_HANDOFF`).
+pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<RunOutput> {
+    if c.status == STATUS_HANDOFF {
+        return None;
+    }
+    let (mut peak_force, mut impact_velocity) = (s.peak_force, s.impact_velocity);
+    if c.mode != MODE_FREE && s.imp_peak > peak_force {
+        peak_force = s.imp_peak;
+        impact_velocity = s.v0;
+    }
+    Some(RunOutput {
+        status: match c.status {
+            STATUS_OK => Status::Ok,
+            STATUS_NON_FINITE => Status::NonFinite,
+            _ => Status::StepLimit,
+        },
+        impacts: c.impacts,
+        peak_force,
+        peak_penetration: s.peak_penetration,
+        peak_u1: s.peak_u1,
+        peak_u2: s.peak_u2,
+        impact_velocity,
+        first_impact: (c.impacts > 0).then_some(s.first_impact),
+        contact_time: s.contact_time,
+        dissipated_energy: s.dissipated,
+        substeps: c.substeps as u64,
+        energy: energy.then(|| {
+            let b1 = Oscillator {
+                m: p.m1,
+                k: p.k1,
+                c: p.c1,
+            };
+            let b2 = Oscillator {
+                m: p.m2,
+                k: p.k2,
+                c: p.c2,
+            };
+            let held = b1.energy(s.u1, s.v1) + b2.energy(s.u2, s.v2);
+            EnergyBalance::close(0.0, s.e_in, s.e_damp, s.w, held, s.e_peak)
+        }),
+    })
+}
+
+/// A storage buffer of `size` bytes left as wgpu creates it: zeroed (no upload).
+pub(super) fn zeroed(
+    ctx: &GpuContext,
+    label: &str,
+    size: u64,
+    extra: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer, GpuError> {
+    buffer(ctx, label, size.max(4), extra, &[])
+}
+
+pub(super) fn storage(
+    ctx: &GpuContext,
+    label: &str,
+    bytes: &[u8],
+    extra: wgpu::BufferUsages,
+) -> Result<wgpu::Buffer, GpuError> {
+    buffer(ctx, label, bytes.len() as u64, extra, bytes)
+}
+
+/// A storage buffer of `size` bytes holding `contents` (its first bytes; the rest zero), out of
+/// memory reported as an error.
+fn buffer(
+    ctx: &GpuContext,
+    label: &str,
+    size: u64,
+    extra: wgpu::BufferUsages,
+    contents: &[u8],
+) -> Result<wgpu::Buffer, GpuError> {
+    let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    // Not `create_buffer_init`: a buffer mapped at creation panics on a lost device, and a
+    // lost device must come back as an error.
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+        mapped_at_creation: false,
+    });
+    if !contents.is_empty() {
+        ctx.queue.write_buffer(&buffer, 0, contents);
+    }
+    if pollster::block_on(scope.pop()).is_some() {
+        return Err(GpuError::OutOfMemory {
+            what: label.to_string(),
+            bytes: size,
+        });
+    }
+    Ok(buffer)
+}
+
+/// A bind group of whole buffers, bound in order (binding `i` is `buffers[i]`).
+pub(super) fn bind_group(
+    ctx: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    label: &str,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+pub(super) fn wait(ctx: &GpuContext) -> Result<(), GpuError> {
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| GpuError::Other {
+            message: e.to_string(),
+        })?;
+    match ctx.take_error() {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Map a MAP_READ buffer whose copy has been submitted, wait, and return its bytes.
+pub(super) fn map_read(ctx: &GpuContext, staging: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let failed = |e: String| GpuError::Other {
+        message: format!("reading results back: {e}"),
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, move |r| drop(tx.send(r)));
+    wait(ctx)?;
+    rx.recv()
+        .map_err(|e| failed(e.to_string()))?
+        .map_err(|e| failed(e.to_string()))?;
+    let data = staging
+        .slice(..)
+        .get_mapped_range()
+        .map_err(|e| failed(e.to_string()))?
+        .to_vec();
+    staging.unmap();
+    Ok(data)
+}
+
+pub(super) fn read(ctx: &GpuContext, src: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    read_prefix(ctx, src, src.size())
+}
+
+/// The first `size` bytes of a buffer (a multiple of 4).
+pub(super) fn read_prefix(
+    ctx: &GpuContext,
+    src: &wgpu::Buffer,
+    size: u64,
+) -> Result<Vec<u8>, GpuError> {
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    ctx.submit("readback copy", |enc| {
+        enc.copy_buffer_to_buffer(src, 0, &staging, 0, size)
+    });
+    map_read(ctx, &staging)
+}
+
+/// Integrate packed runs from rest over their whole records; results in input order, None for
+/// runs handed back to the host (see [`GpuOptions::handoff_substeps_per_step`]).
+pub fn run_chunk(
+    ctx: &GpuContext,
+    recs: &GpuRecords,
+    runs: &[Packed],
+    opts: &GpuOptions,
+) -> Result<(Vec<Option<RunOutput>>, ChunkTimes), GpuError> {
+    if runs.is_empty() {
+        return Ok((Vec::new(), ChunkTimes::default()));
+    }
+    let (done, mut times) = integrate(ctx, recs, runs, opts)?;
+    let t = Instant::now();
+    let out = read_outputs(ctx, &done, runs, opts)?;
+    times.readback = t.elapsed();
+    Ok((out, times))
+}
+
+/// A chunk's final states and counters, still on the device.
+pub struct Integrated {
+    pub states: wgpu::Buffer,
+    pub counters: wgpu::Buffer,
+    pub runs: u32,
+}
+
+/// Integrate packed runs (at least one) from rest over their whole records, leaving the final
+/// states on the device.
+pub fn integrate(
+    ctx: &GpuContext,
+    recs: &GpuRecords,
+    runs: &[Packed],
+    opts: &GpuOptions,
+) -> Result<(Integrated, ChunkTimes), GpuError> {
+    let mut times = ChunkTimes::default();
+    let kernel = ctx.kernel(opts.precision, opts.fast.energy)?;
+    let n = runs.len();
+    let t = Instant::now();
+    let params: Vec<u8> = match opts.precision {
+        Precision::F64 => {
+            let v: Vec<Params64> = runs.iter().map(|r| r.params).collect();
+            bytemuck::cast_slice(&v).to_vec()
+        }
+        Precision::F32 => {
+            let v: Vec<Params32> = runs.iter().map(|r| Params32::from_f64(&r.params)).collect();
+            bytemuck::cast_slice(&v).to_vec()
+        }
+    };
+    let metas: Vec<Meta> = runs.iter().map(|r| r.meta).collect();
+    let energy = opts.fast.energy;
+    let forms: Vec<f64> = if energy {
+        runs.iter()
+            .flat_map(|r| r.forms.expect("packed with the energy forms"))
+            .collect()
+    } else {
+        vec![0.0]
+    };
+    let forms = storage(
+        ctx,
+        "energy forms",
+        &opts.precision.reals(&forms),
+        wgpu::BufferUsages::empty(),
+    )?;
+    let params = storage(ctx, "params", &params, wgpu::BufferUsages::empty())?;
+    let metas_buf = storage(
+        ctx,
+        "metas",
+        bytemuck::cast_slice(&metas),
+        wgpu::BufferUsages::empty(),
+    )?;
+    // Runs start from rest: a new buffer is zeroed, which is the zero state and `Counters`.
+    let states = zeroed(
+        ctx,
+        "states",
+        (n * layout::state_bytes(opts.precision)) as u64,
+        wgpu::BufferUsages::COPY_SRC,
+    )?;
+    let counters = zeroed(
+        ctx,
+        "counters",
+        (n * size_of::<Counters>()) as u64,
+        wgpu::BufferUsages::COPY_SRC,
+    )?;
+    let active = storage(
+        ctx,
+        "active runs",
+        &[0; 4],
+        wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+    )?;
+    // Run ids of the active runs, ping-ponged: a dispatch reads one list and appends the runs it
+    // leaves unfinished to the other.
+    let all: Vec<u32> = (0..n as u32).collect();
+    let ids = [
+        storage(
+            ctx,
+            "run ids a",
+            bytemuck::cast_slice(&all),
+            wgpu::BufferUsages::empty(),
+        )?,
+        // Written by the first dispatch before any dispatch reads it.
+        zeroed(
+            ctx,
+            "run ids b",
+            (n * 4) as u64,
+            wgpu::BufferUsages::empty(),
+        )?,
+    ];
+    let uniform = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("dispatch"),
+        size: size_of::<Dispatch>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bind = |from: &wgpu::Buffer, to: &wgpu::Buffer, label| {
+        let buffers = [
+            &uniform,
+            &params,
+            &metas_buf,
+            &recs.buffer,
+            &states,
+            &counters,
+            &active,
+            from,
+            to,
+            &forms,
+        ];
+        bind_group(ctx, &kernel.layout, label, &buffers)
+    };
+    let binds = [
+        bind(&ids[0], &ids[1], "fast bind group a->b"),
+        bind(&ids[1], &ids[0], "fast bind group b->a"),
+    ];
+    wait(ctx)?;
+    times.upload = t.elapsed();
+
+    let t = Instant::now();
+    let mut budget = opts.units_per_dispatch.max(1);
+    if ctx.info.device_type == wgpu::DeviceType::Cpu {
+        budget = budget.min(CPU_ADAPTER_BUDGET);
+    }
+    let mut d = Dispatch {
+        budget,
+        nactive: n as u32,
+        max_substeps_per_step: opts.fast.max_substeps_per_step,
+        max_substeps: opts.fast.max_substeps,
+        handoff_substeps_per_step: opts.handoff(),
+        ..Default::default()
+    };
+    let active_staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("active readback"),
+        size: 4,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    for parity in (0..2).cycle() {
+        ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&d));
+        ctx.queue.write_buffer(&active, 0, &[0; 4]);
+        let groups = (layout::workgroups(d.nactive), 1);
+        ctx.dispatch("fast", &kernel, &binds[parity], groups, |enc| {
+            enc.copy_buffer_to_buffer(&active, 0, &active_staging, 0, 4)
+        });
+        let v = map_read(ctx, &active_staging)?;
+        d.nactive = u32::from_le_bytes([v[0], v[1], v[2], v[3]]);
+        if d.nactive == 0 {
+            break;
+        }
+    }
+    times.kernel = t.elapsed();
+    Ok((
+        Integrated {
+            states,
+            counters,
+            runs: n as u32,
+        },
+        times,
+    ))
+}
+
+/// Each run's results from its final state, in input order (None: handed back).
+pub fn read_outputs(
+    ctx: &GpuContext,
+    done: &Integrated,
+    runs: &[Packed],
+    opts: &GpuOptions,
+) -> Result<Vec<Option<RunOutput>>, GpuError> {
+    let energy = opts.fast.energy;
+    let sbytes = read(ctx, &done.states)?;
+    let cbytes = read(ctx, &done.counters)?;
+    let cs: &[Counters] = bytemuck::cast_slice(&cbytes);
+    let out: Vec<Option<RunOutput>> = match opts.precision {
+        Precision::F64 => {
+            let ss: &[State64] = bytemuck::cast_slice(&sbytes);
+            ss.iter()
+                .zip(cs)
+                .zip(runs)
+                .map(|((s, c), r)| output(s, c, &r.params, energy))
+                .collect()
+        }
+        Precision::F32 => {
+            let ss: &[State32] = bytemuck::cast_slice(&sbytes);
+            ss.iter()
+                .zip(cs)
+                .zip(runs)
+                .map(|((s, c), r)| output(&s.to_f64(), c, &r.params, energy))
+                .collect()
+        }
+    };
+    Ok(out)
+}

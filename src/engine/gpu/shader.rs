@@ -1,0 +1,90 @@
+//! WGSL sources and their per-precision prelude.
+
+use super::layout::{FORMS_PER_RUN, WORKGROUP_SIZE};
+
+/// Floating-point precision of the GPU path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Precision {
+    F32,
+    F64,
+}
+
+impl Precision {
+    pub fn key(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+
+    pub fn from_key(s: &str) -> Option<Precision> {
+        match s {
+            "f32" => Some(Precision::F32),
+            "f64" => Some(Precision::F64),
+            _ => None,
+        }
+    }
+
+    /// `x` as this precision's reals, in bytes (as the shaders' `array<real>` reads them).
+    pub fn reals(self, x: &[f64]) -> Vec<u8> {
+        match self {
+            Precision::F64 => bytemuck::cast_slice(x).to_vec(),
+            Precision::F32 => {
+                let v: Vec<f32> = x.iter().map(|&y| y as f32).collect();
+                bytemuck::cast_slice(&v).to_vec()
+            }
+        }
+    }
+
+    /// Bytes per real.
+    pub fn bytes(self) -> usize {
+        match self {
+            Precision::F32 => 4,
+            Precision::F64 => 8,
+        }
+    }
+}
+
+/// Structs and codes every stage shares, then one file per stage, as in `shaders/`.
+pub const TYPES_WGSL: &str = include_str!("../../../shaders/types.wgsl");
+pub const FAST_WGSL: &str = include_str!("../../../shaders/fast.wgsl");
+pub const AGGREGATE_WGSL: &str = include_str!("../../../shaders/aggregate.wgsl");
+
+/// What every stage starts with: the `real` alias, its epsilon, a tiny and a huge number (for
+/// degenerate-cubic and finiteness tests), the workgroup size, then `types.wgsl`.
+fn prelude(precision: Precision) -> String {
+    let real = match precision {
+        Precision::F32 => "alias real = f32;\nconst EPS: real = 1.1920929e-7;\nconst TINY: real = 1e-30;\nconst BIG: real = 1e37;\n",
+        Precision::F64 => "alias real = f64;\nconst EPS: real = 2.220446049250313e-16;\nconst TINY: real = 1e-300;\nconst BIG: real = 1e300;\n",
+    };
+    format!("{real}const WG: u32 = {WORKGROUP_SIZE}u;\n{TYPES_WGSL}")
+}
+
+/// `shaders/fast.wgsl` for `precision`, after the prelude: with the reals per run of the
+/// `forms` buffer, and `ENERGY`: whether this variant integrates the energy balance. Two
+/// variants rather than a uniform branch, because lavapipe compiled the untaken energy code
+/// into the free step and lost 30 % of its runs/s (measured with `pound bench`).
+pub fn fast_source(precision: Precision, energy: bool) -> String {
+    format!(
+        "{}const FORMS: u32 = {FORMS_PER_RUN}u;\nconst ENERGY: bool = {energy};\n{FAST_WGSL}",
+        prelude(precision)
+    )
+}
+
+/// `shaders/aggregate.wgsl` for `precision`, after the prelude: with the sketch's bucket range
+/// and the partials' layout, all from `aggregate` and `layout` (one source of truth).
+pub fn aggregate_source(precision: Precision) -> String {
+    use super::layout::{PART_R, PART_U, P_EXCEED, P_FAILURES, P_IMPACTS, P_POUNDED, P_RUNS};
+    use crate::engine::aggregate::{
+        BUCKETS, GAMMA, KMAX, KMIN, MAX_EXCEED, NOUT, SKETCH_MAX, SKETCH_MIN,
+    };
+    let inv_ln_g = 1.0 / GAMMA.ln();
+    format!(
+        "{}const NOUT: u32 = {NOUT}u;\nconst BUCKETS: u32 = {BUCKETS}u;\nconst KMIN: i32 = {KMIN}i;\nconst KMAX: i32 = {KMAX}i;\n\
+         const SKETCH_MIN: real = {SKETCH_MIN:e};\nconst SKETCH_MAX: real = {SKETCH_MAX:e};\nconst INV_LN_G: f32 = {inv_ln_g:?};\n\
+         const MAX_EXCEED: u32 = {MAX_EXCEED}u;\nconst PART_U: u32 = {PART_U}u;\nconst PART_R: u32 = {PART_R}u;\n\
+         const P_RUNS: u32 = {P_RUNS}u;\nconst P_FAILURES: u32 = {P_FAILURES}u;\n\
+         const P_POUNDED: u32 = {P_POUNDED}u;\nconst P_IMPACTS: u32 = {P_IMPACTS}u;\nconst P_EXCEED: u32 = {P_EXCEED}u;\n{AGGREGATE_WGSL}",
+        prelude(precision)
+    )
+}

@@ -1,0 +1,128 @@
+//! A range of runs on the GPU, chunk after chunk: packed on the host while the device integrates
+//! the previous chunk, read back, the runs the kernel hands back finished on the CPU in f64.
+
+use crate::engine::Summary;
+use crate::physics::model::RunOutput;
+use crate::physics::solver::Scheme;
+use crate::plan::{Plan, RunSpec};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Where a GPU sweep spent its time, s (packing is host work; upload, kernel and readback are
+/// timed around the GPU calls that wait for completion).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GpuTimes {
+    pub pack: f64,
+    pub upload: f64,
+    pub kernel: f64,
+    pub readback: f64,
+    /// Finishing handed-back runs on the CPU.
+    pub handoff: f64,
+    pub sink: f64,
+    /// Runs handed back by the kernel and finished on the CPU in f64.
+    pub handed_off: u64,
+    /// `--aggregate`: folding on the device and reading the partials back, s.
+    pub aggregate: f64,
+    /// `--aggregate`: chunks with more groups than the device's histogram slots (read back and
+    /// folded on the host), and times the slots were flushed to the host before the end.
+    pub host_folded_chunks: u64,
+    pub slot_flushes: u64,
+}
+
+impl GpuTimes {
+    /// Add a chunk's device times.
+    pub(crate) fn add_chunk(&mut self, ct: &super::ChunkTimes) {
+        self.upload += ct.upload.as_secs_f64();
+        self.kernel += ct.kernel.as_secs_f64();
+        self.readback += ct.readback.as_secs_f64();
+    }
+
+    /// A chunk's outputs as read back, with the runs the kernel handed back finished on the CPU
+    /// in f64 (`spec(k)` is the run of `outs[k]`).
+    pub(crate) fn finish<'a>(
+        &mut self,
+        plan: &Plan,
+        fast: &crate::physics::solver::FastOptions,
+        outs: Vec<Option<RunOutput>>,
+        spec: impl Fn(usize) -> &'a RunSpec + Sync,
+    ) -> Vec<RunOutput> {
+        let t = Instant::now();
+        let cpu = Scheme::Fast(*fast);
+        self.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
+        let done = outs
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, o)| o.unwrap_or_else(|| crate::engine::cpu::run_one(plan, spec(k), &cpu)))
+            .collect();
+        self.handoff += t.elapsed().as_secs_f64();
+        done
+    }
+}
+
+/// Run the runs `runs` of `plan` on the GPU, `chunk` runs per chunk (capped by the device's limits);
+/// `sink` gets each chunk's results in run order as it finishes. Runs the kernel hands back
+/// (more substeps per record step than its precision resolves) are finished on the CPU's fast
+/// path in f64. Rows already handed to `sink` stay there if a later chunk fails (device loss,
+/// out of memory).
+pub fn run_range<E: From<super::GpuError>>(
+    plan: &Plan,
+    runs: std::ops::Range<u64>,
+    ctx: &super::GpuContext,
+    opts: &super::GpuOptions,
+    chunk: usize,
+    mut sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    mut progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), E> {
+    use super::{pack, run_chunk, GpuRecords};
+    let start = Instant::now();
+    let mut times = GpuTimes::default();
+    let accels: Vec<&[f64]> = plan.spec.records.iter().map(|r| &r.accel[..]).collect();
+    let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
+    let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
+    let n = runs.end;
+    let mut s = Summary::default();
+    // Packing is host work: the next chunk is packed while the device integrates this one.
+    let prep = |c0: u64| {
+        let t = Instant::now();
+        let (specs, packed): (Vec<RunSpec>, Vec<_>) = (c0..(c0 + chunk).min(n))
+            .into_par_iter()
+            .map(|i| {
+                let spec = plan.run(i);
+                let p = pack(
+                    &spec.pair(),
+                    &plan.forcing(&spec),
+                    spec.record,
+                    &recs,
+                    &opts.fast,
+                );
+                (spec, p)
+            })
+            .unzip();
+        (specs, packed, t.elapsed().as_secs_f64())
+    };
+    let mut c0 = runs.start;
+    let mut next = (c0 < n).then(|| prep(c0));
+    while let Some((specs, packed, pack_s)) = next.take() {
+        let c1 = (c0 + chunk).min(n);
+        times.pack += pack_s;
+        let (done, upcoming) = rayon::join(
+            || run_chunk(ctx, &recs, &packed, opts),
+            || (c1 < n).then(|| prep(c1)),
+        );
+        next = upcoming;
+        let (outs, ct) = done?;
+        times.add_chunk(&ct);
+        let outs = times.finish(plan, &opts.fast, outs, |k| &specs[k]);
+        let rows: Vec<(RunSpec, RunOutput)> = specs.into_iter().zip(outs).collect();
+        let t = Instant::now();
+        for (_, o) in &rows {
+            s.count(o);
+        }
+        sink(&rows)?;
+        times.sink += t.elapsed().as_secs_f64();
+        progress(s.runs);
+        c0 = c1;
+    }
+    s.seconds = start.elapsed().as_secs_f64();
+    Ok((s, times))
+}

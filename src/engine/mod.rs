@@ -1,0 +1,396 @@
+//! The engine: runs a range of a plan's runs and hands their outputs on, a chunk at a time in run
+//! order ([`Engine::run`]), folded into groups ([`Engine::fold`], `--aggregate`), or all at once
+//! ([`Engine::collect`]). One enum, [`Engine`], is every path: the CPU (the physics' solvers on a
+//! rayon pool, [`cpu`]) or the GPU (the WGSL kernel, [`gpu`]; with `--aggregate`, the fold runs
+//! on the device too). [`Backend`] and [`Engine::new`] are the one place a backend is chosen.
+//!
+//! May import the physics, records and the plan; never io, studies or the command line.
+
+pub mod aggregate;
+pub mod cpu;
+pub mod gpu;
+
+use crate::physics::model::{RunOutput, Status};
+use crate::physics::solver::Scheme;
+use crate::plan::limits::{MAX_CPU_CHUNK, MAX_GPU_CHUNK, WHY_CHUNK};
+use crate::plan::{Plan, RunSpec};
+use aggregate::Aggregator;
+use gpu::{GpuContext, GpuError, GpuOptions, GpuTimes, Precision};
+use std::ops::Range;
+
+/// Runs per parallel task on the CPU: small enough to balance uneven runs over the threads.
+pub const CPU_CHUNK: usize = 64;
+/// Runs per GPU chunk: enough lanes to fill a large GPU, few enough to stream the output.
+pub const GPU_CHUNK: usize = 65536;
+
+/// Totals of a finished sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Summary {
+    pub runs: u64,
+    pub seconds: f64,
+    pub runs_with_impacts: u64,
+    pub impacts: u64,
+    pub failures: u64,
+}
+
+impl Summary {
+    /// Count one finished run.
+    pub(crate) fn count(&mut self, o: &RunOutput) {
+        self.runs += 1;
+        self.impacts += o.impacts as u64;
+        self.runs_with_impacts += (o.impacts > 0) as u64;
+        self.failures += (o.status != Status::Ok) as u64;
+    }
+
+    /// Count the runs of a device partial (handed-back runs are counted when finished).
+    fn count_partial(&mut self, p: &aggregate::Partial) {
+        self.runs += p.runs;
+        self.impacts += p.impacts;
+        self.runs_with_impacts += p.pounded;
+        self.failures += p.failures;
+    }
+
+    pub fn runs_per_second(&self) -> f64 {
+        self.runs as f64 / self.seconds.max(1e-9)
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum EngineError {
+    #[error("--chunk {chunk}: expected 1 to {max} on the {on} ({WHY_CHUNK})")]
+    Chunk {
+        chunk: usize,
+        max: usize,
+        on: &'static str,
+    },
+    #[error("--backend gpu runs the fast scheme only; use --scheme fast or --backend cpu")]
+    GpuNeedsFast,
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+}
+
+/// Where runs should be integrated, as asked (`--backend`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backend {
+    /// A hardware GPU if one is found, else the CPU (with a notice saying why): a software
+    /// adapter (lavapipe) is slower than the CPU path on the same cores.
+    Auto,
+    /// Any adapter, software ones included; none is an error.
+    Gpu,
+    Cpu,
+}
+
+impl Backend {
+    /// The GPU this backend asks for: none for `Cpu`, an error if `Gpu` finds none, and for
+    /// `Auto` a hardware adapter or, without one, none and a notice (`fallback: why`).
+    pub fn acquire(
+        self,
+        fallback: &str,
+        note: &mut dyn FnMut(String),
+    ) -> Result<Option<GpuContext>, GpuError> {
+        Ok(match self {
+            Backend::Cpu => None,
+            Backend::Gpu => Some(GpuContext::new()?),
+            Backend::Auto => match GpuContext::new() {
+                Ok(c) if c.is_software() => {
+                    note(format!(
+                        "notice: {fallback}: the adapter found, {}, is a software one (slower than the CPU path on the same cores); --backend gpu uses it",
+                        c.info.name
+                    ));
+                    None
+                }
+                Ok(c) => Some(c),
+                Err(e) => {
+                    note(format!("notice: {fallback}: {e}"));
+                    None
+                }
+            },
+        })
+    }
+}
+
+/// What a finished engine call reports: the sweep's totals, and on the GPU where time went.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Report {
+    pub summary: Summary,
+    /// All zero on the CPU.
+    pub gpu: GpuTimes,
+}
+
+/// One way of integrating runs. Every caller (the sweep, the studies, the benchmarks) goes
+/// through it, so the paths share chunking, ordering and the hand-off of hard runs.
+#[derive(Clone, Copy)]
+pub enum Engine<'c> {
+    /// The physics' solvers in f64 ([`Scheme`]), `chunk` runs per rayon task on the current pool.
+    Cpu { scheme: Scheme, chunk: usize },
+    /// The WGSL kernel (the fast scheme), `chunk` runs per dispatch chunk (capped by the device).
+    Gpu {
+        ctx: &'c GpuContext,
+        opts: GpuOptions,
+        chunk: usize,
+    },
+}
+
+/// `chunk`, or the path's default, checked against the path's bound.
+fn chunk_or_default(chunk: Option<usize>, gpu: bool) -> Result<usize, EngineError> {
+    let (default, max, on) = if gpu {
+        (GPU_CHUNK, MAX_GPU_CHUNK, "GPU")
+    } else {
+        (CPU_CHUNK, MAX_CPU_CHUNK, "CPU")
+    };
+    let chunk = chunk.unwrap_or(default);
+    if chunk == 0 || chunk > max {
+        return Err(EngineError::Chunk { chunk, max, on });
+    }
+    Ok(chunk)
+}
+
+impl<'c> Engine<'c> {
+    /// The engine for `scheme`: the GPU kernel at `precision` when `gpu` is given and the scheme
+    /// is `fast`, else the CPU. `chunk` defaults to [`CPU_CHUNK`] or [`GPU_CHUNK`].
+    pub fn new(
+        scheme: Scheme,
+        gpu: Option<&'c GpuContext>,
+        precision: Precision,
+        chunk: Option<usize>,
+    ) -> Result<Engine<'c>, EngineError> {
+        match (gpu, scheme) {
+            (Some(ctx), Scheme::Fast(fast)) => Engine::gpu(
+                ctx,
+                GpuOptions {
+                    precision,
+                    fast,
+                    ..Default::default()
+                },
+                chunk,
+            ),
+            _ => Engine::cpu(scheme, chunk),
+        }
+    }
+
+    /// The CPU engine.
+    pub fn cpu(scheme: Scheme, chunk: Option<usize>) -> Result<Engine<'c>, EngineError> {
+        Ok(Engine::Cpu {
+            scheme,
+            chunk: chunk_or_default(chunk, false)?,
+        })
+    }
+
+    /// The GPU engine; f64 needs an adapter that has it.
+    pub fn gpu(
+        ctx: &'c GpuContext,
+        opts: GpuOptions,
+        chunk: Option<usize>,
+    ) -> Result<Engine<'c>, EngineError> {
+        if opts.precision == Precision::F64 && !ctx.supports_f64() {
+            return Err(GpuError::NoF64 {
+                adapter: ctx.info.name.clone(),
+            }
+            .into());
+        }
+        Ok(Engine::Gpu {
+            ctx,
+            opts,
+            chunk: chunk_or_default(chunk, true)?,
+        })
+    }
+
+    /// The scheme's settings as run.
+    pub fn scheme(&self) -> Scheme {
+        match self {
+            Engine::Cpu { scheme, .. } => *scheme,
+            Engine::Gpu { opts, .. } => Scheme::Fast(opts.fast),
+        }
+    }
+
+    /// `cpu`, `gpu-f32` or `gpu-f64` (the sidecar's `backend`).
+    pub fn key(&self) -> String {
+        match self {
+            Engine::Cpu { .. } => "cpu".into(),
+            Engine::Gpu { opts, .. } => format!("gpu-{}", opts.precision.key()),
+        }
+    }
+
+    /// Where runs go, in words (`GPU <adapter> in f32`, `CPU, 8 threads`).
+    pub fn describe(&self) -> String {
+        match self {
+            Engine::Cpu { .. } => format!("CPU, {} threads", rayon::current_num_threads()),
+            Engine::Gpu { ctx, opts, .. } => {
+                format!("GPU {} in {}", ctx.describe(), opts.precision.key())
+            }
+        }
+    }
+
+    /// Run the runs `runs` of `plan`; `sink` gets each chunk's results in run order (rows already
+    /// handed to it stay there if a later chunk fails), `progress` the runs done so far.
+    pub fn run<E: From<GpuError>>(
+        &self,
+        plan: &Plan,
+        runs: Range<u64>,
+        sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, E> {
+        match self {
+            Engine::Cpu { scheme, chunk } => Ok(Report {
+                summary: cpu::run_range(plan, runs, scheme, *chunk, sink, progress)?,
+                gpu: GpuTimes::default(),
+            }),
+            Engine::Gpu { ctx, opts, chunk } => {
+                let (summary, gpu) =
+                    gpu::sweep::run_range(plan, runs, ctx, opts, *chunk, sink, progress)?;
+                Ok(Report { summary, gpu })
+            }
+        }
+    }
+
+    /// Run the runs `runs` of `plan` and fold each into its group of `agg`: on the host for the
+    /// CPU, on the device for the GPU (only the groups' partials come back).
+    pub fn fold(
+        &self,
+        plan: &Plan,
+        runs: Range<u64>,
+        agg: &mut Aggregator,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, GpuError> {
+        match self {
+            Engine::Cpu { .. } => self.run(
+                plan,
+                runs,
+                |rows: &[(RunSpec, RunOutput)]| -> Result<(), GpuError> {
+                    for (s, o) in rows {
+                        let g = agg.group_of(plan, s);
+                        agg.add(g, o);
+                    }
+                    Ok(())
+                },
+                progress,
+            ),
+            Engine::Gpu { ctx, opts, chunk } => {
+                let (summary, gpu) = gpu::fold::fold_range(
+                    plan,
+                    runs,
+                    ctx,
+                    opts,
+                    *chunk,
+                    gpu::reduce::DEFAULT_SLOTS,
+                    agg,
+                    progress,
+                )?;
+                Ok(Report { summary, gpu })
+            }
+        }
+    }
+
+    /// Every run of `plan`, its output in run order.
+    pub fn collect(&self, plan: &Plan) -> Result<(Vec<RunOutput>, Report), GpuError> {
+        let mut outs = Vec::with_capacity(plan.len() as usize);
+        let report = self.run(
+            plan,
+            0..plan.len(),
+            |rows: &[(RunSpec, RunOutput)]| -> Result<(), GpuError> {
+                outs.extend(rows.iter().map(|(_, o)| *o));
+                Ok(())
+            },
+            |_| {},
+        )?;
+        Ok((outs, report))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::solver::{FastOptions, ReferenceOptions};
+
+    #[test]
+    fn chunks_default_per_path_and_are_bounded() {
+        assert_eq!(chunk_or_default(None, false).unwrap(), CPU_CHUNK);
+        assert_eq!(chunk_or_default(None, true).unwrap(), GPU_CHUNK);
+        assert_eq!(chunk_or_default(Some(7), false).unwrap(), 7);
+        for (chunk, gpu) in [(0, false), (0, true), (MAX_CPU_CHUNK + 1, false)] {
+            let e = chunk_or_default(Some(chunk), gpu).unwrap_err().to_string();
+            assert!(
+                e.starts_with(&format!("--chunk {chunk}: expected 1 to ")),
+                "{e}"
+            );
+        }
+        assert!(chunk_or_default(Some(MAX_CPU_CHUNK + 1), true).is_ok());
+    }
+
+    /// Without a GPU every scheme runs on the CPU, with its settings as given.
+    #[test]
+    fn without_a_gpu_the_engine_is_the_cpu() {
+        for scheme in [
+            Scheme::Fast(FastOptions::default()),
+            Scheme::Reference(ReferenceOptions::default()),
+        ] {
+            let e = Engine::new(scheme, None, Precision::F32, None).unwrap();
+            assert!(matches!(
+                e,
+                Engine::Cpu {
+                    chunk: CPU_CHUNK,
+                    ..
+                }
+            ));
+            assert_eq!(e.scheme(), scheme);
+            assert_eq!(e.key(), "cpu");
+        }
+    }
+
+    /// Folding on the CPU gives the summary a host fold of the rows gives, for any chunking.
+    #[test]
+    fn cpu_fold_is_the_fold_of_the_rows() {
+        let plan = crate::plan::config::parse(
+            "[building1]\nmass_kg = 1.0e5\nperiod_s = [0.3, 0.5]\ndamping_ratio = 0.05\n[building2]\nmass_kg = 1.0e5\nperiod_s = 0.9\ndamping_ratio = 0.05\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = [0.0, 0.005, 0.5]\n[[record]]\nsynthetic = { seed = 3, duration_s = 2.0 }\n",
+            std::path::Path::new("fold.toml"),
+            std::path::Path::new("."),
+            std::path::Path::new("."),
+        )
+        .unwrap();
+        let by = ["gap_m".to_string()];
+        let exceed = ["impacts=0".to_string()];
+        let engine = Engine::cpu(plan.spec.scheme, Some(1)).unwrap();
+        let mut host = Aggregator::new(&by, &exceed).unwrap();
+        let rows = engine
+            .run(
+                &plan,
+                0..plan.len(),
+                |c: &[(RunSpec, RunOutput)]| -> Result<(), GpuError> {
+                    for (s, o) in c {
+                        let g = host.group_of(&plan, s);
+                        host.add(g, o);
+                    }
+                    Ok(())
+                },
+                |_| {},
+            )
+            .unwrap();
+        let mut folded = Aggregator::new(&by, &exceed).unwrap();
+        let report = Engine::cpu(plan.spec.scheme, Some(4))
+            .unwrap()
+            .fold(&plan, 0..plan.len(), &mut folded, |_| {})
+            .unwrap();
+        assert_eq!(report.summary.runs, plan.len());
+        assert_eq!(report.summary.impacts, rows.summary.impacts);
+        assert!(report.summary.runs_with_impacts > 0);
+        assert_eq!(folded.groups(), 3);
+        // Each group's label, runs, exceedances, and per output its count, max and median.
+        let stats = |a: &Aggregator| {
+            a.labelled()
+                .map(|(label, g)| {
+                    let s = g
+                        .stats
+                        .iter()
+                        .map(|s| (s.count(), s.max(), s.quantile(0.5)));
+                    (
+                        label.to_vec(),
+                        g.runs,
+                        g.exceed.clone(),
+                        s.collect::<Vec<_>>(),
+                    )
+                })
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(stats(&folded), stats(&host));
+    }
+}

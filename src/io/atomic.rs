@@ -1,0 +1,72 @@
+//! Files that appear whole or not at all: written into a locked `OUT.partial`, fsynced and
+//! renamed; streams (standard output, character devices, FIFOs) written in place.
+
+use crate::io::target::{PartialLock, Target};
+use std::fs::File;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Open a stream target for writing in place.
+pub fn open_stream(target: &Target) -> std::io::Result<Box<dyn Write + Send>> {
+    Ok(match target {
+        Target::Stdout => Box::new(std::io::stdout()),
+        Target::Stream(p) => Box::new(std::fs::OpenOptions::new().write(true).open(p)?),
+        Target::File(p) => Box::new(File::create(p)?),
+    })
+}
+
+/// Empty a `.partial` left by an earlier attempt (a zero-length or non-regular one, such as a
+/// device, is left as it is).
+pub fn empty(file: &File) -> std::io::Result<()> {
+    if file.metadata()?.len() > 0 {
+        file.set_len(0)?;
+    }
+    Ok(())
+}
+
+/// `path` with `suffix` appended to its name (`OUT` -> `OUT.partial`): the unfinished file and
+/// the sidecars of an output.
+pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
+    let mut p = path.as_os_str().to_owned();
+    p.push(suffix);
+    PathBuf::from(p)
+}
+
+/// Write `bytes` to `path` atomically (temporary file, fsync, rename); standard output (`-`), a
+/// character device or a FIFO is written in place.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let target = Target::resolve("the output", path).map_err(std::io::Error::other)?;
+    if !target.is_file() {
+        let mut w = open_stream(&target)?;
+        w.write_all(bytes)?;
+        return w.flush();
+    }
+    let path = target.path();
+    let tmp = sibling(path, ".partial");
+    // `OUT.partial` may be a sweep's: running (locked) or resumable (with its journal).
+    let journal = sibling(path, ".progress.toml");
+    if journal.exists() {
+        return Err(std::io::Error::other(format!(
+            "{} holds the rows of an unfinished sweep (see {}): finish it with --resume, or delete both",
+            tmp.display(),
+            journal.display()
+        )));
+    }
+    let lock = PartialLock::acquire(&tmp).map_err(std::io::Error::other)?;
+    let written = lock
+        .file()
+        .map_err(std::io::Error::other)
+        .and_then(|mut f| {
+            empty(&f)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        });
+    match written {
+        Ok(()) => std::fs::rename(&tmp, path),
+        Err(e) => {
+            // Nothing half-written stays behind (a full disk, say).
+            let _ = std::fs::remove_file(&tmp);
+            Err(e)
+        }
+    }
+}

@@ -1,0 +1,228 @@
+//! What an output was computed from and what it holds: the plan fingerprint, the sidecar
+//! `OUT.meta.toml` written beside every finished output, and the journal `OUT.progress.toml` of
+//! an unfinished one. `pound merge`, `--resume` and the studies check them.
+
+use crate::plan::shard::Shard;
+use crate::plan::Plan;
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+
+/// What an output was computed from: the validated plan (axes, scheme, settings), the records'
+/// content, and the engine version. Two outputs may be combined or continued only when all three
+/// match.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Fingerprint {
+    pub plan: String,
+    pub records: String,
+    pub engine: String,
+}
+
+fn hex(d: impl AsRef<[u8]>) -> String {
+    d.as_ref()
+        .iter()
+        .take(16)
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+impl Fingerprint {
+    pub fn of(plan: &Plan) -> Fingerprint {
+        let s = &plan.spec;
+        // Debug prints every f64 exactly (shortest round-trip), so equal plans hash equally.
+        let text = format!(
+            "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+            s.laws,
+            s.formulas,
+            s.e,
+            s.k_linear,
+            s.beta,
+            s.intensities,
+            s.building1,
+            s.building2,
+            s.gaps,
+            s.scheme,
+            s.tail,
+            s.samples,
+            s.records.iter().map(|r| &r.name).collect::<Vec<_>>(),
+        );
+        let mut rec = Sha256::new();
+        for r in &s.records {
+            rec.update(r.name.as_bytes());
+            rec.update(r.dt.to_le_bytes());
+            rec.update(r.t0.to_le_bytes());
+            rec.update((r.accel.len() as u64).to_le_bytes());
+            for a in &r.accel {
+                rec.update(a.to_le_bytes());
+            }
+        }
+        Fingerprint {
+            plan: hex(Sha256::digest(text.as_bytes())),
+            records: hex(rec.finalize()),
+            engine: env!("CARGO_PKG_VERSION").to_string(),
+        }
+    }
+
+    /// The first part that differs from `other`, in words; None if they match.
+    pub fn differs(&self, other: &Fingerprint) -> Option<&'static str> {
+        if self.engine != other.engine {
+            Some("the engine version")
+        } else if self.records != other.records {
+            Some("the records (their content)")
+        } else if self.plan != other.plan {
+            Some("the config (the validated plan)")
+        } else {
+            None
+        }
+    }
+}
+
+/// The sidecar of a finished output (`OUT.meta.toml`): what it was computed from and which runs
+/// it holds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Meta {
+    pub fingerprint: Fingerprint,
+    /// Runs in the whole plan.
+    pub plan_runs: u64,
+    pub first_run: u64,
+    pub end_run: u64,
+    pub shard: Option<Shard>,
+    /// Where the runs were integrated: `cpu`, `gpu-f32` or `gpu-f64` (a resumed sweep must keep
+    /// it; merged shards may mix them).
+    pub backend: String,
+    /// The columns written, when `--columns` chose them (all otherwise).
+    #[serde(default)]
+    pub columns: Option<Vec<String>>,
+    /// What the file holds (rows and hashes): `pound merge` and the studies check it.
+    #[serde(default)]
+    pub content: Option<crate::io::journal::Content>,
+}
+
+/// `OUT.meta.toml` for the output `OUT`.
+pub fn meta_path(out: &Path) -> PathBuf {
+    crate::io::atomic::sibling(out, ".meta.toml")
+}
+
+/// Progress of an unfinished output (`OUT.progress.toml`), rewritten atomically after each
+/// chunk's rows are on disk: the first `done` runs of the range are in the first `bytes` bytes of
+/// `OUT.partial`, whose SHA-256 is `sha256`; anything after that is a half-written chunk. A hint,
+/// never the truth: `--resume` re-reads and checks those bytes before it continues.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Progress {
+    pub meta: Meta,
+    pub done: u64,
+    pub bytes: u64,
+    #[serde(default)]
+    pub sha256: String,
+}
+
+pub fn progress_path(out: &Path) -> PathBuf {
+    crate::io::atomic::sibling(out, ".progress.toml")
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SidecarError {
+    #[error("{}: {message}", path.display())]
+    Io { path: PathBuf, message: String },
+    #[error(transparent)]
+    Verify(#[from] crate::io::journal::VerifyError),
+    #[error(transparent)]
+    Target(#[from] crate::io::target::TargetError),
+}
+
+/// Read a TOML sidecar.
+pub fn read_toml<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T, SidecarError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SidecarError::Io {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    toml::from_str(&text).map_err(|e| SidecarError::Io {
+        path: path.into(),
+        message: format!("not a valid sidecar: {e}"),
+    })
+}
+
+/// Write a TOML sidecar atomically.
+pub fn write_toml<T: Serialize>(path: &Path, v: &T) -> Result<(), SidecarError> {
+    let text = toml::to_string(v).map_err(|e| SidecarError::Io {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    crate::io::atomic::write_atomic(path, text.as_bytes()).map_err(|e| SidecarError::Io {
+        path: path.into(),
+        message: e.to_string(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn differs_names_the_first_part_that_differs() {
+        let a = Fingerprint {
+            plan: "p".into(),
+            records: "r".into(),
+            engine: "e".into(),
+        };
+        let with = |f: fn(&mut Fingerprint)| {
+            let mut b = a.clone();
+            f(&mut b);
+            b
+        };
+        assert_eq!(a.differs(&a.clone()), None);
+        assert_eq!(
+            a.differs(&with(|b| b.plan = "q".into())),
+            Some("the config (the validated plan)")
+        );
+        assert_eq!(
+            a.differs(&with(|b| b.records = "s".into())),
+            Some("the records (their content)")
+        );
+        // The engine version is named first: a new pound may read the same config otherwise.
+        assert_eq!(
+            a.differs(&with(|b| {
+                b.engine = "f".into();
+                b.plan = "q".into();
+            })),
+            Some("the engine version")
+        );
+    }
+
+    /// The fingerprint covers the axes, the scheme and the records' content, and nothing that
+    /// does not change the runs (the config's file name, or its text's spelling).
+    #[test]
+    fn fingerprint_follows_what_changes_the_runs() {
+        let base = "[building1]\nmass_kg = 1.0e5\nperiod_s = [0.3, 0.5]\ndamping_ratio = 0.05\n[building2]\nmass_kg = 1.0e5\nperiod_s = 0.9\ndamping_ratio = 0.05\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = 0.0\n";
+        let fp = |text: &str, name: &str| {
+            let plan =
+                crate::plan::config::parse(text, Path::new(name), Path::new("."), Path::new("."))
+                    .unwrap();
+            Fingerprint::of(&plan)
+        };
+        let rec =
+            |seed: u32| format!("[[record]]\nsynthetic = {{ seed = {seed}, duration_s = 1.0 }}\n");
+        let a = fp(&format!("{base}{}", rec(1)), "a.toml");
+        assert_eq!(a, fp(&format!("{base}{}", rec(1)), "elsewhere/b.toml"));
+        assert_eq!(
+            a,
+            fp(
+                &format!("{}{}", base.replace("1.0e5", "100000.0"), rec(1)),
+                "a.toml"
+            )
+        );
+        let other_axis = fp(
+            &format!("{}{}", base.replace("[0.3, 0.5]", "[0.3, 0.6]"), rec(1)),
+            "a.toml",
+        );
+        assert_eq!(
+            a.differs(&other_axis),
+            Some("the config (the validated plan)")
+        );
+        let other_record = fp(&format!("{base}{}", rec(2)), "a.toml");
+        assert_eq!(
+            a.differs(&other_record),
+            Some("the records (their content)")
+        );
+    }
+}

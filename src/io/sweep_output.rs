@@ -1,0 +1,633 @@
+//! Where a sweep's rows go, and the protocol that keeps them honest: a CSV row per run (journaled
+//! after every chunk, resumable), Parquet, or a summary per group (`--aggregate`). A file output
+//! is written into `OUT.partial` under an exclusive lock held for the sweep's life; `--resume`
+//! re-reads and verifies what the journal vouches for before continuing; the output is renamed
+//! into place only after its row count, run sequence and hash are checked against the plan, with
+//! its sidecar (`OUT.meta.toml`) written first. Standard output, character devices and FIFOs are
+//! written in place, with no journal and no sidecar.
+
+use crate::engine::aggregate::Aggregator;
+use crate::io::atomic::sibling;
+use crate::io::csv::{header_for, header_line, CsvOut};
+use crate::io::journal::{verify_file, verify_prefix, Content};
+use crate::io::parquet::ParquetOut;
+use crate::io::provenance::{meta_path, progress_path, read_toml, write_toml, Meta, Progress};
+use crate::io::target::{PartialLock, Target};
+use crate::physics::model::RunOutput;
+use crate::plan::{Plan, RunSpec};
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("{}: {message}", path.display())]
+    At { path: PathBuf, message: String },
+    #[error(transparent)]
+    Target(#[from] crate::io::target::TargetError),
+}
+
+fn at(path: &Path, message: impl std::fmt::Display) -> OutputError {
+    OutputError::At {
+        path: path.into(),
+        message: message.to_string(),
+    }
+}
+
+/// How rows are written.
+pub enum Format {
+    Csv,
+    Parquet,
+    /// One row per group ([`Aggregator`]).
+    Summary(Box<Aggregator>),
+}
+
+enum Sink {
+    Csv {
+        out: Box<CsvOut>,
+        /// The journal and its path (file outputs only).
+        journal: Option<Box<(Progress, PathBuf)>>,
+    },
+    Parquet(Box<ParquetOut>),
+    Summary(Box<Aggregator>),
+}
+
+/// An open sweep output.
+pub struct SweepOutput {
+    target: Target,
+    /// Held until the output is in place (file outputs).
+    lock: Option<PartialLock>,
+    meta: Meta,
+    columns: Option<Vec<usize>>,
+    /// None once finished.
+    sink: Option<Sink>,
+    /// Runs of the range already on disk when it was opened (`--resume`).
+    done: u64,
+    /// The run the next row must be.
+    next_run: u64,
+}
+
+/// What [`SweepOutput::open`] found.
+pub enum Opened {
+    Ready(Box<SweepOutput>),
+    /// `--resume` of an output that is already complete (and checked).
+    Complete(PathBuf),
+}
+
+impl SweepOutput {
+    /// Open `target` for the runs `meta.first_run..meta.end_run`: a fresh output, or with
+    /// `resume` the verified prefix an interrupted sweep left. `columns` are indices into
+    /// [`crate::plan::columns::header`] (`--columns`). `note` receives one-line notices.
+    pub fn open(
+        target: Target,
+        meta: Meta,
+        format: Format,
+        columns: Option<Vec<usize>>,
+        resume: bool,
+        note: &mut dyn FnMut(String),
+    ) -> Result<Opened, OutputError> {
+        let path = target.path().to_path_buf();
+        if resume && !matches!(format, Format::Csv) {
+            return Err(at(
+                &path,
+                "--resume continues CSV output only (a Parquet file is readable only once its footer is written; a summary is kept in memory)",
+            ));
+        }
+        if resume && !target.is_file() {
+            return Err(at(
+                &path,
+                "--resume needs a file output: standard output, devices and FIFOs keep no journal",
+            ));
+        }
+        let lock = match &target {
+            Target::File(p) => {
+                let partial = sibling(p, ".partial");
+                let existed = partial.exists();
+                let lock = PartialLock::acquire(&partial)?;
+                Some((lock, existed))
+            }
+            _ => None,
+        };
+        let opened = Self::open_locked(&target, &meta, format, resume, &lock, note);
+        match opened {
+            Ok(Some((sink, done))) => Ok(Opened::Ready(Box::new(SweepOutput {
+                lock: lock.map(|(l, _)| l),
+                next_run: meta.first_run + done,
+                target,
+                meta,
+                columns,
+                sink: Some(sink),
+                done,
+            }))),
+            Ok(None) | Err(_) => {
+                // Leave no empty `.partial` behind that this call created.
+                if let Some((l, false)) = &lock {
+                    let _ = std::fs::remove_file(l.path());
+                }
+                opened.map(|_| Opened::Complete(path))
+            }
+        }
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn open_locked(
+        target: &Target,
+        meta: &Meta,
+        format: Format,
+        resume: bool,
+        lock: &Option<(PartialLock, bool)>,
+        note: &mut dyn FnMut(String),
+    ) -> Result<Option<(Sink, u64)>, OutputError> {
+        let path = target.path();
+        let lock = lock.as_ref().map(|(l, _)| l);
+        let names = header_for(meta.columns.as_deref());
+        let header = header_line(&names);
+        let progress_file = progress_path(path);
+        // An unfinished CSV sweep's rows are only ever continued (CSV, --resume), never
+        // overwritten by a fresh sweep of any format.
+        if let Some(l) = lock {
+            if progress_file.exists() && !(resume && matches!(format, Format::Csv)) {
+                let held = read_toml::<Progress>(&progress_file)
+                    .map(|p| format!("holds {} finished runs of", p.done))
+                    .unwrap_or_else(|_| "belongs to".into());
+                return Err(at(
+                    l.path(),
+                    format!(
+                        "{held} an unfinished CSV sweep: rerun with --resume to continue it, or delete {} and {} to start over",
+                        l.path().display(),
+                        progress_file.display()
+                    ),
+                ));
+            }
+        }
+        match format {
+            Format::Summary(agg) => return Ok(Some((Sink::Summary(agg), 0))),
+            Format::Parquet => {
+                let out = ParquetOut::create(target, lock, &names, meta)
+                    .map_err(|e| at(path, format!("cannot create it: {e}")))?;
+                return Ok(Some((Sink::Parquet(Box::new(out)), 0)));
+            }
+            Format::Csv => {}
+        }
+        let Some(lock) = lock else {
+            let out = CsvOut::create(target, None, &names, Some(meta.first_run))
+                .map_err(|e| at(path, format!("cannot write it: {e}")))?;
+            return Ok(Some((
+                Sink::Csv {
+                    out: Box::new(out),
+                    journal: None,
+                },
+                0,
+            )));
+        };
+        let start_over = format!(
+            "delete {} and {} to start over",
+            lock.path().display(),
+            progress_file.display()
+        );
+        let (out, done) = if resume && progress_file.exists() {
+            let p: Progress = read_toml(&progress_file)
+                .map_err(|e| at(path, format!("cannot resume: {e}; {start_over}")))?;
+            let cannot = |what: &str| {
+                at(
+                    path,
+                    format!(
+                        "cannot resume: {what} differs from the sweep that wrote it; rerun without --resume after deleting {} to start over",
+                        progress_file.display()
+                    ),
+                )
+            };
+            if let Some(what) = p.meta.fingerprint.differs(&meta.fingerprint) {
+                return Err(cannot(what));
+            }
+            if (p.meta.first_run, p.meta.end_run, p.meta.shard)
+                != (meta.first_run, meta.end_run, meta.shard)
+            {
+                return Err(cannot("the shard (--shard)"));
+            }
+            if p.meta.backend != meta.backend {
+                return Err(cannot("the backend (--backend, --precision)"));
+            }
+            if p.meta.columns != meta.columns {
+                return Err(cannot("the columns (--columns)"));
+            }
+            if p.sha256.is_empty() {
+                return Err(at(
+                    path,
+                    format!("cannot resume: its journal {} carries no checksum (written by an older pound); {start_over}", progress_file.display()),
+                ));
+            }
+            if p.done > meta.end_run - meta.first_run {
+                return Err(at(
+                    path,
+                    format!(
+                        "cannot resume: its journal claims {} runs of a range of {}: it was edited; {start_over}",
+                        p.done,
+                        meta.end_run - meta.first_run
+                    ),
+                ));
+            }
+            // The journal is a hint: what the `.partial` holds is checked, row by row.
+            let hasher = verify_prefix(
+                lock.path(),
+                &header,
+                meta.first_run,
+                p.done,
+                p.bytes,
+                &p.sha256,
+            )
+            .map_err(|e| at(path, format!("cannot resume: {e}; {start_over}")))?;
+            let out = CsvOut::resume(path, lock, &names, meta.first_run, hasher)
+                .map_err(|e| at(path, format!("cannot resume: {e}")))?;
+            (out, p.done)
+        } else {
+            if resume {
+                let meta_file = meta_path(path);
+                if path.exists() && meta_file.exists() {
+                    if let Ok(m) = read_toml::<Meta>(&meta_file) {
+                        let same = m.fingerprint.differs(&meta.fingerprint).is_none()
+                            && (m.first_run, m.end_run, &m.columns)
+                                == (meta.first_run, meta.end_run, &meta.columns);
+                        let intact = m.content.as_ref().is_some_and(|c| {
+                            verify_file(path, &header, Some(meta.first_run), c).is_ok()
+                        });
+                        if same && intact {
+                            note(format!("{} is already complete", path.display()));
+                            return Ok(None);
+                        }
+                    }
+                }
+                note(format!(
+                    "nothing to resume for {}: starting",
+                    path.display()
+                ));
+            }
+            let out = CsvOut::create(target, Some(lock), &names, Some(meta.first_run))
+                .map_err(|e| at(path, format!("cannot create it: {e}")))?;
+            (out, 0)
+        };
+        let mut out = out;
+        let (bytes, sha256) = out.sync().map_err(|e| at(lock.path(), e))?;
+        let progress = Progress {
+            meta: meta.clone(),
+            done,
+            bytes,
+            sha256,
+        };
+        write_toml(&progress_file, &progress).map_err(|e| at(path, e))?;
+        Ok(Some((
+            Sink::Csv {
+                out: Box::new(out),
+                journal: Some(Box::new((progress, progress_file))),
+            },
+            done,
+        )))
+    }
+
+    /// Runs of the range already on disk (resumed).
+    pub fn done(&self) -> u64 {
+        self.done
+    }
+
+    /// The runs still to compute.
+    pub fn todo(&self) -> std::ops::Range<u64> {
+        self.next_run..self.meta.end_run
+    }
+
+    /// Where rows are being written (`OUT.partial` for a file).
+    pub fn partial_path(&self) -> PathBuf {
+        match &self.lock {
+            Some(l) => l.path().to_path_buf(),
+            None => self.target.path().to_path_buf(),
+        }
+    }
+
+    /// The summary being folded (`--aggregate`), for the device fold.
+    pub fn aggregator(&mut self) -> Option<&mut Aggregator> {
+        match &mut self.sink {
+            Some(Sink::Summary(a)) => Some(a),
+            _ => None,
+        }
+    }
+
+    /// Write a chunk of finished runs, which must be the next runs in order. CSV rows are
+    /// fsynced before the journal counts them, so a crash leaves a consistent prefix.
+    pub fn take(&mut self, plan: &Plan, rows: &[(RunSpec, RunOutput)]) -> Result<(), OutputError> {
+        let path = self.partial_path();
+        for (k, (s, _)) in rows.iter().enumerate() {
+            if s.index != self.next_run + k as u64 {
+                return Err(at(
+                    &path,
+                    format!(
+                        "run {} came where run {} was due: refusing to write rows out of order",
+                        s.index,
+                        self.next_run + k as u64
+                    ),
+                ));
+            }
+        }
+        self.next_run += rows.len() as u64;
+        let columns = self.columns.as_deref();
+        let Some(sink) = &mut self.sink else {
+            return Err(at(&path, "rows after the output was finished"));
+        };
+        match sink {
+            Sink::Csv { out, journal } => {
+                out.write_encoded(&crate::io::csv::encode_csv(plan, rows, columns))
+                    .map_err(|e| at(&path, e))?;
+                if let Some(j) = journal {
+                    let (progress, file) = &mut **j;
+                    let (bytes, sha) = out.sync().map_err(|e| at(&path, e))?;
+                    progress.bytes = bytes;
+                    progress.sha256 = sha;
+                    progress.done += rows.len() as u64;
+                    write_toml(file, progress).map_err(|e| at(file, e))?;
+                }
+            }
+            Sink::Parquet(out) => {
+                let cells = crate::io::csv::cells(plan, rows, columns);
+                out.write(&cells).map_err(|e| at(&path, e))?;
+            }
+            Sink::Summary(agg) => {
+                for (s, o) in rows {
+                    let g = agg.group_of(plan, s);
+                    agg.add(g, o);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Put the output in place once it holds every run of its range: checked, labelled with
+    /// its sidecar (file outputs), renamed; the journal removed last. Returns the final path
+    /// and a line about the output (groups of a summary).
+    pub fn finish(mut self) -> Result<(PathBuf, String), OutputError> {
+        let sink = self.sink.take().expect("finished once");
+        let resumable = matches!(sink, Sink::Csv { .. });
+        let (target, lock, mut meta) = (self.target.clone(), self.lock.take(), self.meta.clone());
+        let path = target.path().to_path_buf();
+        let expect = meta.end_run - meta.first_run;
+        let is_file = target.is_file();
+        let meta_file = meta_path(&path);
+        let mut label = |c: &Content| -> std::io::Result<()> {
+            if is_file {
+                meta.content = Some(c.clone());
+                write_toml(&meta_file, &meta).map_err(std::io::Error::other)?;
+            }
+            Ok(())
+        };
+        let done = (|| -> Result<(PathBuf, String), OutputError> {
+            Ok(match sink {
+                Sink::Csv { out, journal } => {
+                    let (p, c) = out
+                        .finish(Some(expect), &mut label)
+                        .map_err(|e| at(&path, format!("not put in place: {e}")))?;
+                    if let Some(j) = journal {
+                        let file = &j.1;
+                        std::fs::remove_file(file).map_err(|e| at(file, e))?;
+                    }
+                    (p, format!("{} rows", c.rows))
+                }
+                Sink::Parquet(out) => {
+                    let (p, c) = out
+                        .finish(expect, &mut label)
+                        .map_err(|e| at(&path, format!("not put in place: {e}")))?;
+                    (p, format!("{} rows", c.rows))
+                }
+                Sink::Summary(agg) => {
+                    if agg.runs() != expect {
+                        return Err(at(
+                            &path,
+                            format!(
+                                "not written: the summary folded {} runs where the sweep has {expect}",
+                                agg.runs()
+                            ),
+                        ));
+                    }
+                    let text = crate::io::summary::csv(&agg);
+                    write_summary(&target, lock.as_ref(), text.as_bytes(), &mut label)
+                        .map_err(|e| at(&path, e))?;
+                    (path.clone(), format!("{} groups", agg.groups()))
+                }
+            })
+        })();
+        if done.is_err() && is_file {
+            if !path.exists() {
+                // No sidecar for an output that is not there (disk full, say).
+                let _ = std::fs::remove_file(&meta_file);
+            }
+            if let (false, Some(l)) = (resumable, &lock) {
+                // Only CSV can be resumed; nothing else of an unfinished output is kept.
+                let _ = std::fs::remove_file(l.path());
+            }
+        }
+        drop(lock);
+        done
+    }
+}
+
+/// Dropped unfinished (an error, a changed record): CSV rows stay in the `.partial` with their
+/// journal, for `--resume`; an unfinished Parquet file or summary cannot be continued and is
+/// removed.
+impl Drop for SweepOutput {
+    fn drop(&mut self) {
+        if matches!(self.sink, Some(Sink::Parquet(_) | Sink::Summary(_))) {
+            if let Some(l) = &self.lock {
+                let _ = std::fs::remove_file(l.path());
+            }
+        }
+    }
+}
+
+/// Write a summary whole: into the locked `.partial` (fsync, label, rename) or a stream.
+fn write_summary(
+    target: &Target,
+    lock: Option<&PartialLock>,
+    bytes: &[u8],
+    label: &mut dyn FnMut(&Content) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    use std::io::Write;
+    let content = Content {
+        rows: bytes
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count()
+            .saturating_sub(1) as u64,
+        sha256: {
+            use sha2::Digest;
+            sha2::Sha256::digest(bytes)
+                .iter()
+                .map(|b| format!("{b:02x}"))
+                .collect()
+        },
+        blocks: Vec::new(),
+    };
+    match (target, lock) {
+        (Target::File(p), Some(l)) => {
+            let written = (|| {
+                let mut f = l.file().map_err(std::io::Error::other)?;
+                crate::io::atomic::empty(&f)?;
+                f.write_all(bytes)?;
+                f.sync_all()?;
+                label(&content)?;
+                std::fs::rename(l.path(), p)
+            })();
+            if written.is_err() {
+                let _ = std::fs::remove_file(l.path());
+            }
+            written
+        }
+        _ => {
+            let mut w = crate::io::atomic::open_stream(target)?;
+            w.write_all(bytes)?;
+            w.flush()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::provenance::Fingerprint;
+
+    const CFG: &str = r#"
+[building1]
+mass_kg = 1.0e5
+period_s = [0.3, 0.6]
+damping_ratio = 0.05
+[building2]
+mass_kg = 1.0e5
+period_s = 0.9
+damping_ratio = 0.05
+[contact]
+law = "linear"
+k_n_per_m = 1e9
+gap_m = [0.0, 0.01, 0.02]
+[[record]]
+synthetic = { seed = 2, duration_s = 2.0 }
+"#;
+
+    fn rows(plan: &Plan) -> Vec<(RunSpec, RunOutput)> {
+        let mut all = Vec::new();
+        crate::engine::Engine::cpu(plan.spec.scheme, Some(2))
+            .unwrap()
+            .run(
+                plan,
+                0..plan.len(),
+                |c: &[(RunSpec, RunOutput)]| -> Result<(), crate::engine::gpu::GpuError> {
+                    all.extend_from_slice(c);
+                    Ok(())
+                },
+                |_| {},
+            )
+            .unwrap();
+        all
+    }
+
+    fn meta(plan: &Plan) -> Meta {
+        Meta {
+            fingerprint: Fingerprint::of(plan),
+            plan_runs: plan.len(),
+            first_run: 0,
+            end_run: plan.len(),
+            shard: None,
+            backend: "cpu".into(),
+            columns: None,
+            content: None,
+        }
+    }
+
+    fn open(out: &Path, plan: &Plan, resume: bool) -> Result<Opened, OutputError> {
+        SweepOutput::open(
+            Target::File(out.into()),
+            meta(plan),
+            Format::Csv,
+            None,
+            resume,
+            &mut |_| {},
+        )
+    }
+
+    fn ready(o: Result<Opened, OutputError>) -> Box<SweepOutput> {
+        match o.unwrap() {
+            Opened::Ready(o) => o,
+            Opened::Complete(p) => panic!("{} already complete", p.display()),
+        }
+    }
+
+    #[test]
+    fn an_interrupted_output_resumes_to_the_whole_and_is_labelled() {
+        let plan =
+            crate::plan::config::parse(CFG, Path::new("t.toml"), Path::new("."), Path::new("."))
+                .unwrap();
+        let all = rows(&plan);
+        assert_eq!(all.len(), 6);
+        let d = tempfile::tempdir().unwrap();
+        let whole = d.path().join("whole.csv");
+        let mut o = ready(open(&whole, &plan, false));
+        o.take(&plan, &all).unwrap();
+        o.finish().unwrap();
+        // Rows out of order are refused.
+        let mut o = ready(open(&d.path().join("order.csv"), &plan, false));
+        let e = o.take(&plan, &all[1..2]).unwrap_err();
+        assert!(
+            e.to_string().contains("run 1 came where run 0 was due"),
+            "{e}"
+        );
+        // Half the runs, then a crash (dropped unfinished): the CSV keeps its journal.
+        let out = d.path().join("o.csv");
+        let mut o = ready(open(&out, &plan, false));
+        o.take(&plan, &all[..3]).unwrap();
+        drop(o);
+        assert!(crate::io::atomic::sibling(&out, ".progress.toml").exists());
+        // A plain open refuses to overwrite it; a resume continues at run 3.
+        assert!(open(&out, &plan, false).is_err());
+        let mut o = ready(open(&out, &plan, true));
+        assert_eq!((o.done(), o.todo()), (3, 3..6));
+        o.take(&plan, &all[3..]).unwrap();
+        let (path, _) = o.finish().unwrap();
+        assert_eq!(path, out);
+        assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&whole).unwrap());
+        let m: Meta = read_toml(&meta_path(&out)).unwrap();
+        let c = m.content.unwrap();
+        assert_eq!(c.rows, 6);
+        assert_eq!(c.sha256, crate::io::journal::file_sha256(&out).unwrap());
+        // Resuming a complete, intact output does nothing.
+        assert!(matches!(
+            open(&out, &plan, true).unwrap(),
+            Opened::Complete(_)
+        ));
+    }
+
+    #[test]
+    fn an_output_missing_runs_is_not_put_in_place() {
+        let plan =
+            crate::plan::config::parse(CFG, Path::new("t.toml"), Path::new("."), Path::new("."))
+                .unwrap();
+        let all = rows(&plan);
+        let d = tempfile::tempdir().unwrap();
+        let out = d.path().join("o.csv");
+        let mut o = ready(open(&out, &plan, false));
+        o.take(&plan, &all[..5]).unwrap();
+        let e = o.finish().unwrap_err();
+        assert!(e.to_string().contains("5 rows were written where 6"), "{e}");
+        assert!(!out.exists() && !meta_path(&out).exists());
+        // A summary that folded fewer runs than the range is not written either.
+        let agg = Aggregator::new(&["gap_m".into()], &[]).unwrap();
+        let sum = d.path().join("s.csv");
+        let mut o = ready(SweepOutput::open(
+            Target::File(sum.clone()),
+            meta(&plan),
+            Format::Summary(Box::new(agg)),
+            None,
+            false,
+            &mut |_| {},
+        ));
+        o.take(&plan, &all[..4]).unwrap();
+        let e = o.finish().unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("folded 4 runs where the sweep has 6"),
+            "{e}"
+        );
+        assert!(!sum.exists() && !crate::io::atomic::sibling(&sum, ".partial").exists());
+    }
+}

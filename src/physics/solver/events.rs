@@ -1,0 +1,185 @@
+//! Locating the non-smooth instants inside a step: first touch, the turn, separation, and a
+//! touch hidden inside a free step; the mode change each calls for.
+
+use super::hermite::hermite_range;
+use super::tracker::Tracker;
+use super::{ddelta, delta, force, Mode, Segment, State};
+use crate::physics::model::{Oscillator, Pair};
+
+/// Positive once `mode` must end: first touch (Free), the turn `delta' = 0` (Approach),
+/// separation (Restitution).
+#[inline]
+pub(crate) fn event_value(p: &Pair, mode: Mode, v0: f64, z: &State) -> f64 {
+    match mode {
+        Mode::Free => p.contact.gauge(delta(p, z), ddelta(z), v0),
+        Mode::Approach => -ddelta(z),
+        Mode::Restitution => -p.contact.gauge(delta(p, z), ddelta(z), v0),
+    }
+}
+
+/// Regula falsi (Illinois) for the first instant in `(0, h]` where `f > 0`, given
+/// `f(0) <= 0 < f(h)`. `step(x)` re-takes the step with length `x`. Each estimate is followed
+/// by a guard probe `tol` beyond it (towards the other end), which closes the bracket at once
+/// when the estimate is good and keeps regula falsi from stalling on one side. Returns the length
+/// and state on the far side of the event, so the next mode starts with a consistent sign.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn locate(
+    h: f64,
+    f0: f64,
+    z1: State,
+    f1: f64,
+    tol: f64,
+    max_iter: u32,
+    mut step: impl FnMut(f64) -> State,
+    eval: impl Fn(&State) -> f64,
+) -> (f64, State) {
+    let (mut a, mut fa) = (0.0, f0.min(0.0));
+    let (mut b, mut fb, mut zb) = (h, f1, z1);
+    let mut last = 0i8;
+    for _ in 0..max_iter {
+        if b - a <= tol {
+            break;
+        }
+        let mut x = if fb != fa {
+            b - fb * (b - a) / (fb - fa)
+        } else {
+            0.5 * (a + b)
+        };
+        if !(x > a && x < b) {
+            x = 0.5 * (a + b);
+        }
+        let zx = step(x);
+        let fx = eval(&zx);
+        let g = if fx > 0.0 {
+            (b, fb, zb) = (x, fx, zx);
+            if last == 1 {
+                fa *= 0.5;
+            }
+            last = 1;
+            x - 0.5 * tol
+        } else {
+            (a, fa) = (x, fx);
+            if last == -1 {
+                fb *= 0.5;
+            }
+            last = -1;
+            x + 0.5 * tol
+        };
+        if g > a && g < b {
+            let zg = step(g);
+            let fg = eval(&zg);
+            if fg > 0.0 {
+                (b, fb, zb) = (g, fg, zg);
+            } else {
+                (a, fa) = (g, fg);
+            }
+        }
+    }
+    (b, zb)
+}
+
+/// In free mode a step whose end is still apart can hide a brief, grazing touch. If the Hermite
+/// cubic of `delta` over the step rises above 0 inside, return the fraction of the step at its
+/// maximum (the step is then re-taken to there and checked for the event).
+#[inline]
+pub(crate) fn hidden_touch(p: &Pair, z0: &State, z1: &State, h: f64) -> Option<f64> {
+    let (y0, d0, y1, d1) = (delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1));
+    if y1 > 0.0 || d0 <= 0.0 && d1 >= 0.0 {
+        return None;
+    }
+    let (m0, m1) = (h * d0, h * d1);
+    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
+    let c = 2.0 * (y0 - y1) + m0 + m1;
+    let (qa, qb, qc) = (3.0 * c, 2.0 * b, m0);
+    let mut best: Option<(f64, f64)> = None;
+    let disc = qb * qb - 4.0 * qa * qc;
+    if qa.abs() > 1e-300 && disc >= 0.0 {
+        let r = disc.sqrt();
+        for s in [(-qb + r) / (2.0 * qa), (-qb - r) / (2.0 * qa)] {
+            if s > 0.0 && s < 1.0 {
+                let v = y0 + s * (m0 + s * (b + s * c));
+                if v > 0.0 && best.is_none_or(|(bv, _)| v > bv) {
+                    best = Some((v, s));
+                }
+            }
+        }
+    }
+    best.map(|(_, s)| s)
+}
+
+/// Bound on `|u''''|` of a free oscillator over a step (inside a step `ag'' = 0`), for the
+/// Hermite error margin of the near-contact test.
+#[inline]
+fn fourth_derivative_bound(o: &Oscillator, u: f64, v: f64, seg: &Segment) -> f64 {
+    let w2 = o.k / o.m;
+    let cm = o.c / o.m;
+    let a2 = w2 * u + cm * v + seg.a0.abs().max(seg.a1.abs());
+    let a3 = w2 * v + cm * a2 + ((seg.a1 - seg.a0) / seg.dt).abs();
+    w2 * a2 + cm * a3
+}
+
+/// Could the bodies touch inside a free step from `z0` to `z1` (length `h`)? Uses the Hermite
+/// cubic of `delta` plus twice its interpolation-error bound `h^4/384 max|delta''''|`.
+#[inline]
+pub(crate) fn may_touch(p: &Pair, seg: &Segment, z0: &State, z1: &State, h: f64, v0: f64) -> bool {
+    let (d0, d1) = (delta(p, z0), delta(p, z1));
+    if p.contact.gauge(d0, ddelta(z0), v0) > 0.0 || p.contact.gauge(d1, ddelta(z1), v0) > 0.0 {
+        return true;
+    }
+    let (_, hi) = hermite_range(d0, ddelta(z0), d1, ddelta(z1), h);
+    let (u1, v1) = (z0[0].abs().max(z1[0].abs()), z0[1].abs().max(z1[1].abs()));
+    let (u2, v2) = (z0[2].abs().max(z1[2].abs()), z0[3].abs().max(z1[3].abs()));
+    let bound =
+        fourth_derivative_bound(&p.b1, u1, v1, seg) + fourth_derivative_bound(&p.b2, u2, v2, seg);
+    let h2 = h * h;
+    hi > -2.0 * h2 * h2 / 384.0 * bound
+}
+
+/// Apply the mode change an event at state `z` (time `t`) calls for; `before` is the state at
+/// the start of the step in which the event was located.
+#[inline]
+pub(crate) fn transition(
+    p: &Pair,
+    mode: Mode,
+    t: f64,
+    z: &State,
+    before: &State,
+    tr: &mut Tracker,
+) -> Mode {
+    match mode {
+        Mode::Free => {
+            let v = ddelta(z);
+            // A first touch takes v0 = delta' at delta = 0. A clamped law that re-engages while
+            // still overlapping (force back above 0) continues the previous impact's v0.
+            let v0 = if delta(p, before) <= 0.0 || tr.v0 <= 0.0 {
+                v.abs()
+            } else {
+                tr.v0
+            };
+            let v0 = v0.max(1e-12);
+            let next = if v > 0.0 {
+                Mode::Approach
+            } else {
+                Mode::Restitution
+            };
+            tr.onset(t, v0, force(p, next, v0, z));
+            next
+        }
+        Mode::Approach => Mode::Restitution,
+        Mode::Restitution => {
+            tr.end_impact();
+            Mode::Free
+        }
+    }
+}
+
+/// After a step without a located event: a restituting contact that starts to close again goes
+/// back to the approach phase.
+#[inline]
+pub(crate) fn reapproach(mode: Mode, z: &State) -> Mode {
+    if mode == Mode::Restitution && ddelta(z) > 0.0 {
+        Mode::Approach
+    } else {
+        mode
+    }
+}

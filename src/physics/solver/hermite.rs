@@ -1,0 +1,117 @@
+//! Hermite interpolation inside a step: the range of the contact gap and the peak displacement
+//! between the states the solvers keep.
+
+/// Min and max over `[0, h]` of the cubic Hermite through `(y0, y0')` and `(y1, y1')`.
+#[inline]
+pub(crate) fn hermite_range(y0: f64, d0: f64, y1: f64, d1: f64, h: f64) -> (f64, f64) {
+    let (m0, m1) = (h * d0, h * d1);
+    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
+    let c = 2.0 * (y0 - y1) + m0 + m1;
+    let p = |s: f64| y0 + s * (m0 + s * (b + s * c));
+    let (mut lo, mut hi) = (y0.min(y1), y0.max(y1));
+    for s in hermite_extrema(m0, b, c) {
+        if s > 0.0 && s < 1.0 {
+            let v = p(s);
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    (lo, hi)
+}
+
+/// Where the cubic Hermite `y0 + s (m0 + s (b + s c))` may have extrema: the roots of
+/// `p'(s) = m0 + 2 b s + 3 c s^2` by the stable formula, -1 where there is none. Callers keep
+/// those in `(0, 1)`.
+#[inline]
+pub(crate) fn hermite_extrema(m0: f64, b: f64, c: f64) -> [f64; 2] {
+    let (qa, qb, qc) = (3.0 * c, 2.0 * b, m0);
+    if qa.abs() < 1e-300 {
+        if qb != 0.0 {
+            return [-qc / qb, -1.0];
+        }
+    } else {
+        let disc = qb * qb - 4.0 * qa * qc;
+        if disc >= 0.0 {
+            let q = -0.5 * (qb + qb.signum() * disc.sqrt());
+            if q != 0.0 {
+                return [q / qa, qc / q];
+            }
+        }
+    }
+    [-1.0, -1.0]
+}
+
+/// Largest `|y|` over `[0, h]` of the quintic Hermite through `(y, y', y'')` at both ends.
+/// Used for peak displacements over free record steps, where the cubic's error,
+/// `(omega h)^4 / 384`, reaches 5e-3 at `omega h` = 1.3; the quintic's is about
+/// `(omega h)^6 / 46080`. Its extrema lie near the cubic's: each cubic extremum inside the step
+/// is refined by three Newton steps on the quintic's derivative.
+#[inline]
+pub(crate) fn quintic_peak_abs(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) -> f64 {
+    let (m0, m1, q0, q1) = (h * d[0], h * d[1], h * h * a[0], h * h * a[1]);
+    let dy = y[1] - y[0];
+    let c2 = 0.5 * q0;
+    let c3 = 10.0 * dy - 6.0 * m0 - 4.0 * m1 - 1.5 * q0 + 0.5 * q1;
+    let c4 = -15.0 * dy + 8.0 * m0 + 7.0 * m1 + 1.5 * q0 - q1;
+    let c5 = 6.0 * dy - 3.0 * m0 - 3.0 * m1 - 0.5 * q0 + 0.5 * q1;
+    let mut peak = y[0].abs().max(y[1].abs());
+    let b = 3.0 * dy - 2.0 * m0 - m1;
+    let c = -2.0 * dy + m0 + m1;
+    for s0 in hermite_extrema(m0, b, c) {
+        if !(s0 > 0.0 && s0 < 1.0) {
+            continue;
+        }
+        let mut s = s0;
+        for _ in 0..3 {
+            let d1 = m0 + s * (2.0 * c2 + s * (3.0 * c3 + s * (4.0 * c4 + s * 5.0 * c5)));
+            let d2 = 2.0 * c2 + s * (6.0 * c3 + s * (12.0 * c4 + s * 20.0 * c5));
+            if d2 != 0.0 {
+                s = (s - d1 / d2).clamp(0.0, 1.0);
+            }
+        }
+        let v = y[0] + s * (m0 + s * (c2 + s * (c3 + s * (c4 + s * c5))));
+        peak = peak.max(v.abs());
+    }
+    peak
+}
+
+#[cfg(test)]
+mod tests {
+    use super::quintic_peak_abs;
+
+    /// Exact for a quintic, and within its error bound `(omega h)^6 / 46080` for a sine whose
+    /// crest lies inside the step (where the cubic Hermite is off by up to `(omega h)^4 / 384`).
+    #[test]
+    fn quintic_peak_is_exact_for_quintics_and_tight_for_sines() {
+        let p = |t: f64| 0.3 + t * (1.0 + t * (-2.0 + t * (0.5 + t * (0.2 - 0.1 * t))));
+        let dp = |t: f64| 1.0 + t * (-4.0 + t * (1.5 + t * (0.8 - 0.5 * t)));
+        let ddp = |t: f64| -4.0 + t * (3.0 + t * (2.4 - 2.0 * t));
+        let h = 1.0;
+        let exact = (0..=100_000)
+            .map(|i| p(i as f64 * 1e-5).abs())
+            .fold(0.0, f64::max);
+        let got = quintic_peak_abs([p(0.0), p(h)], [dp(0.0), dp(h)], [ddp(0.0), ddp(h)], h);
+        assert!((got - exact).abs() < 1e-9, "{got} vs {exact}");
+        for wh in [0.3f64, 0.8, 1.3] {
+            // Step [1.2, 2.2]: the crest pi / (2 w) lies inside for w = 0.8 and 1.3, not 0.3.
+            let (w, t0) = (wh, 1.2);
+            let t1 = t0 + 1.0;
+            let y = |t: f64| (w * t).sin();
+            let got = quintic_peak_abs(
+                [y(t0), y(t1)],
+                [w * (w * t0).cos(), w * (w * t1).cos()],
+                [-w * w * y(t0), -w * w * y(t1)],
+                1.0,
+            );
+            let truth = if (t0..t1).contains(&(std::f64::consts::FRAC_PI_2 / w)) {
+                1.0
+            } else {
+                y(t0).abs().max(y(t1).abs())
+            };
+            assert!(
+                (got - truth).abs() <= wh.powi(6) / 46080.0 * 2.0 + 1e-15,
+                "omega h = {wh}: {got} vs {truth}"
+            );
+        }
+    }
+}

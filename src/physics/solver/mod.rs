@@ -1,0 +1,177 @@
+//! CPU integration of one run, in f64. Two schemes share the machinery here:
+//!
+//! - [`fast`] (production): exact linear stepping at the record's `dt` while the buildings are
+//!   apart, fixed RK4 substeps sized to the contact duration only in record steps where a contact
+//!   may happen.
+//! - [`reference`] (truth): adaptive Dormand-Prince 5(4) with error control, steps that never
+//!   cross a record sample (where `ag` has kinks), and a cap on the step in contact.
+//!
+//! Both locate every non-smooth instant inside the step (first touch `delta = 0`, the turn
+//! `delta' = 0`, separation at `delta = 0` or `F = 0`) by regula falsi on re-taken partial
+//! steps ([`events`]), so each step integrates a smooth right-hand side. The contact work
+//! `w' = F delta'` rides along as a fifth state so the dissipated energy is integrated to the
+//! scheme's own order. [`tracker`] keeps peaks and impacts, [`hermite`] the peaks between
+//! samples; [`collision`] solves one isolated collision (the `exact` restitution formula).
+//! `shaders/fast.wgsl` is the GPU twin of [`fast`], function for function.
+
+pub mod collision;
+mod events;
+pub mod fast;
+mod hermite;
+pub mod reference;
+mod tracker;
+
+pub use collision::{single_collision, single_collision_observed, Collision, EXACT_RTOL};
+pub use fast::FastOptions;
+pub use reference::ReferenceOptions;
+
+use crate::physics::model::{Forcing, Initial, Pair, RunOutput};
+
+/// `[u1, v1, u2, v2, w, e_in, e_damp]`: displacements and velocities, then the contact work
+/// `w' = F delta'`, the input work `e_in' = -ag (m1 v1 + m2 v2)` and the structural damping work
+/// `e_damp' = c1 v1^2 + c2 v2^2`. The last two ride along for the energy balance; error control
+/// and events look only at the first five.
+pub type State = [f64; 7];
+
+/// Contact mode; changes only at located events.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    Free,
+    Approach,
+    Restitution,
+}
+
+/// Which integration scheme a run uses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Scheme {
+    Fast(FastOptions),
+    Reference(ReferenceOptions),
+}
+
+impl Scheme {
+    pub fn key(&self) -> &'static str {
+        match self {
+            Scheme::Fast(_) => "fast",
+            Scheme::Reference(_) => "reference",
+        }
+    }
+}
+
+/// A point handed to an observer after every accepted step and event.
+#[derive(Debug, Clone, Copy)]
+pub struct Sample {
+    pub t: f64,
+    pub z: State,
+    pub force: f64,
+    pub mode: Mode,
+}
+
+/// Simulate one run from rest (or from `init`) over the forcing's whole duration.
+pub fn simulate(pair: &Pair, forcing: &Forcing, init: &Initial, scheme: &Scheme) -> RunOutput {
+    simulate_observed(pair, forcing, init, scheme, None)
+}
+
+/// As [`simulate`], calling `observer` after every step.
+pub fn simulate_observed(
+    pair: &Pair,
+    forcing: &Forcing,
+    init: &Initial,
+    scheme: &Scheme,
+    observer: Option<&mut dyn FnMut(&Sample)>,
+) -> RunOutput {
+    match scheme {
+        Scheme::Fast(o) => fast::run(pair, forcing, init, o, observer),
+        Scheme::Reference(o) => reference::run(pair, forcing, init, o, observer, None),
+    }
+}
+
+/// Ground acceleration over one record interval: linear from `a0` at `t0` to `a1` at `t0 + dt`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Segment {
+    pub t0: f64,
+    pub dt: f64,
+    pub a0: f64,
+    pub a1: f64,
+}
+
+impl Segment {
+    pub fn of(forcing: &Forcing, i: usize) -> Segment {
+        Segment {
+            t0: forcing.t0 + i as f64 * forcing.dt,
+            dt: forcing.dt,
+            a0: forcing.sample(i),
+            a1: forcing.sample(i + 1),
+        }
+    }
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        self.a0 + (self.a1 - self.a0) * ((t - self.t0) / self.dt)
+    }
+    pub fn t1(&self) -> f64 {
+        self.t0 + self.dt
+    }
+}
+
+#[inline]
+pub(crate) fn delta(p: &Pair, z: &State) -> f64 {
+    z[0] - z[2] - p.gap
+}
+
+#[inline]
+pub(crate) fn ddelta(z: &State) -> f64 {
+    z[1] - z[3]
+}
+
+/// Contact force in `mode`.
+#[inline]
+pub(crate) fn force(p: &Pair, mode: Mode, v0: f64, z: &State) -> f64 {
+    match mode {
+        Mode::Free => 0.0,
+        _ => p
+            .contact
+            .force(delta(p, z), ddelta(z), v0, mode == Mode::Approach),
+    }
+}
+
+// Always inlined: with the energy terms it grew past the inliner's threshold, and the call
+// cost 25 % of the CPU fast path's runs/s.
+#[inline(always)]
+pub(crate) fn rhs(p: &Pair, mode: Mode, v0: f64, ag: f64, z: &State) -> State {
+    let f = force(p, mode, v0, z);
+    let (b1, b2) = (&p.b1, &p.b2);
+    [
+        z[1],
+        (-b1.c * z[1] - b1.k * z[0] - f) / b1.m - ag,
+        z[3],
+        (-b2.c * z[3] - b2.k * z[2] + f) / b2.m - ag,
+        f * ddelta(z),
+        -ag * (b1.m * z[1] + b2.m * z[3]),
+        b1.c * z[1] * z[1] + b2.c * z[3] * z[3],
+    ]
+}
+
+/// Relative acceleration `delta''` from the structures alone (the ground motion cancels).
+#[inline]
+pub(crate) fn structural_rel_accel(p: &Pair, z: &State) -> f64 {
+    let (b1, b2) = (&p.b1, &p.b2);
+    -(b1.c * z[1] + b1.k * z[0]) / b1.m + (b2.c * z[3] + b2.k * z[2]) / b2.m
+}
+
+/// Step that resolves an impact at approach speed `v` with `per_contact` steps. The impact
+/// lasts the free-collision duration `t_c(v)`, or less when the structures reverse the relative
+/// motion first (about `2 v / |a|` for a relative deceleration `a`); the kinematic bound is
+/// floored at `t_c / 16` so a grazing touch cannot ask for unbounded steps.
+pub(crate) fn impact_step(p: &Pair, v: f64, a: f64, per_contact: f64) -> f64 {
+    let tc = p.contact.duration_estimate(v);
+    let tk = if a != 0.0 {
+        2.0 * v / a.abs()
+    } else {
+        f64::INFINITY
+    };
+    let t = tc.min(tk.max(tc / 16.0));
+    t / (per_contact * (1.0 + 2.0 * p.contact.damping_ratio))
+}
+
+pub(crate) fn finite(z: &State) -> bool {
+    z.iter().all(|x| x.is_finite())
+}

@@ -1,0 +1,270 @@
+//! What a run records as it goes (peaks, impacts, the energy balance) and the state of one run
+//! being integrated, shared by both schemes.
+
+use super::events::{event_value, hidden_touch, locate, reapproach, transition};
+use super::hermite::{hermite_range, quintic_peak_abs};
+use super::{ddelta, delta, force, Mode, Sample, Segment, State};
+use crate::physics::model::{EnergyBalance, Initial, Pair, RunOutput, Status};
+
+/// Peaks and impact bookkeeping shared by both schemes.
+pub(crate) struct Tracker {
+    pub out: RunOutput,
+    /// Approach speed of the current impact.
+    pub v0: f64,
+    imp_peak: f64,
+    /// Kinetic plus strain energy at the start, and the largest `initial + input` so far (the
+    /// energy balance's scale).
+    e_initial: f64,
+    e_peak: f64,
+    /// Onset time of the current impact; force-sample times are kept relative to it, as the
+    /// shader does (so f32 times keep their resolution late in a record).
+    t_onset: f64,
+    hist: [(f64, f64); 2],
+    nhist: usize,
+    impacts_ended: u32,
+}
+
+impl Tracker {
+    pub fn new() -> Tracker {
+        Tracker {
+            out: RunOutput::default(),
+            v0: 0.0,
+            imp_peak: 0.0,
+            e_initial: 0.0,
+            e_peak: 0.0,
+            t_onset: 0.0,
+            hist: [(0.0, 0.0); 2],
+            nhist: 0,
+            impacts_ended: 0,
+        }
+    }
+
+    /// Onset time of the current (or last) impact.
+    pub fn onset_time(&self) -> f64 {
+        self.t_onset
+    }
+
+    pub fn impacts_ended(&self) -> u32 {
+        self.impacts_ended
+    }
+
+    /// Account for a free record step over `seg`, from `z0` to `z1`: peak displacements from
+    /// the quintic Hermite (both ends' accelerations are known in free flight).
+    #[inline]
+    pub fn free_step(&mut self, p: &Pair, seg: &Segment, z0: &State, z1: &State) {
+        let acc = |o: &crate::physics::model::Oscillator, u: f64, v: f64, ag: f64| {
+            (-o.c * v - o.k * u) / o.m - ag
+        };
+        let o = &mut self.out;
+        let a1 = [
+            acc(&p.b1, z0[0], z0[1], seg.a0),
+            acc(&p.b1, z1[0], z1[1], seg.a1),
+        ];
+        let pk = quintic_peak_abs([z0[0], z1[0]], [z0[1], z1[1]], a1, seg.dt);
+        o.peak_u1 = o.peak_u1.max(pk);
+        let a2 = [
+            acc(&p.b2, z0[2], z0[3], seg.a0),
+            acc(&p.b2, z1[2], z1[3], seg.a1),
+        ];
+        let pk = quintic_peak_abs([z0[2], z1[2]], [z0[3], z1[3]], a2, seg.dt);
+        o.peak_u2 = o.peak_u2.max(pk);
+        self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
+    }
+
+    /// Account for a step `t0 -> t0 + h` spent in `mode`, from `z0` to `z1`.
+    #[inline]
+    pub fn step(&mut self, p: &Pair, mode: Mode, t0: f64, h: f64, z0: &State, z1: &State) {
+        let o = &mut self.out;
+        let (lo, hi) = hermite_range(z0[0], z0[1], z1[0], z1[1], h);
+        o.peak_u1 = o.peak_u1.max(hi.abs()).max(lo.abs());
+        let (lo, hi) = hermite_range(z0[2], z0[3], z1[2], z1[3], h);
+        o.peak_u2 = o.peak_u2.max(hi.abs()).max(lo.abs());
+        self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
+        if mode != Mode::Free {
+            o.contact_time += h;
+            let (_, dmax) = hermite_range(delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1), h);
+            o.peak_penetration = o.peak_penetration.max(dmax);
+            o.dissipated_energy = z1[4];
+            let f = force(p, mode, self.v0, z1);
+            self.force_sample(t0 + h - self.t_onset, f);
+        }
+    }
+
+    /// A force sample `t` after the onset of the current impact; a local maximum of three samples is refined by
+    /// the vertex of their parabola.
+    fn force_sample(&mut self, t: f64, f: f64) {
+        self.imp_peak = self.imp_peak.max(f);
+        if self.nhist == 2 {
+            let [(x0, y0), (x1, y1)] = self.hist;
+            if y1 >= y0 && y1 >= f && x1 > x0 && t > x1 {
+                let d1 = (y1 - y0) / (x1 - x0);
+                let d2 = (f - y1) / (t - x1);
+                let a = (d2 - d1) / (t - x0);
+                if a < 0.0 {
+                    // Newton form around x0, x1: y(x) = y0 + d1 (x - x0) + a (x - x0)(x - x1).
+                    let xv = (0.5 * (x0 + x1) - 0.5 * d1 / a).clamp(x0, t);
+                    let yv = y0 + d1 * (xv - x0) + a * (xv - x0) * (xv - x1);
+                    self.imp_peak = self.imp_peak.max(yv);
+                }
+            }
+            self.hist = [self.hist[1], (t, f)];
+        } else {
+            self.hist[self.nhist] = (t, f);
+            self.nhist += 1;
+        }
+    }
+
+    #[inline]
+    pub fn onset(&mut self, t: f64, v0: f64, f: f64) {
+        self.out.impacts += 1;
+        if self.out.first_impact.is_none() {
+            self.out.first_impact = Some(t);
+        }
+        self.v0 = v0;
+        self.imp_peak = 0.0;
+        self.t_onset = t;
+        self.nhist = 0;
+        self.force_sample(0.0, f);
+    }
+
+    #[inline]
+    pub fn end_impact(&mut self) {
+        if self.imp_peak > self.out.peak_force {
+            self.out.peak_force = self.imp_peak;
+            self.out.impact_velocity = self.v0;
+        }
+        self.impacts_ended += 1;
+    }
+
+    pub fn finish(mut self, mode: Mode, status: Status) -> RunOutput {
+        if mode != Mode::Free {
+            self.end_impact();
+        }
+        self.out.status = status;
+        self.out
+    }
+
+    /// The energy balance at state `z`.
+    #[inline]
+    pub fn energy(&self, p: &Pair, z: &State) -> EnergyBalance {
+        let held = mechanical_energy(p, z);
+        EnergyBalance::close(self.e_initial, z[5], z[6], z[4], held, self.e_peak)
+    }
+}
+
+/// Kinetic plus strain energy of both buildings, J.
+#[inline]
+pub(crate) fn mechanical_energy(p: &Pair, z: &State) -> f64 {
+    p.b1.energy(z[0], z[1]) + p.b2.energy(z[2], z[3])
+}
+
+/// The state of one run being integrated, shared by both schemes: they decide step lengths and
+/// take trial steps; [`Integration::accept`] does the rest.
+pub(crate) struct Integration<'a, 'o> {
+    pub pair: &'a Pair,
+    pub z: State,
+    pub mode: Mode,
+    pub tr: Tracker,
+    /// Report the energy balance (its integrals are complete).
+    pub energy: bool,
+    observer: Option<&'o mut dyn FnMut(&Sample)>,
+}
+
+impl<'a, 'o> Integration<'a, 'o> {
+    /// Start at `t0` from `init` (already in contact if the bodies overlap).
+    pub fn start(
+        pair: &'a Pair,
+        init: &Initial,
+        t0: f64,
+        observer: Option<&'o mut dyn FnMut(&Sample)>,
+    ) -> Self {
+        let z = [init.u1, init.v1, init.u2, init.v2, 0.0, 0.0, 0.0];
+        let mut run = Integration {
+            pair,
+            z,
+            mode: Mode::Free,
+            tr: Tracker::new(),
+            energy: true,
+            observer,
+        };
+        run.tr.e_initial = mechanical_energy(pair, &z);
+        if event_value(pair, run.mode, 0.0, &z) > 0.0 {
+            run.mode = transition(pair, run.mode, t0, &z, &z, &mut run.tr);
+        }
+        run.emit(t0);
+        run
+    }
+
+    pub fn emit(&mut self, t: f64) {
+        if let Some(obs) = self.observer.as_mut() {
+            let force = force(self.pair, self.mode, self.tr.v0, &self.z);
+            obs(&Sample {
+                t,
+                z: self.z,
+                force,
+                mode: self.mode,
+            });
+        }
+    }
+
+    /// The free record step over `seg` to `z1`, with no possible contact (already checked by the
+    /// caller).
+    pub fn free_step(&mut self, seg: &Segment, z1: State) {
+        self.tr.free_step(self.pair, seg, &self.z, &z1);
+        self.z = z1;
+        self.emit(seg.t1());
+    }
+
+    /// Accept `trial`, the step `t -> t + h` in the current mode; `step(x)` re-takes it with
+    /// length `x`. A touch hidden inside a free step and any event inside the step are located
+    /// (to `tol_rel * h`, at most `max_iter` iterations); the step then ends there. Updates peaks
+    /// and mode and returns the length advanced.
+    pub fn accept(
+        &mut self,
+        t: f64,
+        h: f64,
+        trial: State,
+        tol_rel: f64,
+        max_iter: u32,
+        mut step: impl FnMut(f64) -> State,
+    ) -> f64 {
+        let (p, mode, v0, z0) = (self.pair, self.mode, self.tr.v0, self.z);
+        let (mut trial, mut h) = (trial, h);
+        let mut f1 = event_value(p, mode, v0, &trial);
+        if mode == Mode::Free && f1 <= 0.0 {
+            if let Some(s) = hidden_touch(p, &z0, &trial, h) {
+                let zs = step(s * h);
+                let fs = event_value(p, mode, v0, &zs);
+                if fs > 0.0 {
+                    (trial, f1, h) = (zs, fs, s * h);
+                }
+            }
+        }
+        let advanced = if f1 > 0.0 {
+            let f0 = event_value(p, mode, v0, &z0);
+            let tol = (tol_rel * h).max(4.0 * f64::EPSILON * t.abs());
+            let eval = |s: &State| event_value(p, mode, v0, s);
+            let (x, zb) = locate(h, f0, trial, f1, tol, max_iter, &mut step, eval);
+            self.tr.step(p, mode, t, x, &z0, &zb);
+            self.mode = transition(p, mode, t + x, &zb, &z0, &mut self.tr);
+            self.z = zb;
+            x
+        } else {
+            self.tr.step(p, mode, t, h, &z0, &trial);
+            self.z = trial;
+            self.mode = reapproach(mode, &self.z);
+            h
+        };
+        self.emit(t + advanced);
+        advanced
+    }
+
+    /// End the run with `status`, after `substeps` steps of integration work.
+    pub fn finish(self, status: Status, substeps: u64) -> RunOutput {
+        let energy = self.energy.then(|| self.tr.energy(self.pair, &self.z));
+        let mut out = self.tr.finish(self.mode, status);
+        out.substeps = substeps;
+        out.energy = energy;
+        out
+    }
+}

@@ -1,0 +1,186 @@
+//! The schema of a run: its swept parameters and outputs as named columns (units in the
+//! names), and the text of each cell. CSV, Parquet, `--columns`, `--aggregate` groups and the
+//! device fold all name columns from here.
+
+use crate::physics::model::RunOutput;
+use crate::plan::{Intensity, Plan, RunSpec};
+
+/// Every column, in file order: the swept parameters, then the status and the outputs. Units are
+/// in the names. The last three, the energy balance, are empty unless it was asked for
+/// (`run.energy`, `--energy`).
+pub const HEADER: [&str; 33] = [
+    "run",
+    "law",
+    "formula",
+    "e",
+    "impact_damping",
+    "k_n_per_m",
+    "beta_n_per_m1_5",
+    "record",
+    "target_pga_g",
+    "scale_factor",
+    "pga_g",
+    "m1_kg",
+    "t1_s",
+    "xi1",
+    "m2_kg",
+    "t2_s",
+    "xi2",
+    "gap_m",
+    "sample",
+    "status",
+    "impacts",
+    "peak_force_n",
+    "peak_penetration_m",
+    "peak_u1_m",
+    "peak_u2_m",
+    "impact_velocity_m_s",
+    "first_impact_s",
+    "contact_time_s",
+    "dissipated_energy_j",
+    "substeps",
+    "input_energy_j",
+    "damping_energy_j",
+    "energy_residual",
+];
+
+/// Where [`SUMMARISED`] lies in [`HEADER`].
+const SUMMARISED_AT: [usize; 8] = [20, 21, 22, 23, 24, 25, 27, 28];
+
+/// The outputs an `--aggregate` summary folds per group (as magnitudes): every numeric output
+/// but the first impact's time (absent where nothing touches), the step count and the energy
+/// balance (absent unless asked for).
+pub const SUMMARISED: [&str; 8] = {
+    let mut names = [""; 8];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = HEADER[SUMMARISED_AT[i]];
+        i += 1;
+    }
+    names
+};
+
+/// Shortest round-trip text; scientific notation outside [1e-4, 1e15) so tiny values stay short.
+fn num(x: f64) -> String {
+    let a = x.abs();
+    if a != 0.0 && !(1e-4..1e15).contains(&a) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// The fields of one row, in [`HEADER`] order.
+pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
+    let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+    let hertz = spec.law.is_hertzian();
+    vec![
+        spec.index.to_string(),
+        spec.law.key().to_string(),
+        spec.formula
+            .map(|f| f.key().to_string())
+            .unwrap_or_default(),
+        opt(spec.e),
+        if spec.law.is_damped() {
+            num(spec.damping)
+        } else {
+            String::new()
+        },
+        if hertz {
+            String::new()
+        } else {
+            num(spec.stiffness)
+        },
+        if hertz {
+            num(spec.stiffness)
+        } else {
+            String::new()
+        },
+        plan.spec.records[spec.record].name.clone(),
+        match spec.intensity {
+            Intensity::PgaG(g) => num(g),
+            Intensity::Scale(_) => String::new(),
+        },
+        num(spec.scale),
+        num(spec.pga_g),
+        num(spec.m1),
+        num(spec.t1),
+        num(spec.xi1),
+        num(spec.m2),
+        num(spec.t2),
+        num(spec.xi2),
+        num(spec.gap),
+        spec.sample.map(|s| s.to_string()).unwrap_or_default(),
+        out.status.key().to_string(),
+        out.impacts.to_string(),
+        num(out.peak_force),
+        num(out.peak_penetration),
+        num(out.peak_u1),
+        num(out.peak_u2),
+        num(out.impact_velocity),
+        opt(out.first_impact),
+        num(out.contact_time),
+        num(out.dissipated_energy),
+        out.substeps.to_string(),
+        opt(out.energy.map(|e| e.input)),
+        opt(out.energy.map(|e| e.damping)),
+        opt(out.energy.map(|e| e.residual)),
+    ]
+}
+
+/// Indices into [`header`] of `names` (`run` first, added if missing), or the first name that is
+/// not a column.
+pub fn select(names: &[String]) -> Result<Vec<usize>, String> {
+    let h = header();
+    let mut idx = vec![0];
+    for n in names {
+        let i = h.iter().position(|c| c == n).ok_or_else(|| n.clone())?;
+        if !idx.contains(&i) {
+            idx.push(i);
+        }
+    }
+    Ok(idx)
+}
+
+/// All column names.
+pub fn header() -> Vec<&'static str> {
+    HEADER.to_vec()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn select_keeps_run_first_once_and_names_the_first_unknown() {
+        let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+        let h = header();
+        let at = |c: &str| h.iter().position(|x| *x == c).unwrap();
+        assert_eq!(
+            select(&names(&["gap_m", "peak_force_n"])),
+            Ok(vec![0, at("gap_m"), at("peak_force_n")])
+        );
+        assert_eq!(
+            select(&names(&["peak_force_n", "run", "peak_force_n"])),
+            Ok(vec![0, at("peak_force_n")])
+        );
+        assert_eq!(select(&[]), Ok(vec![0]));
+        assert_eq!(
+            select(&names(&["gap_m", "gap", "nope"])),
+            Err("gap".to_string())
+        );
+    }
+
+    #[test]
+    fn header_names_are_unique_and_summarised_outputs_are_outputs() {
+        let mut h = header();
+        h.sort();
+        h.dedup();
+        assert_eq!(h.len(), HEADER.len());
+        let status = HEADER.iter().position(|c| *c == "status").unwrap();
+        for s in SUMMARISED {
+            let i = HEADER.iter().position(|c| *c == s).unwrap();
+            assert!(i > status, "{s} is an output column");
+        }
+    }
+}

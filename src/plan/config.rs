@@ -1,0 +1,835 @@
+//! TOML sweep configs: raw serde structs (stage 1), turned into a validated [`Plan`] (stage 2).
+//! Every error names the file and the key; unknown keys are errors.
+//!
+//! An axis is a number, a list of numbers, or a range table
+//! `{ from = .., to = .., n = .. }` (add `log = true` for log spacing) or `{ from, to, step }`.
+
+use crate::physics::contact::LawKind;
+use crate::physics::restitution::Formula;
+use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
+use crate::plan::sample::{draw, Dist, Method};
+use crate::plan::{BuildingAxes, Intensity, Plan, PlanError, PlanSpec, SampledAxis, Samples};
+use crate::record::{
+    read_record, synthetic, Format, ReadOptions, Record, RecordError, SyntheticSpec, Units,
+};
+use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
+use serde::Deserialize;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Default directory of real records when `POUND_RECORDS_DIR` is unset (relative to the working
+/// directory, i.e. the repository root beside `shared/`).
+pub const DEFAULT_RECORDS_DIR: &str = "../shared/records";
+
+/// Where `file = ...` records are looked up.
+pub fn records_dir() -> PathBuf {
+    std::env::var_os("POUND_RECORDS_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_RECORDS_DIR))
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{}: cannot read config: {error}", path.display())]
+    Io {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    #[error("{}: {message}", path.display())]
+    Toml { path: PathBuf, message: String },
+    #[error("{}: {key}: {message}", path.display())]
+    Invalid {
+        path: PathBuf,
+        key: String,
+        message: String,
+    },
+    #[error("{}: {key}: {error}", path.display())]
+    Record {
+        path: PathBuf,
+        key: String,
+        error: RecordError,
+    },
+}
+
+/// A sweep axis as written.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Axis {
+    List(Vec<f64>),
+    Range(RangeSpec),
+}
+
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangeSpec {
+    pub from: f64,
+    pub to: f64,
+    pub n: Option<usize>,
+    pub step: Option<f64>,
+    #[serde(default)]
+    pub log: bool,
+}
+
+impl<'de> Deserialize<'de> for Axis {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Axis, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Axis;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number, a list of numbers, or a range table { from, to, n } / { from, to, step }")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Axis, E> {
+                Ok(Axis::List(vec![v]))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Axis, E> {
+                Ok(Axis::List(vec![v as f64]))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Axis, E> {
+                Ok(Axis::List(vec![v as f64]))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Axis, A::Error> {
+                let mut v = Vec::new();
+                while let Some(x) = seq.next_element::<f64>()? {
+                    v.push(x);
+                }
+                Ok(Axis::List(v))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Axis, A::Error> {
+                RangeSpec::deserialize(de::value::MapAccessDeserializer::new(map)).map(Axis::Range)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// Parse `start:stop:step` (the CLI's range syntax) into values, stop included.
+pub fn parse_colon_range(s: &str) -> Option<Vec<f64>> {
+    let p: Vec<f64> = s
+        .split(':')
+        .map(|x| x.trim().parse().ok())
+        .collect::<Option<_>>()?;
+    match p[..] {
+        [v] => Some(vec![v]),
+        [a, b, st] => Axis::Range(RangeSpec {
+            from: a,
+            to: b,
+            n: None,
+            step: Some(st),
+            log: false,
+        })
+        .values()
+        .ok(),
+        _ => None,
+    }
+}
+
+/// Round to 12 significant digits, so generated ranges read as typed (0.35, not
+/// 0.35000000000000003) in outputs.
+fn tidy(v: f64) -> f64 {
+    format!("{v:.11e}").parse().unwrap_or(v)
+}
+
+impl Axis {
+    pub fn values(&self) -> Result<Vec<f64>, String> {
+        match self {
+            Axis::List(v) => Ok(v.clone()),
+            Axis::Range(r) => Self::range_values(r).map(|v| v.into_iter().map(tidy).collect()),
+        }
+    }
+
+    /// The number of values, without computing them (so a sweep too large to run is refused
+    /// before gigabytes of axes are built).
+    pub fn count(&self) -> Result<usize, String> {
+        match self {
+            Axis::List(v) => Ok(v.len()),
+            Axis::Range(r) => Self::range_count(r),
+        }
+    }
+
+    fn range_count(r: &RangeSpec) -> Result<usize, String> {
+        let max = crate::plan::limits::MAX_AXIS_POINTS;
+        if !(r.from.is_finite() && r.to.is_finite()) {
+            return Err("range ends must be finite".into());
+        }
+        match (r.n, r.step) {
+            (Some(n), None) => {
+                if n == 0 || n > max {
+                    return Err(format!("n = {n}: expected 1 to 1e7 points"));
+                }
+                if n == 1 && r.to != r.from {
+                    return Err(format!(
+                        "n = 1 gives the single value from = {}, and to = {} would be ignored: give one value, or n >= 2",
+                        r.from, r.to
+                    ));
+                }
+                Ok(n)
+            }
+            (None, Some(step)) if !r.log => {
+                if !(step.is_finite() && step != 0.0) || (r.to - r.from) * step < 0.0 {
+                    return Err(format!(
+                        "step = {step:?} does not lead from {:?} to {:?}",
+                        r.from, r.to
+                    ));
+                }
+                let count = ((r.to - r.from) / step + 1e-9).floor() + 1.0;
+                if count.is_nan() || count > max as f64 {
+                    return Err(format!(
+                        "step = {step:?} gives {count:.3e} points from {:?} to {:?}: expected at most 1e7",
+                        r.from, r.to
+                    ));
+                }
+                Ok(count as usize)
+            }
+            _ => Err("give exactly one of n or step (log ranges take n)".into()),
+        }
+    }
+
+    fn range_values(r: &RangeSpec) -> Result<Vec<f64>, String> {
+        let count = Self::range_count(r)?;
+        match (r.n, r.step) {
+            (Some(n), None) => {
+                if n == 1 {
+                    return Ok(vec![r.from]);
+                }
+                if r.log {
+                    if !(r.from > 0.0 && r.to > 0.0) {
+                        return Err("a log range needs from > 0 and to > 0".into());
+                    }
+                    let (a, b) = (r.from.ln(), r.to.ln());
+                    Ok((0..n)
+                        .map(|i| {
+                            if i == n - 1 {
+                                r.to
+                            } else {
+                                (a + (b - a) * i as f64 / (n - 1) as f64).exp()
+                            }
+                        })
+                        .collect())
+                } else {
+                    Ok((0..n)
+                        .map(|i| {
+                            if i == n - 1 {
+                                r.to
+                            } else {
+                                r.from + (r.to - r.from) * i as f64 / (n - 1) as f64
+                            }
+                        })
+                        .collect())
+                }
+            }
+            (None, Some(step)) => Ok((0..count).map(|i| r.from + step * i as f64).collect()),
+            _ => Err("give exactly one of n or step (log ranges take n)".into()),
+        }
+    }
+}
+
+/// One string or a list of strings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum Names {
+    One(String),
+    List(Vec<String>),
+}
+
+impl Names {
+    fn list(&self) -> Vec<String> {
+        match self {
+            Names::One(s) => vec![s.clone()],
+            Names::List(v) => v.clone(),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRun {
+    /// "fast" (default) or "reference".
+    pub scheme: Option<String>,
+    pub substeps_per_contact: Option<f64>,
+    /// Stated accuracy of the reference scheme (relative, peak force).
+    pub tol: Option<f64>,
+    pub tail_s: Option<f64>,
+    /// Report each run's energy balance (fast scheme; the reference always does).
+    pub energy: Option<bool>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBuilding {
+    /// Each may be left out when `[[sample.axis]]` samples it.
+    pub mass_kg: Option<Axis>,
+    pub period_s: Option<Axis>,
+    pub damping_ratio: Option<Axis>,
+}
+
+/// `[sample]`: uncertain parameters drawn jointly, crossed with every grid axis.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSample {
+    /// `latin_hypercube` (default) or `monte_carlo`.
+    pub method: Option<String>,
+    pub n: usize,
+    pub seed: u64,
+    #[serde(rename = "axis", default)]
+    pub axes: Vec<RawSampledAxis>,
+}
+
+/// One `[[sample.axis]]`: `key` names the parameter as in the grid (`building1.period_s`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSampledAxis {
+    pub key: String,
+    /// `uniform` (min, max), `normal` (mean, sd; min, max optional) or `lognormal` (median,
+    /// beta = the log standard deviation; min, max optional).
+    pub dist: String,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub mean: Option<f64>,
+    pub sd: Option<f64>,
+    pub median: Option<f64>,
+    pub beta: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawContact {
+    pub law: Names,
+    pub formula: Option<Names>,
+    pub e: Option<Axis>,
+    /// May be left out when sampled.
+    pub gap_m: Option<Axis>,
+    pub k_n_per_m: Option<Axis>,
+    pub beta_n_per_m1_5: Option<Axis>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSynthetic {
+    pub seed: u64,
+    pub duration_s: Option<f64>,
+    pub dt_s: Option<f64>,
+    pub pga_g: Option<f64>,
+    pub fg_hz: Option<f64>,
+    pub zeta_g: Option<f64>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRecord {
+    /// A file in the records directory (`POUND_RECORDS_DIR`, default `../shared/records`).
+    pub file: Option<String>,
+    /// A file path, relative to the config file.
+    pub path: Option<String>,
+    pub synthetic: Option<RawSynthetic>,
+    /// Label in outputs (default: file stem, or `synthetic-sSEED`).
+    pub name: Option<String>,
+    pub format: Option<String>,
+    pub units: Option<String>,
+    pub dt_s: Option<f64>,
+    pub skip_lines: Option<usize>,
+    /// `[start, end]`, s: simulate only this part of the record.
+    pub window_s: Option<[f64; 2]>,
+}
+
+impl RawRecord {
+    /// The file this record reads: `file =` in the records directory `records`, `path =`
+    /// relative to the config's folder `base`; None for a synthetic record.
+    fn file_path(&self, base: &Path, records: &Path) -> Option<PathBuf> {
+        match (&self.file, &self.path) {
+            (Some(f), _) => Some(records.join(f)),
+            (_, Some(p)) => Some(base.join(p)),
+            _ => None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawIntensity {
+    pub pga_g: Option<Axis>,
+    pub scale: Option<Axis>,
+}
+
+/// A config file as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawConfig {
+    #[serde(default)]
+    pub run: RawRun,
+    pub building1: RawBuilding,
+    pub building2: RawBuilding,
+    pub contact: RawContact,
+    #[serde(rename = "record", default)]
+    pub records: Vec<RawRecord>,
+    #[serde(default)]
+    pub intensity: RawIntensity,
+    pub sample: Option<RawSample>,
+}
+
+/// Read and validate a config file.
+pub fn load(path: &Path) -> Result<Plan, ConfigError> {
+    load_with_text(path).map(|(plan, _)| plan)
+}
+
+/// [`load`], also returning the config's text (for [`changed_records`]).
+pub fn load_with_text(path: &Path) -> Result<(Plan, String), ConfigError> {
+    let text = read_text(path)?;
+    let plan = load_text(&text, path)?;
+    Ok((plan, text))
+}
+
+/// The text of a config file, read once (it may be a pipe: `pound sweep <(make-config)`).
+pub fn read_text(path: &Path) -> Result<String, ConfigError> {
+    std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
+        path: path.into(),
+        error,
+    })
+}
+
+/// Validate config `text` read from `path` (records resolved beside it and in
+/// [`records_dir`]).
+pub fn load_text(text: &str, path: &Path) -> Result<Plan, ConfigError> {
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse(text, path, &base, &records_dir())
+}
+
+/// The record files config `text` (read from `path`) reads, `file =` and `path =` records
+/// resolved, so a command can refuse to write over one of them. Text that does not parse lists
+/// none (loading it reports the error).
+pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
+    let Ok(raw) = toml::from_str::<RawConfig>(text) else {
+        return Vec::new();
+    };
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let records = records_dir();
+    raw.records
+        .iter()
+        .filter_map(|r| r.file_path(&base, &records))
+        .collect()
+}
+
+/// The records of `plan` (from the config `text` at `path`) whose files no longer hold what was
+/// read, by name; or why they cannot be read again. A sweep reads its records once, so this
+/// finds files changed while it ran.
+pub fn changed_records(text: &str, path: &Path, plan: &Plan) -> Vec<String> {
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    match parse(text, path, &base, &records_dir()) {
+        Err(e) => vec![format!("the records can no longer be read ({e})")],
+        Ok(now) => plan
+            .spec
+            .records
+            .iter()
+            .zip(&now.spec.records)
+            .filter(|(a, b)| a != b)
+            .map(|(a, _)| format!("record `{}`", a.name))
+            .collect(),
+    }
+}
+
+/// Parse and validate config text. `path` names the file in errors; `base` resolves `path =`
+/// records; `records` resolves `file =` records.
+pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Plan, ConfigError> {
+    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Toml {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    let invalid = |key: &str, message: String| ConfigError::Invalid {
+        path: path.into(),
+        key: key.into(),
+        message,
+    };
+    let axis = |key: &str, a: &Axis| a.values().map_err(|m| invalid(key, m));
+    let opt_axis =
+        |key: &str, a: &Option<Axis>| a.as_ref().map_or(Ok(Vec::new()), |a| axis(key, a));
+
+    let scheme = match raw.run.scheme.as_deref().unwrap_or("fast") {
+        "fast" => {
+            let mut o = FastOptions::default();
+            if let Some(n) = raw.run.substeps_per_contact {
+                if !(n.is_finite()
+                    && (1.0..=crate::plan::limits::MAX_SUBSTEPS_PER_CONTACT).contains(&n))
+                {
+                    return Err(invalid(
+                        "run.substeps_per_contact",
+                        format!(
+                            "{n}: expected 1 to {} ({})",
+                            crate::plan::limits::MAX_SUBSTEPS_PER_CONTACT,
+                            crate::plan::limits::WHY_SUBSTEPS
+                        ),
+                    ));
+                }
+                o.substeps_per_contact = n;
+            }
+            o.energy = raw.run.energy.unwrap_or(false);
+            Scheme::Fast(o)
+        }
+        "reference" => {
+            let tol = raw
+                .run
+                .tol
+                .unwrap_or(crate::physics::solver::reference::DEFAULT_TOL);
+            if !(tol > 1e-13 && tol < 1e-2) {
+                return Err(invalid(
+                    "run.tol",
+                    format!("{tol}: expected 1e-13 < tol < 1e-2"),
+                ));
+            }
+            Scheme::Reference(ReferenceOptions::with_tol(tol))
+        }
+        other => {
+            return Err(invalid(
+                "run.scheme",
+                format!("`{other}`: expected fast or reference"),
+            ))
+        }
+    };
+
+    let mut laws = Vec::new();
+    for (i, k) in raw.contact.law.list().iter().enumerate() {
+        laws.push(LawKind::from_key(k).ok_or_else(|| {
+            invalid(
+                &format!("contact.law[{i}]"),
+                format!("unknown law `{k}`: expected one of {}", LawKind::keys()),
+            )
+        })?);
+    }
+    let mut formulas = Vec::new();
+    for (i, k) in raw
+        .contact
+        .formula
+        .as_ref()
+        .map(Names::list)
+        .unwrap_or_default()
+        .iter()
+        .enumerate()
+    {
+        formulas.push(Formula::from_key(k).ok_or_else(|| {
+            invalid(
+                &format!("contact.formula[{i}]"),
+                format!("unknown formula `{k}`: expected one of {}", Formula::keys()),
+            )
+        })?);
+    }
+
+    check_size(&raw, &laws, &invalid)?;
+    let samples = raw
+        .sample
+        .as_ref()
+        .map(|s| samples(s, &invalid))
+        .transpose()?;
+    let sampled = |key: &str| {
+        samples
+            .as_ref()
+            .is_some_and(|s| s.axes.iter().any(|a| a.key() == key))
+    };
+    // A grid axis or a sampled one, not both; a sampled axis holds one placeholder in the grid
+    // (0.5: valid for every axis, never used).
+    let grid = |key: &str, a: &Option<Axis>| -> Result<Vec<f64>, ConfigError> {
+        match (a, sampled(key)) {
+            (Some(a), false) => axis(key, a),
+            (None, true) => Ok(vec![0.5]),
+            (Some(_), true) => Err(invalid(
+                key,
+                "is sampled under [sample]: remove it from the grid".into(),
+            )),
+            (None, false) => Err(invalid(key, "missing: give values or sample it".into())),
+        }
+    };
+    let building = |name: &str, b: &RawBuilding| -> Result<BuildingAxes, ConfigError> {
+        Ok(BuildingAxes {
+            mass: grid(&format!("{name}.mass_kg"), &b.mass_kg)?,
+            period: grid(&format!("{name}.period_s"), &b.period_s)?,
+            damping: grid(&format!("{name}.damping_ratio"), &b.damping_ratio)?,
+        })
+    };
+
+    let intensities = match (&raw.intensity.pga_g, &raw.intensity.scale) {
+        (Some(a), None) => axis("intensity.pga_g", a)?
+            .into_iter()
+            .map(Intensity::PgaG)
+            .collect(),
+        (None, Some(a)) => axis("intensity.scale", a)?
+            .into_iter()
+            .map(Intensity::Scale)
+            .collect(),
+        (None, None) => vec![Intensity::Scale(1.0)],
+        (Some(_), Some(_)) => {
+            return Err(invalid("intensity", "give pga_g or scale, not both".into()))
+        }
+    };
+
+    let mut recs = Vec::new();
+    for (i, r) in raw.records.iter().enumerate() {
+        let key = format!("record[{i}]");
+        let rec = load_record(r, base, records).map_err(|e| match e {
+            LoadError::Invalid(m) => invalid(&key, m),
+            LoadError::Record(error) => ConfigError::Record {
+                path: path.into(),
+                key: key.clone(),
+                error,
+            },
+        })?;
+        recs.push(Arc::new(rec));
+    }
+
+    let spec = PlanSpec {
+        laws,
+        formulas,
+        e: opt_axis("contact.e", &raw.contact.e)?,
+        k_linear: opt_axis("contact.k_n_per_m", &raw.contact.k_n_per_m)?,
+        beta: opt_axis("contact.beta_n_per_m1_5", &raw.contact.beta_n_per_m1_5)?,
+        records: recs,
+        intensities,
+        building1: building("building1", &raw.building1)?,
+        building2: building("building2", &raw.building2)?,
+        gaps: grid("contact.gap_m", &raw.contact.gap_m)?,
+        scheme,
+        tail: raw.run.tail_s.unwrap_or(0.0),
+        samples,
+    };
+    Plan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
+}
+
+/// Refuse a sweep of more than [`crate::plan::limits::MAX_RUNS`] runs from the axes' sizes alone,
+/// before any axis is built or sample drawn.
+fn check_size(
+    raw: &RawConfig,
+    laws: &[LawKind],
+    invalid: &dyn Fn(&str, String) -> ConfigError,
+) -> Result<(), ConfigError> {
+    let count = |key: &str, a: &Option<Axis>| -> Result<usize, ConfigError> {
+        a.as_ref()
+            .map_or(Ok(1), |a| a.count().map_err(|m| invalid(key, m)))
+    };
+    let b = |name: &str, r: &RawBuilding| -> Result<[usize; 3], ConfigError> {
+        Ok([
+            count(&format!("{name}.mass_kg"), &r.mass_kg)?,
+            count(&format!("{name}.period_s"), &r.period_s)?,
+            count(&format!("{name}.damping_ratio"), &r.damping_ratio)?,
+        ])
+    };
+    let counts = crate::plan::AxisCounts {
+        formulas: raw.contact.formula.as_ref().map_or(0, |f| f.list().len()),
+        e: count("contact.e", &raw.contact.e)?,
+        k_linear: count("contact.k_n_per_m", &raw.contact.k_n_per_m)?,
+        beta: count("contact.beta_n_per_m1_5", &raw.contact.beta_n_per_m1_5)?,
+        records: raw.records.len(),
+        intensities: count("intensity.pga_g", &raw.intensity.pga_g)?
+            * count("intensity.scale", &raw.intensity.scale)?,
+        samples: raw.sample.as_ref().map_or(1, |s| s.n.max(1)),
+        building1: b("building1", &raw.building1)?,
+        building2: b("building2", &raw.building2)?,
+        gaps: count("contact.gap_m", &raw.contact.gap_m)?,
+    };
+    crate::plan::check_run_count(laws, &counts)
+        .map(|_| ())
+        .map_err(|e| invalid(&e.key, e.message))
+}
+
+/// Stage 2 of `[sample]`: distributions checked, points drawn.
+fn samples(
+    s: &RawSample,
+    invalid: &dyn Fn(&str, String) -> ConfigError,
+) -> Result<Samples, ConfigError> {
+    let method = match s.method.as_deref().unwrap_or("latin_hypercube") {
+        "latin_hypercube" => Method::LatinHypercube,
+        "monte_carlo" => Method::MonteCarlo,
+        other => {
+            return Err(invalid(
+                "sample.method",
+                format!("`{other}`: expected latin_hypercube or monte_carlo"),
+            ))
+        }
+    };
+    if s.n == 0 {
+        return Err(invalid(
+            "sample.n",
+            "is 0: expected at least one sample".into(),
+        ));
+    }
+    if s.n > crate::plan::limits::MAX_SAMPLES {
+        return Err(invalid(
+            "sample.n",
+            format!(
+                "{}: expected at most {} ({})",
+                s.n,
+                crate::plan::limits::MAX_SAMPLES,
+                crate::plan::limits::WHY_SAMPLES
+            ),
+        ));
+    }
+    if s.axes.is_empty() {
+        return Err(invalid(
+            "sample.axis",
+            "is empty: add [[sample.axis]] entries (key, dist, ...)".into(),
+        ));
+    }
+    let mut axes = Vec::new();
+    let mut dists = Vec::new();
+    for (i, a) in s.axes.iter().enumerate() {
+        let key = format!("sample.axis[{i}]");
+        let axis = SampledAxis::from_key(&a.key).ok_or_else(|| {
+            invalid(
+                &format!("{key}.key"),
+                format!(
+                    "`{}`: expected one of {}",
+                    a.key,
+                    SampledAxis::ALL.map(|x| x.key()).join(", ")
+                ),
+            )
+        })?;
+        if axes.contains(&axis) {
+            return Err(invalid(
+                &format!("{key}.key"),
+                format!("`{}` is sampled twice", a.key),
+            ));
+        }
+        let need = |name: &str, v: Option<f64>| {
+            v.filter(|x| x.is_finite()).ok_or_else(|| {
+                invalid(
+                    &format!("{key}.{name}"),
+                    format!("a {} distribution needs a finite `{name}`", a.dist),
+                )
+            })
+        };
+        let (lo, hi) = (
+            a.min.unwrap_or(f64::NEG_INFINITY),
+            a.max.unwrap_or(f64::INFINITY),
+        );
+        let allowed: &[&str] = match a.dist.as_str() {
+            "uniform" => &["min", "max"],
+            "normal" => &["mean", "sd", "min", "max"],
+            "lognormal" => &["median", "beta", "min", "max"],
+            _ => &[],
+        };
+        for (name, given) in [
+            ("min", a.min),
+            ("max", a.max),
+            ("mean", a.mean),
+            ("sd", a.sd),
+            ("median", a.median),
+            ("beta", a.beta),
+        ] {
+            if given.is_some() && !allowed.is_empty() && !allowed.contains(&name) {
+                return Err(invalid(
+                    &format!("{key}.{name}"),
+                    format!(
+                        "does not apply to a {} distribution (it takes {})",
+                        a.dist,
+                        allowed.join(", ")
+                    ),
+                ));
+            }
+        }
+        let d = match a.dist.as_str() {
+            "uniform" => Dist::Uniform {
+                min: need("min", a.min)?,
+                max: need("max", a.max)?,
+            },
+            "normal" => Dist::Normal {
+                mean: need("mean", a.mean)?,
+                sd: need("sd", a.sd)?,
+                min: lo,
+                max: hi,
+            },
+            "lognormal" => Dist::LogNormal {
+                median: need("median", a.median)?,
+                beta: need("beta", a.beta)?,
+                min: lo,
+                max: hi,
+            },
+            other => {
+                return Err(invalid(
+                    &format!("{key}.dist"),
+                    format!("`{other}`: expected uniform, normal or lognormal"),
+                ))
+            }
+        };
+        let bad = match d {
+            Dist::Uniform { min, max } => (min >= max).then_some("expected min < max"),
+            Dist::Normal { sd, .. } if sd <= 0.0 => Some("expected sd > 0"),
+            Dist::LogNormal { median, beta, .. } if median <= 0.0 || beta <= 0.0 => {
+                Some("expected median > 0 and beta > 0")
+            }
+            _ => (lo >= hi).then_some("expected min < max"),
+        };
+        if let Some(m) = bad {
+            return Err(invalid(&key, m.into()));
+        }
+        axes.push(axis);
+        dists.push(d);
+    }
+    Ok(Samples {
+        axes,
+        points: draw(method, s.n, &dists, s.seed),
+    })
+}
+
+enum LoadError {
+    Invalid(String),
+    Record(RecordError),
+}
+
+fn load_record(r: &RawRecord, base: &Path, records: &Path) -> Result<Record, LoadError> {
+    let sources = [r.file.is_some(), r.path.is_some(), r.synthetic.is_some()]
+        .iter()
+        .filter(|x| **x)
+        .count();
+    if sources != 1 {
+        return Err(LoadError::Invalid(
+            "give exactly one of file, path or synthetic".into(),
+        ));
+    }
+    let mut rec = if let Some(s) = &r.synthetic {
+        if r.format.is_some() || r.units.is_some() || r.dt_s.is_some() || r.skip_lines.is_some() {
+            return Err(LoadError::Invalid("format, units, dt_s and skip_lines apply to files, not synthetic records (use synthetic.dt_s)".into()));
+        }
+        let d = SyntheticSpec::default();
+        let spec = SyntheticSpec {
+            seed: s.seed,
+            duration: s.duration_s.unwrap_or(d.duration),
+            dt: s.dt_s.unwrap_or(d.dt),
+            pga_g: s.pga_g.unwrap_or(d.pga_g),
+            fg_hz: s.fg_hz.unwrap_or(d.fg_hz),
+            zeta_g: s.zeta_g.unwrap_or(d.zeta_g),
+        };
+        synthetic(&spec).map_err(LoadError::Record)?
+    } else {
+        let file = r
+            .file_path(base, records)
+            .expect("one source checked above");
+        let format = match &r.format {
+            Some(f) => Format::parse(f).ok_or_else(|| {
+                LoadError::Invalid(format!("format `{f}`: expected {}", Format::KEYS))
+            })?,
+            None => Format::Auto,
+        };
+        let units = match &r.units {
+            Some(u) => Some(Units::parse(u).ok_or_else(|| {
+                LoadError::Invalid(format!("units `{u}`: expected {}", Units::KEYS))
+            })?),
+            None => None,
+        };
+        let opts = ReadOptions {
+            format,
+            units,
+            dt: r.dt_s,
+            skip_lines: r.skip_lines.unwrap_or(0),
+        };
+        read_record(&file, &opts).map_err(LoadError::Record)?
+    };
+    if let Some([start, end]) = r.window_s {
+        rec = rec.window(start, end).ok_or_else(|| {
+            LoadError::Invalid(format!(
+                "window_s = [{start}, {end}]: expected start < end holding at least two samples of the record ({} s to {} s, dt {} s)",
+                rec.t0,
+                rec.t0 + (rec.npts().max(1) - 1) as f64 * rec.dt,
+                rec.dt
+            ))
+        })?;
+    }
+    if let Some(n) = &r.name {
+        rec.name = n.clone();
+    }
+    Ok(rec)
+}

@@ -1,0 +1,263 @@
+//! Speed against error: each path (CPU fast f64, GPU f32, GPU f64) at each accuracy setting
+//! (RK4 substeps per contact duration) on one benchmark sweep, against the reference solved once.
+//! Every path runs with the energy balance on, so each point also carries the distribution of
+//! the runs' energy residuals (the check a user gets on any sweep without a reference).
+
+use crate::engine::gpu::{GpuContext, GpuError, GpuOptions, Precision};
+use crate::engine::{Engine, EngineError};
+use crate::physics::model::{RunOutput, Status};
+use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
+use crate::plan::Plan;
+use crate::studies::plot::{Panel, Series};
+
+/// One path at one setting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// `reference` (errors 0 by definition; its speed and energy residual), `cpu-fast-f64`,
+    /// `gpu-f32`, `gpu-f64`.
+    pub path: String,
+    pub substeps_per_contact: f64,
+    pub runs_per_second: f64,
+    pub errors: Errors,
+}
+
+/// Relative errors against the reference over the runs both end `ok` with equal impact counts
+/// (medians and 99th percentiles), and the fraction of runs whose impact count differs.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Errors {
+    pub force_median: f64,
+    pub force_p99: f64,
+    pub displacement_median: f64,
+    pub displacement_p99: f64,
+    pub energy_median: f64,
+    pub energy_p99: f64,
+    pub impact_count_differs: f64,
+    pub failed: u64,
+    /// `|energy residual|` over the runs that end `ok` (`model::EnergyBalance`).
+    pub residual_median: f64,
+    pub residual_p99: f64,
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs().max(1e-300)
+}
+
+fn quantile(v: &mut [f64], p: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * p).round() as usize]
+}
+
+/// Errors of `out` against `truth`, run by run.
+pub fn errors(truth: &[RunOutput], out: &[RunOutput]) -> Errors {
+    let (mut f, mut u, mut w) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut differ, mut failed) = (0usize, 0u64);
+    let mut r = Vec::new();
+    for (t, o) in truth.iter().zip(out) {
+        if o.status == Status::Ok {
+            r.extend(o.energy.map(|e| e.residual.abs()));
+        }
+        if t.status != Status::Ok || o.status != Status::Ok {
+            failed += 1;
+            continue;
+        }
+        if t.impacts != o.impacts {
+            differ += 1;
+            continue;
+        }
+        if t.peak_force > 0.0 {
+            f.push(rel(o.peak_force, t.peak_force));
+        }
+        u.push(rel(o.peak_u1, t.peak_u1).max(rel(o.peak_u2, t.peak_u2)));
+        // Elastic laws dissipate only rounding.
+        if t.dissipated_energy > 1e-9 * t.peak_force * t.peak_penetration.max(1e-300) {
+            w.push(rel(o.dissipated_energy, t.dissipated_energy));
+        }
+    }
+    Errors {
+        force_median: quantile(&mut f, 0.5),
+        force_p99: quantile(&mut f, 0.99),
+        displacement_median: quantile(&mut u, 0.5),
+        displacement_p99: quantile(&mut u, 0.99),
+        energy_median: quantile(&mut w, 0.5),
+        energy_p99: quantile(&mut w, 0.99),
+        impact_count_differs: differ as f64 / truth.len().max(1) as f64,
+        failed,
+        residual_median: quantile(&mut r, 0.5),
+        residual_p99: quantile(&mut r, 0.99),
+    }
+}
+
+/// Every run of `plan` on `engine`: outputs in run order and runs per second.
+fn collect(plan: &Plan, engine: Engine) -> Result<(Vec<RunOutput>, f64), GpuError> {
+    let (outs, report) = engine.collect(plan)?;
+    Ok((outs, report.summary.runs_per_second()))
+}
+
+/// Runs per CPU task here: the benchmark sweep is small, so smaller tasks balance the threads.
+const CPU_CHUNK: usize = 16;
+
+/// The CPU engine with `scheme`.
+fn cpu<'c>(scheme: Scheme) -> Engine<'c> {
+    Engine::cpu(scheme, Some(CPU_CHUNK)).expect("a chunk in range")
+}
+
+/// The reference at `tol`, then every path at every setting. `progress` hears each point.
+pub fn study(
+    plan: &Plan,
+    ctx: Option<&GpuContext>,
+    settings: &[f64],
+    tol: f64,
+    mut progress: impl FnMut(&Point),
+) -> Result<Vec<Point>, GpuError> {
+    let (truth, rps) = collect(
+        plan,
+        cpu(Scheme::Reference(ReferenceOptions::with_tol(tol))),
+    )?;
+    let reference = Point {
+        path: "reference".into(),
+        substeps_per_contact: f64::NAN,
+        runs_per_second: rps,
+        errors: errors(&truth, &truth),
+    };
+    progress(&reference);
+    let mut points = vec![reference];
+    for &spc in settings {
+        let fast = FastOptions {
+            substeps_per_contact: spc,
+            energy: true,
+            ..Default::default()
+        };
+        let mut runs = vec![(
+            "cpu-fast-f64".to_string(),
+            collect(plan, cpu(Scheme::Fast(fast)))?,
+        )];
+        if let Some(ctx) = ctx {
+            for precision in [Precision::F32, Precision::F64] {
+                if precision == Precision::F64 && !ctx.supports_f64() {
+                    continue;
+                }
+                let opts = GpuOptions {
+                    precision,
+                    fast,
+                    ..Default::default()
+                };
+                let engine = Engine::gpu(ctx, opts, None).map_err(|e| match e {
+                    EngineError::Gpu(g) => g,
+                    other => GpuError::Other {
+                        message: other.to_string(),
+                    },
+                })?;
+                runs.push((format!("gpu-{}", precision.key()), collect(plan, engine)?));
+            }
+        }
+        for (path, (outs, rps)) in runs {
+            let p = Point {
+                path,
+                substeps_per_contact: spc,
+                runs_per_second: rps,
+                errors: errors(&truth, &outs),
+            };
+            progress(&p);
+            points.push(p);
+        }
+    }
+    Ok(points)
+}
+
+impl Errors {
+    /// Medians and 99th percentiles: force, displacement, energy, energy residual.
+    pub fn quantiles(&self) -> [f64; 8] {
+        [
+            self.force_median,
+            self.force_p99,
+            self.displacement_median,
+            self.displacement_p99,
+            self.energy_median,
+            self.energy_p99,
+            self.residual_median,
+            self.residual_p99,
+        ]
+    }
+}
+
+/// The points as CSV.
+pub fn csv(points: &[Point]) -> String {
+    let mut s = String::from("path,substeps_per_contact,runs_per_second,force_median,force_p99,displacement_median,displacement_p99,energy_median,energy_p99,residual_median,residual_p99,impact_count_differs,failed\n");
+    for p in points {
+        let q = p.errors.quantiles().map(|x| format!("{x:e}"));
+        s.push_str(&format!(
+            "{},{},{:.1},{},{},{}\n",
+            p.path,
+            if p.substeps_per_contact.is_nan() {
+                String::new()
+            } else {
+                p.substeps_per_contact.to_string()
+            },
+            p.runs_per_second,
+            q.join(","),
+            p.errors.impact_count_differs,
+            p.errors.failed
+        ));
+    }
+    s
+}
+
+/// Work-precision panels: runs/s against the median and the 99th percentile of the peak-force
+/// error, one line per path through its settings.
+pub fn panels(points: &[Point]) -> Vec<Panel> {
+    let mut paths: Vec<&str> = points
+        .iter()
+        .map(|p| p.path.as_str())
+        .filter(|p| *p != "reference")
+        .collect();
+    paths.sort();
+    paths.dedup();
+    let panel = |title: &str, err: fn(&Errors) -> f64| Panel {
+        title: title.into(),
+        x_label: "peak-force relative error".into(),
+        y_label: "runs/s".into(),
+        log_x: true,
+        log_y: true,
+        series: paths
+            .iter()
+            .map(|path| Series {
+                name: path.to_string(),
+                points: points
+                    .iter()
+                    .filter(|p| p.path == *path)
+                    .map(|p| (err(&p.errors), p.runs_per_second))
+                    .collect(),
+                scatter: false,
+            })
+            .collect(),
+    };
+    vec![
+        panel("median error", |e| e.force_median),
+        panel("99th percentile error", |e| e.force_p99),
+    ]
+}
+
+/// A markdown table header for [`markdown_row`].
+pub const MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | peak force median / p99 | peak u median / p99 | energy median / p99 | energy residual median / p99 | impact counts differ |\n|---|---:|---:|---|---|---|---|---:|";
+
+/// One point as a markdown table row.
+pub fn markdown_row(p: &Point) -> String {
+    let q = p.errors.quantiles().map(|x| format!("{x:.1e}"));
+    format!(
+        "| {} | {} | {:.0} | {} | {:.2} % |",
+        p.path,
+        if p.substeps_per_contact.is_nan() {
+            "-".to_string()
+        } else {
+            p.substeps_per_contact.to_string()
+        },
+        p.runs_per_second,
+        [&q[0..2], &q[2..4], &q[4..6], &q[6..8]]
+            .map(|pair| pair.join(" / "))
+            .join(" | "),
+        100.0 * p.errors.impact_count_differs
+    )
+}

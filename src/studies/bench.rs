@@ -1,0 +1,214 @@
+//! `pound bench`: runs per second of the CPU and GPU paths on the same sweeps, with where the
+//! time goes. The sweep is the quickstart physics (nonlinear viscoelastic contact, Ebrahimi
+//! zeta, e = 0.65) on a 20 s synthetic record at dt = 0.01 s, gaps 0..50 mm: most runs pound.
+
+use crate::engine::aggregate::Aggregator;
+use crate::engine::gpu::GpuError;
+use crate::engine::Engine;
+use crate::physics::model::RunOutput;
+use crate::plan::{Plan, RunSpec};
+use std::path::Path;
+use std::time::Instant;
+
+/// A sweep of about `n` runs (periods of both buildings x 10 gaps).
+pub fn config(n: u64) -> String {
+    let per = (n as f64 / 10.0).max(1.0);
+    let a = per.sqrt().ceil().max(1.0) as u64;
+    let b = (per / a as f64).ceil().max(1.0) as u64;
+    format!(
+        r#"[building1]
+mass_kg = 1.0e5
+period_s = {{ from = 0.2, to = 2.0, n = {a} }}
+damping_ratio = 0.05
+
+[building2]
+mass_kg = 1.0e5
+period_s = {{ from = 0.15, to = 1.5, n = {b} }}
+damping_ratio = 0.05
+
+[contact]
+law = "nonlinear_viscoelastic"
+formula = "ebrahimi"
+e = 0.65
+beta_n_per_m1_5 = 2.75e9
+gap_m = {{ from = 0.0, to = 0.05, n = 10 }}
+
+[[record]]
+synthetic = {{ seed = 1, duration_s = 20.0, dt_s = 0.01, pga_g = 0.35 }}
+"#
+    )
+}
+
+/// The bench plan for about `n` runs.
+pub fn plan(n: u64) -> Plan {
+    crate::plan::config::parse(
+        &config(n),
+        Path::new("bench.toml"),
+        Path::new("."),
+        Path::new("."),
+    )
+    .expect("bench config is valid")
+}
+
+/// One measured sweep; times in seconds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    pub runs: u64,
+    pub backend: String,
+    pub seconds: f64,
+    pub pack: f64,
+    pub upload: f64,
+    pub kernel: f64,
+    pub readback: f64,
+    /// Finishing handed-back runs on the CPU.
+    pub handoff: f64,
+    pub csv: f64,
+    pub impacts: u64,
+    /// Runs the kernel handed back to the CPU.
+    pub handed_off: u64,
+}
+
+impl Row {
+    pub fn runs_per_second(&self) -> f64 {
+        self.runs as f64 / self.seconds.max(1e-12)
+    }
+}
+
+/// Formats each chunk's rows as CSV into a sink, timing it (the cost a real sweep pays).
+struct CsvSink<'a> {
+    plan: &'a Plan,
+    w: std::io::Sink,
+    seconds: f64,
+}
+
+impl CsvSink<'_> {
+    fn write(&mut self, rows: &[(RunSpec, RunOutput)]) {
+        use std::io::Write;
+        let t = Instant::now();
+        let lines = crate::io::csv::encode_csv(self.plan, rows, None);
+        self.w
+            .write_all(&lines)
+            .expect("writing to a sink cannot fail");
+        self.seconds += t.elapsed().as_secs_f64();
+    }
+}
+
+/// The table's name for `engine`.
+fn label(engine: &Engine) -> String {
+    match engine {
+        Engine::Cpu { .. } => format!("cpu ({} threads)", rayon::current_num_threads()),
+        Engine::Gpu { ctx, opts, .. } => {
+            format!("gpu {} ({})", opts.precision.key(), ctx.info.name)
+        }
+    }
+}
+
+/// Every run of `plan` on `engine`, each chunk's rows formatted as CSV (into a sink): the CPU
+/// fast path on all threads of the current pool, or the GPU path.
+pub fn run(plan: &Plan, engine: &Engine) -> Result<Row, GpuError> {
+    let mut sink = CsvSink {
+        plan,
+        w: std::io::sink(),
+        seconds: 0.0,
+    };
+    let r = engine.run(
+        plan,
+        0..plan.len(),
+        |rows| -> Result<(), GpuError> {
+            sink.write(rows);
+            Ok(())
+        },
+        |_| {},
+    )?;
+    let (s, t) = (r.summary, r.gpu);
+    Ok(match engine {
+        Engine::Cpu { .. } => Row {
+            runs: s.runs,
+            backend: label(engine),
+            seconds: s.seconds,
+            pack: 0.0,
+            upload: 0.0,
+            kernel: s.seconds - sink.seconds,
+            readback: 0.0,
+            handoff: 0.0,
+            csv: sink.seconds,
+            impacts: s.impacts,
+            handed_off: 0,
+        },
+        Engine::Gpu { .. } => Row {
+            runs: s.runs,
+            backend: label(engine),
+            seconds: s.seconds,
+            pack: t.pack,
+            upload: t.upload,
+            kernel: t.kernel,
+            readback: t.readback,
+            handoff: t.handoff,
+            csv: sink.seconds,
+            impacts: s.impacts,
+            handed_off: t.handed_off,
+        },
+    })
+}
+
+/// Every run of `plan` on `engine` folded by `--aggregate by` (on the device for the GPU):
+/// `readback` is the fold and its partials' readback, `csv` writing the summary.
+pub fn fold(plan: &Plan, engine: &Engine, by: &[String]) -> Result<Row, GpuError> {
+    let mut agg = Aggregator::new(by, &[]).map_err(|e| GpuError::Other {
+        message: e.to_string(),
+    })?;
+    let r = engine.fold(plan, 0..plan.len(), &mut agg, |_| {})?;
+    let (s, t) = (r.summary, r.gpu);
+    let c = Instant::now();
+    let summary = crate::io::summary::csv(&agg);
+    let csv = c.elapsed().as_secs_f64();
+    let on = match engine {
+        Engine::Cpu { .. } => format!("cpu ({} threads)", rayon::current_num_threads()),
+        Engine::Gpu { ctx, opts, .. } => {
+            format!("gpu {} ({})", opts.precision.key(), ctx.info.name)
+        }
+    };
+    Ok(Row {
+        runs: s.runs,
+        backend: format!(
+            "{on}, --aggregate {} ({} groups, {} bytes)",
+            by.join(","),
+            agg.groups(),
+            summary.len()
+        ),
+        seconds: s.seconds + csv,
+        pack: t.pack,
+        upload: t.upload,
+        kernel: t.kernel,
+        readback: t.aggregate,
+        handoff: t.handoff,
+        csv,
+        impacts: s.impacts,
+        handed_off: t.handed_off,
+    })
+}
+
+/// A markdown table of rows.
+pub fn table(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "| runs | backend | total s | runs/s | pack s | upload s | kernel s | readback s | handoff s (runs) | csv s | impacts |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        s.push_str(&format!(
+            "| {} | {} | {:.3} | {:.0} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} ({}) | {:.3} | {} |\n",
+            r.runs,
+            r.backend,
+            r.seconds,
+            r.runs_per_second(),
+            r.pack,
+            r.upload,
+            r.kernel,
+            r.readback,
+            r.handoff,
+            r.handed_off,
+            r.csv,
+            r.impacts
+        ));
+    }
+    s
+}

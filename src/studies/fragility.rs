@@ -1,0 +1,297 @@
+//! Fragility curves from a results CSV (`pound fragility`): at each intensity level, the share of
+//! runs whose demand exceeds a threshold, and the lognormal fragility
+//! `P(EDP > threshold | IM) = Phi(ln(IM / median) / beta)` fitted to the counts by maximum
+//! likelihood (binomial at each level; Baker 2015), solved as a probit regression on `ln IM` by
+//! Fisher scoring.
+
+use crate::io::table::{label, order_key, Filter, Table, TableError};
+use crate::plan::sample::phi;
+use crate::studies::plot::{Panel, Series};
+use std::collections::BTreeMap;
+
+/// Runs at one intensity level.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Level {
+    pub im: f64,
+    pub n: u64,
+    pub exceed: u64,
+}
+
+/// A fitted lognormal fragility, with standard errors from the inverse Fisher information.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fit {
+    pub median: f64,
+    pub beta: f64,
+    /// Standard error of `ln median`.
+    pub se_ln_median: f64,
+    pub se_beta: f64,
+    pub log_likelihood: f64,
+}
+
+impl Fit {
+    pub fn probability(&self, im: f64) -> f64 {
+        phi((im / self.median).ln() / self.beta)
+    }
+}
+
+/// Why no curve could be fitted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NoFit {
+    #[error("no run exceeds the threshold")]
+    NoneExceed,
+    #[error("every run exceeds the threshold")]
+    AllExceed,
+    #[error("only one intensity level with runs")]
+    OneLevel,
+    #[error("intensities must be > 0 for a lognormal fragility")]
+    NonPositiveIm,
+    #[error(
+        "the counts separate perfectly (all below one intensity, none above): the dispersion is 0"
+    )]
+    Separated,
+}
+
+/// Maximum-likelihood lognormal fragility through `levels`.
+pub fn fit(levels: &[Level]) -> Result<Fit, NoFit> {
+    let lv: Vec<&Level> = levels.iter().filter(|l| l.n > 0).collect();
+    if lv.iter().any(|l| l.im <= 0.0) {
+        return Err(NoFit::NonPositiveIm);
+    }
+    let (n, k): (u64, u64) = lv.iter().fold((0, 0), |(n, k), l| (n + l.n, k + l.exceed));
+    if k == 0 {
+        return Err(NoFit::NoneExceed);
+    }
+    if k == n {
+        return Err(NoFit::AllExceed);
+    }
+    if lv.len() < 2 {
+        return Err(NoFit::OneLevel);
+    }
+    let x: Vec<f64> = lv.iter().map(|l| l.im.ln()).collect();
+    // Start from a median at the weighted mean of ln IM and beta = its spread.
+    let w: f64 = n as f64;
+    let mx = lv.iter().zip(&x).map(|(l, x)| l.n as f64 * x).sum::<f64>() / w;
+    let sx = (lv
+        .iter()
+        .zip(&x)
+        .map(|(l, x)| l.n as f64 * (x - mx) * (x - mx))
+        .sum::<f64>()
+        / w)
+        .sqrt()
+        .max(1e-3);
+    let (mut a, mut b) = (-mx / sx, 1.0 / sx);
+    let loglik = |a: f64, b: f64| -> f64 {
+        lv.iter()
+            .zip(&x)
+            .map(|(l, &x)| {
+                let p = phi(a + b * x).clamp(1e-300, 1.0 - 1e-16);
+                l.exceed as f64 * p.ln() + (l.n - l.exceed) as f64 * (1.0 - p).ln()
+            })
+            .sum()
+    };
+    let mut info = [[0.0; 2]; 2];
+    for _ in 0..200 {
+        // Fisher scoring: information I and score U of the probit model.
+        let (mut i00, mut i01, mut i11, mut u0, mut u1) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        for (l, &x) in lv.iter().zip(&x) {
+            let eta = a + b * x;
+            let p = phi(eta).clamp(1e-15, 1.0 - 1e-15);
+            let d = (-0.5 * eta * eta).exp() / (2.0 * std::f64::consts::PI).sqrt();
+            let wi = l.n as f64 * d * d / (p * (1.0 - p));
+            let r = (l.exceed as f64 - l.n as f64 * p) * d / (p * (1.0 - p));
+            i00 += wi;
+            i01 += wi * x;
+            i11 += wi * x * x;
+            u0 += r;
+            u1 += r * x;
+        }
+        info = [[i00, i01], [i01, i11]];
+        let det = i00 * i11 - i01 * i01;
+        if !(det.is_finite() && det > 0.0) {
+            return Err(NoFit::Separated);
+        }
+        let (mut da, mut db) = ((i11 * u0 - i01 * u1) / det, (i00 * u1 - i01 * u0) / det);
+        // Halve the step until the likelihood does not fall (scoring can overshoot).
+        let l0 = loglik(a, b);
+        let mut halvings = 0;
+        while loglik(a + da, b + db) < l0 - 1e-12 && halvings < 30 {
+            da *= 0.5;
+            db *= 0.5;
+            halvings += 1;
+        }
+        a += da;
+        b += db;
+        if b > 1e6 || !b.is_finite() {
+            return Err(NoFit::Separated);
+        }
+        if da.abs() < 1e-12 * (1.0 + a.abs()) && db.abs() < 1e-12 * (1.0 + b.abs()) {
+            break;
+        }
+    }
+    if b <= 0.0 {
+        // Exceedance falling with intensity: not a fragility.
+        return Err(NoFit::Separated);
+    }
+    // Covariance of (a, b) = I^-1; ln median = -a / b, beta = 1 / b (delta method).
+    let det = info[0][0] * info[1][1] - info[0][1] * info[0][1];
+    let (vaa, vab, vbb) = (info[1][1] / det, -info[0][1] / det, info[0][0] / det);
+    let (ga, gb) = (-1.0 / b, a / (b * b));
+    let var_ln_median = ga * ga * vaa + 2.0 * ga * gb * vab + gb * gb * vbb;
+    let se_beta = vbb.sqrt() / (b * b);
+    Ok(Fit {
+        median: (-a / b).exp(),
+        beta: 1.0 / b,
+        se_ln_median: var_ln_median.max(0.0).sqrt(),
+        se_beta,
+        log_likelihood: loglik(a, b),
+    })
+}
+
+/// What to count.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FragilitySpec {
+    pub im: String,
+    pub edp: String,
+    /// Exceedance is `EDP > threshold`.
+    pub thresholds: Vec<f64>,
+    pub filters: Vec<Filter>,
+}
+
+/// Counts per threshold and intensity level, and how many rows were left out (status not
+/// `ok`, or no IM or EDP value).
+pub fn levels(table: &Table, spec: &FragilitySpec) -> Result<(Vec<Vec<Level>>, usize), TableError> {
+    let (ci, ce) = (table.col(&spec.im)?, table.col(&spec.edp)?);
+    let cs = table.col("status").ok();
+    let rows = table.select(&spec.filters)?;
+    let mut by_im: BTreeMap<u64, (f64, Vec<f64>)> = BTreeMap::new();
+    let mut skipped = 0;
+    for i in rows {
+        if cs.is_some_and(|c| table.rows[i][c] != "ok") {
+            skipped += 1;
+            continue;
+        }
+        let (Some(im), Some(edp)) = (table.num(i, ci)?, table.num(i, ce)?) else {
+            skipped += 1;
+            continue;
+        };
+        // Levels keyed by the IM rounded to 12 significant digits (CSV text round-trips exactly,
+        // but scaled PGAs computed per record may differ in the last bits).
+        let key = format!("{im:.11e}").parse::<f64>().unwrap_or(im);
+        by_im
+            .entry(order_key(key))
+            .or_insert((key, Vec::new()))
+            .1
+            .push(edp);
+    }
+    let out = spec
+        .thresholds
+        .iter()
+        .map(|&t| {
+            by_im
+                .values()
+                .map(|(im, edps)| Level {
+                    im: *im,
+                    n: edps.len() as u64,
+                    exceed: edps.iter().filter(|&&e| e > t).count() as u64,
+                })
+                .collect()
+        })
+        .collect();
+    Ok((out, skipped))
+}
+
+/// The counts as CSV: threshold, im, n, exceed, fraction.
+pub fn csv(spec: &FragilitySpec, levels: &[Vec<Level>]) -> String {
+    let mut s = format!("threshold,{},runs,exceed,fraction\n", spec.im);
+    for (t, lv) in spec.thresholds.iter().zip(levels) {
+        for l in lv {
+            s.push_str(&format!(
+                "{t},{},{},{},{}\n",
+                l.im,
+                l.n,
+                l.exceed,
+                l.exceed as f64 / l.n as f64
+            ));
+        }
+    }
+    s
+}
+
+/// One panel: the observed fractions (points) and the fitted curves (lines), per threshold.
+pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, NoFit>]) -> Panel {
+    let mut series = Vec::new();
+    let (lo, hi) = levels
+        .iter()
+        .flatten()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), l| {
+            (a.min(l.im), b.max(l.im))
+        });
+    for ((t, lv), f) in spec.thresholds.iter().zip(levels).zip(fits) {
+        let name = format!("{} > {t}", spec.edp);
+        series.push(Series {
+            name: format!("{name}: observed"),
+            points: lv
+                .iter()
+                .map(|l| (l.im, l.exceed as f64 / l.n as f64))
+                .collect(),
+            scatter: true,
+        });
+        if let Ok(f) = f {
+            let n = 100;
+            series.push(Series {
+                name: format!("{name}: median {:.3}, beta {:.3}", f.median, f.beta),
+                points: (0..=n)
+                    .map(|i| {
+                        let im = lo + (hi - lo) * i as f64 / n as f64;
+                        (im, if im > 0.0 { f.probability(im) } else { 0.0 })
+                    })
+                    .collect(),
+                scatter: false,
+            });
+        }
+    }
+    Panel {
+        title: format!("P({} > threshold) against {}", spec.edp, spec.im),
+        x_label: label(&spec.im),
+        y_label: "probability of exceedance".into(),
+        log_x: false,
+        log_y: false,
+        series,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A curve through exact probabilities is recovered to the solver's precision.
+    #[test]
+    fn fit_recovers_exact_probabilities() {
+        let (median, beta) = (0.4, 0.35);
+        let levels: Vec<Level> = (1..=10)
+            .map(|i| {
+                let im = 0.1 * i as f64;
+                let n = 1_000_000u64;
+                let p = phi((im / median).ln() / beta);
+                Level {
+                    im,
+                    n,
+                    exceed: (p * n as f64).round() as u64,
+                }
+            })
+            .collect();
+        let f = fit(&levels).unwrap();
+        assert!((f.median / median - 1.0).abs() < 1e-4, "{f:?}");
+        assert!((f.beta / beta - 1.0).abs() < 1e-3, "{f:?}");
+        let none: Vec<Level> = levels.iter().map(|l| Level { exceed: 0, ..*l }).collect();
+        assert_eq!(fit(&none), Err(NoFit::NoneExceed));
+        let step: Vec<Level> = levels
+            .iter()
+            .map(|l| Level {
+                exceed: if l.im > 0.5 { l.n } else { 0 },
+                ..*l
+            })
+            .collect();
+        assert_eq!(fit(&step), Err(NoFit::Separated));
+    }
+}

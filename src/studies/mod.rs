@@ -1,0 +1,15 @@
+//! What users do with sweeps and single collisions: speed against error ([`accuracy`]),
+//! throughput ([`bench`]), restitution fidelity and hysteresis loops ([`fidelity`]), the
+//! formulas' zeta(e) ([`formulas`]), fragility curves ([`fragility`]), sensitivity plots
+//! ([`sensitivity`]), the seed paper's checks ([`paper`]), and drawing them ([`plot`]).
+//!
+//! The top layer of the library: may import every layer below; nothing below imports it.
+
+pub mod accuracy;
+pub mod bench;
+pub mod fidelity;
+pub mod formulas;
+pub mod fragility;
+pub mod paper;
+pub mod plot;
+pub mod sensitivity;

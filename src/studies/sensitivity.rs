@@ -1,0 +1,148 @@
+//! Sensitivity plots from a results CSV (`pound plot`): an output against a swept parameter, one
+//! series per value of a grouping column. Rows can be fixed by filters; the parameters neither
+//! plotted nor grouped are aggregated over (max, mean, median or min of the output at each x),
+//! or every row is drawn as a point.
+
+use crate::io::table::{label, order_key, Filter, Table, TableError};
+use crate::studies::plot::{Panel, Series};
+use std::collections::BTreeMap;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Aggregate {
+    Max,
+    Mean,
+    Median,
+    Min,
+    /// No aggregation: every row is a point.
+    None,
+}
+
+impl Aggregate {
+    pub fn key(self) -> &'static str {
+        match self {
+            Aggregate::Max => "max",
+            Aggregate::Mean => "mean",
+            Aggregate::Median => "median",
+            Aggregate::Min => "min",
+            Aggregate::None => "none",
+        }
+    }
+
+    fn apply(self, v: &mut [f64]) -> f64 {
+        match self {
+            Aggregate::Max | Aggregate::None => v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            Aggregate::Min => v.iter().copied().fold(f64::INFINITY, f64::min),
+            Aggregate::Mean => v.iter().sum::<f64>() / v.len() as f64,
+            Aggregate::Median => {
+                v.sort_by(f64::total_cmp);
+                let n = v.len();
+                if n % 2 == 1 {
+                    v[n / 2]
+                } else {
+                    0.5 * (v[n / 2 - 1] + v[n / 2])
+                }
+            }
+        }
+    }
+}
+
+/// What to plot.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlotSpec {
+    pub x: String,
+    pub y: String,
+    pub by: Option<String>,
+    pub filters: Vec<Filter>,
+    pub aggregate: Aggregate,
+    pub log_x: bool,
+    pub log_y: bool,
+}
+
+/// Order group names as numbers when they all are, else as text.
+fn sorted_groups(names: Vec<String>) -> Vec<String> {
+    let mut v = names;
+    if v.iter().all(|s| s.parse::<f64>().is_ok()) {
+        v.sort_by(|a, b| {
+            a.parse::<f64>()
+                .unwrap()
+                .total_cmp(&b.parse::<f64>().unwrap())
+        });
+    } else {
+        v.sort();
+    }
+    v.dedup();
+    v
+}
+
+/// The panel for `spec` over `table`, and the number of failed runs left out. Rows with an
+/// empty x or y (a run that did not pound has no first impact) are left out, and so are runs
+/// whose `status` is not `ok` (their values are whatever a diverged run held) and non-finite
+/// values.
+pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableError> {
+    let (cx, cy) = (table.col(&spec.x)?, table.col(&spec.y)?);
+    let cby = spec.by.as_deref().map(|b| table.col(b)).transpose()?;
+    let cstatus = table.col("status").ok();
+    let rows = table.select(&spec.filters)?;
+    let mut groups: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    let mut failed = 0;
+    for i in rows {
+        if cstatus.is_some_and(|c| table.rows[i][c] != "ok") {
+            failed += 1;
+            continue;
+        }
+        let (Some(x), Some(y)) = (table.num(i, cx)?, table.num(i, cy)?) else {
+            continue;
+        };
+        if !(x.is_finite() && y.is_finite()) {
+            failed += 1;
+            continue;
+        }
+        let g = cby.map_or(String::new(), |c| table.rows[i][c].clone());
+        groups.entry(g).or_default().push((x, y));
+    }
+    let names = sorted_groups(groups.keys().cloned().collect());
+    let series = names
+        .into_iter()
+        .map(|g| {
+            let pts = &groups[&g];
+            let points = if spec.aggregate == Aggregate::None {
+                pts.clone()
+            } else {
+                let mut at: BTreeMap<u64, (f64, Vec<f64>)> = BTreeMap::new();
+                for &(x, y) in pts {
+                    at.entry(order_key(x)).or_insert((x, Vec::new())).1.push(y);
+                }
+                at.into_values()
+                    .map(|(x, mut ys)| (x, spec.aggregate.apply(&mut ys)))
+                    .collect()
+            };
+            let name = match &spec.by {
+                Some(b) => format!("{b} = {g}"),
+                None => label(&spec.y),
+            };
+            Series {
+                name,
+                points,
+                scatter: spec.aggregate == Aggregate::None,
+            }
+        })
+        .collect();
+    let mut title = format!("{} against {}", label(&spec.y), label(&spec.x));
+    if spec.aggregate != Aggregate::None {
+        title.push_str(&format!(
+            " ({} over the other parameters)",
+            spec.aggregate.key()
+        ));
+    }
+    Ok((
+        Panel {
+            title,
+            x_label: label(&spec.x),
+            y_label: label(&spec.y),
+            log_x: spec.log_x,
+            log_y: spec.log_y,
+            series,
+        },
+        failed,
+    ))
+}

@@ -1,0 +1,101 @@
+//! Every helper the integration tests share: temp dirs, a diffing text comparison, the records
+//! dir, scene builders and collected sweeps here; running `pound` in [`run`]; the shared GPU
+//! device and GPU comparisons in [`gpu`].
+
+pub mod gpu;
+pub mod run;
+
+pub use gpu::{ctx, gpu_collect, grazing_contacts, peak_diff};
+pub use run::{ok, pound, pound_with_file_limit, pound_with_outputs};
+
+use pounding::physics::contact::{Contact, LawKind};
+use pounding::physics::model::RunOutput;
+use pounding::physics::model::{Oscillator, Pair};
+use pounding::physics::solver::Scheme;
+use pounding::plan::{Plan, RunSpec};
+use std::path::PathBuf;
+
+/// The real-records directory (`POUND_RECORDS_DIR`, default `../shared/records`). Tests that need
+/// it fail, never skip, when it is missing: CI has it beside the clone.
+pub fn records_dir() -> PathBuf {
+    let d = pounding::plan::config::records_dir();
+    assert!(
+        d.join("SOURCES.md").is_file(),
+        "records directory {} not found (set POUND_RECORDS_DIR)",
+        d.display()
+    );
+    d
+}
+
+pub fn tempdir() -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix("pound-test-")
+        .tempdir()
+        .expect("temp dir")
+}
+
+/// Assert two texts are equal, showing the first differing lines on failure.
+pub fn assert_same_text(label: &str, a: &str, b: &str) {
+    if a == b {
+        return;
+    }
+    let (la, lb): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
+    let mut diff = String::new();
+    let mut shown = 0;
+    for i in 0..la.len().max(lb.len()) {
+        let (x, y) = (
+            la.get(i).copied().unwrap_or("<none>"),
+            lb.get(i).copied().unwrap_or("<none>"),
+        );
+        if x != y {
+            diff.push_str(&format!("line {}:\n  - {x}\n  + {y}\n", i + 1));
+            shown += 1;
+            if shown == 10 {
+                break;
+            }
+        }
+    }
+    panic!(
+        "{label}: texts differ ({} vs {} lines)\n{diff}",
+        la.len(),
+        lb.len()
+    );
+}
+
+/// Relative difference with a floor.
+pub fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs().max(1e-300)
+}
+
+/// Two SDOF buildings with a contact law.
+pub fn pair(
+    law: LawKind,
+    stiffness: f64,
+    damping: f64,
+    (m1, t1, xi1): (f64, f64, f64),
+    (m2, t2, xi2): (f64, f64, f64),
+    gap: f64,
+) -> Pair {
+    let b1 = Oscillator::from_period(m1, t1, xi1);
+    let b2 = Oscillator::from_period(m2, t2, xi2);
+    Pair {
+        b1,
+        b2,
+        gap,
+        contact: Contact::new(law, stiffness, damping, Pair::m_eff(&b1, &b2)),
+    }
+}
+
+/// Every run of `plan` with `scheme`, in run order.
+pub fn collect(plan: &Plan, scheme: &Scheme, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
+    let mut rows = Vec::new();
+    let sink = |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::engine::gpu::GpuError> {
+        rows.extend_from_slice(c);
+        Ok(())
+    };
+    pounding::engine::Engine::cpu(*scheme, Some(chunk))
+        .unwrap()
+        .run(plan, 0..plan.len(), sink, |_| {})
+        .unwrap();
+    rows
+}
