@@ -1,6 +1,7 @@
 //! The commands of `pound`, one module each: its flags (clap) turned into ready values, the
 //! library called, the outcome reported. Logic lives in the library; what stays here is
 //! wording, exit paths and the order of checks (every output is checked before any work).
+//! Part of the binary, not the library: it may use every library layer, and nothing uses it.
 
 use anyhow::{bail, Context, Result};
 use clap::{Subcommand, ValueEnum};
