@@ -418,11 +418,9 @@ mod tests {
     /// a summary's columns and a CSV's say the same thing.
     #[test]
     fn outputs_are_the_cells_of_the_summarised_columns() {
-        let plan = crate::plan::config::parse(
+        let plan = crate::plan::config::parse_builtin(
             "[building1]\nmass_kg = 1.0e5\nperiod_s = 0.3\ndamping_ratio = 0.05\n[building2]\nmass_kg = 1.0e5\nperiod_s = 0.9\ndamping_ratio = 0.05\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = 0.0\n[[record]]\nsynthetic = { seed = 1, duration_s = 1.0 }\n",
-            std::path::Path::new("one.toml"),
-            std::path::Path::new("."),
-            std::path::Path::new("."),
+            "one.toml",
         )
         .unwrap();
         let out = RunOutput {

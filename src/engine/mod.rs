@@ -340,11 +340,9 @@ mod tests {
     /// Folding on the CPU gives the summary a host fold of the rows gives, for any chunking.
     #[test]
     fn cpu_fold_is_the_fold_of_the_rows() {
-        let plan = crate::plan::config::parse(
+        let plan = crate::plan::config::parse_builtin(
             "[building1]\nmass_kg = 1.0e5\nperiod_s = [0.3, 0.5]\ndamping_ratio = 0.05\n[building2]\nmass_kg = 1.0e5\nperiod_s = 0.9\ndamping_ratio = 0.05\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = [0.0, 0.005, 0.5]\n[[record]]\nsynthetic = { seed = 3, duration_s = 2.0 }\n",
-            std::path::Path::new("fold.toml"),
-            std::path::Path::new("."),
-            std::path::Path::new("."),
+            "fold.toml",
         )
         .unwrap();
         let by = ["gap_m".to_string()];

@@ -195,9 +195,7 @@ mod tests {
     fn fingerprint_follows_what_changes_the_runs() {
         let base = "[building1]\nmass_kg = 1.0e5\nperiod_s = [0.3, 0.5]\ndamping_ratio = 0.05\n[building2]\nmass_kg = 1.0e5\nperiod_s = 0.9\ndamping_ratio = 0.05\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = 0.0\n";
         let fp = |text: &str, name: &str| {
-            let plan =
-                crate::plan::config::parse(text, Path::new(name), Path::new("."), Path::new("."))
-                    .unwrap();
+            let plan = crate::plan::config::parse_builtin(text, name).unwrap();
             Fingerprint::of(&plan)
         };
         let rec =

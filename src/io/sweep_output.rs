@@ -555,9 +555,7 @@ synthetic = { seed = 2, duration_s = 2.0 }
 
     #[test]
     fn an_interrupted_output_resumes_to_the_whole_and_is_labelled() {
-        let plan =
-            crate::plan::config::parse(CFG, Path::new("t.toml"), Path::new("."), Path::new("."))
-                .unwrap();
+        let plan = crate::plan::config::parse_builtin(CFG, "t.toml").unwrap();
         let all = rows(&plan);
         assert_eq!(all.len(), 6);
         let d = tempfile::tempdir().unwrap();
@@ -599,9 +597,7 @@ synthetic = { seed = 2, duration_s = 2.0 }
 
     #[test]
     fn an_output_missing_runs_is_not_put_in_place() {
-        let plan =
-            crate::plan::config::parse(CFG, Path::new("t.toml"), Path::new("."), Path::new("."))
-                .unwrap();
+        let plan = crate::plan::config::parse_builtin(CFG, "t.toml").unwrap();
         let all = rows(&plan);
         let d = tempfile::tempdir().unwrap();
         let out = d.path().join("o.csv");

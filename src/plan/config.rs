@@ -426,6 +426,12 @@ pub fn changed_records(text: &str, path: &Path, plan: &Plan) -> Vec<String> {
     }
 }
 
+/// A plan from config text that names no record file (synthetic records only), `name` standing
+/// for its file in messages: built-in sweeps (`pound bench`) and tests.
+pub fn parse_builtin(text: &str, name: &str) -> Result<Plan, ConfigError> {
+    parse(text, Path::new(name), Path::new("."), Path::new("."))
+}
+
 /// Parse and validate config text. `path` names the file in errors; `base` resolves `path =`
 /// records; `records` resolves `file =` records.
 pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Plan, ConfigError> {

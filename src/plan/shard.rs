@@ -61,11 +61,10 @@ pub fn shard_range(plan: &Plan, shard: Shard) -> Range<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
 
     /// Two records of different lengths, so runs differ in cost: 3 x 2 x 2 = 12 runs.
     fn plan() -> Plan {
-        crate::plan::config::parse(
+        crate::plan::config::parse_builtin(
             r#"
 [building1]
 mass_kg = 1.0e5
@@ -84,9 +83,7 @@ synthetic = { seed = 1, duration_s = 2.0 }
 [[record]]
 synthetic = { seed = 2, duration_s = 8.0 }
 "#,
-            Path::new("shards.toml"),
-            Path::new("."),
-            Path::new("."),
+            "shards.toml",
         )
         .unwrap()
     }

@@ -7,7 +7,6 @@ use crate::engine::gpu::GpuError;
 use crate::engine::Engine;
 use crate::physics::model::RunOutput;
 use crate::plan::{Plan, RunSpec};
-use std::path::Path;
 use std::time::Instant;
 
 /// A sweep of about `n` runs (periods of both buildings x 10 gaps).
@@ -41,13 +40,7 @@ synthetic = {{ seed = 1, duration_s = 20.0, dt_s = 0.01, pga_g = 0.35 }}
 
 /// The bench plan for about `n` runs.
 pub fn plan(n: u64) -> Plan {
-    crate::plan::config::parse(
-        &config(n),
-        Path::new("bench.toml"),
-        Path::new("."),
-        Path::new("."),
-    )
-    .expect("bench config is valid")
+    crate::plan::config::parse_builtin(&config(n), "bench.toml").expect("bench config is valid")
 }
 
 /// One measured sweep; times in seconds.

@@ -6,7 +6,7 @@ use crate::physics::restitution::{exact_damping, Formula, RestitutionError};
 use crate::studies::plot::{Panel, Series};
 
 /// The laws whose `exact` zeta the table lists (Hunt-Crossley's `a` comes last, apart).
-const EXACT_LAWS: [LawKind; 4] = [
+pub const EXACT_LAWS: [LawKind; 4] = [
     LawKind::KelvinVoigt,
     LawKind::KelvinVoigtNoTension,
     LawKind::ModifiedLinear,

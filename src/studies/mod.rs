@@ -1,5 +1,5 @@
 //! What users do with sweeps and single collisions: speed against error ([`accuracy`]),
-//! throughput ([`bench`]), restitution fidelity and hysteresis loops ([`fidelity`]), the
+//! throughput ([`bench`](mod@bench)), restitution fidelity and hysteresis loops ([`fidelity`]), the
 //! formulas' zeta(e) ([`formulas`]), fragility curves ([`fragility`]), sensitivity plots
 //! ([`sensitivity`]), the seed paper's checks ([`paper`]), and drawing them ([`plot`]).
 //!

@@ -3,14 +3,15 @@
 //! - [`fast`] (production): exact linear stepping at the record's `dt` while the buildings are
 //!   apart, fixed RK4 substeps sized to the contact duration only in record steps where a contact
 //!   may happen.
-//! - [`reference`] (truth): adaptive Dormand-Prince 5(4) with error control, steps that never
-//!   cross a record sample (where `ag` has kinks), and a cap on the step in contact.
+//! - [`reference`](mod@reference) (truth): adaptive Dormand-Prince 5(4) with error control,
+//!   steps that never cross a record sample (where `ag` has kinks), and a cap on the step in
+//!   contact.
 //!
 //! Both locate every non-smooth instant inside the step (first touch `delta = 0`, the turn
 //! `delta' = 0`, separation at `delta = 0` or `F = 0`) by regula falsi on re-taken partial
-//! steps ([`events`]), so each step integrates a smooth right-hand side. The contact work
+//! steps (`events.rs`), so each step integrates a smooth right-hand side. The contact work
 //! `w' = F delta'` rides along as a fifth state so the dissipated energy is integrated to the
-//! scheme's own order. [`tracker`] keeps peaks and impacts, [`hermite`] the peaks between
+//! scheme's own order. `tracker.rs` keeps peaks and impacts, `hermite.rs` the peaks between
 //! samples; [`collision`] solves one isolated collision (the `exact` restitution formula).
 //! `shaders/fast.wgsl` is the GPU twin of [`fast`], function for function.
 
