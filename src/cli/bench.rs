@@ -2,8 +2,8 @@
 
 use super::{check_outputs, write_file, PrecisionArg};
 use anyhow::{bail, Context, Result};
-use pounding::engine::gpu::{GpuContext, GpuOptions};
-use pounding::engine::Engine;
+use pounding::engine::gpu::GpuOptions;
+use pounding::engine::{Backend, Engine};
 use pounding::physics::solver::{FastOptions, Scheme};
 use pounding::plan::limits::{MAX_BENCH_RUNS, MAX_GPU_CHUNK, WHY_CHUNK};
 use pounding::studies::bench;
@@ -43,13 +43,7 @@ pub fn run(a: Args) -> Result<()> {
         );
     }
     check_outputs(&[], &[("-o", a.output.as_deref())])?;
-    let ctx = match GpuContext::new() {
-        Ok(c) => Some(c),
-        Err(e) => {
-            note!("notice: CPU only: {e}");
-            None
-        }
-    };
+    let ctx = Backend::Any.acquire("CPU only", &mut |l| note!("{l}"))?;
     let gpu = match &ctx {
         Some(ctx) => {
             let opts = GpuOptions {

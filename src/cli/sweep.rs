@@ -115,14 +115,6 @@ fn check_threads(t: usize) -> Result<usize> {
     Ok(t)
 }
 
-/// Runs whose peak displacement exceeds the building's height estimated from its period.
-fn absurd_drifts(rows: &[(RunSpec, RunOutput)]) -> u64 {
-    let h = pounding::plan::limits::HEIGHT_PER_PERIOD_M;
-    rows.iter()
-        .filter(|(s, o)| o.peak_u1 > h * s.t1 || o.peak_u2 > h * s.t2)
-        .count() as u64
-}
-
 pub fn run(a: Args) -> Result<()> {
     let Args {
         config,
@@ -280,7 +272,7 @@ pub fn run(a: Args) -> Result<()> {
                     &plan,
                     todo.clone(),
                     |c: &[(RunSpec, RunOutput)]| {
-                        absurd += absurd_drifts(c);
+                        absurd += pounding::plan::limits::above_height(c);
                         out.take(&plan, c).map_err(anyhow::Error::from)
                     },
                     progress,

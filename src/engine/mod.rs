@@ -77,12 +77,16 @@ pub enum Backend {
     Auto,
     /// Any adapter, software ones included; none is an error.
     Gpu,
+    /// Any adapter, software ones included, else the CPU with a notice (`pound bench`, which
+    /// measures whatever is there).
+    Any,
     Cpu,
 }
 
 impl Backend {
     /// The GPU this backend asks for: none for `Cpu`, an error if `Gpu` finds none, and for
-    /// `Auto` a hardware adapter or, without one, none and a notice (`fallback: why`).
+    /// `Auto` a hardware adapter (`Any`: any adapter) or, without one, none and a notice
+    /// (`fallback: why`).
     pub fn acquire(
         self,
         fallback: &str,
@@ -91,8 +95,8 @@ impl Backend {
         Ok(match self {
             Backend::Cpu => None,
             Backend::Gpu => Some(GpuContext::new()?),
-            Backend::Auto => match GpuContext::new() {
-                Ok(c) if c.is_software() => {
+            Backend::Auto | Backend::Any => match GpuContext::new() {
+                Ok(c) if c.is_software() && self == Backend::Auto => {
                     note(format!(
                         "notice: {fallback}: the adapter found, {}, is a software one (slower than the CPU path on the same cores); --backend gpu uses it",
                         c.info.name

@@ -54,5 +54,14 @@ pub const WARN_PGA_G: f64 = 5.0;
 /// about 3 m). A peak displacement above it is physically absurd, and a sweep warns.
 pub const HEIGHT_PER_PERIOD_M: f64 = 30.0;
 
+/// Runs whose peak displacement exceeds a building's height estimated from its period
+/// ([`HEIGHT_PER_PERIOD_M`]).
+pub fn above_height(rows: &[(crate::plan::RunSpec, crate::physics::model::RunOutput)]) -> u64 {
+    let h = HEIGHT_PER_PERIOD_M;
+    rows.iter()
+        .filter(|(s, o)| o.peak_u1 > h * s.t1 || o.peak_u2 > h * s.t2)
+        .count() as u64
+}
+
 /// The runs of a grid axis or range (`{ from, to, n }`).
 pub const MAX_AXIS_POINTS: usize = 10_000_000;
