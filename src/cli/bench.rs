@@ -5,7 +5,7 @@ use anyhow::{bail, Context, Result};
 use pounding::engine::gpu::GpuOptions;
 use pounding::engine::{Backend, Engine};
 use pounding::physics::solver::{FastOptions, Scheme};
-use pounding::plan::limits::{MAX_BENCH_RUNS, MAX_GPU_CHUNK, WHY_CHUNK};
+use pounding::plan::limits::MAX_BENCH_RUNS;
 use pounding::studies::bench;
 use std::io::Write as _;
 use std::path::PathBuf;
@@ -36,12 +36,8 @@ pub fn run(a: Args) -> Result<()> {
     if let Some(n) = a.sizes.iter().find(|&&n| n == 0 || n > MAX_BENCH_RUNS) {
         bail!("--sizes: {n} runs is out of range: expected 1 to {MAX_BENCH_RUNS}");
     }
-    if a.chunk == 0 || a.chunk > MAX_GPU_CHUNK {
-        bail!(
-            "--chunk {}: expected 1 to {MAX_GPU_CHUNK} ({WHY_CHUNK})",
-            a.chunk
-        );
-    }
+    // Checked here, not only when an adapter is found, so a typo fails on every machine.
+    let chunk = pounding::engine::check_chunk(Some(a.chunk), true)?;
     check_outputs(&[], &[("-o", a.output.as_deref())])?;
     let ctx = Backend::Any.acquire("CPU only", &mut |l| note!("{l}"))?;
     let gpu = match &ctx {
@@ -50,7 +46,7 @@ pub fn run(a: Args) -> Result<()> {
                 precision,
                 ..Default::default()
             };
-            Some(Engine::gpu(ctx, opts, Some(a.chunk))?)
+            Some(Engine::gpu(ctx, opts, Some(chunk))?)
         }
         None => None,
     };

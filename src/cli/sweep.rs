@@ -176,9 +176,11 @@ pub fn run(a: Args) -> Result<()> {
     if backend == Backend::Gpu && !fast {
         bail!(EngineError::GpuNeedsFast)
     }
-    let gpu = match fast {
-        true => backend.acquire("running on the CPU", &mut |l| note!("{l}"))?,
-        false => None,
+    // The reference scheme runs on the CPU only: no adapter is looked for.
+    let gpu = if fast {
+        backend.acquire("running on the CPU", &mut |l| note!("{l}"))?
+    } else {
+        None
     };
     let engine = Engine::new(scheme, gpu.as_ref(), precision, chunk)?;
     let mut pool = rayon::ThreadPoolBuilder::new();

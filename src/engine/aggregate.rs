@@ -381,6 +381,14 @@ impl Aggregator {
         self.groups[id as usize].1.add(o, &self.exceed);
     }
 
+    /// Fold in finished runs of `plan`, each into its group.
+    pub fn add_rows(&mut self, plan: &Plan, rows: &[(RunSpec, RunOutput)]) {
+        for (s, o) in rows {
+            let g = self.group_of(plan, s);
+            self.add(g, o);
+        }
+    }
+
     pub fn groups(&self) -> usize {
         self.groups.len()
     }

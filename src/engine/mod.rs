@@ -135,8 +135,8 @@ pub enum Engine<'c> {
     },
 }
 
-/// `chunk`, or the path's default, checked against the path's bound.
-fn chunk_or_default(chunk: Option<usize>, gpu: bool) -> Result<usize, EngineError> {
+/// `chunk`, or the path's default, checked against the path's bound (`gpu`: the GPU's).
+pub fn check_chunk(chunk: Option<usize>, gpu: bool) -> Result<usize, EngineError> {
     let (default, max, on) = if gpu {
         (GPU_CHUNK, MAX_GPU_CHUNK, "GPU")
     } else {
@@ -176,7 +176,7 @@ impl<'c> Engine<'c> {
     pub fn cpu(scheme: Scheme, chunk: Option<usize>) -> Result<Engine<'c>, EngineError> {
         Ok(Engine::Cpu {
             scheme,
-            chunk: chunk_or_default(chunk, false)?,
+            chunk: check_chunk(chunk, false)?,
         })
     }
 
@@ -195,7 +195,7 @@ impl<'c> Engine<'c> {
         Ok(Engine::Gpu {
             ctx,
             opts,
-            chunk: chunk_or_default(chunk, true)?,
+            chunk: check_chunk(chunk, true)?,
         })
     }
 
@@ -261,10 +261,7 @@ impl<'c> Engine<'c> {
                 plan,
                 runs,
                 |rows: &[(RunSpec, RunOutput)]| -> Result<(), GpuError> {
-                    for (s, o) in rows {
-                        let g = agg.group_of(plan, s);
-                        agg.add(g, o);
-                    }
+                    agg.add_rows(plan, rows);
                     Ok(())
                 },
                 progress,
@@ -308,17 +305,17 @@ mod tests {
 
     #[test]
     fn chunks_default_per_path_and_are_bounded() {
-        assert_eq!(chunk_or_default(None, false).unwrap(), CPU_CHUNK);
-        assert_eq!(chunk_or_default(None, true).unwrap(), GPU_CHUNK);
-        assert_eq!(chunk_or_default(Some(7), false).unwrap(), 7);
+        assert_eq!(check_chunk(None, false).unwrap(), CPU_CHUNK);
+        assert_eq!(check_chunk(None, true).unwrap(), GPU_CHUNK);
+        assert_eq!(check_chunk(Some(7), false).unwrap(), 7);
         for (chunk, gpu) in [(0, false), (0, true), (MAX_CPU_CHUNK + 1, false)] {
-            let e = chunk_or_default(Some(chunk), gpu).unwrap_err().to_string();
+            let e = check_chunk(Some(chunk), gpu).unwrap_err().to_string();
             assert!(
                 e.starts_with(&format!("--chunk {chunk}: expected 1 to ")),
                 "{e}"
             );
         }
-        assert!(chunk_or_default(Some(MAX_CPU_CHUNK + 1), true).is_ok());
+        assert!(check_chunk(Some(MAX_CPU_CHUNK + 1), true).is_ok());
     }
 
     /// Without a GPU every scheme runs on the CPU, with its settings as given.
@@ -358,10 +355,7 @@ mod tests {
                 &plan,
                 0..plan.len(),
                 |c: &[(RunSpec, RunOutput)]| -> Result<(), GpuError> {
-                    for (s, o) in c {
-                        let g = host.group_of(&plan, s);
-                        host.add(g, o);
-                    }
+                    host.add_rows(&plan, c);
                     Ok(())
                 },
                 |_| {},

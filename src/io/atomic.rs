@@ -32,6 +32,11 @@ pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
     PathBuf::from(p)
 }
 
+/// `OUT.partial` for the output `OUT`: where it is written until it is complete.
+pub fn partial_path(out: &Path) -> PathBuf {
+    sibling(out, ".partial")
+}
+
 /// Write `bytes` to `path` atomically (temporary file, fsync, rename); standard output (`-`), a
 /// character device or a FIFO is written in place.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
@@ -42,9 +47,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         return w.flush();
     }
     let path = target.path();
-    let tmp = sibling(path, ".partial");
+    let tmp = partial_path(path);
     // `OUT.partial` may be a sweep's: running (locked) or resumable (with its journal).
-    let journal = sibling(path, ".progress.toml");
+    let journal = crate::io::provenance::progress_path(path);
     if journal.exists() {
         return Err(std::io::Error::other(format!(
             "{} holds the rows of an unfinished sweep (see {}): finish it with --resume, or delete both",

@@ -371,8 +371,8 @@ fn check_block(
 /// Why a results file handed to a study may not be what `pound sweep` wrote (no sidecar, an
 /// unfinished sweep, edited since); None when its sidecar vouches for it. For warnings.
 pub fn provenance_warning(path: &Path) -> Option<String> {
-    let meta = crate::io::atomic::sibling(path, ".meta.toml");
-    let progress = crate::io::atomic::sibling(path, ".progress.toml");
+    let meta = crate::io::provenance::meta_path(path);
+    let progress = crate::io::provenance::progress_path(path);
     if progress.exists() {
         return Some(format!(
             "{} belongs to an unfinished sweep ({} exists)",

@@ -119,7 +119,7 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, SidecarError> {
     }
     let lock = if target.is_file() {
         Some(crate::io::target::PartialLock::acquire(
-            &crate::io::atomic::sibling(target.path(), ".partial"),
+            &crate::io::atomic::partial_path(target.path()),
         )?)
     } else {
         None

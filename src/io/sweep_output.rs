@@ -7,7 +7,7 @@
 //! written in place, with no journal and no sidecar.
 
 use crate::engine::aggregate::Aggregator;
-use crate::io::atomic::sibling;
+use crate::io::atomic::partial_path;
 use crate::io::csv::{header_for, header_line, CsvOut};
 use crate::io::journal::{verify_file, verify_prefix, Content};
 use crate::io::parquet::ParquetOut;
@@ -99,7 +99,7 @@ impl SweepOutput {
         }
         let lock = match &target {
             Target::File(p) => {
-                let partial = sibling(p, ".partial");
+                let partial = partial_path(p);
                 let existed = partial.exists();
                 let lock = PartialLock::acquire(&partial)?;
                 Some((lock, existed))
@@ -346,12 +346,7 @@ impl SweepOutput {
                 let cells = crate::io::csv::cells(plan, rows, columns);
                 out.write(&cells).map_err(|e| at(&path, e))?;
             }
-            Sink::Summary(agg) => {
-                for (s, o) in rows {
-                    let g = agg.group_of(plan, s);
-                    agg.add(g, o);
-                }
-            }
+            Sink::Summary(agg) => agg.add_rows(plan, rows),
         }
         Ok(())
     }
@@ -575,7 +570,7 @@ synthetic = { seed = 2, duration_s = 2.0 }
         let mut o = ready(open(&out, &plan, false));
         o.take(&plan, &all[..3]).unwrap();
         drop(o);
-        assert!(crate::io::atomic::sibling(&out, ".progress.toml").exists());
+        assert!(progress_path(&out).exists());
         // A plain open refuses to overwrite it; a resume continues at run 3.
         assert!(open(&out, &plan, false).is_err());
         let mut o = ready(open(&out, &plan, true));
@@ -624,6 +619,6 @@ synthetic = { seed = 2, duration_s = 2.0 }
                 .contains("folded 4 runs where the sweep has 6"),
             "{e}"
         );
-        assert!(!sum.exists() && !crate::io::atomic::sibling(&sum, ".partial").exists());
+        assert!(!sum.exists() && !partial_path(&sum).exists());
     }
 }

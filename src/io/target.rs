@@ -145,15 +145,15 @@ pub fn check_outputs(
     for (what, t) in outputs {
         files.push((what.to_string(), t.path().to_path_buf()));
         if t.is_file() {
-            for (suffix, name) in [
-                (".partial", "partial file"),
-                (".meta.toml", "sidecar"),
-                (".progress.toml", "journal"),
+            for (beside, name) in [
+                (
+                    crate::io::atomic::partial_path as fn(&Path) -> PathBuf,
+                    "partial file",
+                ),
+                (crate::io::provenance::meta_path, "sidecar"),
+                (crate::io::provenance::progress_path, "journal"),
             ] {
-                files.push((
-                    format!("{what}'s {name}"),
-                    crate::io::atomic::sibling(t.path(), suffix),
-                ));
+                files.push((format!("{what}'s {name}"), beside(t.path())));
             }
         }
     }

@@ -111,7 +111,7 @@ pub fn study(
     settings: &[f64],
     tol: f64,
     mut progress: impl FnMut(&Point),
-) -> Result<Vec<Point>, GpuError> {
+) -> Result<Vec<Point>, EngineError> {
     let (truth, rps) = collect(
         plan,
         cpu(Scheme::Reference(ReferenceOptions::with_tol(tol))),
@@ -144,12 +144,7 @@ pub fn study(
                     fast,
                     ..Default::default()
                 };
-                let engine = Engine::gpu(ctx, opts, None).map_err(|e| match e {
-                    EngineError::Gpu(g) => g,
-                    other => GpuError::Other {
-                        message: other.to_string(),
-                    },
-                })?;
+                let engine = Engine::gpu(ctx, opts, None)?;
                 runs.push((format!("gpu-{}", precision.key()), collect(plan, engine)?));
             }
         }

@@ -519,10 +519,7 @@ fn gpu_aggregate_on_device_matches_the_host_fold() {
             ..Default::default()
         };
         let mut host = Aggregator::new(&by, &exceed).unwrap();
-        for (s, o) in gpu_collect(&plan, &opts, c.chunk) {
-            let g = host.group_of(&plan, &s);
-            host.add(g, &o);
-        }
+        host.add_rows(&plan, &gpu_collect(&plan, &opts, c.chunk));
         let mut dev = Aggregator::new(&by, &exceed).unwrap();
         let (summary, t) = pounding::engine::gpu::fold::fold_range(
             &plan,

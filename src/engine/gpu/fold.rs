@@ -26,12 +26,11 @@ pub fn fold_range(
 ) -> Result<(Summary, GpuTimes), super::GpuError> {
     use super::layout::{Segment, MAX_SEGMENT};
     use super::reduce::{reduce, Slots};
-    use super::{integrate, pack, run_chunk, GpuRecords};
+    use super::sweep::{pack_run, upload_records};
+    use super::{integrate, run_chunk};
     let start = Instant::now();
     let mut times = GpuTimes::default();
-    let accels: Vec<&[f64]> = plan.spec.records.iter().map(|r| &r.accel[..]).collect();
-    let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
-    let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
+    let (recs, chunk) = upload_records(plan, ctx, opts, chunk)?;
     let mut slots = Slots::new(ctx, max_slots);
     let thresholds = agg.thresholds().to_vec();
     let mut s = Summary::default();
@@ -50,10 +49,7 @@ pub fn fold_range(
         order.sort_by_key(|&i| gids[i]);
         let packed: Vec<_> = order
             .par_iter()
-            .map(|&i| {
-                let r = &specs[i];
-                pack(&r.pair(), &plan.forcing(r), r.record, &recs, &opts.fast)
-            })
+            .map(|&i| pack_run(plan, &specs[i], &recs, opts))
             .collect();
         let mut segments: Vec<(u32, Segment)> = Vec::new();
         for (k, &i) in order.iter().enumerate() {

@@ -59,6 +59,36 @@ impl GpuTimes {
     }
 }
 
+/// The plan's records on the device, and `chunk` capped by what one chunk's buffers may hold:
+/// what every GPU sweep of `plan` starts with.
+pub(crate) fn upload_records(
+    plan: &Plan,
+    ctx: &super::GpuContext,
+    opts: &super::GpuOptions,
+    chunk: usize,
+) -> Result<(super::GpuRecords, u64), super::GpuError> {
+    let accels: Vec<&[f64]> = plan.spec.records.iter().map(|r| &r.accel[..]).collect();
+    let recs = super::GpuRecords::upload(ctx, opts.precision, &accels)?;
+    let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
+    Ok((recs, chunk))
+}
+
+/// Pack run `spec` of `plan` for the kernel.
+pub(crate) fn pack_run(
+    plan: &Plan,
+    spec: &RunSpec,
+    recs: &super::GpuRecords,
+    opts: &super::GpuOptions,
+) -> super::run::Packed {
+    super::pack(
+        &spec.pair(),
+        &plan.forcing(spec),
+        spec.record,
+        recs,
+        &opts.fast,
+    )
+}
+
 /// Run the runs `runs` of `plan` on the GPU, `chunk` runs per chunk (capped by the device's limits);
 /// `sink` gets each chunk's results in run order as it finishes. Runs the kernel hands back
 /// (more substeps per record step than its precision resolves) are finished on the CPU's fast
@@ -73,12 +103,9 @@ pub fn run_range<E: From<super::GpuError>>(
     mut sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
     mut progress: impl FnMut(u64),
 ) -> Result<(Summary, GpuTimes), E> {
-    use super::{pack, run_chunk, GpuRecords};
     let start = Instant::now();
     let mut times = GpuTimes::default();
-    let accels: Vec<&[f64]> = plan.spec.records.iter().map(|r| &r.accel[..]).collect();
-    let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
-    let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
+    let (recs, chunk) = upload_records(plan, ctx, opts, chunk)?;
     let n = runs.end;
     let mut s = Summary::default();
     // Packing is host work: the next chunk is packed while the device integrates this one.
@@ -88,13 +115,7 @@ pub fn run_range<E: From<super::GpuError>>(
             .into_par_iter()
             .map(|i| {
                 let spec = plan.run(i);
-                let p = pack(
-                    &spec.pair(),
-                    &plan.forcing(&spec),
-                    spec.record,
-                    &recs,
-                    &opts.fast,
-                );
+                let p = pack_run(plan, &spec, &recs, opts);
                 (spec, p)
             })
             .unzip();
@@ -106,7 +127,7 @@ pub fn run_range<E: From<super::GpuError>>(
         let c1 = (c0 + chunk).min(n);
         times.pack += pack_s;
         let (done, upcoming) = rayon::join(
-            || run_chunk(ctx, &recs, &packed, opts),
+            || super::run_chunk(ctx, &recs, &packed, opts),
             || (c1 < n).then(|| prep(c1)),
         );
         next = upcoming;
