@@ -2,7 +2,7 @@
 //! being integrated, shared by both schemes.
 
 use super::events::{event_value, hidden_touch, locate, reapproach, transition};
-use super::hermite::{hermite_range, quintic_peak_abs};
+use super::hermite::{cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak};
 use super::{ddelta, delta, force, Mode, Sample, Segment, State};
 use crate::physics::model::{EnergyBalance, Initial, Pair, RunOutput, Status};
 
@@ -60,14 +60,12 @@ impl Tracker {
             acc(&p.b1, z0[0], z0[1], seg.a0),
             acc(&p.b1, z1[0], z1[1], seg.a1),
         ];
-        let pk = quintic_peak_abs([z0[0], z1[0]], [z0[1], z1[1]], a1, seg.dt);
-        o.peak_u1 = o.peak_u1.max(pk);
+        o.peak_u1 = raise_quintic_peak(o.peak_u1, [z0[0], z1[0]], [z0[1], z1[1]], a1, seg.dt);
         let a2 = [
             acc(&p.b2, z0[2], z0[3], seg.a0),
             acc(&p.b2, z1[2], z1[3], seg.a1),
         ];
-        let pk = quintic_peak_abs([z0[2], z1[2]], [z0[3], z1[3]], a2, seg.dt);
-        o.peak_u2 = o.peak_u2.max(pk);
+        o.peak_u2 = raise_quintic_peak(o.peak_u2, [z0[2], z1[2]], [z0[3], z1[3]], a2, seg.dt);
         self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
     }
 
@@ -75,15 +73,16 @@ impl Tracker {
     #[inline]
     pub fn step(&mut self, p: &Pair, mode: Mode, t0: f64, h: f64, z0: &State, z1: &State) {
         let o = &mut self.out;
-        let (lo, hi) = hermite_range(z0[0], z0[1], z1[0], z1[1], h);
-        o.peak_u1 = o.peak_u1.max(hi.abs()).max(lo.abs());
-        let (lo, hi) = hermite_range(z0[2], z0[3], z1[2], z1[3], h);
-        o.peak_u2 = o.peak_u2.max(hi.abs()).max(lo.abs());
+        o.peak_u1 = raise_cubic_peak(o.peak_u1, z0[0], z0[1], z1[0], z1[1], h);
+        o.peak_u2 = raise_cubic_peak(o.peak_u2, z0[2], z0[3], z1[2], z1[3], h);
         self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
         if mode != Mode::Free {
             o.contact_time += h;
-            let (_, dmax) = hermite_range(delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1), h);
-            o.peak_penetration = o.peak_penetration.max(dmax);
+            let (y0, d0, y1, d1) = (delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1));
+            if cubic_max_bound(y0, d0, y1, d1, h) > o.peak_penetration {
+                let (_, dmax) = hermite_range(y0, d0, y1, d1, h);
+                o.peak_penetration = o.peak_penetration.max(dmax);
+            }
             o.dissipated_energy = z1[4];
             let f = force(p, mode, self.v0, z1);
             self.force_sample(t0 + h - self.t_onset, f);
