@@ -50,7 +50,15 @@ const LOCATE_ITER: u32 = 16u;
 // Runs still integrating after this dispatch: their count, and their indices (in any order)
 // for the next dispatch, which then launches only those. Packing the unfinished runs together
 // keeps lanes busy: runs that pound for long are rare and spread over every workgroup.
-@group(0) @binding(6) var<storage, read_write> active_runs: atomic<u32>;
+// With them, the lane tally of the dispatch: loop trips that did work, summed over lanes, and
+// the trips the lanes were held for (each workgroup's longest lane times WG). Their ratio is
+// the lane utilisation.
+struct Tally {
+    active_runs: atomic<u32>,
+    lane_units: atomic<u32>,
+    lane_slots: atomic<u32>,
+}
+@group(0) @binding(6) var<storage, read_write> tally: Tally;
 @group(0) @binding(7) var<storage, read> run_ids: array<u32>;
 @group(0) @binding(8) var<storage, read_write> next_ids: array<u32>;
 // Exact free-step energy integrals, FORMS reals per run (layout::forms); read only in the ENERGY
@@ -637,6 +645,7 @@ fn begin_interval(seg: Seg) {
                 z1.ed = z1.ed + (P.c1 * vv1 + P.c2 * vv2);
             }
             track_free_step(seg, z0, z1);
+            C.free_steps = C.free_steps + 1u;
             ZS = z1;
             if (!finite(z1)) {
                 C.status = STATUS_NON_FINITE;
@@ -715,17 +724,36 @@ fn piece(seg: Seg) {
     }
 }
 
+var<workgroup> longest_lane: atomic<u32>;
+
 @compute @workgroup_size(WG)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= disp.nactive) {
-        return;
+fn main(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let units = integrate_run(gid.x);
+    if (units > 0u) {
+        atomicAdd(&tally.lane_units, units);
+        atomicMax(&longest_lane, units);
     }
-    let r = run_ids[gid.x];
+    workgroupBarrier();
+    if (lid == 0u) {
+        atomicAdd(&tally.lane_slots, atomicLoad(&longest_lane) * WG);
+    }
+}
+
+// One lane's work in a dispatch: at most disp.budget units of run run_ids[lane]; returns the
+// units it did.
+fn integrate_run(lane: u32) -> u32 {
+    if (lane >= disp.nactive) {
+        return 0u;
+    }
+    let r = run_ids[lane];
     R = r;
     C = counters[r];
     M = metas[r];
     if (C.status != STATUS_OK || C.i >= M.intervals) {
-        return;
+        return 0u;
     }
     P = params[r];
     S = states[r];
@@ -753,6 +781,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     states[r] = S;
     counters[r] = C;
     if (C.status == STATUS_OK && C.i < M.intervals) {
-        next_ids[atomicAdd(&active_runs, 1u)] = r;
+        next_ids[atomicAdd(&tally.active_runs, 1u)] = r;
     }
+    return disp.budget - budget;
 }

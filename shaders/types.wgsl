@@ -52,7 +52,7 @@ struct Counters {
     j: u32,
     m: u32,
     pieces: u32,
-    _pad0: u32,
+    free_steps: u32,
     _pad1: u32,
 }
 

@@ -27,6 +27,15 @@ pub struct Args {
     /// Work-precision plot (SVG).
     #[arg(long)]
     plot: Option<PathBuf>,
+    /// Check `--target-error` instead of trying --settings: for each error E, run the setting
+    /// it chooses and fail unless every path's p99 peak-force error on CONFIG is at most E.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_name = "E",
+        conflicts_with = "settings"
+    )]
+    target_error: Option<Vec<f64>>,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -37,7 +46,20 @@ pub fn run(a: Args) -> Result<()> {
         backend,
         output,
         plot,
+        target_error,
     } = a;
+    let choices = target_error
+        .unwrap_or_default()
+        .into_iter()
+        .map(super::target_error)
+        .collect::<Result<Vec<_>>>()?;
+    let settings = if choices.is_empty() {
+        settings
+    } else {
+        let mut s: Vec<f64> = choices.iter().map(|c| c.substeps_per_contact).collect();
+        s.dedup();
+        s
+    };
     let most = MAX_SUBSTEPS_PER_CONTACT;
     if let Some(bad) = settings.iter().find(|s| !(**s >= 1.0 && **s <= most)) {
         bail!(
@@ -74,6 +96,33 @@ pub fn run(a: Args) -> Result<()> {
     write_file(&output, accuracy::csv(&points).as_bytes())?;
     if let Some(p) = plot {
         pounding::studies::plot::svg(&p, &accuracy::panels(&points), 2)?;
+    }
+    let mut missed = Vec::new();
+    for c in &choices {
+        for p in points
+            .iter()
+            .filter(|p| p.path != "reference" && p.substeps_per_contact == c.substeps_per_contact)
+        {
+            let met = p.errors.force_p99 <= c.target;
+            say!(
+                "--target-error {:e}: {} substeps per contact, {}: p99 peak-force error {:.2e} ({})",
+                c.target,
+                c.substeps_per_contact,
+                p.path,
+                p.errors.force_p99,
+                if met { "met" } else { "NOT met" }
+            );
+            if !met {
+                missed.push(format!("{:e} on {}", c.target, p.path));
+            }
+        }
+    }
+    if !missed.is_empty() {
+        bail!(
+            "--target-error not met on {}: {}",
+            config.display(),
+            missed.join(", ")
+        );
     }
     Ok(())
 }

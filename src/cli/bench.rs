@@ -29,6 +29,10 @@ pub struct Args {
     /// Also time each GPU sweep with `--aggregate COLUMNS` folded on the device (e.g. gap_m).
     #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
     aggregate: Option<Vec<String>>,
+    /// Run the fast scheme at the setting this peak-force error chooses (as `pound sweep
+    /// --target-error`), instead of the default 64 substeps per contact.
+    #[arg(long, value_name = "E")]
+    target_error: Option<f64>,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -39,18 +43,33 @@ pub fn run(a: Args) -> Result<()> {
     // Checked here, not only when an adapter is found, so a typo fails on every machine.
     let chunk = pounding::engine::check_chunk(Some(a.chunk), true)?;
     check_outputs(&[], &[("-o", a.output.as_deref())])?;
+    let mut fast = FastOptions::default();
+    if let Some(e) = a.target_error {
+        fast.substeps_per_contact = super::target_error(e)?.substeps_per_contact;
+    }
+    match pounding::physics::solver::calibration::calibrated_p99(fast.substeps_per_contact) {
+        Some(e) => note!(
+            "fast scheme at {} substeps per contact: p99 peak-force error {e:.1e} on configs/accuracy.toml (pound accuracy)",
+            fast.substeps_per_contact
+        ),
+        None => note!(
+            "fast scheme at {} substeps per contact (not a calibrated setting: pound accuracy --settings measures its error)",
+            fast.substeps_per_contact
+        ),
+    }
     let ctx = Backend::Any.acquire("CPU only", &mut |l| note!("{l}"))?;
     let gpu = match &ctx {
         Some(ctx) => {
             let opts = GpuOptions {
                 precision,
+                fast,
                 ..Default::default()
             };
             Some(Engine::gpu(ctx, opts, Some(chunk))?)
         }
         None => None,
     };
-    let cpu = Engine::cpu(Scheme::Fast(FastOptions::default()), None)?;
+    let cpu = Engine::cpu(Scheme::Fast(fast), None)?;
     let mut rows = Vec::new();
     for &n in &a.sizes {
         let plan = bench::plan(n);

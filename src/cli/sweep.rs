@@ -62,6 +62,12 @@ pub struct Args {
     /// Write only these columns (comma-separated; `run` is always kept, first).
     #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
     columns: Option<Vec<String>>,
+    /// The relative peak-force error you accept (e.g. 1e-2 for a fragility study): the fast
+    /// scheme takes the cheapest accuracy setting whose p99 error on the accuracy suite is at
+    /// most this (calibrated by `pound accuracy`; overrides `run.substeps_per_contact`; recorded
+    /// in the sidecar).
+    #[arg(long, value_name = "E")]
+    target_error: Option<f64>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -131,6 +137,7 @@ pub fn run(a: Args) -> Result<()> {
         exceed,
         format,
         columns,
+        target_error,
     } = a;
     if format == FormatArg::Parquet && resume {
         bail!("--resume continues CSV output only: a Parquet file is readable only once its footer is written at the end");
@@ -168,7 +175,18 @@ pub fn run(a: Args) -> Result<()> {
     for w in plan.warnings() {
         note!("warning: {}: {w}", config.display());
     }
-    let scheme = scheme_as_run(plan.spec.scheme, scheme, energy);
+    let mut scheme = scheme_as_run(plan.spec.scheme, scheme, energy);
+    let chosen = match (target_error, &mut scheme) {
+        (None, _) => None,
+        (Some(_), Scheme::Reference(_)) => bail!(
+            "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.rtol)"
+        ),
+        (Some(e), Scheme::Fast(o)) => {
+            let c = super::target_error(e)?;
+            o.substeps_per_contact = c.substeps_per_contact;
+            Some(c)
+        }
+    };
     // The fingerprint covers the scheme as run, not as configured.
     plan.spec.scheme = scheme;
     let fast = matches!(scheme, Scheme::Fast(_));
@@ -201,6 +219,11 @@ pub fn run(a: Args) -> Result<()> {
         backend: engine.key(),
         columns: picked_names.clone(),
         content: None,
+        target_error: chosen.map(|c| pounding::io::provenance::TargetError {
+            target: c.target,
+            substeps_per_contact: c.substeps_per_contact,
+            calibrated_p99: c.calibrated_p99,
+        }),
     };
     let fmt = match &aggregate {
         Some(by) => Format::Summary(Box::new(pounding::engine::aggregate::Aggregator::new(

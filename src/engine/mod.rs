@@ -31,6 +31,10 @@ pub struct Summary {
     pub runs_with_impacts: u64,
     pub impacts: u64,
     pub failures: u64,
+    /// Exact free record steps and RK4 substeps, summed over runs (not counted by the device
+    /// fold: 0 there).
+    pub free_steps: u64,
+    pub substeps: u64,
 }
 
 impl Summary {
@@ -40,6 +44,8 @@ impl Summary {
         self.impacts += o.impacts as u64;
         self.runs_with_impacts += (o.impacts > 0) as u64;
         self.failures += (o.status != Status::Ok) as u64;
+        self.free_steps += o.free_steps;
+        self.substeps += o.substeps;
     }
 
     /// Count the runs of a device partial (handed-back runs are counted when finished).

@@ -151,6 +151,8 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, SidecarError> {
             backend: backends.join("+"),
             columns: first.columns.clone(),
             content: Some(content.clone()),
+            // Shards share the fingerprint, so the setting; the first one's target is kept.
+            target_error: first.target_error,
         };
         let is_file = target.is_file();
         let (_, content) = w

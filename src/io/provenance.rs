@@ -96,6 +96,18 @@ pub struct Meta {
     /// What the file holds (rows and hashes): `pound merge` and the studies check it.
     #[serde(default)]
     pub content: Option<crate::io::journal::Content>,
+    /// `--target-error`: the error asked for and the setting it chose.
+    #[serde(default)]
+    pub target_error: Option<TargetError>,
+}
+
+/// The accuracy a sweep was asked for (`--target-error`) and what it chose: the fast scheme's
+/// RK4 substeps per contact and their calibrated p99 relative peak-force error.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TargetError {
+    pub target: f64,
+    pub substeps_per_contact: f64,
+    pub calibrated_p99: f64,
 }
 
 /// `OUT.meta.toml` for the output `OUT`.

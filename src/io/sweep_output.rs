@@ -527,6 +527,7 @@ synthetic = { seed = 2, duration_s = 2.0 }
             backend: "cpu".into(),
             columns: None,
             content: None,
+            target_error: None,
         }
     }
 

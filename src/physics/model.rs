@@ -160,6 +160,8 @@ pub struct RunOutput {
     /// Integration work beyond the exact free steps: RK4 substeps (fast scheme, both backends)
     /// or trial steps (reference). 0 for a run that never came near contact.
     pub substeps: u64,
+    /// Record steps taken whole by the exact free propagator (fast scheme).
+    pub free_steps: u64,
     /// The run's energy balance, where it was asked for (always with the reference scheme).
     pub energy: Option<EnergyBalance>,
 }

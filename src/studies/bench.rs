@@ -59,6 +59,11 @@ pub struct Row {
     pub impacts: u64,
     /// Runs the kernel handed back to the CPU.
     pub handed_off: u64,
+    /// Exact free record steps and RK4 substeps taken (0 where the device fold kept no count).
+    pub free_steps: u64,
+    pub substeps: u64,
+    /// GPU: share of the lane trips the kernel held that did work.
+    pub lane_utilisation: Option<f64>,
 }
 
 impl Row {
@@ -130,6 +135,9 @@ pub fn run(plan: &Plan, engine: &Engine) -> Result<Row, GpuError> {
         csv: sink.seconds,
         impacts: s.impacts,
         handed_off: t.handed_off,
+        free_steps: s.free_steps,
+        substeps: s.substeps,
+        lane_utilisation: t.lane_utilisation(),
     })
 }
 
@@ -167,21 +175,37 @@ pub fn fold(plan: &Plan, engine: &Engine, by: &[String]) -> Result<Row, GpuError
         csv,
         impacts: s.impacts,
         handed_off: t.handed_off,
+        free_steps: s.free_steps,
+        substeps: s.substeps,
+        lane_utilisation: t.lane_utilisation(),
     })
 }
 
 /// A markdown table of rows.
 pub fn table(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| runs | backend | total s | runs/s | pack s | upload s | kernel s | readback s | handoff s (runs) | csv s | impacts |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| runs | backend | total s | runs/s | free steps/s | RK4 substeps/s | lanes busy | pack s | upload s | kernel s | readback s | handoff s (runs) | csv s | impacts |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
+    let rate = |n: u64, r: &Row| {
+        if n == 0 {
+            "-".to_string()
+        } else {
+            format!("{:.3e}", n as f64 / r.seconds.max(1e-12))
+        }
+    };
     for r in rows {
+        let lanes = r
+            .lane_utilisation
+            .map_or("-".to_string(), |u| format!("{:.0} %", 100.0 * u));
         s.push_str(&format!(
-            "| {} | {} | {:.3} | {:.0} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} ({}) | {:.3} | {} |\n",
+            "| {} | {} | {:.3} | {:.0} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} ({}) | {:.3} | {} |\n",
             r.runs,
             r.backend,
             r.seconds,
             r.runs_per_second(),
+            rate(r.free_steps, r),
+            rate(r.substeps, r),
+            lanes,
             r.pack,
             r.upload,
             r.kernel,

@@ -259,3 +259,66 @@ fn closed_pipe_ends_quietly() {
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(!err.contains("panicked"), "{err}");
 }
+
+/// `--target-error` picks the calibrated setting, says so, records it in the sidecar, and the
+/// runs take it (fewer substeps at 1e-2 than at the default 64); a target below the calibration
+/// is refused. `pound accuracy --target-error` checks the choice on a suite.
+#[test]
+fn target_error_chooses_records_and_is_checked() {
+    let d = tempdir();
+    let cfg = d.path().join("small.toml");
+    std::fs::write(&cfg, SMALL).unwrap();
+    let sweep = |out: &std::path::Path, extra: &[&str]| {
+        let mut args = vec!["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        pound(&args)
+    };
+    let substeps = |p: &std::path::Path| -> u64 {
+        let text = std::fs::read_to_string(p).unwrap();
+        let mut lines = text.lines();
+        let h: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let i = h.iter().position(|c| *c == "substeps").unwrap();
+        lines
+            .map(|l| l.split(',').nth(i).unwrap().parse::<u64>().unwrap())
+            .sum()
+    };
+    let (coarse, default) = (d.path().join("coarse.csv"), d.path().join("default.csv"));
+    let r = sweep(&coarse, &["--target-error", "1e-2", "--backend", "cpu"]);
+    ok(&r);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(err.contains("16 RK4 substeps per contact"), "{err}");
+    let meta = std::fs::read_to_string(d.path().join("coarse.csv.meta.toml")).unwrap();
+    assert!(
+        meta.contains("[target_error]") && meta.contains("substeps_per_contact = 16.0"),
+        "{meta}"
+    );
+    ok(&sweep(&default, &["--backend", "cpu"]));
+    let (few, many) = (substeps(&coarse), substeps(&default));
+    assert!(
+        few > 0 && few * 2 < many,
+        "{few} substeps at 1e-2, {many} at 64"
+    );
+    let bad = sweep(&d.path().join("never.csv"), &["--target-error", "1e-6"]);
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        err.contains("below what the fast scheme is calibrated for"),
+        "{err}"
+    );
+    assert!(!d.path().join("never.csv").exists());
+    let out = ok(&pound(&[
+        "accuracy",
+        cfg.to_str().unwrap(),
+        "--target-error",
+        "1e-2",
+        "--backend",
+        "cpu",
+        "-o",
+        d.path().join("a.csv").to_str().unwrap(),
+    ]));
+    assert!(
+        out.contains("--target-error 1e-2: 16 substeps per contact, cpu-fast-f64")
+            && out.contains("(met)"),
+        "{out}"
+    );
+}

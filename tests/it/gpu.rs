@@ -578,3 +578,63 @@ fn gpu_aggregate_on_device_matches_the_host_fold() {
         eprintln!("case {n}: {moved} quantiles one bucket apart");
     }
 }
+
+/// The kernel's lane tally and work counts: every free interval and RK4 piece is one unit of a
+/// lane, so the units cover the free steps and substeps the runs report; the units fit in the
+/// slots the lanes were held for; and the free steps and substeps match the CPU's work on the
+/// same runs (f64: the same decisions, up to rounding at the edge of the near-contact test).
+#[test]
+fn gpu_lane_tally_and_work_counts_match_the_runs() {
+    let Some(ctx) = ctx() else { return };
+    let plan = pounding::studies::bench::plan(200);
+    let opts = GpuOptions {
+        precision: pounding::engine::gpu::Precision::F64,
+        ..Default::default()
+    };
+    let mut gpu = Vec::new();
+    let report = Engine::gpu(ctx, opts, None)
+        .unwrap()
+        .run(
+            &plan,
+            0..plan.len(),
+            |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::engine::gpu::GpuError> {
+                gpu.extend_from_slice(c);
+                Ok(())
+            },
+            |_| {},
+        )
+        .unwrap();
+    let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
+    let (t, s) = (report.gpu, report.summary);
+    let (free, sub): (u64, u64) = (s.free_steps, s.substeps);
+    assert_eq!(free, gpu.iter().map(|(_, o)| o.free_steps).sum::<u64>());
+    assert!(free > 0 && sub > 0, "{s:?}");
+    assert!(t.lane_units >= free + sub, "{t:?} against {s:?}");
+    assert!(t.lane_units <= t.lane_slots, "{t:?}");
+    let u = t.lane_utilisation().unwrap();
+    assert!(u > 0.0 && u <= 1.0, "{u}");
+    for ((spec, g), (_, c)) in gpu.iter().zip(&cpu) {
+        let intervals = plan.forcing(spec).intervals() as u64;
+        assert!(g.free_steps <= intervals && c.free_steps <= intervals);
+        if c.substeps == 0 {
+            assert_eq!(c.free_steps, intervals, "run {}", spec.index);
+        }
+        let near = |a: u64, b: u64| a.abs_diff(b) <= 2 + a.max(b) / 1000;
+        assert!(
+            near(g.free_steps, c.free_steps) && near(g.substeps, c.substeps),
+            "run {}: GPU {} free steps, {} substeps; CPU {}, {}",
+            spec.index,
+            g.free_steps,
+            g.substeps,
+            c.free_steps,
+            c.substeps
+        );
+    }
+    eprintln!(
+        "lane utilisation on {}: {:.1} % ({} units in {} slots)",
+        ctx.info.name,
+        100.0 * u,
+        t.lane_units,
+        t.lane_slots
+    );
+}

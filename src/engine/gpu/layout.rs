@@ -144,7 +144,8 @@ pub struct Counters {
     pub m: u32,
     /// Pieces (event cuts) taken in substep `j`.
     pub pieces: u32,
-    pub _pad0: u32,
+    /// Record intervals taken by the exact free step.
+    pub free_steps: u32,
     pub _pad1: u32,
 }
 
@@ -194,7 +195,7 @@ impl Layout for Counters {
             ("j", offset_of!(Counters, j)),
             ("m", offset_of!(Counters, m)),
             ("pieces", offset_of!(Counters, pieces)),
-            ("_pad0", offset_of!(Counters, _pad0)),
+            ("free_steps", offset_of!(Counters, free_steps)),
             ("_pad1", offset_of!(Counters, _pad1)),
         ]
     }

@@ -55,6 +55,9 @@ impl GpuOptions {
     }
 }
 
+/// Bytes of the kernel's tally (`Tally` in fast.wgsl): three u32.
+const TALLY_BYTES: usize = 12;
+
 /// Budget cap on CPU (software) adapters: lavapipe ends any loop after about 65,535
 /// iterations per invocation without an error, and one unit runs at most 17 loop iterations.
 pub const CPU_ADAPTER_BUDGET: u32 = 1024;
@@ -65,6 +68,11 @@ pub struct ChunkTimes {
     pub upload: Duration,
     pub kernel: Duration,
     pub readback: Duration,
+    /// The kernel's lane tally, summed over dispatches: loop trips that did work (a free
+    /// interval or an RK4 piece) and the trips lanes were held for (each workgroup's longest
+    /// lane times its size).
+    pub lane_units: u64,
+    pub lane_slots: u64,
 }
 
 /// Every record of a sweep in one buffer, converted to the kernel's precision.
@@ -212,6 +220,7 @@ pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<R
         contact_time: s.contact_time,
         dissipated_energy: s.dissipated,
         substeps: c.substeps as u64,
+        free_steps: c.free_steps as u64,
         energy: energy.then(|| {
             let b1 = Oscillator {
                 m: p.m1,
@@ -438,10 +447,11 @@ pub fn integrate(
         (n * size_of::<Counters>()) as u64,
         wgpu::BufferUsages::COPY_SRC,
     )?;
+    // The dispatch's tally: [runs still active, lane units, lane slots].
     let active = storage(
         ctx,
-        "active runs",
-        &[0; 4],
+        "active runs and lane tally",
+        &[0; TALLY_BYTES],
         wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
     )?;
     // Run ids of the active runs, ping-ponged: a dispatch reads one list and appends the runs it
@@ -504,20 +514,24 @@ pub fn integrate(
         ..Default::default()
     };
     let active_staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("active readback"),
-        size: 4,
+        label: Some("tally readback"),
+        size: TALLY_BYTES as u64,
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
     for parity in (0..2).cycle() {
         ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&d));
-        ctx.queue.write_buffer(&active, 0, &[0; 4]);
+        ctx.queue.write_buffer(&active, 0, &[0; TALLY_BYTES]);
         let groups = (layout::workgroups(d.nactive), 1);
         ctx.dispatch("fast", &kernel, &binds[parity], groups, |enc| {
-            enc.copy_buffer_to_buffer(&active, 0, &active_staging, 0, 4)
+            enc.copy_buffer_to_buffer(&active, 0, &active_staging, 0, TALLY_BYTES as u64)
         });
         let v = map_read(ctx, &active_staging)?;
-        d.nactive = u32::from_le_bytes([v[0], v[1], v[2], v[3]]);
+        let word =
+            |i: usize| u32::from_le_bytes([v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]]);
+        d.nactive = word(0);
+        times.lane_units += word(1) as u64;
+        times.lane_slots += word(2) as u64;
         if d.nactive == 0 {
             break;
         }

@@ -27,6 +27,10 @@ pub struct GpuTimes {
     /// folded on the host), and times the slots were flushed to the host before the end.
     pub host_folded_chunks: u64,
     pub slot_flushes: u64,
+    /// The kernel's lane tally ([`super::ChunkTimes`]): trips that did work, trips lanes were
+    /// held for.
+    pub lane_units: u64,
+    pub lane_slots: u64,
 }
 
 impl GpuTimes {
@@ -35,6 +39,13 @@ impl GpuTimes {
         self.upload += ct.upload.as_secs_f64();
         self.kernel += ct.kernel.as_secs_f64();
         self.readback += ct.readback.as_secs_f64();
+        self.lane_units += ct.lane_units;
+        self.lane_slots += ct.lane_slots;
+    }
+
+    /// Share of the lane trips the kernel held that did work (None before any dispatch).
+    pub fn lane_utilisation(&self) -> Option<f64> {
+        (self.lane_slots > 0).then(|| self.lane_units as f64 / self.lane_slots as f64)
     }
 
     /// A chunk's outputs as read back, with the runs the kernel handed back finished on the CPU

@@ -15,6 +15,7 @@
 //! samples; [`collision`] solves one isolated collision (the `exact` restitution formula).
 //! `shaders/fast.wgsl` is the GPU twin of [`fast`], function for function.
 
+pub mod calibration;
 pub mod collision;
 mod events;
 pub mod fast;

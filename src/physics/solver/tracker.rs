@@ -56,6 +56,7 @@ impl Tracker {
             (-o.c * v - o.k * u) / o.m - ag
         };
         let o = &mut self.out;
+        o.free_steps += 1;
         let a1 = [
             acc(&p.b1, z0[0], z0[1], seg.a0),
             acc(&p.b1, z1[0], z1[1], seg.a1),
