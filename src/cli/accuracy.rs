@@ -56,7 +56,9 @@ pub fn run(a: Args) -> Result<()> {
     let settings = if choices.is_empty() {
         settings
     } else {
+        // Targets may come in any order and share a setting: each setting runs once.
         let mut s: Vec<f64> = choices.iter().map(|c| c.substeps_per_contact).collect();
+        s.sort_by(f64::total_cmp);
         s.dedup();
         s
     };

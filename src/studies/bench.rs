@@ -152,16 +152,11 @@ pub fn fold(plan: &Plan, engine: &Engine, by: &[String]) -> Result<Row, GpuError
     let c = Instant::now();
     let summary = crate::io::summary::csv(&agg);
     let csv = c.elapsed().as_secs_f64();
-    let on = match engine {
-        Engine::Cpu { .. } => format!("cpu ({} threads)", rayon::current_num_threads()),
-        Engine::Gpu { ctx, opts, .. } => {
-            format!("gpu {} ({})", opts.precision.key(), ctx.info.name)
-        }
-    };
     Ok(Row {
         runs: s.runs,
         backend: format!(
-            "{on}, --aggregate {} ({} groups, {} bytes)",
+            "{}, --aggregate {} ({} groups, {} bytes)",
+            label(engine),
             by.join(","),
             agg.groups(),
             summary.len()

@@ -118,7 +118,7 @@ fn shared_constants_match_the_shader() {
     }
 }
 
-use crate::support::{collect, ctx, gpu_collect, grazing_contacts, peak_diff, rel};
+use crate::support::{collect, ctx, gpu_collect, gpu_run, grazing_contacts, peak_diff, rel};
 use pounding::engine::gpu::{GpuContext, GpuOptions};
 use pounding::engine::Engine;
 use pounding::physics::model::RunOutput;
@@ -385,27 +385,15 @@ fn gpu_chunking_does_not_change_results() {
 /// integrated on the GPU.
 #[test]
 fn gpu_hands_runs_past_its_precision_to_the_cpu() {
-    let Some(ctx) = ctx() else { return };
+    let Some(_) = ctx() else { return };
     let plan = pounding::studies::bench::plan(200);
     let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
     let opts = GpuOptions {
         handoff_substeps_per_step: Some(16),
         ..Default::default()
     };
-    let mut gpu = Vec::new();
-    let t = Engine::gpu(ctx, opts, Some(1000))
-        .unwrap()
-        .run(
-            &plan,
-            0..plan.len(),
-            |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::engine::gpu::GpuError> {
-                gpu.extend_from_slice(c);
-                Ok(())
-            },
-            |_| {},
-        )
-        .unwrap()
-        .gpu;
+    let (gpu, report) = gpu_run(&plan, &opts, 1000);
+    let t = report.gpu;
     let exact = cpu
         .iter()
         .zip(&gpu)
@@ -591,19 +579,7 @@ fn gpu_lane_tally_and_work_counts_match_the_runs() {
         precision: pounding::engine::gpu::Precision::F64,
         ..Default::default()
     };
-    let mut gpu = Vec::new();
-    let report = Engine::gpu(ctx, opts, None)
-        .unwrap()
-        .run(
-            &plan,
-            0..plan.len(),
-            |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::engine::gpu::GpuError> {
-                gpu.extend_from_slice(c);
-                Ok(())
-            },
-            |_| {},
-        )
-        .unwrap();
+    let (gpu, report) = gpu_run(&plan, &opts, pounding::engine::GPU_CHUNK);
     let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
     let (t, s) = (report.gpu, report.summary);
     let (free, sub): (u64, u64) = (s.free_steps, s.substeps);

@@ -2,7 +2,7 @@
 
 use super::rel;
 use pounding::engine::gpu::{GpuContext, GpuOptions};
-use pounding::engine::Engine;
+use pounding::engine::{Engine, Report};
 use pounding::physics::model::RunOutput;
 use pounding::physics::solver::{FastOptions, Scheme};
 use pounding::plan::{Plan, RunSpec};
@@ -28,16 +28,25 @@ pub fn ctx() -> Option<&'static GpuContext> {
 }
 
 pub fn gpu_collect(plan: &Plan, opts: &GpuOptions, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
+    gpu_run(plan, opts, chunk).0
+}
+
+/// Every run of `plan` on the shared device, with the engine's report (times, lane tally).
+pub fn gpu_run(
+    plan: &Plan,
+    opts: &GpuOptions,
+    chunk: usize,
+) -> (Vec<(RunSpec, RunOutput)>, Report) {
     let mut rows = Vec::new();
     let sink = |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::engine::gpu::GpuError> {
         rows.extend_from_slice(c);
         Ok(())
     };
-    Engine::gpu(ctx().unwrap(), *opts, Some(chunk))
+    let report = Engine::gpu(ctx().unwrap(), *opts, Some(chunk))
         .unwrap()
         .run(plan, 0..plan.len(), sink, |_| {})
         .unwrap();
-    rows
+    (rows, report)
 }
 
 /// Largest relative difference of the peak outputs of two results of one run.
