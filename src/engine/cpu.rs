@@ -4,7 +4,7 @@
 
 use crate::engine::Summary;
 use crate::physics::model::{Initial, RunOutput};
-use crate::physics::solver::{simulate, Scheme};
+use crate::physics::solver::{simulate, simulate_shared, FreeResponse, Scheme};
 use crate::plan::{Plan, RunSpec};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -17,6 +17,44 @@ pub fn run_one(plan: &Plan, spec: &RunSpec, scheme: &Scheme) -> RunOutput {
         &Initial::default(),
         scheme,
     )
+}
+
+/// Consecutive runs that share buildings, record and intensity (the gap axis is the innermost)
+/// share one free response when there are at least this many of them: building it costs about
+/// as much as one run's free steps, and each run saves the steps before its first possible
+/// contact and after its early end.
+pub const MIN_SHARED_RUNS: usize = 4;
+
+/// Runs that differ at most in gap and contact law move alike while apart.
+fn same_free_motion(a: &RunSpec, b: &RunSpec) -> bool {
+    (a.record, a.scale, a.m1, a.t1, a.xi1, a.m2, a.t2, a.xi2)
+        == (b.record, b.scale, b.m1, b.t1, b.xi1, b.m2, b.t2, b.xi2)
+}
+
+/// Run `specs` in order; the fast scheme shares one free response ([`FreeResponse`]) among each
+/// stretch of at least [`MIN_SHARED_RUNS`] consecutive runs with the same free motion.
+pub fn run_many(plan: &Plan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunOutput> {
+    let mut out = Vec::with_capacity(specs.len());
+    let mut rest = specs;
+    while let Some(first) = rest.first() {
+        let len = rest
+            .iter()
+            .position(|s| !same_free_motion(first, s))
+            .unwrap_or(rest.len());
+        let (group, tail) = rest.split_at(len);
+        if len >= MIN_SHARED_RUNS && matches!(scheme, Scheme::Fast(_)) {
+            let forcing = plan.forcing(first);
+            let pair = first.pair();
+            let shared = FreeResponse::new(&pair.b1, &pair.b2, &forcing);
+            out.extend(group.iter().map(|s| {
+                simulate_shared(&s.pair(), &forcing, &Initial::default(), scheme, &shared)
+            }));
+        } else {
+            out.extend(group.iter().map(|s| run_one(plan, s, scheme)));
+        }
+        rest = tail;
+    }
+    out
 }
 
 /// Run the runs `runs` of `plan` with `scheme`, `chunk` runs per task, on the current rayon pool;
@@ -41,13 +79,11 @@ pub fn run_range<E>(
         let results: Vec<Vec<(RunSpec, RunOutput)>> = (c0..c1)
             .into_par_iter()
             .map(|c| {
-                (first + c * chunk..(first + (c + 1) * chunk).min(n))
-                    .map(|i| {
-                        let spec = plan.run(i);
-                        let out = run_one(plan, &spec, scheme);
-                        (spec, out)
-                    })
-                    .collect()
+                let specs: Vec<RunSpec> = (first + c * chunk..(first + (c + 1) * chunk).min(n))
+                    .map(|i| plan.run(i))
+                    .collect();
+                let outs = run_many(plan, &specs, scheme);
+                specs.into_iter().zip(outs).collect()
             })
             .collect();
         for r in &results {

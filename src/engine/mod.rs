@@ -35,6 +35,10 @@ pub struct Summary {
     /// fold: 0 there).
     pub free_steps: u64,
     pub substeps: u64,
+    /// Record steps settled by a shared free response, and the runs that settled any (started
+    /// at their first possible contact or ended early; the CPU fast path only).
+    pub shared_steps: u64,
+    pub runs_sharing: u64,
 }
 
 impl Summary {
@@ -46,6 +50,8 @@ impl Summary {
         self.failures += (o.status != Status::Ok) as u64;
         self.free_steps += o.free_steps;
         self.substeps += o.substeps;
+        self.shared_steps += o.shared_steps;
+        self.runs_sharing += (o.shared_steps > 0) as u64;
     }
 
     /// Count the runs of a device partial (handed-back runs are counted when finished).

@@ -162,6 +162,10 @@ pub struct RunOutput {
     pub substeps: u64,
     /// Record steps taken whole by the exact free propagator (fast scheme).
     pub free_steps: u64,
+    /// Record steps settled by a shared free response instead (fast scheme on the CPU): those
+    /// before the run's first possible contact, and those after it ended early because the
+    /// rest of the record could neither close its gap nor raise its peaks.
+    pub shared_steps: u64,
     /// The run's energy balance, where it was asked for (always with the reference scheme).
     pub energy: Option<EnergyBalance>,
 }

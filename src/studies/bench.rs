@@ -62,6 +62,9 @@ pub struct Row {
     /// Exact free record steps and RK4 substeps taken (0 where the device fold kept no count).
     pub free_steps: u64,
     pub substeps: u64,
+    /// Record steps settled by a shared free response, and the runs that settled any.
+    pub shared_steps: u64,
+    pub runs_sharing: u64,
     /// GPU: share of the lane trips the kernel held that did work.
     pub lane_utilisation: Option<f64>,
 }
@@ -137,6 +140,8 @@ pub fn run(plan: &Plan, engine: &Engine) -> Result<Row, GpuError> {
         handed_off: t.handed_off,
         free_steps: s.free_steps,
         substeps: s.substeps,
+        shared_steps: s.shared_steps,
+        runs_sharing: s.runs_sharing,
         lane_utilisation: t.lane_utilisation(),
     })
 }
@@ -172,6 +177,8 @@ pub fn fold(plan: &Plan, engine: &Engine, by: &[String]) -> Result<Row, GpuError
         handed_off: t.handed_off,
         free_steps: s.free_steps,
         substeps: s.substeps,
+        shared_steps: s.shared_steps,
+        runs_sharing: s.runs_sharing,
         lane_utilisation: t.lane_utilisation(),
     })
 }
@@ -179,7 +186,7 @@ pub fn fold(plan: &Plan, engine: &Engine, by: &[String]) -> Result<Row, GpuError
 /// A markdown table of rows.
 pub fn table(rows: &[Row]) -> String {
     let mut s = String::from(
-        "| runs | backend | total s | runs/s | free steps/s | RK4 substeps/s | lanes busy | pack s | upload s | kernel s | readback s | handoff s (runs) | csv s | impacts |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| runs | backend | total s | runs/s | free steps/s | RK4 substeps/s | runs sharing | steps shared | lanes busy | pack s | upload s | kernel s | readback s | handoff s (runs) | csv s | impacts |\n|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     let rate = |n: u64, r: &Row| {
         if n == 0 {
@@ -192,14 +199,24 @@ pub fn table(rows: &[Row]) -> String {
         let lanes = r
             .lane_utilisation
             .map_or("-".to_string(), |u| format!("{:.0} %", 100.0 * u));
+        let share = |part: u64, whole: u64| {
+            if whole == 0 {
+                "-".to_string()
+            } else {
+                format!("{:.0} %", 100.0 * part as f64 / whole as f64)
+            }
+        };
+        let steps = r.free_steps + r.shared_steps;
         s.push_str(&format!(
-            "| {} | {} | {:.3} | {:.0} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} ({}) | {:.3} | {} |\n",
+            "| {} | {} | {:.3} | {:.0} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} ({}) | {:.3} | {} |\n",
             r.runs,
             r.backend,
             r.seconds,
             r.runs_per_second(),
             rate(r.free_steps, r),
             rate(r.substeps, r),
+            share(r.runs_sharing, if steps == 0 { 0 } else { r.runs }),
+            share(r.shared_steps, steps),
             lanes,
             r.pack,
             r.upload,

@@ -118,7 +118,9 @@ fn shared_constants_match_the_shader() {
     }
 }
 
-use crate::support::{collect, ctx, gpu_collect, gpu_run, grazing_contacts, peak_diff, rel};
+use crate::support::{
+    collect, ctx, gpu_collect, gpu_run, grazing_contacts, peak_diff, rel, without_work,
+};
 use pounding::engine::gpu::{GpuContext, GpuOptions};
 use pounding::engine::Engine;
 use pounding::physics::model::RunOutput;
@@ -397,7 +399,7 @@ fn gpu_hands_runs_past_its_precision_to_the_cpu() {
     let exact = cpu
         .iter()
         .zip(&gpu)
-        .filter(|((_, c), (_, g))| c == g)
+        .filter(|((_, c), (_, g))| without_work(c) == without_work(g))
         .count() as u64;
     eprintln!("{} of {} runs handed off", t.handed_off, plan.len());
     assert!(
@@ -591,6 +593,11 @@ fn gpu_lane_tally_and_work_counts_match_the_runs() {
     assert!(u > 0.0 && u <= 1.0, "{u}");
     for ((spec, g), (_, c)) in gpu.iter().zip(&cpu) {
         let intervals = plan.forcing(spec).intervals() as u64;
+        // The CPU settles some free steps from a shared free response; the GPU steps them.
+        let c = &RunOutput {
+            free_steps: c.free_steps + c.shared_steps,
+            ..*c
+        };
         assert!(g.free_steps <= intervals && c.free_steps <= intervals);
         if c.substeps == 0 {
             assert_eq!(c.free_steps, intervals, "run {}", spec.index);

@@ -12,5 +12,6 @@ mod layers;
 mod oracles;
 mod records;
 mod scale;
+mod shared;
 mod studies;
 pub mod support;

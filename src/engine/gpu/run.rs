@@ -221,6 +221,7 @@ pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<R
         dissipated_energy: s.dissipated,
         substeps: c.substeps as u64,
         free_steps: c.free_steps as u64,
+        shared_steps: 0,
         energy: energy.then(|| {
             let b1 = Oscillator {
                 m: p.m1,

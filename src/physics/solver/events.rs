@@ -1,7 +1,7 @@
 //! Locating the non-smooth instants inside a step: first touch, the turn, separation, and a
 //! touch hidden inside a free step; the mode change each calls for.
 
-use super::hermite::{cubic_max_bound, hermite_range};
+use super::hermite::{cubic_max_bound, hermite_range, CUBIC_SLOPE_WEIGHT};
 use super::tracker::Tracker;
 use super::{ddelta, delta, force, Mode, Segment, State};
 use crate::physics::model::{Oscillator, Pair};
@@ -139,6 +139,48 @@ pub(crate) fn may_touch(p: &Pair, seg: &Segment, z0: &State, z1: &State, h: f64,
     }
     let (_, hi) = hermite_range(d0, ddelta(z0), d1, ddelta(z1), h);
     hi > margin
+}
+
+/// Relative slack of [`contact_reach`]: far above the rounding of the free steps (about
+/// 1e-12 of the state over a long record) and of `may_touch`'s own bound.
+pub(crate) const REACH_SLACK: f64 = 1e-6;
+
+/// The smallest gap that the first test of [`may_touch`] could fail to clear over the free
+/// step from `z0` to `z1` (only the buildings' motion, not the gap or the contact, enters):
+/// a run with `gap * (1 - REACH_SLACK) > contact_reach` takes this step free for certain.
+/// It is `may_touch`'s `cubic_max_bound(...) - margin` with the gap left out, plus slack.
+#[inline]
+pub(crate) fn contact_reach(
+    b1: &Oscillator,
+    b2: &Oscillator,
+    seg: &Segment,
+    z0: &State,
+    z1: &State,
+    h: f64,
+) -> f64 {
+    let (u1, v1) = (z0[0].abs().max(z1[0].abs()), z0[1].abs().max(z1[1].abs()));
+    let (u2, v2) = (z0[2].abs().max(z1[2].abs()), z0[3].abs().max(z1[3].abs()));
+    let bound = fourth_derivative_bound(b1, u1, v1, seg) + fourth_derivative_bound(b2, u2, v2, seg);
+    let h2 = h * h;
+    let margin = 2.0 * h2 * h2 / 384.0 * bound;
+    let slope = CUBIC_SLOPE_WEIGHT * h * (ddelta(z0).abs() + ddelta(z1).abs());
+    let reach = (z0[0] - z0[2]).max(z1[0] - z1[2]) + slope + margin;
+    reach + REACH_SLACK * (u1 + u2 + slope + margin)
+}
+
+/// How much [`contact_reach`] can grow per metre of `R`, where a run's motion differs from the
+/// one it was computed on by a free (homogeneous) response of `o` with `|u| <= R` and
+/// `|v| <= omega R` throughout: the reach's terms are affine in `|u|`, `|v|` and `u1 - u2`.
+pub(crate) fn contact_reach_growth(o: &Oscillator, h: f64) -> f64 {
+    let (w2, cm) = (o.k / o.m, o.c / o.m);
+    let w = w2.sqrt();
+    // fourth_derivative_bound's linear part at (|u|, |v|) = (1, omega).
+    let a2 = w2 + cm * w;
+    let a3 = w2 * w + cm * a2;
+    let h2 = h * h;
+    let margin = 2.0 * h2 * h2 / 384.0 * (w2 * a2 + cm * a3);
+    let slope = CUBIC_SLOPE_WEIGHT * h * 2.0 * w;
+    (1.0 + slope + margin) * (1.0 + 2.0 * REACH_SLACK)
 }
 
 /// Apply the mode change an event at state `z` (time `t`) calls for; `before` is the state at

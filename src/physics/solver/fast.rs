@@ -24,9 +24,12 @@
 //!    ends are known; the cubic's `(omega dt)^4 / 384` error was 5e-3 at T = 0.1 s, dt = 0.02 s).
 //!
 //! Cost is therefore one cheap exact step per record sample for runs that never pound, plus
-//! `M` RK4 substeps only for the record steps near or in contact.
+//! `M` RK4 substeps only for the record steps near or in contact. With a shared free response
+//! ([`super::shared`]) a run also skips the steps before its first possible contact, settles
+//! most free steps with a comparison, and ends early, all with the same output.
 
 use super::events::may_touch;
+use super::shared::FreeResponse;
 use super::tracker::Integration;
 use super::{
     ddelta, delta, finite, impact_step, structural_rel_accel, Mode, Sample, Segment, State,
@@ -88,13 +91,21 @@ pub(crate) fn rk4(
     std::array::from_fn(|i| z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
 }
 
+/// A free run checks whether it can end early (the shared response's `can_end`) every this
+/// many record steps: the check costs about a tenth of a free step.
+const END_CHECK_EVERY: usize = 8;
+
 pub(crate) fn run(
     pair: &Pair,
     forcing: &Forcing,
     init: &Initial,
     o: &FastOptions,
+    shared: Option<&FreeResponse>,
     observer: Option<&mut dyn FnMut(&Sample)>,
 ) -> RunOutput {
+    // The shortcuts keep every output but the energy integrals and the observer's samples.
+    let shared =
+        shared.filter(|s| !o.energy && observer.is_none() && s.serves(pair, forcing, init));
     let dt = forcing.dt;
     let (p1, p2) = (Propagator::new(&pair.b1, dt), Propagator::new(&pair.b2, dt));
     let forms = o.energy.then(|| {
@@ -106,21 +117,51 @@ pub(crate) fn run(
     let mut run = Integration::start(pair, init, forcing.t0, observer);
     run.energy = o.energy;
     let mut substeps: u32 = 0;
-    for i in 0..forcing.intervals() {
+    let n = forcing.intervals();
+    let mut first = 0;
+    if let Some(sh) = shared.filter(|_| run.mode == Mode::Free) {
+        first = sh.first_possible_contact(pair.gap);
+        let (z, peaks) = sh.at(first);
+        run.z = z;
+        run.tr.resume_free(first as u64, peaks);
+    }
+    // While the run steps free with the exact propagator, its distance from the shared motion
+    // (`FreeResponse::distance`); None after any other step.
+    let mut distance: Option<[f64; 2]> = None;
+    for i in first..n {
+        let peaks = [run.tr.out.peak_u1, run.tr.out.peak_u2];
+        if let Some(sh) = shared.filter(|_| run.mode == Mode::Free) {
+            if distance.is_none() || i % END_CHECK_EVERY == 0 {
+                let r = sh.distance(i, &run.z);
+                if sh.can_end(i, r, pair.gap, peaks) {
+                    run.tr.out.shared_steps += (n - i) as u64;
+                    break;
+                }
+                distance = Some(r);
+            }
+        }
         let seg = Segment::of(forcing, i);
         let z = run.z;
         let (v_est, d_est, a_est) = if run.mode == Mode::Free {
             let (u1, v1) = p1.step(z[0], z[1], seg.a0, seg.a1);
             let (u2, v2) = p2.step(z[2], z[3], seg.a0, seg.a1);
             let mut z1 = [u1, v1, u2, v2, z[4], z[5], z[6]];
-            if !may_touch(pair, &seg, &z, &z1, dt, run.tr.v0) {
+            // The shared response settles most free steps with a comparison or three; the
+            // rest take the full test and peak search.
+            let (clear, settled) = match (shared, distance) {
+                (Some(sh), Some(r)) if sh.clears(i, r, pair.gap) => {
+                    (true, sh.peaks_settled(i, r, peaks))
+                }
+                _ => (false, [false; 2]),
+            };
+            if clear || !may_touch(pair, &seg, &z, &z1, dt, run.tr.v0) {
                 if let Some((f1, f2)) = &forms {
                     let (vv1, agv1) = f1.integrals(z[0], z[1], seg.a0, seg.a1);
                     let (vv2, agv2) = f2.integrals(z[2], z[3], seg.a0, seg.a1);
                     z1[5] -= pair.b1.m * agv1 + pair.b2.m * agv2;
                     z1[6] += pair.b1.c * vv1 + pair.b2.c * vv2;
                 }
-                run.free_step(&seg, z1);
+                run.free_step(&seg, z1, settled);
                 if !finite(&run.z) {
                     return run.finish(Status::NonFinite, substeps as u64);
                 }
@@ -151,6 +192,7 @@ pub(crate) fn run(
         } else {
             impact_step(pair, v_est, a_est, o.substeps_per_contact).min(h_rate)
         };
+        distance = None;
         let m = (dt / h).ceil().max(1.0);
         if m.is_nan() || m > o.max_substeps_per_step as f64 {
             return run.finish(Status::StepLimit, substeps as u64);

@@ -46,9 +46,9 @@ pub(crate) fn hermite_extrema(m0: f64, b: f64, c: f64) -> [f64; 2] {
 /// of both lie in [0, 1] and sum to 1. So `max|y|` over a step is at most the larger end plus
 /// these times the ends' scaled slopes (and curvatures): a bound that lets a step that cannot
 /// raise a peak skip the search for it. The factor covers rounding in the searched value.
-const CUBIC_SLOPE_WEIGHT: f64 = 4.0 / 27.0;
-const QUINTIC_SLOPE_WEIGHT: f64 = 16.0 / 81.0;
-const QUINTIC_CURVATURE_WEIGHT: f64 = 54.0 / 3125.0;
+pub(crate) const CUBIC_SLOPE_WEIGHT: f64 = 4.0 / 27.0;
+pub(crate) const QUINTIC_SLOPE_WEIGHT: f64 = 16.0 / 81.0;
+pub(crate) const QUINTIC_CURVATURE_WEIGHT: f64 = 54.0 / 3125.0;
 const BOUND_SLACK: f64 = 1.0 + 1e-9;
 
 /// Upper bound on the cubic Hermite through `(y0, y0')`, `(y1, y1')` over `[0, h]`.
@@ -71,14 +71,19 @@ pub(crate) fn raise_cubic_peak(peak: f64, y0: f64, d0: f64, y1: f64, d1: f64, h:
     peak.max(hi.abs()).max(lo.abs())
 }
 
+/// Upper bound on `|y|` of the quintic Hermite through `(y, y', y'')` at both ends over `[0, h]`.
+#[inline]
+pub(crate) fn quintic_max_bound(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) -> f64 {
+    y[0].abs().max(y[1].abs())
+        + QUINTIC_SLOPE_WEIGHT * h * (d[0].abs() + d[1].abs())
+        + QUINTIC_CURVATURE_WEIGHT * h * h * (a[0].abs() + a[1].abs())
+}
+
 /// `peak` raised to [`quintic_peak_abs`] (the search skipped when the quintic cannot reach
 /// `peak`).
 #[inline]
 pub(crate) fn raise_quintic_peak(peak: f64, y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) -> f64 {
-    let bound = y[0].abs().max(y[1].abs())
-        + QUINTIC_SLOPE_WEIGHT * h * (d[0].abs() + d[1].abs())
-        + QUINTIC_CURVATURE_WEIGHT * h * h * (a[0].abs() + a[1].abs());
-    if bound * BOUND_SLACK <= peak {
+    if quintic_max_bound(y, d, a, h) * BOUND_SLACK <= peak {
         return peak;
     }
     peak.max(quintic_peak_abs(y, d, a, h))

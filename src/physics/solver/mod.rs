@@ -12,7 +12,7 @@
 //! steps (`events.rs`), so each step integrates a smooth right-hand side. The contact work
 //! `w' = F delta'` rides along as a fifth state so the dissipated energy is integrated to the
 //! scheme's own order. `tracker.rs` keeps peaks and impacts, `hermite.rs` the peaks between
-//! samples; [`collision`] solves one isolated collision (the `exact` restitution formula).
+//! samples, [`shared`] the free response that runs differing only in gap and contact share; [`collision`] solves one isolated collision (the `exact` restitution formula).
 //! `shaders/fast.wgsl` is the GPU twin of [`fast`], function for function.
 
 pub mod calibration;
@@ -21,11 +21,13 @@ mod events;
 pub mod fast;
 mod hermite;
 pub mod reference;
+pub mod shared;
 mod tracker;
 
 pub use collision::{single_collision, single_collision_observed, Collision, EXACT_RTOL};
 pub use fast::FastOptions;
 pub use reference::ReferenceOptions;
+pub use shared::FreeResponse;
 
 use crate::physics::model::{Forcing, Initial, Pair, RunOutput};
 
@@ -82,8 +84,25 @@ pub fn simulate_observed(
     observer: Option<&mut dyn FnMut(&Sample)>,
 ) -> RunOutput {
     match scheme {
-        Scheme::Fast(o) => fast::run(pair, forcing, init, o, observer),
+        Scheme::Fast(o) => fast::run(pair, forcing, init, o, None, observer),
         Scheme::Reference(o) => reference::run(pair, forcing, init, o, observer, None),
+    }
+}
+
+/// As [`simulate`], with the shared free response of the run's buildings under `forcing`
+/// ([`shared`]): the fast scheme starts at the first possible contact and may end early, with
+/// the same output. A response that does not serve this run (other buildings or forcing, an
+/// initial state other than rest), energy balances and the reference scheme ignore it.
+pub fn simulate_shared(
+    pair: &Pair,
+    forcing: &Forcing,
+    init: &Initial,
+    scheme: &Scheme,
+    shared: &FreeResponse,
+) -> RunOutput {
+    match scheme {
+        Scheme::Fast(o) => fast::run(pair, forcing, init, o, Some(shared), None),
+        Scheme::Reference(o) => reference::run(pair, forcing, init, o, None, None),
     }
 }
 

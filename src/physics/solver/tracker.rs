@@ -4,7 +4,7 @@
 use super::events::{event_value, hidden_touch, locate, reapproach, transition};
 use super::hermite::{cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak};
 use super::{ddelta, delta, force, Mode, Sample, Segment, State};
-use crate::physics::model::{EnergyBalance, Initial, Pair, RunOutput, Status};
+use crate::physics::model::{EnergyBalance, Initial, Oscillator, Pair, RunOutput, Status};
 
 /// Peaks and impact bookkeeping shared by both schemes.
 pub(crate) struct Tracker {
@@ -51,23 +51,31 @@ impl Tracker {
     /// Account for a free record step over `seg`, from `z0` to `z1`: peak displacements from
     /// the quintic Hermite (both ends' accelerations are known in free flight).
     #[inline]
-    pub fn free_step(&mut self, p: &Pair, seg: &Segment, z0: &State, z1: &State) {
-        let acc = |o: &crate::physics::model::Oscillator, u: f64, v: f64, ag: f64| {
-            (-o.c * v - o.k * u) / o.m - ag
-        };
+    /// A building whose peak is `settled` (it cannot be raised over this step) skips the search.
+    pub fn free_step(
+        &mut self,
+        p: &Pair,
+        seg: &Segment,
+        z0: &State,
+        z1: &State,
+        settled: [bool; 2],
+    ) {
         let o = &mut self.out;
         o.free_steps += 1;
-        let a1 = [
-            acc(&p.b1, z0[0], z0[1], seg.a0),
-            acc(&p.b1, z1[0], z1[1], seg.a1),
-        ];
-        o.peak_u1 = raise_quintic_peak(o.peak_u1, [z0[0], z1[0]], [z0[1], z1[1]], a1, seg.dt);
-        let a2 = [
-            acc(&p.b2, z0[2], z0[3], seg.a0),
-            acc(&p.b2, z1[2], z1[3], seg.a1),
-        ];
-        o.peak_u2 = raise_quintic_peak(o.peak_u2, [z0[2], z1[2]], [z0[3], z1[3]], a2, seg.dt);
+        if !settled[0] {
+            o.peak_u1 = free_peak(&p.b1, o.peak_u1, seg, [z0[0], z0[1]], [z1[0], z1[1]]);
+        }
+        if !settled[1] {
+            o.peak_u2 = free_peak(&p.b2, o.peak_u2, seg, [z0[2], z0[3]], [z1[2], z1[3]]);
+        }
         self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
+    }
+
+    /// Start from a free state reached by the shared free response ([`super::shared`]):
+    /// `steps` record steps taken there, with these peak displacements.
+    pub fn resume_free(&mut self, steps: u64, peaks: [f64; 2]) {
+        self.out.shared_steps += steps;
+        [self.out.peak_u1, self.out.peak_u2] = peaks;
     }
 
     /// Account for a step `t0 -> t0 + h` spent in `mode`, from `z0` to `z1`.
@@ -152,6 +160,30 @@ impl Tracker {
     }
 }
 
+/// Acceleration of a free oscillator at `(u, v)` under ground acceleration `ag`.
+#[inline]
+pub(crate) fn free_accel(o: &Oscillator, u: f64, v: f64, ag: f64) -> f64 {
+    (-o.c * v - o.k * u) / o.m - ag
+}
+
+/// `peak` raised to the largest `|u|` of one oscillator's quintic Hermite over the free record
+/// step `seg` from `(u, v)` = `s0` to `s1`. The run and the shared free response
+/// ([`super::shared`]) both call it, so their peaks agree to the bit.
+#[inline]
+pub(crate) fn free_peak(
+    o: &Oscillator,
+    peak: f64,
+    seg: &Segment,
+    s0: [f64; 2],
+    s1: [f64; 2],
+) -> f64 {
+    let a = [
+        free_accel(o, s0[0], s0[1], seg.a0),
+        free_accel(o, s1[0], s1[1], seg.a1),
+    ];
+    raise_quintic_peak(peak, [s0[0], s1[0]], [s0[1], s1[1]], a, seg.dt)
+}
+
 /// Kinetic plus strain energy of both buildings, J.
 #[inline]
 pub(crate) fn mechanical_energy(p: &Pair, z: &State) -> f64 {
@@ -208,9 +240,9 @@ impl<'a, 'o> Integration<'a, 'o> {
     }
 
     /// The free record step over `seg` to `z1`, with no possible contact (already checked by the
-    /// caller).
-    pub fn free_step(&mut self, seg: &Segment, z1: State) {
-        self.tr.free_step(self.pair, seg, &self.z, &z1);
+    /// caller); `settled`: the buildings whose peaks this step cannot raise.
+    pub fn free_step(&mut self, seg: &Segment, z1: State, settled: [bool; 2]) {
+        self.tr.free_step(self.pair, seg, &self.z, &z1, settled);
         self.z = z1;
         self.emit(seg.t1());
     }

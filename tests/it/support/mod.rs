@@ -62,6 +62,16 @@ pub fn assert_same_text(label: &str, a: &str, b: &str) {
     );
 }
 
+/// A run's output without its work counters (they differ between paths and chunkings that
+/// compute the same result: the CPU settles some free steps from a shared free response).
+pub fn without_work(o: &RunOutput) -> RunOutput {
+    RunOutput {
+        free_steps: 0,
+        shared_steps: 0,
+        ..*o
+    }
+}
+
 /// Relative difference with a floor.
 pub fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)
