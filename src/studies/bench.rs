@@ -3,8 +3,8 @@
 //! zeta, e = 0.65) on a 20 s synthetic record at dt = 0.01 s, gaps 0..50 mm: most runs pound.
 
 use crate::engine::aggregate::Aggregator;
-use crate::engine::gpu::GpuError;
-use crate::engine::Engine;
+use crate::engine::gpu::{GpuError, GpuTimes};
+use crate::engine::{Engine, Summary};
 use crate::physics::model::RunOutput;
 use crate::plan::{Plan, RunSpec};
 use std::time::Instant;
@@ -70,6 +70,28 @@ pub struct Row {
 }
 
 impl Row {
+    /// The row of a finished engine call, times as the engine reports them (no CSV time).
+    fn new(backend: String, s: &Summary, t: &GpuTimes) -> Row {
+        Row {
+            runs: s.runs,
+            backend,
+            seconds: s.seconds,
+            pack: t.pack,
+            upload: t.upload,
+            kernel: t.kernel,
+            readback: t.readback,
+            handoff: t.handoff,
+            csv: 0.0,
+            impacts: s.impacts,
+            handed_off: t.handed_off,
+            free_steps: s.free_steps,
+            substeps: s.substeps,
+            shared_steps: s.shared_steps,
+            runs_sharing: s.runs_sharing,
+            lane_utilisation: t.lane_utilisation(),
+        }
+    }
+
     pub fn runs_per_second(&self) -> f64 {
         self.runs as f64 / self.seconds.max(1e-12)
     }
@@ -123,26 +145,13 @@ pub fn run(plan: &Plan, engine: &Engine) -> Result<Row, GpuError> {
     )?;
     let (s, t) = (r.summary, r.gpu);
     Ok(Row {
-        runs: s.runs,
-        backend: label(engine),
-        seconds: s.seconds,
-        pack: t.pack,
-        upload: t.upload,
         // The CPU integrates and formats in one loop: its kernel time is what formatting left.
         kernel: match engine {
             Engine::Cpu { .. } => s.seconds - sink.seconds,
             Engine::Gpu { .. } => t.kernel,
         },
-        readback: t.readback,
-        handoff: t.handoff,
         csv: sink.seconds,
-        impacts: s.impacts,
-        handed_off: t.handed_off,
-        free_steps: s.free_steps,
-        substeps: s.substeps,
-        shared_steps: s.shared_steps,
-        runs_sharing: s.runs_sharing,
-        lane_utilisation: t.lane_utilisation(),
+        ..Row::new(label(engine), &s, &t)
     })
 }
 
@@ -157,29 +166,18 @@ pub fn fold(plan: &Plan, engine: &Engine, by: &[String]) -> Result<Row, GpuError
     let c = Instant::now();
     let summary = crate::io::summary::csv(&agg);
     let csv = c.elapsed().as_secs_f64();
+    let backend = format!(
+        "{}, --aggregate {} ({} groups, {} bytes)",
+        label(engine),
+        by.join(","),
+        agg.groups(),
+        summary.len()
+    );
     Ok(Row {
-        runs: s.runs,
-        backend: format!(
-            "{}, --aggregate {} ({} groups, {} bytes)",
-            label(engine),
-            by.join(","),
-            agg.groups(),
-            summary.len()
-        ),
         seconds: s.seconds + csv,
-        pack: t.pack,
-        upload: t.upload,
-        kernel: t.kernel,
         readback: t.aggregate,
-        handoff: t.handoff,
         csv,
-        impacts: s.impacts,
-        handed_off: t.handed_off,
-        free_steps: s.free_steps,
-        substeps: s.substeps,
-        shared_steps: s.shared_steps,
-        runs_sharing: s.runs_sharing,
-        lane_utilisation: t.lane_utilisation(),
+        ..Row::new(backend, &s, &t)
     })
 }
 

@@ -118,17 +118,37 @@ fn fourth_derivative_bound(o: &Oscillator, u: f64, v: f64, seg: &Segment) -> f64
     w2 * a2 + cm * a3
 }
 
+/// Twice the cubic Hermite's interpolation-error bound, `2 h^4/384 max|delta''''|`, for a
+/// bound on `|delta''''|`.
+#[inline]
+fn error_margin(bound: f64, h: f64) -> f64 {
+    let h2 = h * h;
+    2.0 * h2 * h2 / 384.0 * bound
+}
+
+/// [`error_margin`] over the free step from `z0` to `z1` (length `h`), and the larger `|u1|` plus
+/// the larger `|u2|` at its ends.
+#[inline]
+fn free_step_margin(
+    b1: &Oscillator,
+    b2: &Oscillator,
+    seg: &Segment,
+    z0: &State,
+    z1: &State,
+    h: f64,
+) -> (f64, f64) {
+    let (u1, v1) = (z0[0].abs().max(z1[0].abs()), z0[1].abs().max(z1[1].abs()));
+    let (u2, v2) = (z0[2].abs().max(z1[2].abs()), z0[3].abs().max(z1[3].abs()));
+    let bound = fourth_derivative_bound(b1, u1, v1, seg) + fourth_derivative_bound(b2, u2, v2, seg);
+    (error_margin(bound, h), u1 + u2)
+}
+
 /// Could the bodies touch inside a free step from `z0` to `z1` (length `h`)? Uses the Hermite
 /// cubic of `delta` plus twice its interpolation-error bound `h^4/384 max|delta''''|`.
 #[inline]
 pub(crate) fn may_touch(p: &Pair, seg: &Segment, z0: &State, z1: &State, h: f64, v0: f64) -> bool {
     let (d0, d1) = (delta(p, z0), delta(p, z1));
-    let (u1, v1) = (z0[0].abs().max(z1[0].abs()), z0[1].abs().max(z1[1].abs()));
-    let (u2, v2) = (z0[2].abs().max(z1[2].abs()), z0[3].abs().max(z1[3].abs()));
-    let bound =
-        fourth_derivative_bound(&p.b1, u1, v1, seg) + fourth_derivative_bound(&p.b2, u2, v2, seg);
-    let h2 = h * h;
-    let margin = -2.0 * h2 * h2 / 384.0 * bound;
+    let margin = -free_step_margin(&p.b1, &p.b2, seg, z0, z1, h).0;
     // Most free steps are far from the gap: the cubic's bound settles them without its
     // extrema. Below 0 it also settles the gauges, which are positive only where delta is.
     if cubic_max_bound(d0, ddelta(z0), d1, ddelta(z1), h) <= margin {
@@ -158,27 +178,25 @@ pub(crate) fn contact_reach(
     z1: &State,
     h: f64,
 ) -> f64 {
-    let (u1, v1) = (z0[0].abs().max(z1[0].abs()), z0[1].abs().max(z1[1].abs()));
-    let (u2, v2) = (z0[2].abs().max(z1[2].abs()), z0[3].abs().max(z1[3].abs()));
-    let bound = fourth_derivative_bound(b1, u1, v1, seg) + fourth_derivative_bound(b2, u2, v2, seg);
-    let h2 = h * h;
-    let margin = 2.0 * h2 * h2 / 384.0 * bound;
+    let (margin, u) = free_step_margin(b1, b2, seg, z0, z1, h);
     let slope = CUBIC_SLOPE_WEIGHT * h * (ddelta(z0).abs() + ddelta(z1).abs());
     let reach = (z0[0] - z0[2]).max(z1[0] - z1[2]) + slope + margin;
-    reach + REACH_SLACK * (u1 + u2 + slope + margin)
+    reach + REACH_SLACK * (u + slope + margin)
 }
 
 /// How much [`contact_reach`] can grow per metre of `R`, where a run's motion differs from the
 /// one it was computed on by a free (homogeneous) response of `o` with `|u| <= R` and
 /// `|v| <= omega R` throughout: the reach's terms are affine in `|u|`, `|v|` and `u1 - u2`.
 pub(crate) fn contact_reach_growth(o: &Oscillator, h: f64) -> f64 {
-    let (w2, cm) = (o.k / o.m, o.c / o.m);
-    let w = w2.sqrt();
-    // fourth_derivative_bound's linear part at (|u|, |v|) = (1, omega).
-    let a2 = w2 + cm * w;
-    let a3 = w2 * w + cm * a2;
-    let h2 = h * h;
-    let margin = 2.0 * h2 * h2 / 384.0 * (w2 * a2 + cm * a3);
+    let w = (o.k / o.m).sqrt();
+    // fourth_derivative_bound's linear part at (|u|, |v|) = (1, omega): no ground motion.
+    let still = Segment {
+        t0: 0.0,
+        dt: h,
+        a0: 0.0,
+        a1: 0.0,
+    };
+    let margin = error_margin(fourth_derivative_bound(o, 1.0, w, &still), h);
     let slope = CUBIC_SLOPE_WEIGHT * h * 2.0 * w;
     (1.0 + slope + margin) * (1.0 + 2.0 * REACH_SLACK)
 }

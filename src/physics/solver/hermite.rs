@@ -47,8 +47,8 @@ pub(crate) fn hermite_extrema(m0: f64, b: f64, c: f64) -> [f64; 2] {
 /// these times the ends' scaled slopes (and curvatures): a bound that lets a step that cannot
 /// raise a peak skip the search for it. The factor covers rounding in the searched value.
 pub(crate) const CUBIC_SLOPE_WEIGHT: f64 = 4.0 / 27.0;
-pub(crate) const QUINTIC_SLOPE_WEIGHT: f64 = 16.0 / 81.0;
-pub(crate) const QUINTIC_CURVATURE_WEIGHT: f64 = 54.0 / 3125.0;
+const QUINTIC_SLOPE_WEIGHT: f64 = 16.0 / 81.0;
+const QUINTIC_CURVATURE_WEIGHT: f64 = 54.0 / 3125.0;
 const BOUND_SLACK: f64 = 1.0 + 1e-9;
 
 /// Upper bound on the cubic Hermite through `(y0, y0')`, `(y1, y1')` over `[0, h]`.

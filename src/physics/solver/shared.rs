@@ -19,7 +19,7 @@
 //! field; only the work counters (`free_steps`, `shared_steps`) differ.
 
 use super::events::{contact_reach, contact_reach_growth, REACH_SLACK};
-use super::hermite::{quintic_max_bound, QUINTIC_CURVATURE_WEIGHT, QUINTIC_SLOPE_WEIGHT};
+use super::hermite::quintic_max_bound;
 use super::tracker::{free_accel, free_peak};
 use super::{Segment, State};
 use crate::physics::model::{Forcing, Initial, Oscillator, Pair};
@@ -103,9 +103,9 @@ impl<'f> FreeResponse<'f> {
         let growth = |o: &Oscillator| {
             let (w2, cm) = (o.k / o.m, o.c / o.m);
             let w = w2.sqrt();
-            let g = 1.0
-                + 2.0 * QUINTIC_SLOPE_WEIGHT * dt * w
-                + 2.0 * QUINTIC_CURVATURE_WEIGHT * dt * dt * (cm * w + w2);
+            // The quintic bound is affine in |u|, |v|, |a|; per metre of R they grow by 1,
+            // omega and (c/m) omega + omega^2 at both ends.
+            let g = quintic_max_bound([1.0; 2], [w; 2], [cm * w + w2; 2], dt);
             (
                 w,
                 contact_reach_growth(o, dt),
