@@ -64,6 +64,10 @@ struct Tally {
 // Exact free-step energy integrals, FORMS reals per run (layout::forms); read only in the ENERGY
 // variant (otherwise a one-element placeholder).
 @group(0) @binding(9) var<storage, read> forms: array<real>;
+// The chunk's shared free responses (src/engine/gpu/shared.rs: SH_HEADER reals, then SH_CHECK
+// per checkpoint); a run's table starts at M.response. Read only outside the ENERGY variant
+// (otherwise a one-element placeholder).
+@group(0) @binding(10) var<storage, read> responses: array<real>;
 
 // This invocation's run.
 var<private> P: Params;
@@ -618,6 +622,48 @@ fn quadratic(base: u32, u: real, v: real, a0: real, a1: real) -> real {
         + a1 * forms[c + 9u] * a1;
 }
 
+// ---- shared.rs: the run's shared free response (FreeResponse's methods on its table) ----
+
+// Is the run beside a shared free response? Never in the ENERGY variant (the host shares none
+// there; the constant keeps the code out of it).
+fn sharing() -> bool {
+    return !ENERGY && M.response != NO_RESPONSE;
+}
+
+// FreeResponse::distance at checkpoint sample i (a multiple of SH_EVERY), into S.dist1, S.dist2.
+fn shared_distance(i: u32, z: Z) {
+    let h = M.response;
+    let c = h + SH_HEADER + SH_CHECK * (i / SH_EVERY);
+    let eu1 = z.u1 - responses[c];
+    let ev1 = (z.v1 - responses[c + 1u]) / responses[h];
+    let eu2 = z.u2 - responses[c + 2u];
+    let ev2 = (z.v2 - responses[c + 3u]) / responses[h + 1u];
+    S.dist1 = sqrt(eu1 * eu1 + ev1 * ev1) * (1.0 + REACH_SLACK);
+    S.dist2 = sqrt(eu2 * eu2 + ev2 * ev2) * (1.0 + REACH_SLACK);
+}
+
+// FreeResponse::clear_of: a reach grown by the run's distance stays clear of its gap.
+fn shared_clear(reach: real) -> bool {
+    let h = M.response;
+    return reach + responses[h + 2u] * S.dist1 + responses[h + 3u] * S.dist2
+        < P.gap * (1.0 - REACH_SLACK);
+}
+
+// Do peak bounds grown by the distance stay below the peaks?
+fn shared_settled(bound1: real, bound2: real) -> vec2<bool> {
+    let h = M.response;
+    return vec2<bool>(
+        bound1 + responses[h + 4u] * S.dist1 < S.peak_u1,
+        bound2 + responses[h + 5u] * S.dist2 < S.peak_u2,
+    );
+}
+
+// FreeResponse::can_end at checkpoint sample i.
+fn shared_can_end(i: u32) -> bool {
+    let c = M.response + SH_HEADER + SH_CHECK * (i / SH_EVERY);
+    return shared_clear(responses[c + 4u]) && all(shared_settled(responses[c + 5u], responses[c + 6u]));
+}
+
 // The start of the current record interval (fast.rs `run`, loop body): take it with the exact
 // free step if no contact can occur inside, else set up its M RK4 substeps.
 fn begin_interval(seg: Seg) {
@@ -628,11 +674,25 @@ fn begin_interval(seg: Seg) {
     var a_est: real;
     var substep = true;
     if (C.mode == MODE_FREE) {
+        // fast.rs: every SH_EVERY samples a run beside a shared response learns its distance
+        // from it, and ends here if the rest of the record can neither close its gap nor raise
+        // its peaks.
+        if (sharing() && C.i % SH_EVERY == 0u) {
+            shared_distance(C.i, z0);
+            if (shared_can_end(C.i)) {
+                C.shared_steps = C.shared_steps + (M.intervals - C.i);
+                C.i = M.intervals;
+                return;
+            }
+        }
         let u1 = P.p1_uu * z0.u1 + P.p1_uv * z0.v1 + P.p1_ua0 * seg.a0 + P.p1_ua1 * seg.a1;
         let v1 = P.p1_vu * z0.u1 + P.p1_vv * z0.v1 + P.p1_va0 * seg.a0 + P.p1_va1 * seg.a1;
         let u2 = P.p2_uu * z0.u2 + P.p2_uv * z0.v2 + P.p2_ua0 * seg.a0 + P.p2_ua1 * seg.a1;
         let v2 = P.p2_vu * z0.u2 + P.p2_vv * z0.v2 + P.p2_va0 * seg.a0 + P.p2_va1 * seg.a1;
         var z1 = Z(u1, v1, u2, v2, z0.w, z0.ein, z0.ed);
+        // Unlike fast.rs, each free step takes the full near-contact test and peak search even
+        // beside a shared response: settling them from its per-step tables made lavapipe's
+        // kernel 15 % slower (the lanes that cannot settle hold the rest).
         if (!may_touch(seg, z0, z1, dt, S.v0)) {
             if (ENERGY) {
                 // fast.rs: the exact free-step input and damping work (EnergyForms::integrals).
@@ -664,6 +724,8 @@ fn begin_interval(seg: Seg) {
         a_est = abs(structural_rel_accel(z0));
     }
     if (substep) {
+        // The distance from the shared motion holds only while the run steps free.
+        S.dist1 = -1.0;
         // Resolve an impact at v_est, and stay stable at twice the current penetration.
         let h_rate = 6.283185307179586 / P.substeps_per_contact
             / max(local_rate(2.0 * d_est, S.v0), structural_rate());
@@ -688,8 +750,20 @@ fn begin_interval(seg: Seg) {
     }
 }
 
+// The move past the end of substep j: to the next substep, or to the next interval.
+fn end_substep(tau_target: real) {
+    S.tau = tau_target;
+    C.j = C.j + 1u;
+    C.pieces = 0u;
+    if (C.j > C.m) {
+        C.j = 0u;
+        C.i = C.i + 1u;
+    }
+}
+
 // One piece of substep j of the current interval: an RK4 step to the substep's end, cut short
-// at a located event; or, once the end is reached, the move to the next substep or interval.
+// at a located event, and the move on once the end is reached (in the same unit of work: a
+// unit of its own would hold the lanes for another loop trip per substep).
 fn piece(seg: Seg) {
     let dt = P.dt;
     let h = dt / real(C.m);
@@ -697,7 +771,8 @@ fn piece(seg: Seg) {
     if (C.j < C.m) {
         tau_target = real(C.j) * h;
     }
-    if (tau_target - S.tau > max(LOCATE_TOL * h, 4.0 * EPS * dt)) {
+    let tol = max(LOCATE_TOL * h, 4.0 * EPS * dt);
+    if (tau_target - S.tau > tol) {
         C.substeps = C.substeps + 1u;
         C.pieces = C.pieces + 1u;
         if (C.substeps > disp.max_substeps || C.pieces > MAX_PIECES_PER_SUBSTEP) {
@@ -711,16 +786,12 @@ fn piece(seg: Seg) {
             ZS = znew;
             if (!finite(znew)) {
                 C.status = STATUS_NON_FINITE;
+            } else if (!(tau_target - S.tau > tol)) {
+                end_substep(tau_target);
             }
         }
     } else {
-        S.tau = tau_target;
-        C.j = C.j + 1u;
-        C.pieces = 0u;
-        if (C.j > C.m) {
-            C.j = 0u;
-            C.i = C.i + 1u;
-        }
+        end_substep(tau_target);
     }
 }
 

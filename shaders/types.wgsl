@@ -32,6 +32,7 @@ struct State {
     contact_time: real,
     dissipated: real,
     e_in: real, e_damp: real, e_peak: real,
+    dist1: real, dist2: real,
 }
 
 struct Meta {
@@ -39,6 +40,7 @@ struct Meta {
     rec_offset: u32,
     rec_len: u32,
     intervals: u32,
+    response: u32,
 }
 
 struct Counters {
@@ -53,7 +55,7 @@ struct Counters {
     m: u32,
     pieces: u32,
     free_steps: u32,
-    _pad1: u32,
+    shared_steps: u32,
 }
 
 // Run modes and statuses (the MODE_/STATUS_ constants in layout.rs).

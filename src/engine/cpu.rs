@@ -26,7 +26,7 @@ pub fn run_one(plan: &Plan, spec: &RunSpec, scheme: &Scheme) -> RunOutput {
 pub const MIN_SHARED_RUNS: usize = 4;
 
 /// Runs that differ at most in gap and contact law move alike while apart.
-fn same_free_motion(a: &RunSpec, b: &RunSpec) -> bool {
+pub(crate) fn same_free_motion(a: &RunSpec, b: &RunSpec) -> bool {
     (a.record, a.scale, a.m1, a.t1, a.xi1, a.m2, a.t2, a.xi2)
         == (b.record, b.scale, b.m1, b.t1, b.xi1, b.m2, b.t2, b.xi2)
 }

@@ -12,7 +12,7 @@ use std::path::Path;
 
 /// Every law, stiff and soft and equal buildings, a real record with a tail of free vibration
 /// and a synthetic one; gaps from 0 to beyond contact.
-const SCENES: &str = r#"
+pub const SCENES: &str = r#"
 [run]
 tail_s = 4.0
 
@@ -46,7 +46,7 @@ synthetic = { seed = 3, duration_s = 10.0, dt_s = 0.01 }
 pga_g = 0.4
 "#;
 
-fn plan(text: &str) -> Plan {
+pub fn plan(text: &str) -> Plan {
     config::parse(
         text,
         Path::new("shared.toml"),

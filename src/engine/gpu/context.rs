@@ -270,6 +270,7 @@ impl GpuContext {
                 entry(7, storage(true)),
                 entry(8, storage(false)),
                 entry(9, storage(true)),
+                entry(10, storage(true)),
             ],
             Stage::Aggregate => (0..9).map(|b| entry(b, storage(b < 5))).collect(),
         };
@@ -298,6 +299,14 @@ impl GpuContext {
             });
         }
         Ok(Kernel { pipeline, layout })
+    }
+
+    /// Most reals of `precision` one storage buffer may hold on this device (the shared free
+    /// responses of a chunk, [`super::shared`]).
+    pub fn max_buffer_reals(&self, precision: Precision) -> usize {
+        let l = self.device.limits();
+        let binding = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
+        (binding / precision.bytes() as u64) as usize
     }
 
     /// Largest number of runs one chunk may hold on this device at `precision`.

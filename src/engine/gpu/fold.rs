@@ -26,7 +26,7 @@ pub fn fold_range(
 ) -> Result<(Summary, GpuTimes), super::GpuError> {
     use super::layout::{Segment, MAX_SEGMENT};
     use super::reduce::{reduce, Slots};
-    use super::sweep::{pack_run, upload_records};
+    use super::sweep::{pack_chunk, upload_records};
     use super::{integrate, run_chunk};
     let start = Instant::now();
     let mut times = GpuTimes::default();
@@ -47,10 +47,8 @@ pub fn fold_range(
         // Pack sorted by group (stable), so each group is a run of consecutive runs.
         let mut order: Vec<usize> = (0..specs.len()).collect();
         order.sort_by_key(|&i| gids[i]);
-        let packed: Vec<_> = order
-            .par_iter()
-            .map(|&i| pack_run(plan, &specs[i], &recs, opts))
-            .collect();
+        let sorted: Vec<&RunSpec> = order.iter().map(|&i| &specs[i]).collect();
+        let packed = pack_chunk(plan, &sorted, ctx, &recs, opts);
         let mut segments: Vec<(u32, Segment)> = Vec::new();
         for (k, &i) in order.iter().enumerate() {
             match segments.last_mut() {
@@ -155,7 +153,7 @@ struct Prepared {
     gids: Vec<u32>,
     /// Runs sorted by group: `packed[k]` is run `specs[order[k]]`.
     order: Vec<usize>,
-    packed: Vec<super::run::Packed>,
+    packed: super::PackedChunk,
     /// Each segment's group, and the segment (slot not yet assigned).
     segments: Vec<(u32, super::layout::Segment)>,
     /// The distinct groups, in segment order.

@@ -104,6 +104,9 @@ real_structs! {
         /// Input and structural damping work so far, and the largest input reached, J (the
         /// energy balance: `cpu::State` and `Tracker`).
         e_in, e_damp, e_peak,
+        /// `R` of each building while the run steps free beside its shared free response
+        /// (`FreeResponse::distance`); negative when not known (after a substepped interval).
+        dist1, dist2,
     }
 }
 
@@ -119,7 +122,13 @@ pub struct Meta {
     pub rec_len: u32,
     /// Record intervals to simulate (record plus tail).
     pub intervals: u32,
+    /// First real of the run's shared free response in the `shared` buffer
+    /// ([`super::shared`]), or [`NO_RESPONSE`].
+    pub response: u32,
 }
+
+/// `Meta::response` of a run that steps its whole record.
+pub const NO_RESPONSE: u32 = u32::MAX;
 
 /// Per-run integer state, carried between dispatches.
 #[repr(C)]
@@ -146,7 +155,9 @@ pub struct Counters {
     pub pieces: u32,
     /// Record intervals taken by the exact free step.
     pub free_steps: u32,
-    pub _pad1: u32,
+    /// Record intervals settled by the shared free response (skipped at the start, or at an
+    /// early end).
+    pub shared_steps: u32,
 }
 
 /// Uniforms of one dispatch: at most `budget` units of work (a free interval, or one piece of a
@@ -176,6 +187,7 @@ impl Layout for Meta {
             ("rec_offset", offset_of!(Meta, rec_offset)),
             ("rec_len", offset_of!(Meta, rec_len)),
             ("intervals", offset_of!(Meta, intervals)),
+            ("response", offset_of!(Meta, response)),
         ]
     }
 }
@@ -196,7 +208,7 @@ impl Layout for Counters {
             ("m", offset_of!(Counters, m)),
             ("pieces", offset_of!(Counters, pieces)),
             ("free_steps", offset_of!(Counters, free_steps)),
-            ("_pad1", offset_of!(Counters, _pad1)),
+            ("shared_steps", offset_of!(Counters, shared_steps)),
         ]
     }
 }

@@ -5,6 +5,7 @@
 //! - [`layout`]: the `#[repr(C)]` buffer types both sides share (checked against the WGSL by naga);
 //! - [`shader`]: the WGSL text with its constants filled in from Rust;
 //! - [`run`]: packing runs, dispatching, reading back one chunk;
+//! - [`shared`]: the free responses runs of a chunk share, packed for the kernel;
 //! - [`sweep`]: a range of runs chunk after chunk; [`fold`] and [`reduce`]: the device fold.
 //!
 //! May import the physics, the plan and [`crate::engine::aggregate`]; never io or studies.
@@ -15,12 +16,13 @@ pub mod layout;
 pub mod reduce;
 pub mod run;
 pub mod shader;
+pub mod shared;
 pub mod sweep;
 
 pub use context::{GpuContext, GpuError};
 pub use run::{
     integrate, output, pack, read_outputs, run_chunk, ChunkTimes, GpuOptions, GpuRecords,
-    Integrated,
+    Integrated, PackedChunk,
 };
 pub use shader::Precision;
 pub use sweep::GpuTimes;

@@ -3,10 +3,11 @@
 
 use super::context::{GpuContext, GpuError};
 use super::layout::{
-    self, Counters, Dispatch, Meta, Params32, Params64, State32, State64, MODE_FREE,
+    self, Counters, Dispatch, Meta, Params32, Params64, State32, State64, MODE_FREE, NO_RESPONSE,
     STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK,
 };
 use super::shader::Precision;
+use super::shared::Start;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{EnergyBalance, Forcing, Oscillator, Pair, RunOutput, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
@@ -26,6 +27,9 @@ pub struct GpuOptions {
     /// A run whose record step needs more RK4 substeps than this is handed back and finished
     /// on the CPU in f64 (None: [`F32_HANDOFF_SUBSTEPS_PER_STEP`] in f32, never in f64).
     pub handoff_substeps_per_step: Option<u32>,
+    /// Runs that differ only in gap and contact law share one free response
+    /// ([`super::shared`]), as on the CPU (not with the energy balance).
+    pub share_free_response: bool,
 }
 
 impl Default for GpuOptions {
@@ -35,6 +39,7 @@ impl Default for GpuOptions {
             fast: FastOptions::default(),
             units_per_dispatch: 4096,
             handoff_substeps_per_step: None,
+            share_free_response: true,
         }
     }
 }
@@ -124,6 +129,17 @@ pub struct Packed {
     pub meta: Meta,
     /// The free-step energy integrals, when the energy balance is asked for.
     pub forms: Option<[f64; layout::FORMS_PER_RUN]>,
+    /// Where the run starts when it shares a free response (`meta.response` says which); None:
+    /// from rest at the record's start.
+    pub start: Option<Start>,
+}
+
+/// A chunk's packed runs, and the tables of the free responses some of them share
+/// ([`super::shared::share`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PackedChunk {
+    pub runs: Vec<Packed>,
+    pub shared: Vec<f64>,
 }
 
 /// Pack one run: `record` is the index of its record in the [`GpuRecords`] it will run with.
@@ -179,6 +195,7 @@ pub fn pack(
         rec_offset: recs.offsets[record],
         rec_len: recs.lens[record],
         intervals: forcing.intervals() as u32,
+        response: NO_RESPONSE,
     };
     let forms = fast.energy.then(|| {
         layout::forms(
@@ -190,11 +207,12 @@ pub fn pack(
         params,
         meta,
         forms,
+        start: None,
     }
 }
 
 /// A run's results from its final state (what `Tracker::finish` and `Tracker::energy` do on
-/// the CPU; GPU runs start at rest); None for a run handed back to the host (`STATUS_HANDOFF`).
+/// the CPU; GPU runs start at rest, or on their shared free response); None for a run handed back to the host (`STATUS_HANDOFF`).
 pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<RunOutput> {
     if c.status == STATUS_HANDOFF {
         return None;
@@ -221,7 +239,7 @@ pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<R
         dissipated_energy: s.dissipated,
         substeps: c.substeps as u64,
         free_steps: c.free_steps as u64,
-        shared_steps: 0,
+        shared_steps: c.shared_steps as u64,
         energy: energy.then(|| {
             let b1 = Oscillator {
                 m: p.m1,
@@ -366,18 +384,19 @@ pub(super) fn read_prefix(
     map_read(ctx, &staging)
 }
 
-/// Integrate packed runs from rest over their whole records; results in input order, None for
-/// runs handed back to the host (see [`GpuOptions::handoff_substeps_per_step`]).
+/// Integrate packed runs over their whole records; results in input order, None for runs
+/// handed back to the host (see [`GpuOptions::handoff_substeps_per_step`]).
 pub fn run_chunk(
     ctx: &GpuContext,
     recs: &GpuRecords,
-    runs: &[Packed],
+    chunk: &PackedChunk,
     opts: &GpuOptions,
 ) -> Result<(Vec<Option<RunOutput>>, ChunkTimes), GpuError> {
+    let runs = &chunk.runs[..];
     if runs.is_empty() {
         return Ok((Vec::new(), ChunkTimes::default()));
     }
-    let (done, mut times) = integrate(ctx, recs, runs, opts)?;
+    let (done, mut times) = integrate(ctx, recs, chunk, opts)?;
     let t = Instant::now();
     let out = read_outputs(ctx, &done, runs, opts)?;
     times.readback = t.elapsed();
@@ -391,14 +410,15 @@ pub struct Integrated {
     pub runs: u32,
 }
 
-/// Integrate packed runs (at least one) from rest over their whole records, leaving the final
-/// states on the device.
+/// Integrate packed runs (at least one) over their whole records, leaving the final states on
+/// the device.
 pub fn integrate(
     ctx: &GpuContext,
     recs: &GpuRecords,
-    runs: &[Packed],
+    chunk: &PackedChunk,
     opts: &GpuOptions,
 ) -> Result<(Integrated, ChunkTimes), GpuError> {
+    let runs = &chunk.runs[..];
     let mut times = ChunkTimes::default();
     let kernel = ctx.kernel(opts.precision, opts.fast.energy)?;
     let n = runs.len();
@@ -435,18 +455,44 @@ pub fn integrate(
         bytemuck::cast_slice(&metas),
         wgpu::BufferUsages::empty(),
     )?;
-    // Runs start from rest: a new buffer is zeroed, which is the zero state and `Counters`.
-    let states = zeroed(
+    // Runs start from rest (a new buffer is zeroed, which is the zero state and `Counters`),
+    // or where their shared free response puts them.
+    let (states, counters) = if runs.iter().all(|r| r.start.is_none()) {
+        (
+            zeroed(
+                ctx,
+                "states",
+                (n * layout::state_bytes(opts.precision)) as u64,
+                wgpu::BufferUsages::COPY_SRC,
+            )?,
+            zeroed(
+                ctx,
+                "counters",
+                (n * size_of::<Counters>()) as u64,
+                wgpu::BufferUsages::COPY_SRC,
+            )?,
+        )
+    } else {
+        let (states, counters) = initial_states(runs, opts.precision);
+        (
+            storage(ctx, "states", &states, wgpu::BufferUsages::COPY_SRC)?,
+            storage(
+                ctx,
+                "counters",
+                bytemuck::cast_slice(&counters),
+                wgpu::BufferUsages::COPY_SRC,
+            )?,
+        )
+    };
+    let shared = storage(
         ctx,
-        "states",
-        (n * layout::state_bytes(opts.precision)) as u64,
-        wgpu::BufferUsages::COPY_SRC,
-    )?;
-    let counters = zeroed(
-        ctx,
-        "counters",
-        (n * size_of::<Counters>()) as u64,
-        wgpu::BufferUsages::COPY_SRC,
+        "shared free responses",
+        &opts.precision.reals(if chunk.shared.is_empty() {
+            &[0.0]
+        } else {
+            &chunk.shared
+        }),
+        wgpu::BufferUsages::empty(),
     )?;
     // The dispatch's tally: [runs still active, lane units, lane slots].
     let active = storage(
@@ -491,6 +537,7 @@ pub fn integrate(
             from,
             to,
             &forms,
+            &shared,
         ];
         bind_group(ctx, &kernel.layout, label, &buffers)
     };
@@ -546,6 +593,41 @@ pub fn integrate(
         },
         times,
     ))
+}
+
+/// Each run's state and counters before the first dispatch, the state in `precision`'s bytes:
+/// at rest, or at the start its shared free response gives it (`R` = 0 there).
+fn initial_states(runs: &[Packed], precision: Precision) -> (Vec<u8>, Vec<Counters>) {
+    let (states, counters): (Vec<State64>, Vec<Counters>) = runs
+        .iter()
+        .map(|r| match r.start {
+            None => Default::default(),
+            Some(s) => (
+                State64 {
+                    u1: s.state[0],
+                    v1: s.state[1],
+                    u2: s.state[2],
+                    v2: s.state[3],
+                    peak_u1: s.peaks[0],
+                    peak_u2: s.peaks[1],
+                    ..Default::default()
+                },
+                Counters {
+                    i: s.i,
+                    shared_steps: s.i,
+                    ..Default::default()
+                },
+            ),
+        })
+        .unzip();
+    let bytes = match precision {
+        Precision::F64 => bytemuck::cast_slice(&states).to_vec(),
+        Precision::F32 => {
+            let v: Vec<State32> = states.iter().map(State32::from_f64).collect();
+            bytemuck::cast_slice(&v).to_vec()
+        }
+    };
+    (bytes, counters)
 }
 
 /// Each run's results from its final state, in input order (None: handed back).

@@ -64,9 +64,15 @@ fn prelude(precision: Precision) -> String {
 /// `forms` buffer, and `ENERGY`: whether this variant integrates the energy balance. Two
 /// variants rather than a uniform branch, because lavapipe compiled the untaken energy code
 /// into the free step and lost 30 % of its runs/s (measured with `pound bench`).
+/// The shared free response's table layout and slack come from `shared` and the physics.
 pub fn fast_source(precision: Precision, energy: bool) -> String {
+    use super::layout::NO_RESPONSE;
+    use super::shared::{CHECK_EVERY, HEADER, PER_CHECK};
+    use crate::physics::solver::shared::REACH_SLACK;
     format!(
-        "{}const FORMS: u32 = {FORMS_PER_RUN}u;\nconst ENERGY: bool = {energy};\n{FAST_WGSL}",
+        "{}const FORMS: u32 = {FORMS_PER_RUN}u;\nconst ENERGY: bool = {energy};\n\
+         const NO_RESPONSE: u32 = {NO_RESPONSE}u;\nconst SH_HEADER: u32 = {HEADER}u;\n\
+         const SH_CHECK: u32 = {PER_CHECK}u;\nconst SH_EVERY: u32 = {CHECK_EVERY}u;\nconst REACH_SLACK: real = {REACH_SLACK:e};\n{FAST_WGSL}",
         prelude(precision)
     )
 }

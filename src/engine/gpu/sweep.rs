@@ -100,6 +100,29 @@ pub(crate) fn pack_run(
     )
 }
 
+/// Pack the runs `specs` of `plan`, in this order, as one chunk: the runs that can share a free
+/// response ([`super::shared::share`]) get one, unless `opts` says not to or asks for the energy
+/// balance (the shortcuts skip its integrals).
+pub(crate) fn pack_chunk(
+    plan: &Plan,
+    specs: &[&RunSpec],
+    ctx: &super::GpuContext,
+    recs: &super::GpuRecords,
+    opts: &super::GpuOptions,
+) -> super::PackedChunk {
+    let mut runs: Vec<_> = specs
+        .par_iter()
+        .map(|spec| pack_run(plan, spec, recs, opts))
+        .collect();
+    let shared = if opts.share_free_response && !opts.fast.energy {
+        let max = ctx.max_buffer_reals(opts.precision);
+        super::shared::share(plan, specs, &mut runs, max)
+    } else {
+        Vec::new()
+    };
+    super::PackedChunk { runs, shared }
+}
+
 /// Run the runs `runs` of `plan` on the GPU, `chunk` runs per chunk (capped by the device's limits);
 /// `sink` gets each chunk's results in run order as it finishes. Runs the kernel hands back
 /// (more substeps per record step than its precision resolves) are finished on the CPU's fast
@@ -122,14 +145,12 @@ pub fn run_range<E: From<super::GpuError>>(
     // Packing is host work: the next chunk is packed while the device integrates this one.
     let prep = |c0: u64| {
         let t = Instant::now();
-        let (specs, packed): (Vec<RunSpec>, Vec<_>) = (c0..(c0 + chunk).min(n))
+        let specs: Vec<RunSpec> = (c0..(c0 + chunk).min(n))
             .into_par_iter()
-            .map(|i| {
-                let spec = plan.run(i);
-                let p = pack_run(plan, &spec, &recs, opts);
-                (spec, p)
-            })
-            .unzip();
+            .map(|i| plan.run(i))
+            .collect();
+        let refs: Vec<&RunSpec> = specs.iter().collect();
+        let packed = pack_chunk(plan, &refs, ctx, &recs, opts);
         (specs, packed, t.elapsed().as_secs_f64())
     };
     let mut c0 = runs.start;

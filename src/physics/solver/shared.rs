@@ -18,7 +18,8 @@
 //! Both shortcuts are exact: the output is the one the run would have stepped to, field for
 //! field; only the work counters (`free_steps`, `shared_steps`) differ.
 
-use super::events::{contact_reach, contact_reach_growth, REACH_SLACK};
+pub use super::events::REACH_SLACK;
+use super::events::{contact_reach, contact_reach_growth};
 use super::hermite::quintic_max_bound;
 use super::tracker::{free_accel, free_peak};
 use super::{Segment, State};
@@ -148,6 +149,37 @@ impl<'f> FreeResponse<'f> {
     /// The state at sample `i` and the peaks after `i` steps.
     pub(crate) fn at(&self, i: usize) -> (State, [f64; 2]) {
         (full(&self.state[i]), self.peaks[i])
+    }
+
+    /// Record steps the response covers (samples `0..=intervals()`).
+    pub fn intervals(&self) -> usize {
+        self.reach.len()
+    }
+
+    /// `[u1, v1, u2, v2]` at sample `i`.
+    pub fn state(&self, i: usize) -> [f64; 4] {
+        self.state[i]
+    }
+
+    /// Peak `|u1|`, `|u2|` after `i` free steps.
+    pub fn peaks(&self, i: usize) -> [f64; 2] {
+        self.peaks[i]
+    }
+
+    /// Contact reach of record step `j`, and its largest value over steps `j..`.
+    pub fn reach(&self, j: usize) -> (f64, f64) {
+        (self.reach[j], self.reach_after[j])
+    }
+
+    /// Each building's peak bound over record step `j`, and its largest value over steps `j..`.
+    pub fn peak_bound(&self, j: usize) -> ([f64; 2], [f64; 2]) {
+        (self.peak_bound[j], self.peak_bound_after[j])
+    }
+
+    /// Per building: `omega`, and the growth of the reach and of the peak bound per metre of
+    /// `R` (what `distance`, `clears` and `can_end` use).
+    pub fn rates(&self) -> [[f64; 2]; 3] {
+        [self.omega, self.reach_growth, self.peak_growth]
     }
 
     /// `R` of each building for a free run at state `z` at sample `i`: its motion differs from
