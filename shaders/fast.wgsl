@@ -630,38 +630,42 @@ fn sharing() -> bool {
     return !ENERGY && M.response != NO_RESPONSE;
 }
 
-// FreeResponse::distance at checkpoint sample i (a multiple of SH_EVERY), into S.dist1, S.dist2.
-fn shared_distance(i: u32, z: Z) {
+// R of each building (FreeResponse::distance).
+struct Dist { r1: real, r2: real }
+
+// FreeResponse::distance at checkpoint sample i (a multiple of SH_EVERY).
+fn shared_distance(i: u32, z: Z) -> Dist {
     let h = M.response;
     let c = h + SH_HEADER + SH_CHECK * (i / SH_EVERY);
     let eu1 = z.u1 - responses[c];
     let ev1 = (z.v1 - responses[c + 1u]) / responses[h];
     let eu2 = z.u2 - responses[c + 2u];
     let ev2 = (z.v2 - responses[c + 3u]) / responses[h + 1u];
-    S.dist1 = sqrt(eu1 * eu1 + ev1 * ev1) * (1.0 + REACH_SLACK);
-    S.dist2 = sqrt(eu2 * eu2 + ev2 * ev2) * (1.0 + REACH_SLACK);
+    return Dist(
+        sqrt(eu1 * eu1 + ev1 * ev1) * (1.0 + REACH_SLACK),
+        sqrt(eu2 * eu2 + ev2 * ev2) * (1.0 + REACH_SLACK),
+    );
 }
 
 // FreeResponse::clear_of: a reach grown by the run's distance stays clear of its gap.
-fn shared_clear(reach: real) -> bool {
+fn shared_clear(reach: real, d: Dist) -> bool {
     let h = M.response;
-    return reach + responses[h + 2u] * S.dist1 + responses[h + 3u] * S.dist2
+    return reach + responses[h + 2u] * d.r1 + responses[h + 3u] * d.r2
         < P.gap * (1.0 - REACH_SLACK);
 }
 
 // Do peak bounds grown by the distance stay below the peaks?
-fn shared_settled(bound1: real, bound2: real) -> vec2<bool> {
+fn shared_settled(bound1: real, bound2: real, d: Dist) -> bool {
     let h = M.response;
-    return vec2<bool>(
-        bound1 + responses[h + 4u] * S.dist1 < S.peak_u1,
-        bound2 + responses[h + 5u] * S.dist2 < S.peak_u2,
-    );
+    return bound1 + responses[h + 4u] * d.r1 < S.peak_u1
+        && bound2 + responses[h + 5u] * d.r2 < S.peak_u2;
 }
 
-// FreeResponse::can_end at checkpoint sample i.
-fn shared_can_end(i: u32) -> bool {
+// FreeResponse::can_end at checkpoint sample i, for a run at distance d.
+fn shared_can_end(i: u32, d: Dist) -> bool {
     let c = M.response + SH_HEADER + SH_CHECK * (i / SH_EVERY);
-    return shared_clear(responses[c + 4u]) && all(shared_settled(responses[c + 5u], responses[c + 6u]));
+    return shared_clear(responses[c + 4u], d)
+        && shared_settled(responses[c + 5u], responses[c + 6u], d);
 }
 
 // The start of the current record interval (fast.rs `run`, loop body): take it with the exact
@@ -674,12 +678,11 @@ fn begin_interval(seg: Seg) {
     var a_est: real;
     var substep = true;
     if (C.mode == MODE_FREE) {
-        // fast.rs: every SH_EVERY samples a run beside a shared response learns its distance
+        // fast.rs: every SH_EVERY samples a run beside a shared response takes its distance
         // from it, and ends here if the rest of the record can neither close its gap nor raise
         // its peaks.
         if (sharing() && C.i % SH_EVERY == 0u) {
-            shared_distance(C.i, z0);
-            if (shared_can_end(C.i)) {
+            if (shared_can_end(C.i, shared_distance(C.i, z0))) {
                 C.shared_steps = C.shared_steps + (M.intervals - C.i);
                 C.i = M.intervals;
                 return;
@@ -724,8 +727,6 @@ fn begin_interval(seg: Seg) {
         a_est = abs(structural_rel_accel(z0));
     }
     if (substep) {
-        // The distance from the shared motion holds only while the run steps free.
-        S.dist1 = -1.0;
         // Resolve an impact at v_est, and stay stable at twice the current penetration.
         let h_rate = 6.283185307179586 / P.substeps_per_contact
             / max(local_rate(2.0 * d_est, S.v0), structural_rate());

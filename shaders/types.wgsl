@@ -32,7 +32,6 @@ struct State {
     contact_time: real,
     dissipated: real,
     e_in: real, e_damp: real, e_peak: real,
-    dist1: real, dist2: real,
 }
 
 struct Meta {

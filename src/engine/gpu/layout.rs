@@ -104,9 +104,6 @@ real_structs! {
         /// Input and structural damping work so far, and the largest input reached, J (the
         /// energy balance: `cpu::State` and `Tracker`).
         e_in, e_damp, e_peak,
-        /// `R` of each building while the run steps free beside its shared free response
-        /// (`FreeResponse::distance`); negative when not known (after a substepped interval).
-        dist1, dist2,
     }
 }
 

@@ -596,7 +596,7 @@ pub fn integrate(
 }
 
 /// Each run's state and counters before the first dispatch, the state in `precision`'s bytes:
-/// at rest, or at the start its shared free response gives it (`R` = 0 there).
+/// at rest, or at the start its shared free response gives it.
 fn initial_states(runs: &[Packed], precision: Precision) -> (Vec<u8>, Vec<Counters>) {
     let (states, counters): (Vec<State64>, Vec<Counters>) = runs
         .iter()

@@ -16,8 +16,8 @@
 //! - [`PER_CHECK`] per checkpoint, the samples `i = CHECK_EVERY * c < intervals`: the state
 //!   `[u1, v1, u2, v2]` there and the largest reach and peak bounds over steps `i..`.
 //!
-//! A run learns its distance `R` from the shared motion at checkpoints (and at its start, where
-//! it is 0), so one state per `CHECK_EVERY` steps is all the kernel reads.
+//! A run takes its distance `R` from the shared motion only at checkpoints, where it checks for
+//! an early end, so one state per `CHECK_EVERY` steps is all the kernel reads.
 
 use super::layout::NO_RESPONSE;
 use super::run::Packed;
