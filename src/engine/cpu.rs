@@ -31,18 +31,30 @@ pub(crate) fn same_free_motion(a: &RunSpec, b: &RunSpec) -> bool {
         == (b.record, b.scale, b.m1, b.t1, b.xi1, b.m2, b.t2, b.xi2)
 }
 
+/// The stretches of consecutive runs of `specs` with the same free motion, in order.
+pub(crate) fn free_motion_stretches<S: std::borrow::Borrow<RunSpec>>(
+    specs: &[S],
+) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+    let mut k = 0;
+    std::iter::from_fn(move || {
+        let first = specs.get(k)?.borrow();
+        let len = specs[k..]
+            .iter()
+            .position(|s| !same_free_motion(first, s.borrow()))
+            .unwrap_or(specs.len() - k);
+        k += len;
+        Some(k - len..k)
+    })
+}
+
 /// Run `specs` in order; the fast scheme shares one free response ([`FreeResponse`]) among each
 /// stretch of at least [`MIN_SHARED_RUNS`] consecutive runs with the same free motion.
 pub fn run_many(plan: &Plan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunOutput> {
     let mut out = Vec::with_capacity(specs.len());
-    let mut rest = specs;
-    while let Some(first) = rest.first() {
-        let len = rest
-            .iter()
-            .position(|s| !same_free_motion(first, s))
-            .unwrap_or(rest.len());
-        let (group, tail) = rest.split_at(len);
-        if len >= MIN_SHARED_RUNS && matches!(scheme, Scheme::Fast(_)) {
+    for ks in free_motion_stretches(specs) {
+        let group = &specs[ks];
+        let first = &group[0];
+        if group.len() >= MIN_SHARED_RUNS && matches!(scheme, Scheme::Fast(_)) {
             let forcing = plan.forcing(first);
             let pair = first.pair();
             let shared = FreeResponse::new(&pair.b1, &pair.b2, &forcing);
@@ -52,7 +64,6 @@ pub fn run_many(plan: &Plan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunOutpu
         } else {
             out.extend(group.iter().map(|s| run_one(plan, s, scheme)));
         }
-        rest = tail;
     }
     out
 }

@@ -484,7 +484,7 @@ pub fn integrate(
             )?,
         )
     };
-    let shared = storage(
+    let responses = storage(
         ctx,
         "shared free responses",
         &opts.precision.reals(if chunk.shared.is_empty() {
@@ -537,7 +537,7 @@ pub fn integrate(
             from,
             to,
             &forms,
-            &shared,
+            &responses,
         ];
         bind_group(ctx, &kernel.layout, label, &buffers)
     };

@@ -12,7 +12,7 @@
 //!
 //! A response's table at `responses[Meta::response..]`, in reals:
 //! - [`HEADER`]: `omega`, reach growth and peak growth, each for building 1 then 2
-//!   ([`FreeResponse::rates`]);
+//!   (`FreeResponse::rates`);
 //! - [`PER_CHECK`] per checkpoint, the samples `i = CHECK_EVERY * c < intervals`: the state
 //!   `[u1, v1, u2, v2]` there and the largest reach and peak bounds over steps `i..`.
 //!
@@ -21,7 +21,7 @@
 
 use super::layout::NO_RESPONSE;
 use super::run::Packed;
-use crate::engine::cpu::{same_free_motion, MIN_SHARED_RUNS};
+use crate::engine::cpu::{free_motion_stretches, same_free_motion, MIN_SHARED_RUNS};
 use crate::physics::solver::FreeResponse;
 use crate::plan::{Plan, RunSpec};
 use rayon::prelude::*;
@@ -47,9 +47,10 @@ pub fn fill_table(r: &FreeResponse, out: &mut [f64]) {
     debug_assert_eq!(checks.len(), PER_CHECK * n.div_ceil(CHECK_EVERY));
     for (c, t) in checks.chunks_exact_mut(PER_CHECK).enumerate() {
         let i = c * CHECK_EVERY;
-        let ((_, reach_after), (_, bound_after)) = (r.reach(i), r.peak_bound(i));
-        t[..4].copy_from_slice(&r.state(i));
-        t[4..].copy_from_slice(&[reach_after, bound_after[0], bound_after[1]]);
+        let (z, _) = r.at(i);
+        let (reach, bound) = r.maxima_after(i);
+        t[..4].copy_from_slice(&z[..4]);
+        t[4..].copy_from_slice(&[reach, bound[0], bound[1]]);
     }
 }
 
@@ -85,14 +86,9 @@ fn in_long_stretch(plan: &Plan, spec: &RunSpec) -> bool {
 /// another. Stretches past `max_reals` in all step their whole records.
 pub fn share(plan: &Plan, specs: &[&RunSpec], packed: &mut [Packed], max_reals: usize) -> Vec<f64> {
     let mut stretches: Vec<Vec<usize>> = Vec::new();
-    let mut k = 0;
-    while k < specs.len() {
-        let len = specs[k..]
-            .iter()
-            .position(|s| !same_free_motion(specs[k], s))
-            .unwrap_or(specs.len() - k);
-        let ks = k..k + len;
-        let contiguous = specs[k + len - 1].index - specs[k].index == len as u64 - 1;
+    for ks in free_motion_stretches(specs) {
+        let len = ks.len();
+        let contiguous = specs[ks.end - 1].index - specs[ks.start].index == len as u64 - 1;
         let members: Vec<usize> = if len >= MIN_SHARED_RUNS && contiguous {
             ks.collect()
         } else {
@@ -101,7 +97,6 @@ pub fn share(plan: &Plan, specs: &[&RunSpec], packed: &mut [Packed], max_reals: 
         if !members.is_empty() {
             stretches.push(members);
         }
-        k += len;
     }
     // Each table's place, as long as they fit; the tables are then built in parallel in place.
     let max_reals = max_reals.min(u32::MAX as usize);
@@ -134,10 +129,11 @@ pub fn share(plan: &Plan, specs: &[&RunSpec], packed: &mut [Packed], max_reals: 
             ks.iter()
                 .map(|&k| {
                     let first = r.first_possible_contact(specs[k].gap);
+                    let (z, peaks) = r.at(first);
                     Start {
                         i: first as u32,
-                        state: r.state(first),
-                        peaks: r.peaks(first),
+                        state: [z[0], z[1], z[2], z[3]],
+                        peaks,
                     }
                 })
                 .collect()

@@ -161,9 +161,9 @@ pub(crate) fn may_touch(p: &Pair, seg: &Segment, z0: &State, z1: &State, h: f64,
     hi > margin
 }
 
-/// Relative slack of `contact_reach`: far above the rounding of the free steps (about
+/// Relative slack of [`contact_reach`]: far above the rounding of the free steps (about
 /// 1e-12 of the state over a long record) and of `may_touch`'s own bound.
-pub const REACH_SLACK: f64 = 1e-6;
+pub(crate) const REACH_SLACK: f64 = 1e-6;
 
 /// The smallest gap that the first test of [`may_touch`] could fail to clear over the free
 /// step from `z0` to `z1` (only the buildings' motion, not the gap or the contact, enters):

@@ -18,7 +18,7 @@
 //! Both shortcuts are exact: the output is the one the run would have stepped to, field for
 //! field; only the work counters (`free_steps`, `shared_steps`) differ.
 
-pub use super::events::REACH_SLACK;
+pub(crate) use super::events::REACH_SLACK;
 use super::events::{contact_reach, contact_reach_growth};
 use super::hermite::quintic_max_bound;
 use super::tracker::{free_accel, free_peak};
@@ -152,33 +152,19 @@ impl<'f> FreeResponse<'f> {
     }
 
     /// Record steps the response covers (samples `0..=intervals()`).
-    pub fn intervals(&self) -> usize {
+    pub(crate) fn intervals(&self) -> usize {
         self.reach.len()
     }
 
-    /// `[u1, v1, u2, v2]` at sample `i`.
-    pub fn state(&self, i: usize) -> [f64; 4] {
-        self.state[i]
-    }
-
-    /// Peak `|u1|`, `|u2|` after `i` free steps.
-    pub fn peaks(&self, i: usize) -> [f64; 2] {
-        self.peaks[i]
-    }
-
-    /// Contact reach of record step `j`, and its largest value over steps `j..`.
-    pub fn reach(&self, j: usize) -> (f64, f64) {
-        (self.reach[j], self.reach_after[j])
-    }
-
-    /// Each building's peak bound over record step `j`, and its largest value over steps `j..`.
-    pub fn peak_bound(&self, j: usize) -> ([f64; 2], [f64; 2]) {
-        (self.peak_bound[j], self.peak_bound_after[j])
+    /// The largest contact reach and each building's largest peak bound over steps `i..` (what
+    /// [`Self::can_end`] grows by `R`).
+    pub(crate) fn maxima_after(&self, i: usize) -> (f64, [f64; 2]) {
+        (self.reach_after[i], self.peak_bound_after[i])
     }
 
     /// Per building: `omega`, and the growth of the reach and of the peak bound per metre of
-    /// `R` (what `distance`, `clears` and `can_end` use).
-    pub fn rates(&self) -> [[f64; 2]; 3] {
+    /// `R` (what [`Self::distance`], [`Self::clears`] and [`Self::can_end`] use).
+    pub(crate) fn rates(&self) -> [[f64; 2]; 3] {
         [self.omega, self.reach_growth, self.peak_growth]
     }
 
