@@ -84,10 +84,6 @@ struct Z { u1: real, v1: real, u2: real, v2: real, w: real, ein: real, ed: real 
 
 struct Seg { a0: real, a1: real, dt: real }
 
-fn seg_at(s: Seg, tau: real) -> real {
-    return s.a0 + (s.a1 - s.a0) * (tau / s.dt);
-}
-
 fn sample(i: u32) -> real {
     if (i < M.rec_len) {
         return records[M.rec_offset + i] * P.scale;
@@ -196,13 +192,14 @@ fn force(mode: u32, v0: real, z: Z) -> real {
     return contact_force(delta(z), ddelta(z), v0, mode == MODE_APPROACH);
 }
 
-fn rhs(mode: u32, v0: real, ag: real, z: Z) -> Z {
+// solver::rhs: the masses' reciprocals `r1`, `r2` come from the caller, once per rk4.
+fn rhs(mode: u32, v0: real, ag: real, z: Z, r1: real, r2: real) -> Z {
     let f = force(mode, v0, z);
     return Z(
         z.v1,
-        (-P.c1 * z.v1 - P.k1 * z.u1 - f) / P.m1 - ag,
+        (-P.c1 * z.v1 - P.k1 * z.u1 - f) * r1 - ag,
         z.v2,
-        (-P.c2 * z.v2 - P.k2 * z.u2 + f) / P.m2 - ag,
+        (-P.c2 * z.v2 - P.k2 * z.u2 + f) * r2 - ag,
         f * ddelta(z),
         select(0.0, -ag * (P.m1 * z.v1 + P.m2 * z.v2), ENERGY),
         select(0.0, P.c1 * z.v1 * z.v1 + P.c2 * z.v2 * z.v2, ENERGY),
@@ -237,10 +234,17 @@ fn zadd(z: Z, k: Z, s: real) -> Z {
 
 // fast.rs `rk4`: classic RK4 over `h` from local time `tau`.
 fn rk4(mode: u32, v0: real, seg: Seg, tau: real, z: Z, h: real) -> Z {
-    let k1 = rhs(mode, v0, seg_at(seg, tau), z);
-    let k2 = rhs(mode, v0, seg_at(seg, tau + 0.5 * h), zadd(z, k1, 0.5 * h));
-    let k3 = rhs(mode, v0, seg_at(seg, tau + 0.5 * h), zadd(z, k2, 0.5 * h));
-    let k4 = rhs(mode, v0, seg_at(seg, tau + h), zadd(z, k3, h));
+    // Three ground samples and two reciprocal masses per call, off the stages' dependency chain.
+    let slope = (seg.a1 - seg.a0) / seg.dt;
+    let ag0 = seg.a0 + slope * tau;
+    let ag1 = seg.a0 + slope * (tau + 0.5 * h);
+    let ag2 = seg.a0 + slope * (tau + h);
+    let r1 = 1.0 / P.m1;
+    let r2 = 1.0 / P.m2;
+    let k1 = rhs(mode, v0, ag0, z, r1, r2);
+    let k2 = rhs(mode, v0, ag1, zadd(z, k1, 0.5 * h), r1, r2);
+    let k3 = rhs(mode, v0, ag1, zadd(z, k2, 0.5 * h), r1, r2);
+    let k4 = rhs(mode, v0, ag2, zadd(z, k3, h), r1, r2);
     let h6 = h / 6.0;
     return Z(
         z.u1 + h6 * (k1.u1 + 2.0 * k2.u1 + 2.0 * k3.u1 + k4.u1),

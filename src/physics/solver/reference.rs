@@ -108,7 +108,8 @@ pub(crate) fn dopri(
     rtol: f64,
     cs: &ContactScales,
 ) -> (State, f64) {
-    let f = |tt: f64, y: &State| super::rhs(p, mode, v0, seg.at(tt), y);
+    let inv_m = [1.0 / p.b1.m, 1.0 / p.b2.m];
+    let f = |tt: f64, y: &State| super::rhs(p, mode, v0, seg.at(tt), inv_m, y);
     let lin = |c: &[(f64, &State)]| -> State {
         std::array::from_fn(|i| z[i] + h * c.iter().map(|(a, k)| a * k[i]).sum::<f64>())
     };
