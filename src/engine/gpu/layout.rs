@@ -119,7 +119,7 @@ pub struct Meta {
     pub rec_len: u32,
     /// Record intervals to simulate (record plus tail).
     pub intervals: u32,
-    /// First real of the run's shared free response in the `shared` buffer
+    /// First real of the run's shared free response in the `responses` buffer
     /// ([`super::shared`]), or [`NO_RESPONSE`].
     pub response: u32,
 }

@@ -212,7 +212,8 @@ pub fn pack(
 }
 
 /// A run's results from its final state (what `Tracker::finish` and `Tracker::energy` do on
-/// the CPU; GPU runs start at rest, or on their shared free response); None for a run handed back to the host (`STATUS_HANDOFF`).
+/// the CPU; GPU runs start at rest, or on their shared free response); None for a run handed
+/// back to the host (`STATUS_HANDOFF`).
 pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<RunOutput> {
     if c.status == STATUS_HANDOFF {
         return None;

@@ -12,7 +12,8 @@
 //! steps (`events.rs`), so each step integrates a smooth right-hand side. The contact work
 //! `w' = F delta'` rides along as a fifth state so the dissipated energy is integrated to the
 //! scheme's own order. `tracker.rs` keeps peaks and impacts, `hermite.rs` the peaks between
-//! samples, [`shared`] the free response that runs differing only in gap and contact share; [`collision`] solves one isolated collision (the `exact` restitution formula).
+//! samples, [`shared`] the free response that runs differing only in gap and contact share;
+//! [`collision`] solves one isolated collision (the `exact` restitution formula).
 //! `shaders/fast.wgsl` is the GPU twin of [`fast`], function for function.
 
 pub mod calibration;

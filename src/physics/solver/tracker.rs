@@ -49,9 +49,9 @@ impl Tracker {
     }
 
     /// Account for a free record step over `seg`, from `z0` to `z1`: peak displacements from
-    /// the quintic Hermite (both ends' accelerations are known in free flight).
+    /// the quintic Hermite (both ends' accelerations are known in free flight). A building whose
+    /// peak is `settled` (it cannot be raised over this step) skips the search.
     #[inline]
-    /// A building whose peak is `settled` (it cannot be raised over this step) skips the search.
     pub fn free_step(
         &mut self,
         p: &Pair,
