@@ -10,4 +10,6 @@ pub mod contact;
 pub mod model;
 pub mod propagator;
 pub mod restitution;
+pub mod row;
+pub mod shear;
 pub mod solver;

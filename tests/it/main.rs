@@ -9,6 +9,7 @@ mod gpu;
 mod hard;
 mod hostile;
 mod layers;
+mod multistorey;
 mod oracles;
 mod records;
 mod scale;

@@ -23,16 +23,16 @@ pub(crate) fn event_value(p: &Pair, mode: Mode, v0: f64, z: &State) -> f64 {
 /// when the estimate is good and keeps regula falsi from stalling on one side. Returns the length
 /// and state on the far side of the event, so the next mode starts with a consistent sign.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn locate(
+pub(crate) fn locate<S>(
     h: f64,
     f0: f64,
-    z1: State,
+    z1: S,
     f1: f64,
     tol: f64,
     max_iter: u32,
-    mut step: impl FnMut(f64) -> State,
-    eval: impl Fn(&State) -> f64,
-) -> (f64, State) {
+    mut step: impl FnMut(f64) -> S,
+    eval: impl Fn(&S) -> f64,
+) -> (f64, S) {
     let (mut a, mut fa) = (0.0, f0.min(0.0));
     let (mut b, mut fb, mut zb) = (h, f1, z1);
     let mut last = 0i8;
@@ -83,7 +83,12 @@ pub(crate) fn locate(
 /// maximum (the step is then re-taken to there and checked for the event).
 #[inline]
 pub(crate) fn hidden_touch(p: &Pair, z0: &State, z1: &State, h: f64) -> Option<f64> {
-    let (y0, d0, y1, d1) = (delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1));
+    hidden_rise(delta(p, z0), ddelta(z0), delta(p, z1), ddelta(z1), h)
+}
+
+/// [`hidden_touch`] for a penetration `y` with rate `d` at both ends of a step of length `h`.
+#[inline]
+pub(crate) fn hidden_rise(y0: f64, d0: f64, y1: f64, d1: f64, h: f64) -> Option<f64> {
     if y1 > 0.0 || d0 <= 0.0 && d1 >= 0.0 {
         return None;
     }
@@ -110,7 +115,7 @@ pub(crate) fn hidden_touch(p: &Pair, z0: &State, z1: &State, h: f64) -> Option<f
 /// Bound on `|u''''|` of a free oscillator over a step (inside a step `ag'' = 0`), for the
 /// Hermite error margin of the near-contact test.
 #[inline]
-fn fourth_derivative_bound(o: &Oscillator, u: f64, v: f64, seg: &Segment) -> f64 {
+pub(crate) fn fourth_derivative_bound(o: &Oscillator, u: f64, v: f64, seg: &Segment) -> f64 {
     let w2 = o.k / o.m;
     let cm = o.c / o.m;
     let a2 = w2 * u + cm * v + seg.a0.abs().max(seg.a1.abs());
@@ -121,7 +126,7 @@ fn fourth_derivative_bound(o: &Oscillator, u: f64, v: f64, seg: &Segment) -> f64
 /// Twice the cubic Hermite's interpolation-error bound, `2 h^4/384 max|delta''''|`, for a
 /// bound on `|delta''''|`.
 #[inline]
-fn error_margin(bound: f64, h: f64) -> f64 {
+pub(crate) fn error_margin(bound: f64, h: f64) -> f64 {
     let h2 = h * h;
     2.0 * h2 * h2 / 384.0 * bound
 }
@@ -214,20 +219,7 @@ pub(crate) fn transition(
 ) -> Mode {
     match mode {
         Mode::Free => {
-            let v = ddelta(z);
-            // A first touch takes v0 = delta' at delta = 0. A clamped law that re-engages while
-            // still overlapping (force back above 0) continues the previous impact's v0.
-            let v0 = if delta(p, before) <= 0.0 || tr.v0 <= 0.0 {
-                v.abs()
-            } else {
-                tr.v0
-            };
-            let v0 = v0.max(1e-12);
-            let next = if v > 0.0 {
-                Mode::Approach
-            } else {
-                Mode::Restitution
-            };
+            let (v0, next) = touch(delta(p, before), ddelta(z), tr.v0);
             tr.onset(t, v0, force(p, next, v0, z));
             next
         }
@@ -237,6 +229,25 @@ pub(crate) fn transition(
             Mode::Free
         }
     }
+}
+
+/// The impact speed and contact mode of a touch located at penetration rate `v`, where the
+/// step began at penetration `delta_before` and the last impact had speed `last_v0`. A first
+/// touch takes `v0 = delta'` at `delta = 0`; a clamped law that re-engages while still
+/// overlapping (force back above 0) continues the previous impact's `v0`.
+#[inline]
+pub(crate) fn touch(delta_before: f64, v: f64, last_v0: f64) -> (f64, Mode) {
+    let v0 = if delta_before <= 0.0 || last_v0 <= 0.0 {
+        v.abs()
+    } else {
+        last_v0
+    };
+    let next = if v > 0.0 {
+        Mode::Approach
+    } else {
+        Mode::Restitution
+    };
+    (v0.max(1e-12), next)
 }
 
 /// After a step without a located event: a restituting contact that starts to close again goes

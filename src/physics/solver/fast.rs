@@ -200,7 +200,7 @@ pub(crate) fn run(
         let h = if sustained {
             h_rate
         } else {
-            impact_step(pair, v_est, a_est, o.substeps_per_contact).min(h_rate)
+            impact_step(&pair.contact, v_est, a_est, o.substeps_per_contact).min(h_rate)
         };
         distance = None;
         let m = (dt / h).ceil().max(1.0);

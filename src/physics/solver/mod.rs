@@ -22,6 +22,7 @@ mod events;
 pub mod fast;
 mod hermite;
 pub mod reference;
+pub mod row;
 pub mod shared;
 mod tracker;
 
@@ -30,6 +31,7 @@ pub use fast::FastOptions;
 pub use reference::ReferenceOptions;
 pub use shared::FreeResponse;
 
+use crate::physics::contact::Contact;
 use crate::physics::model::{Forcing, Initial, Pair, RunOutput};
 
 /// `[u1, v1, u2, v2, w, e_in, e_damp]`: displacements and velocities, then the contact work
@@ -39,8 +41,9 @@ use crate::physics::model::{Forcing, Initial, Pair, RunOutput};
 pub type State = [f64; 7];
 
 /// Contact mode; changes only at located events.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Mode {
+    #[default]
     Free,
     Approach,
     Restitution,
@@ -184,15 +187,15 @@ pub(crate) fn structural_rel_accel(p: &Pair, z: &State) -> f64 {
 /// lasts the free-collision duration `t_c(v)`, or less when the structures reverse the relative
 /// motion first (about `2 v / |a|` for a relative deceleration `a`); the kinematic bound is
 /// floored at `t_c / 16` so a grazing touch cannot ask for unbounded steps.
-pub(crate) fn impact_step(p: &Pair, v: f64, a: f64, per_contact: f64) -> f64 {
-    let tc = p.contact.duration_estimate(v);
+pub(crate) fn impact_step(c: &Contact, v: f64, a: f64, per_contact: f64) -> f64 {
+    let tc = c.duration_estimate(v);
     let tk = if a != 0.0 {
         2.0 * v / a.abs()
     } else {
         f64::INFINITY
     };
     let t = tc.min(tk.max(tc / 16.0));
-    t / (per_contact * (1.0 + 2.0 * p.contact.damping_ratio))
+    t / (per_contact * (1.0 + 2.0 * c.damping_ratio))
 }
 
 pub(crate) fn finite(z: &State) -> bool {

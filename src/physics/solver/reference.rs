@@ -94,24 +94,20 @@ impl ContactScales {
     }
 }
 
-/// One Dormand-Prince step; returns the 5th-order solution and the scaled error norm
-/// (`<= 1` accepts).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn dopri(
-    p: &Pair,
-    mode: Mode,
-    v0: f64,
-    seg: &Segment,
-    t: f64,
-    z: &State,
-    h: f64,
-    rtol: f64,
-    cs: &ContactScales,
-) -> (State, f64) {
-    let inv_m = [1.0 / p.b1.m, 1.0 / p.b2.m];
-    let f = |tt: f64, y: &State| super::rhs(p, mode, v0, seg.at(tt), inv_m, y);
-    let lin = |c: &[(f64, &State)]| -> State {
-        std::array::from_fn(|i| z[i] + h * c.iter().map(|(a, k)| a * k[i]).sum::<f64>())
+/// The stages of one Dormand-Prince step of `z' = f(t, z)` from `(t, z)` over `h`: the
+/// 5th-order solution and its error estimate (5th minus embedded 4th order), for any state
+/// held as a slice (the pair's array, a row's vector).
+#[inline]
+pub(crate) fn dopri_stages<S>(z: &S, t: f64, h: f64, mut f: impl FnMut(f64, &S) -> S) -> (S, S)
+where
+    S: Clone + AsRef<[f64]> + AsMut<[f64]>,
+{
+    let lin = |c: &[(f64, &S)]| -> S {
+        let mut y = z.clone();
+        for (i, yi) in y.as_mut().iter_mut().enumerate() {
+            *yi += h * c.iter().map(|(a, k)| a * k.as_ref()[i]).sum::<f64>();
+        }
+        y
     };
     let k1 = f(t, z);
     let k2 = f(t + 0.2 * h, &lin(&[(A21, &k1)]));
@@ -127,12 +123,37 @@ pub(crate) fn dopri(
     );
     let y = lin(&[(B1, &k1), (B3, &k3), (B4, &k4), (B5, &k5), (B6, &k6)]);
     let k7 = f(t + h, &y);
+    let mut ev = k1.clone();
+    for (i, e) in ev.as_mut().iter_mut().enumerate() {
+        let k = |s: &S| s.as_ref()[i];
+        *e =
+            h * (E1 * k(&k1) + E3 * k(&k3) + E4 * k(&k4) + E5 * k(&k5) + E6 * k(&k6) + E7 * k(&k7));
+    }
+    (y, ev)
+}
+
+/// One Dormand-Prince step; returns the 5th-order solution and the scaled error norm
+/// (`<= 1` accepts).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn dopri(
+    p: &Pair,
+    mode: Mode,
+    v0: f64,
+    seg: &Segment,
+    t: f64,
+    z: &State,
+    h: f64,
+    rtol: f64,
+    cs: &ContactScales,
+) -> (State, f64) {
+    let inv_m = [1.0 / p.b1.m, 1.0 / p.b2.m];
+    let (y, ev) = dopri_stages(z, t, h, |tt, y| {
+        super::rhs(p, mode, v0, seg.at(tt), inv_m, y)
+    });
     let atol = rtol * 1e-6;
     let mut err: f64 = 0.0;
-    let mut ev = [0.0; 5];
     // The energy integrals (z[5], z[6]) follow from the others; they are not error-controlled.
     for i in 0..5 {
-        ev[i] = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i]);
         let mut sc = z[i].abs().max(y[i].abs());
         if i == 4 && mode != Mode::Free {
             sc = sc.max(cs.energy);
@@ -147,6 +168,26 @@ pub(crate) fn dopri(
         err = err.max((ev[1] - ev[3]).abs() / (rtol * vs));
     }
     (y, err)
+}
+
+/// The step to retry after a step of length `hs` at `t` was rejected with error norm `err`
+/// (NaN where non-finite), or how the run ends when no shorter step is left. Only
+/// floating-point resolution bounds the step: the delta^(1/4) damping of the nonlinear
+/// viscoelastic law needs very short steps just after first touch.
+pub(crate) fn retry(seg: &Segment, t: f64, hs: f64, err: f64, finite: bool) -> Result<f64, Status> {
+    let hmin = 1e-20 * seg.dt + 4.0 * f64::EPSILON * t.abs();
+    if hs <= hmin {
+        return Err(if finite {
+            Status::StepLimit
+        } else {
+            Status::NonFinite
+        });
+    }
+    Ok(if err.is_finite() {
+        hs * (0.9 * err.powf(-0.2)).max(0.1)
+    } else {
+        hs * 0.1
+    })
 }
 
 pub(crate) fn run(
@@ -177,35 +218,22 @@ pub(crate) fn run(
                 t - run.tr.onset_time() > SUSTAINED * pair.contact.duration_estimate(v0);
             if mode != Mode::Free && !sustained {
                 let a = structural_rel_accel(pair, &z0);
-                hs = hs.min(impact_step(pair, v0, a, o.contact_steps));
+                hs = hs.min(impact_step(&pair.contact, v0, a, o.contact_steps));
             }
             let cs = ContactScales::of(pair, v0);
             let (trial, err) = dopri(pair, mode, v0, &seg, t, &z0, hs, o.rtol, &cs);
             if err.is_nan() || err > 1.0 {
-                // Rejected (or non-finite): shrink. Only floating-point resolution bounds the
-                // step: the delta^(1/4) damping of the nonlinear viscoelastic law needs very short
-                // steps just after first touch.
-                let hmin = 1e-20 * seg.dt + 4.0 * f64::EPSILON * t.abs();
-                if hs <= hmin {
-                    let status = if finite(&trial) {
-                        Status::StepLimit
-                    } else {
-                        Status::NonFinite
-                    };
-                    return run.finish(status, steps);
+                match retry(&seg, t, hs, err, finite(&trial)) {
+                    Ok(shorter) => h = shorter,
+                    Err(status) => return run.finish(status, steps),
                 }
-                h = if err.is_finite() {
-                    hs * (0.9 * err.powf(-0.2)).max(0.1)
-                } else {
-                    hs * 0.1
-                };
                 continue;
             }
             if mode == Mode::Free {
                 let v_est = 1.5 * ddelta(&z0).abs().max(ddelta(&trial).abs());
                 let a = structural_rel_accel(pair, &z0).abs();
                 let a = a.max(structural_rel_accel(pair, &trial).abs());
-                let h_touch = impact_step(pair, v_est, a, 8.0);
+                let h_touch = impact_step(&pair.contact, v_est, a, 8.0);
                 if hs > h_touch && may_touch(pair, &seg, &z0, &trial, hs, v0) {
                     h = h_touch;
                     continue;

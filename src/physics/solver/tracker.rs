@@ -19,9 +19,48 @@ pub(crate) struct Tracker {
     /// Onset time of the current impact; force-sample times are kept relative to it, as the
     /// shader does (so f32 times keep their resolution late in a record).
     t_onset: f64,
+    hist: ForceHistory,
+    impacts_ended: u32,
+}
+
+/// The last two force samples of the current impact, for the parabola refinement of its peak.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct ForceHistory {
     hist: [(f64, f64); 2],
     nhist: usize,
-    impacts_ended: u32,
+}
+
+impl ForceHistory {
+    /// Record a force sample `f` at `t` after the impact's onset; returns the impact's peak
+    /// raised to it, and to the vertex of the parabola through the last three samples where
+    /// they make a local maximum.
+    #[inline]
+    pub fn sample(&mut self, peak: f64, t: f64, f: f64) -> f64 {
+        let mut peak = peak.max(f);
+        if self.nhist == 2 {
+            let [(x0, y0), (x1, y1)] = self.hist;
+            if y1 >= y0 && y1 >= f && x1 > x0 && t > x1 {
+                let d1 = (y1 - y0) / (x1 - x0);
+                let d2 = (f - y1) / (t - x1);
+                let a = (d2 - d1) / (t - x0);
+                if a < 0.0 {
+                    // Newton form around x0, x1: y(x) = y0 + d1 (x - x0) + a (x - x0)(x - x1).
+                    let xv = (0.5 * (x0 + x1) - 0.5 * d1 / a).clamp(x0, t);
+                    let yv = y0 + d1 * (xv - x0) + a * (xv - x0) * (xv - x1);
+                    peak = peak.max(yv);
+                }
+            }
+            self.hist = [self.hist[1], (t, f)];
+        } else {
+            self.hist[self.nhist] = (t, f);
+            self.nhist += 1;
+        }
+        peak
+    }
+
+    pub fn clear(&mut self) {
+        self.nhist = 0;
+    }
 }
 
 impl Tracker {
@@ -33,8 +72,7 @@ impl Tracker {
             e_initial: 0.0,
             e_peak: 0.0,
             t_onset: 0.0,
-            hist: [(0.0, 0.0); 2],
-            nhist: 0,
+            hist: ForceHistory::default(),
             impacts_ended: 0,
         }
     }
@@ -98,28 +136,9 @@ impl Tracker {
         }
     }
 
-    /// A force sample `t` after the onset of the current impact; a local maximum of three samples is refined by
-    /// the vertex of their parabola.
+    /// A force sample `t` after the onset of the current impact.
     fn force_sample(&mut self, t: f64, f: f64) {
-        self.imp_peak = self.imp_peak.max(f);
-        if self.nhist == 2 {
-            let [(x0, y0), (x1, y1)] = self.hist;
-            if y1 >= y0 && y1 >= f && x1 > x0 && t > x1 {
-                let d1 = (y1 - y0) / (x1 - x0);
-                let d2 = (f - y1) / (t - x1);
-                let a = (d2 - d1) / (t - x0);
-                if a < 0.0 {
-                    // Newton form around x0, x1: y(x) = y0 + d1 (x - x0) + a (x - x0)(x - x1).
-                    let xv = (0.5 * (x0 + x1) - 0.5 * d1 / a).clamp(x0, t);
-                    let yv = y0 + d1 * (xv - x0) + a * (xv - x0) * (xv - x1);
-                    self.imp_peak = self.imp_peak.max(yv);
-                }
-            }
-            self.hist = [self.hist[1], (t, f)];
-        } else {
-            self.hist[self.nhist] = (t, f);
-            self.nhist += 1;
-        }
+        self.imp_peak = self.hist.sample(self.imp_peak, t, f);
     }
 
     #[inline]
@@ -131,7 +150,7 @@ impl Tracker {
         self.v0 = v0;
         self.imp_peak = 0.0;
         self.t_onset = t;
-        self.nhist = 0;
+        self.hist.clear();
         self.force_sample(0.0, f);
     }
 

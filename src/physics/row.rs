@@ -1,0 +1,212 @@
+//! A row of multi-storey buildings, left to right, that may pound floor against floor: the
+//! scene of a multi-storey run, and what such a run reports.
+//!
+//! Adjacent buildings `a` and `a + 1` stand `gaps[a]` apart. They can touch at every floor level
+//! both have at the same elevation (within [`LEVEL_TOLERANCE_M`]); floors at different heights
+//! never touch floor to floor (mid-column pounding is not modelled). Each such contact level
+//! has its own contact element: the run's law, stiffness and damping ratio, with the effective
+//! mass of the two colliding floors, `m_eff = m_A m_B / (m_A + m_B)`.
+
+use crate::physics::contact::{Contact, LawKind};
+use crate::physics::model::{EnergyBalance, Status};
+use crate::physics::shear::ShearBuilding;
+
+/// Two floors of neighbouring buildings are at the same level when their elevations differ by
+/// at most this, m.
+pub const LEVEL_TOLERANCE_M: f64 = 0.01;
+
+/// A contact level: floor `floor_left` of building `left` against floor `floor_right` of
+/// building `left + 1` (floors counted from 1, the lowest above the ground).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Level {
+    pub left: usize,
+    pub floor_left: usize,
+    pub floor_right: usize,
+    /// Elevation of the level (the left floor's), m.
+    pub elevation: f64,
+    pub contact: Contact,
+}
+
+/// Buildings left to right, the gap between each adjacent two, and the contact levels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    pub buildings: Vec<ShearBuilding>,
+    /// m, `gaps[a]` between building `a` and `a + 1`.
+    pub gaps: Vec<f64>,
+    /// Ordered by adjacent pair, then by elevation.
+    pub levels: Vec<Level>,
+}
+
+impl Row {
+    /// A row whose contact levels all use `law` with `stiffness` and dimensionless damping
+    /// `damping_ratio` (see [`Contact::new`]). Panics unless there is one gap per adjacent pair.
+    pub fn new(
+        buildings: Vec<ShearBuilding>,
+        gaps: Vec<f64>,
+        law: LawKind,
+        stiffness: f64,
+        damping_ratio: f64,
+    ) -> Row {
+        assert_eq!(gaps.len() + 1, buildings.len(), "one gap per adjacent pair");
+        let mut levels = Vec::new();
+        for (a, pair) in buildings.windows(2).enumerate() {
+            let (za, zb) = (pair[0].elevations(), pair[1].elevations());
+            for (fa, &ea) in za.iter().enumerate() {
+                if let Some(fb) = zb
+                    .iter()
+                    .position(|&eb| (ea - eb).abs() <= LEVEL_TOLERANCE_M)
+                {
+                    let (ma, mb) = (pair[0].masses[fa], pair[1].masses[fb]);
+                    levels.push(Level {
+                        left: a,
+                        floor_left: fa + 1,
+                        floor_right: fb + 1,
+                        elevation: ea,
+                        contact: Contact::new(law, stiffness, damping_ratio, ma * mb / (ma + mb)),
+                    });
+                }
+            }
+        }
+        Row {
+            buildings,
+            gaps,
+            levels,
+        }
+    }
+
+    /// Total storeys (degrees of freedom) of the row.
+    pub fn storeys(&self) -> usize {
+        self.buildings.iter().map(|b| b.storeys()).sum()
+    }
+}
+
+/// What one contact level reports. Peaks are over the whole simulated time.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LevelOutput {
+    pub impacts: u32,
+    /// N
+    pub peak_force: f64,
+    /// m
+    pub peak_penetration: f64,
+    /// Approach speed of the impact with the largest peak force, m/s (0 if none).
+    pub impact_velocity: f64,
+    /// s
+    pub first_impact: Option<f64>,
+    /// s
+    pub contact_time: f64,
+    /// Net work of the contact force on the relative motion, J.
+    pub dissipated_energy: f64,
+}
+
+/// What one building reports. Peaks are over the whole simulated time.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BuildingOutput {
+    /// max |u| of the top floor relative to the ground, m.
+    pub peak_roof: f64,
+    /// max over storeys of `|u_j - u_(j-1)| / h_j`.
+    pub peak_drift_ratio: f64,
+    /// The storey of that drift (from 1; 0 while the building has not moved).
+    pub drift_storey: u32,
+    /// max |absolute floor acceleration| (relative acceleration plus the ground's), m/s^2.
+    pub peak_accel: f64,
+    /// The floor of that acceleration (from 1; 0 while the building has not moved).
+    pub accel_floor: u32,
+}
+
+/// Per-run results of a row. The totals gather the levels: impacts summed, the largest peak
+/// force (with its impact velocity), the earliest first impact, contact time and dissipated
+/// energy summed.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RowOutput {
+    pub status: Status,
+    pub impacts: u32,
+    pub peak_force: f64,
+    pub impact_velocity: f64,
+    pub first_impact: Option<f64>,
+    pub contact_time: f64,
+    pub dissipated_energy: f64,
+    pub levels: Vec<LevelOutput>,
+    pub buildings: Vec<BuildingOutput>,
+    /// Integration work beyond the exact free steps (as [`crate::physics::model::RunOutput`]).
+    pub substeps: u64,
+    /// Record steps taken whole by the exact modal propagators.
+    pub free_steps: u64,
+    pub energy: Option<EnergyBalance>,
+}
+
+impl RowOutput {
+    /// Fill the totals from the levels.
+    pub(crate) fn gather(&mut self) {
+        self.impacts = self.levels.iter().map(|l| l.impacts).sum();
+        self.contact_time = self.levels.iter().map(|l| l.contact_time).sum();
+        self.dissipated_energy = self.levels.iter().map(|l| l.dissipated_energy).sum();
+        self.first_impact = self
+            .levels
+            .iter()
+            .filter_map(|l| l.first_impact)
+            .min_by(f64::total_cmp);
+        (self.peak_force, self.impact_velocity) = (0.0, 0.0);
+        for l in &self.levels {
+            if l.peak_force > self.peak_force {
+                (self.peak_force, self.impact_velocity) = (l.peak_force, l.impact_velocity);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::shear::Damping;
+
+    fn building(n: usize, h: f64, m: f64) -> ShearBuilding {
+        ShearBuilding::from_period(
+            vec![m; n],
+            &vec![1.0; n],
+            vec![h; n],
+            0.1 * n as f64,
+            Damping::Modal(0.05),
+        )
+    }
+
+    #[test]
+    fn levels_are_the_floors_at_equal_elevations() {
+        // 3 storeys of 3 m against 6 of 3 m: levels at 3, 6, 9 m. Then 4 of 4.5 m: the 6-storey
+        // building's floors at 9 and 18 m meet floors 2 and 4 of the third.
+        let row = Row::new(
+            vec![
+                building(3, 3.0, 2e5),
+                building(6, 3.0, 4e5),
+                building(4, 4.5, 3e5),
+            ],
+            vec![0.02, 0.03],
+            LawKind::Hertz,
+            2.75e9,
+            0.0,
+        );
+        let got: Vec<(usize, usize, usize)> = row
+            .levels
+            .iter()
+            .map(|l| (l.left, l.floor_left, l.floor_right))
+            .collect();
+        assert_eq!(
+            got,
+            vec![(0, 1, 1), (0, 2, 2), (0, 3, 3), (1, 3, 2), (1, 6, 4)]
+        );
+        let m = 2e5 * 4e5 / 6e5;
+        assert!((row.levels[0].contact.m_eff - m).abs() < 1e-9 * m);
+        assert_eq!(row.storeys(), 13);
+    }
+
+    #[test]
+    fn floors_at_different_heights_never_touch() {
+        let row = Row::new(
+            vec![building(3, 3.0, 2e5), building(3, 3.2, 2e5)],
+            vec![0.02],
+            LawKind::Linear,
+            1e9,
+            0.0,
+        );
+        assert!(row.levels.is_empty());
+    }
+}

@@ -1,0 +1,377 @@
+//! Multi-storey shear buildings and their modes.
+//!
+//! A shear building has `N` lumped floor masses `m_j` joined by storey springs `k_j` (storey `j`
+//! joins floor `j - 1` and floor `j`; floor 0 is the ground), so `K` is tridiagonal. Its damping
+//! is classical (Rayleigh `C = a0 M + a1 K`, or the same ratio on every mode), so the motion
+//! splits into `N` independent modal oscillators. With mass-normalised mode shapes `Phi`
+//! (`Phi^T M Phi = I`) and `u = Phi q`:
+//!
+//! ```text
+//! q_i'' + 2 xi_i w_i q_i' + w_i^2 q_i = -L_i ag + phi_i^T F,   L_i = phi_i^T M 1
+//! ```
+//!
+//! so the exact propagator of [`crate::physics::propagator`] steps each mode with no
+//! truncation error (a unit-mass oscillator under ground motion `L_i ag`).
+
+use crate::physics::model::Oscillator;
+
+/// Most storeys a building may have: the modal transforms cost `N^2` per step and the
+/// eigenvectors are found in `O(N^3)`; taller shear models are not what this tool is for.
+pub const MAX_STOREYS: usize = 60;
+
+/// How a building's damping is specified (both are classical).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Damping {
+    /// Rayleigh `C = a0 M + a1 K` with this ratio on modes 1 and 2 (on mode 1 alone for a
+    /// single storey).
+    Rayleigh(f64),
+    /// This ratio on every mode.
+    Modal(f64),
+}
+
+impl Damping {
+    pub fn ratio(self) -> f64 {
+        match self {
+            Damping::Rayleigh(x) | Damping::Modal(x) => x,
+        }
+    }
+
+    pub fn key(self) -> &'static str {
+        match self {
+            Damping::Rayleigh(_) => "rayleigh",
+            Damping::Modal(_) => "modal",
+        }
+    }
+}
+
+/// A shear building: floor 1 is the lowest floor above the ground.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShearBuilding {
+    /// Floor masses, kg, bottom to top.
+    pub masses: Vec<f64>,
+    /// Storey stiffnesses, N/m: `stiffness[j]` joins floor `j` (0 = ground) and floor `j + 1`.
+    pub stiffness: Vec<f64>,
+    /// Storey heights, m.
+    pub heights: Vec<f64>,
+    pub damping: Damping,
+}
+
+impl ShearBuilding {
+    /// A building whose storey stiffnesses follow `profile` (relative values, bottom to top),
+    /// scaled so its fundamental period is `period` s.
+    pub fn from_period(
+        masses: Vec<f64>,
+        profile: &[f64],
+        heights: Vec<f64>,
+        period: f64,
+        damping: Damping,
+    ) -> ShearBuilding {
+        let mut b = ShearBuilding {
+            masses,
+            stiffness: profile.to_vec(),
+            heights,
+            damping,
+        };
+        let w1 = b.eigen().0[0].sqrt();
+        let target = 2.0 * std::f64::consts::PI / period;
+        let s = (target / w1) * (target / w1);
+        for k in &mut b.stiffness {
+            *k *= s;
+        }
+        b
+    }
+
+    /// The single-storey building equivalent to an oscillator (storey height `height`).
+    pub fn single(o: &Oscillator, xi: f64, height: f64) -> ShearBuilding {
+        ShearBuilding {
+            masses: vec![o.m],
+            stiffness: vec![o.k],
+            heights: vec![height],
+            damping: Damping::Modal(xi),
+        }
+    }
+
+    pub fn storeys(&self) -> usize {
+        self.masses.len()
+    }
+
+    /// Floor elevations above the ground, m, floor 1 first.
+    pub fn elevations(&self) -> Vec<f64> {
+        self.heights
+            .iter()
+            .scan(0.0, |z, h| {
+                *z += h;
+                Some(*z)
+            })
+            .collect()
+    }
+
+    /// `(K u)_j`: the storey forces on floor `j` (tridiagonal).
+    pub fn stiffness_force(&self, u: &[f64]) -> Vec<f64> {
+        let n = self.storeys();
+        (0..n)
+            .map(|j| {
+                let below = if j == 0 { u[0] } else { u[j] - u[j - 1] };
+                let above = if j + 1 < n { u[j + 1] - u[j] } else { 0.0 };
+                self.stiffness[j] * below
+                    - if j + 1 < n {
+                        self.stiffness[j + 1] * above
+                    } else {
+                        0.0
+                    }
+            })
+            .collect()
+    }
+
+    /// Eigenvalues `w^2` (ascending) and `M^(1/2)`-scaled eigenvectors of
+    /// `M^(-1/2) K M^(-1/2)` (columns, `v[j][i]` = component `j` of mode `i`), by cyclic Jacobi:
+    /// slow (`O(N^3)` per sweep) but accurate to rounding for any spread of stiffnesses.
+    #[allow(clippy::needless_range_loop)] // rotations index rows and columns alike
+    fn eigen(&self) -> (Vec<f64>, Vec<Vec<f64>>) {
+        let n = self.storeys();
+        let s: Vec<f64> = self.masses.iter().map(|m| 1.0 / m.sqrt()).collect();
+        let mut a = vec![vec![0.0; n]; n];
+        for j in 0..n {
+            let kj = self.stiffness[j] + self.stiffness.get(j + 1).copied().unwrap_or(0.0);
+            a[j][j] = kj * s[j] * s[j];
+            if j + 1 < n {
+                let off = -self.stiffness[j + 1] * s[j] * s[j + 1];
+                a[j][j + 1] = off;
+                a[j + 1][j] = off;
+            }
+        }
+        let mut v = vec![vec![0.0; n]; n];
+        for (j, row) in v.iter_mut().enumerate() {
+            row[j] = 1.0;
+        }
+        for _sweep in 0..100 {
+            let off: f64 = (0..n)
+                .flat_map(|p| (p + 1..n).map(move |q| (p, q)))
+                .map(|(p, q)| a[p][q] * a[p][q])
+                .sum();
+            let diag: f64 = (0..n).map(|p| a[p][p] * a[p][p]).sum();
+            if off <= 1e-32 * diag {
+                break;
+            }
+            for p in 0..n {
+                for q in p + 1..n {
+                    if a[p][q] == 0.0 {
+                        continue;
+                    }
+                    // The rotation that zeroes a[p][q] (Golub & Van Loan 8.5.2).
+                    let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                    let sign = if theta >= 0.0 { 1.0 } else { -1.0 };
+                    let t = sign / (theta.abs() + (theta * theta + 1.0).sqrt());
+                    let c = 1.0 / (t * t + 1.0).sqrt();
+                    let sn = t * c;
+                    for k in 0..n {
+                        let (akp, akq) = (a[k][p], a[k][q]);
+                        a[k][p] = c * akp - sn * akq;
+                        a[k][q] = sn * akp + c * akq;
+                    }
+                    for k in 0..n {
+                        let (apk, aqk) = (a[p][k], a[q][k]);
+                        a[p][k] = c * apk - sn * aqk;
+                        a[q][k] = sn * apk + c * aqk;
+                    }
+                    for row in v.iter_mut() {
+                        let (vp, vq) = (row[p], row[q]);
+                        row[p] = c * vp - sn * vq;
+                        row[q] = sn * vp + c * vq;
+                    }
+                }
+            }
+        }
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&x, &y| a[x][x].total_cmp(&a[y][y]));
+        let w2 = order.iter().map(|&i| a[i][i].max(0.0)).collect();
+        let vecs = (0..n)
+            .map(|j| order.iter().map(|&i| v[j][i]).collect())
+            .collect();
+        (w2, vecs)
+    }
+
+    /// The building's modes (see the module docs).
+    pub fn modes(&self) -> Modes {
+        let n = self.storeys();
+        let (w2, v) = self.eigen();
+        let omega: Vec<f64> = w2.iter().map(|x| x.sqrt()).collect();
+        // Phi = M^(-1/2) V, each column signed so its roof component is >= 0.
+        let mut shape = vec![vec![0.0; n]; n];
+        for i in 0..n {
+            let sign = if v[n - 1][i] < 0.0 { -1.0 } else { 1.0 };
+            for j in 0..n {
+                shape[j][i] = sign * v[j][i] / self.masses[j].sqrt();
+            }
+        }
+        let xi = match self.damping {
+            Damping::Modal(x) => vec![x; n],
+            Damping::Rayleigh(x) if n == 1 => vec![x],
+            Damping::Rayleigh(x) => {
+                let (w1, w2) = (omega[0], omega[1]);
+                let a0 = 2.0 * x * w1 * w2 / (w1 + w2);
+                let a1 = 2.0 * x / (w1 + w2);
+                omega.iter().map(|w| 0.5 * (a0 / w + a1 * w)).collect()
+            }
+        };
+        let participation = (0..n)
+            .map(|i| (0..n).map(|j| self.masses[j] * shape[j][i]).sum())
+            .collect();
+        Modes {
+            omega,
+            xi,
+            shape,
+            participation,
+        }
+    }
+}
+
+/// A building's modes: mass-normalised shapes, frequencies, damping ratios, participation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Modes {
+    /// rad/s, ascending.
+    pub omega: Vec<f64>,
+    pub xi: Vec<f64>,
+    /// `shape[j][i]`: floor `j + 1` in mode `i`, with `Phi^T M Phi = I` (units kg^-1/2).
+    pub shape: Vec<Vec<f64>>,
+    /// `L_i = phi_i^T M 1`, kg^1/2.
+    pub participation: Vec<f64>,
+}
+
+impl Modes {
+    pub fn count(&self) -> usize {
+        self.omega.len()
+    }
+
+    /// Mode `i` as a unit-mass oscillator (its propagator steps `q_i` under `L_i ag`).
+    pub fn oscillator(&self, i: usize) -> Oscillator {
+        let w = self.omega[i];
+        Oscillator {
+            m: 1.0,
+            k: w * w,
+            c: 2.0 * self.xi[i] * w,
+        }
+    }
+
+    /// Floor displacements `u = Phi q`.
+    pub fn to_floors(&self, q: &[f64]) -> Vec<f64> {
+        self.shape
+            .iter()
+            .map(|row| row.iter().zip(q).map(|(p, x)| p * x).sum())
+            .collect()
+    }
+
+    /// Modal coordinates `q = Phi^T M u` of floor displacements `u`.
+    pub fn to_modes(&self, masses: &[f64], u: &[f64]) -> Vec<f64> {
+        (0..self.count())
+            .map(|i| {
+                (0..u.len())
+                    .map(|j| self.shape[j][i] * masses[j] * u[j])
+                    .sum()
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn uniform(n: usize, m: f64, k: f64, damping: Damping) -> ShearBuilding {
+        ShearBuilding {
+            masses: vec![m; n],
+            stiffness: vec![k; n],
+            heights: vec![3.0; n],
+            damping,
+        }
+    }
+
+    /// A uniform shear building's frequencies in closed form:
+    /// `w_i = 2 sqrt(k/m) sin((2i - 1) pi / (2 (2N + 1)))`.
+    #[test]
+    fn uniform_building_frequencies_are_the_closed_form() {
+        for n in [1, 2, 5, 20, 60] {
+            let (m, k) = (2.5e5, 4e8);
+            let modes = uniform(n, m, k, Damping::Modal(0.05)).modes();
+            for (i, w) in modes.omega.iter().enumerate() {
+                let exact = 2.0
+                    * (k / m).sqrt()
+                    * ((2 * i + 1) as f64 * std::f64::consts::PI / (2.0 * (2 * n + 1) as f64))
+                        .sin();
+                assert!(
+                    (w - exact).abs() <= 1e-12 * exact,
+                    "N {n} mode {i}: {w} vs {exact}"
+                );
+            }
+        }
+    }
+
+    /// `Phi^T M Phi = I`, `Phi^T K Phi = diag(w^2)`, and `sum L_i phi_i = 1` (the modes span the
+    /// rigid-body shape), on a building with a soft storey and uneven masses.
+    #[test]
+    fn modes_diagonalise_mass_and_stiffness() {
+        let b = ShearBuilding {
+            masses: vec![3e5, 2.8e5, 2.8e5, 2.2e5, 1.5e5],
+            stiffness: vec![9e7, 6e8, 5.5e8, 4e8, 3e8],
+            heights: vec![4.0, 3.0, 3.0, 3.0, 3.0],
+            damping: Damping::Rayleigh(0.05),
+        };
+        let md = b.modes();
+        let n = b.storeys();
+        for i in 0..n {
+            let phi_i: Vec<f64> = (0..n).map(|j| md.shape[j][i]).collect();
+            let kphi = b.stiffness_force(&phi_i);
+            for l in 0..n {
+                let mm: f64 = (0..n)
+                    .map(|j| md.shape[j][l] * b.masses[j] * phi_i[j])
+                    .sum();
+                let kk: f64 = (0..n).map(|j| md.shape[j][l] * kphi[j]).sum();
+                let want_m = if i == l { 1.0 } else { 0.0 };
+                let want_k = if i == l { md.omega[i].powi(2) } else { 0.0 };
+                assert!((mm - want_m).abs() < 1e-12, "M {i} {l}: {mm}");
+                assert!(
+                    (kk - want_k).abs() < 1e-11 * md.omega[n - 1].powi(2),
+                    "K {i} {l}: {kk}"
+                );
+            }
+        }
+        for j in 0..n {
+            let s: f64 = (0..n).map(|i| md.participation[i] * md.shape[j][i]).sum();
+            assert!((s - 1.0).abs() < 1e-12, "floor {j}: {s}");
+        }
+    }
+
+    /// Rayleigh damping gives the stated ratio on modes 1 and 2 and `a0 / (2 w) + a1 w / 2` on
+    /// the others; the fundamental period is the one asked for.
+    #[test]
+    fn period_scaling_and_rayleigh_ratios() {
+        let b = ShearBuilding::from_period(
+            vec![2e5; 6],
+            &[3.0, 2.5, 2.0, 1.5, 1.0, 0.5],
+            vec![3.2; 6],
+            0.8,
+            Damping::Rayleigh(0.04),
+        );
+        let md = b.modes();
+        let t1 = 2.0 * std::f64::consts::PI / md.omega[0];
+        assert!((t1 - 0.8).abs() < 1e-12, "{t1}");
+        assert!((md.xi[0] - 0.04).abs() < 1e-14 && (md.xi[1] - 0.04).abs() < 1e-14);
+        // Rayleigh ratios dip between modes 1 and 2 and grow beyond mode 2.
+        assert!(md.xi[5] > md.xi[4] && md.xi[4] > 0.04);
+        assert_eq!(
+            uniform(1, 1.0, 1.0, Damping::Rayleigh(0.03)).modes().xi,
+            vec![0.03]
+        );
+    }
+
+    #[test]
+    fn floor_and_modal_coordinates_round_trip() {
+        let b = uniform(7, 1.3e5, 2e8, Damping::Modal(0.02));
+        let md = b.modes();
+        let u: Vec<f64> = (0..7).map(|j| 0.01 * (j as f64 - 2.5)).collect();
+        let back = md.to_floors(&md.to_modes(&b.masses, &u));
+        for (a, b) in u.iter().zip(&back) {
+            assert!((a - b).abs() < 1e-15, "{a} vs {b}");
+        }
+    }
+}

@@ -1,0 +1,725 @@
+//! Integration of one run of a row of shear buildings ([`crate::physics::row`]), in f64, in
+//! modal coordinates: each building's motion is its mass-normalised modes `q`
+//! ([`crate::physics::shear`]), so free flight is the exact propagator per mode and damping of
+//! either classical kind is diagonal. A contact level adds its force to the modes of the two
+//! floors it joins (`phi^T F`, `O(N)` per level).
+//!
+//! The state is `[q (n), q' (n), w (one per level), e_in, e_damp]`: all buildings' modal
+//! displacements, then velocities, each level's contact work `w_l' = F_l delta_l'`, and the
+//! input and damping work for the energy balance. Each level has its own contact mode
+//! (free, approach, restitution) and impact speed; an event is any level's mode ending, located
+//! on the largest of the levels' event values (which is positive as soon as one of them is).
+//!
+//! Two schemes, as for the pair ([`super`]): [`reference`](mod@reference) (adaptive
+//! Dormand-Prince, the truth) and [`fast`] (exact modal free steps at the record's `dt`, RK4
+//! substeps sized to the contact only in record steps where some level may touch).
+
+pub mod fast;
+pub mod reference;
+
+use super::events::{error_margin, fourth_derivative_bound, hidden_rise, locate, touch};
+use super::hermite::{cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak};
+use super::tracker::ForceHistory;
+use super::{Mode, Segment};
+use crate::physics::contact::Contact;
+use crate::physics::model::{EnergyBalance, Forcing, Status};
+use crate::physics::row::{BuildingOutput, LevelOutput, Row, RowOutput};
+use crate::physics::shear::Modes;
+
+pub use fast::RowFastOptions;
+
+/// One building of the row, as the integrators see it.
+#[derive(Debug, Clone)]
+pub(crate) struct BuildingModel {
+    /// Index of its first mode in `q`.
+    pub off: usize,
+    pub modes: Modes,
+    /// Storey heights, m.
+    pub heights: Vec<f64>,
+    pub masses: Vec<f64>,
+    /// `sqrt` of the total mass: modal coordinates of a 1 m motion are this large.
+    pub scale: f64,
+}
+
+impl BuildingModel {
+    pub fn n(&self) -> usize {
+        self.modes.count()
+    }
+}
+
+/// One contact level, as the integrators see it.
+#[derive(Debug, Clone)]
+pub(crate) struct LevelModel {
+    /// Offset and length of the left and right buildings' modes in `q`.
+    pub a: (usize, usize),
+    pub b: (usize, usize),
+    /// Buildings and floors (from 0) of the level.
+    pub buildings: (usize, usize),
+    pub floors: (usize, usize),
+    /// Mode-shape rows of the two floors: `u_left = phi_a . q[a]`.
+    pub phi_a: Vec<f64>,
+    pub phi_b: Vec<f64>,
+    pub gap: f64,
+    pub contact: Contact,
+}
+
+/// A row resolved for integration: modes of every building and the levels in modal terms.
+#[derive(Debug, Clone)]
+pub struct RowModel {
+    /// Total modes.
+    pub(crate) n: usize,
+    /// Per mode: `w^2`, `2 xi w` and the participation `L`.
+    pub(crate) w2: Vec<f64>,
+    pub(crate) two_xi_w: Vec<f64>,
+    pub(crate) part: Vec<f64>,
+    pub(crate) buildings: Vec<BuildingModel>,
+    pub(crate) levels: Vec<LevelModel>,
+}
+
+impl RowScheme {
+    pub fn key(&self) -> &'static str {
+        match self {
+            RowScheme::Fast(_) => "fast",
+            RowScheme::Reference(_) => "reference",
+        }
+    }
+}
+
+impl RowModel {
+    pub fn new(row: &Row) -> RowModel {
+        let mut buildings = Vec::new();
+        let mut off = 0;
+        let (mut w2, mut two_xi_w, mut part) = (vec![], vec![], vec![]);
+        for b in &row.buildings {
+            let modes = b.modes();
+            for i in 0..modes.count() {
+                w2.push(modes.omega[i] * modes.omega[i]);
+                two_xi_w.push(2.0 * modes.xi[i] * modes.omega[i]);
+                part.push(modes.participation[i]);
+            }
+            let n = modes.count();
+            buildings.push(BuildingModel {
+                off,
+                modes,
+                heights: b.heights.clone(),
+                masses: b.masses.clone(),
+                scale: b.masses.iter().sum::<f64>().sqrt(),
+            });
+            off += n;
+        }
+        let levels = row
+            .levels
+            .iter()
+            .map(|l| {
+                let (ba, bb) = (&buildings[l.left], &buildings[l.left + 1]);
+                let (fa, fb) = (l.floor_left - 1, l.floor_right - 1);
+                LevelModel {
+                    a: (ba.off, ba.n()),
+                    b: (bb.off, bb.n()),
+                    buildings: (l.left, l.left + 1),
+                    floors: (fa, fb),
+                    phi_a: ba.modes.shape[fa].clone(),
+                    phi_b: bb.modes.shape[fb].clone(),
+                    gap: row.gaps[l.left],
+                    contact: l.contact,
+                }
+            })
+            .collect();
+        RowModel {
+            n: off,
+            w2,
+            two_xi_w,
+            part,
+            buildings,
+            levels,
+        }
+    }
+
+    /// Length of the state vector.
+    pub(crate) fn len(&self) -> usize {
+        2 * self.n + self.levels.len() + 2
+    }
+
+    /// The state at rest.
+    pub fn at_rest(&self) -> Vec<f64> {
+        vec![0.0; self.len()]
+    }
+
+    /// The state with floor displacements `u[b]` and velocities `v[b]` of every building `b`
+    /// (relative to the ground).
+    pub fn state_of_floors(&self, u: &[Vec<f64>], v: &[Vec<f64>]) -> Vec<f64> {
+        let mut z = self.at_rest();
+        for (k, b) in self.buildings.iter().enumerate() {
+            let q = b.modes.to_modes(&b.masses, &u[k]);
+            let qd = b.modes.to_modes(&b.masses, &v[k]);
+            z[b.off..b.off + b.n()].copy_from_slice(&q);
+            z[self.n + b.off..self.n + b.off + b.n()].copy_from_slice(&qd);
+        }
+        z
+    }
+
+    /// Floor displacements of building `b` in state `z`.
+    pub fn floors(&self, b: usize, z: &[f64]) -> Vec<f64> {
+        let bm = &self.buildings[b];
+        bm.modes.to_floors(&z[bm.off..bm.off + bm.n()])
+    }
+
+    /// The largest rate of any mode (1/s): `w + 2 xi w`, as [`crate::physics::model::Oscillator::rate`].
+    pub(crate) fn structural_rate(&self) -> f64 {
+        (0..self.n)
+            .map(|i| self.w2[i].sqrt() + self.two_xi_w[i])
+            .fold(0.0, f64::max)
+    }
+
+    /// Kinetic plus strain energy, J.
+    pub(crate) fn mechanical_energy(&self, z: &[f64]) -> f64 {
+        let n = self.n;
+        (0..n)
+            .map(|i| 0.5 * (z[n + i] * z[n + i] + self.w2[i] * z[i] * z[i]))
+            .sum()
+    }
+}
+
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+impl LevelModel {
+    /// Penetration `u_left - u_right - gap`.
+    #[inline]
+    pub(crate) fn delta(&self, z: &[f64]) -> f64 {
+        let (a, b) = (self.a, self.b);
+        dot(&self.phi_a, &z[a.0..a.0 + a.1]) - dot(&self.phi_b, &z[b.0..b.0 + b.1]) - self.gap
+    }
+
+    /// Penetration rate; `n` is the model's mode count (velocities follow the displacements).
+    #[inline]
+    pub(crate) fn ddelta(&self, n: usize, z: &[f64]) -> f64 {
+        let (a, b) = (self.a, self.b);
+        dot(&self.phi_a, &z[n + a.0..n + a.0 + a.1]) - dot(&self.phi_b, &z[n + b.0..n + b.0 + b.1])
+    }
+
+    /// `delta''` from the structures alone (no contact force; the ground motion cancels).
+    pub(crate) fn structural_rel_accel(&self, m: &RowModel, z: &[f64]) -> f64 {
+        let n = m.n;
+        let acc = |phi: &[f64], (o, len): (usize, usize)| -> f64 {
+            (0..len)
+                .map(|i| phi[i] * (-m.two_xi_w[o + i] * z[n + o + i] - m.w2[o + i] * z[o + i]))
+                .sum()
+        };
+        acc(&self.phi_a, self.a) - acc(&self.phi_b, self.b)
+    }
+
+    /// Contact force in `mode`.
+    #[inline]
+    pub(crate) fn force(&self, n: usize, mode: Mode, v0: f64, z: &[f64]) -> f64 {
+        match mode {
+            Mode::Free => 0.0,
+            _ => self
+                .contact
+                .force(self.delta(z), self.ddelta(n, z), v0, mode == Mode::Approach),
+        }
+    }
+
+    /// Positive once `mode` must end (as the pair's `event_value`).
+    #[inline]
+    pub(crate) fn event_value(&self, n: usize, mode: Mode, v0: f64, z: &[f64]) -> f64 {
+        let g = self.contact.gauge(self.delta(z), self.ddelta(n, z), v0);
+        match mode {
+            Mode::Free => g,
+            Mode::Approach => -self.ddelta(n, z),
+            Mode::Restitution => -g,
+        }
+    }
+
+    /// Could the level touch inside a free step from `z0` to `z1` (length `h`)? As the pair's
+    /// `may_touch`: the Hermite cubic of `delta` plus twice its interpolation-error bound,
+    /// `|delta''''|` bounded mode by mode.
+    pub(crate) fn may_touch(
+        &self,
+        m: &RowModel,
+        seg: &Segment,
+        z0: &[f64],
+        z1: &[f64],
+        h: f64,
+        v0: f64,
+    ) -> bool {
+        let n = m.n;
+        let (d0, d1) = (self.delta(z0), self.delta(z1));
+        let (r0, r1) = (self.ddelta(n, z0), self.ddelta(n, z1));
+        let bound = |phi: &[f64], (o, len): (usize, usize)| -> f64 {
+            (0..len)
+                .map(|i| {
+                    let k = o + i;
+                    let osc = crate::physics::model::Oscillator {
+                        m: 1.0,
+                        k: m.w2[k],
+                        c: m.two_xi_w[k],
+                    };
+                    let s = Segment {
+                        a0: seg.a0 * m.part[k],
+                        a1: seg.a1 * m.part[k],
+                        ..*seg
+                    };
+                    let q = z0[k].abs().max(z1[k].abs());
+                    let qd = z0[n + k].abs().max(z1[n + k].abs());
+                    phi[i].abs() * fourth_derivative_bound(&osc, q, qd, &s)
+                })
+                .sum()
+        };
+        let margin = -error_margin(bound(&self.phi_a, self.a) + bound(&self.phi_b, self.b), h);
+        if cubic_max_bound(d0, r0, d1, r1, h) <= margin {
+            return false;
+        }
+        if self.contact.gauge(d0, r0, v0) > 0.0 || self.contact.gauge(d1, r1, v0) > 0.0 {
+            return true;
+        }
+        hermite_range(d0, r0, d1, r1, h).1 > margin
+    }
+}
+
+/// The right-hand side at ground acceleration `ag`, into `out`.
+pub(crate) fn rhs(m: &RowModel, lv: &[LevelState], ag: f64, z: &[f64], out: &mut [f64]) {
+    let n = m.n;
+    let nl = m.levels.len();
+    let (mut e_in, mut e_damp) = (0.0, 0.0);
+    for i in 0..n {
+        let v = z[n + i];
+        out[i] = v;
+        out[n + i] = -m.two_xi_w[i] * v - m.w2[i] * z[i] - m.part[i] * ag;
+        e_in -= ag * m.part[i] * v;
+        e_damp += m.two_xi_w[i] * v * v;
+    }
+    for (l, (lm, ls)) in m.levels.iter().zip(lv).enumerate() {
+        if ls.mode == Mode::Free {
+            out[2 * n + l] = 0.0;
+            continue;
+        }
+        let f = lm.force(n, ls.mode, ls.v0, z);
+        for (i, p) in lm.phi_a.iter().enumerate() {
+            out[n + lm.a.0 + i] -= p * f;
+        }
+        for (i, p) in lm.phi_b.iter().enumerate() {
+            out[n + lm.b.0 + i] += p * f;
+        }
+        out[2 * n + l] = f * lm.ddelta(n, z);
+    }
+    out[2 * n + nl] = e_in;
+    out[2 * n + nl + 1] = e_damp;
+}
+
+/// The contact state of one level and its impact bookkeeping.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LevelState {
+    pub mode: Mode,
+    /// Approach speed of the current impact.
+    pub v0: f64,
+    pub t_onset: f64,
+    imp_peak: f64,
+    hist: ForceHistory,
+    pub out: LevelOutput,
+}
+
+impl LevelState {
+    fn onset(&mut self, t: f64, v0: f64, f: f64) {
+        self.out.impacts += 1;
+        if self.out.first_impact.is_none() {
+            self.out.first_impact = Some(t);
+        }
+        self.v0 = v0;
+        self.t_onset = t;
+        self.hist.clear();
+        self.imp_peak = self.hist.sample(0.0, 0.0, f);
+    }
+
+    fn end_impact(&mut self) {
+        if self.imp_peak > self.out.peak_force {
+            self.out.peak_force = self.imp_peak;
+            self.out.impact_velocity = self.v0;
+        }
+    }
+}
+
+/// Floor kinematics of one building at one instant: displacements, velocities, relative
+/// accelerations and absolute accelerations (with contact forces), and, in free flight, the
+/// absolute accelerations' rates.
+struct Floors {
+    u: Vec<f64>,
+    v: Vec<f64>,
+    a_rel: Vec<f64>,
+    a_abs: Vec<f64>,
+    jerk: Vec<f64>,
+}
+
+impl Floors {
+    /// `forces[j]`: the contact force on floor `j` (positive to the right).
+    #[allow(clippy::needless_range_loop)] // floor j of five vectors
+    fn of(m: &RowModel, b: &BuildingModel, z: &[f64], ag: f64, forces: &[f64]) -> Floors {
+        let n = m.n;
+        let nb = b.n();
+        let o = b.off;
+        // Modal accelerations without ground and contact (they enter floor by floor below).
+        let acc: Vec<f64> = (0..nb)
+            .map(|i| -m.two_xi_w[o + i] * z[n + o + i] - m.w2[o + i] * z[o + i])
+            .collect();
+        // Modal jerk of the structural part, with the ground's contribution to q''.
+        let jrk: Vec<f64> = (0..nb)
+            .map(|i| {
+                let qdd = acc[i] - m.part[o + i] * ag;
+                -m.two_xi_w[o + i] * qdd - m.w2[o + i] * z[n + o + i]
+            })
+            .collect();
+        let sh = &b.modes.shape;
+        let row_dot = |j: usize, x: &[f64]| dot(&sh[j], x);
+        let mut f = Floors {
+            u: vec![0.0; nb],
+            v: vec![0.0; nb],
+            a_rel: vec![0.0; nb],
+            a_abs: vec![0.0; nb],
+            jerk: vec![0.0; nb],
+        };
+        for j in 0..nb {
+            f.u[j] = row_dot(j, &z[o..o + nb]);
+            f.v[j] = row_dot(j, &z[n + o..n + o + nb]);
+            // Phi L = 1, so the ground's part of the relative acceleration is -ag on every floor.
+            let a_abs = row_dot(j, &acc) + forces[j] / b.masses[j];
+            f.a_abs[j] = a_abs;
+            f.a_rel[j] = a_abs - ag;
+            f.jerk[j] = row_dot(j, &jrk);
+        }
+        f
+    }
+}
+
+/// One run of a row being integrated, shared by both schemes (as the pair's `Integration`).
+pub(crate) struct RowRun<'m> {
+    pub m: &'m RowModel,
+    pub z: Vec<f64>,
+    pub levels: Vec<LevelState>,
+    pub buildings: Vec<BuildingOutput>,
+    pub free_steps: u64,
+    /// Report the energy balance.
+    pub energy: bool,
+    e_initial: f64,
+    e_peak: f64,
+}
+
+impl<'m> RowRun<'m> {
+    /// Start at `t0` from state `z` (levels already overlapping start in contact).
+    pub fn start(m: &'m RowModel, z: Vec<f64>, t0: f64) -> Self {
+        let mut run = RowRun {
+            m,
+            levels: vec![LevelState::default(); m.levels.len()],
+            buildings: vec![BuildingOutput::default(); m.buildings.len()],
+            free_steps: 0,
+            energy: true,
+            e_initial: m.mechanical_energy(&z),
+            e_peak: 0.0,
+            z,
+        };
+        let z = run.z.clone();
+        run.transitions(t0, &z, &z);
+        run
+    }
+
+    pub fn any_contact(&self) -> bool {
+        self.levels.iter().any(|l| l.mode != Mode::Free)
+    }
+
+    /// The largest event value of the levels (positive once any level's mode must end).
+    fn event_max(&self, z: &[f64]) -> f64 {
+        let n = self.m.n;
+        self.m
+            .levels
+            .iter()
+            .zip(&self.levels)
+            .map(|(lm, ls)| lm.event_value(n, ls.mode, ls.v0, z))
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The contact forces on each building's floors in state `z`.
+    fn floor_forces(&self, z: &[f64]) -> Vec<Vec<f64>> {
+        let n = self.m.n;
+        let mut f: Vec<Vec<f64>> = self.m.buildings.iter().map(|b| vec![0.0; b.n()]).collect();
+        for (lm, ls) in self.m.levels.iter().zip(&self.levels) {
+            let fl = lm.force(n, ls.mode, ls.v0, z);
+            f[lm.buildings.0][lm.floors.0] -= fl;
+            f[lm.buildings.1][lm.floors.1] += fl;
+        }
+        f
+    }
+
+    /// Raise the buildings' peaks over the piece `z0 -> z1` of length `h` (ground acceleration
+    /// `ag0`, `ag1` at its ends). A building no contact acts on takes its displacement and
+    /// drift peaks from the quintic Hermite (both ends' accelerations are exact) and its floor
+    /// accelerations' from the cubic Hermite with their rates; one in contact takes the cubic
+    /// Hermite of displacements and drifts, and its accelerations at the piece's ends (a
+    /// contact force's spike is not smooth enough for the cubic).
+    fn track_buildings(&mut self, z0: &[f64], z1: &[f64], ag: (f64, f64), h: f64) {
+        let m = self.m;
+        let (f0, f1) = (self.floor_forces(z0), self.floor_forces(z1));
+        let mut touched = vec![false; m.buildings.len()];
+        for (lm, ls) in m.levels.iter().zip(&self.levels) {
+            if ls.mode != Mode::Free {
+                touched[lm.buildings.0] = true;
+                touched[lm.buildings.1] = true;
+            }
+        }
+        for (k, bm) in m.buildings.iter().enumerate() {
+            let free = !touched[k];
+            let s0 = Floors::of(m, bm, z0, ag.0, &f0[k]);
+            let s1 = Floors::of(m, bm, z1, ag.1, &f1[k]);
+            let out = &mut self.buildings[k];
+            let nb = bm.n();
+            let raise = |peak: f64, y: [f64; 2], d: [f64; 2], a: [f64; 2]| -> f64 {
+                if free {
+                    raise_quintic_peak(peak, y, d, a, h)
+                } else {
+                    raise_cubic_peak(peak, y[0], d[0], y[1], d[1], h)
+                }
+            };
+            let top = nb - 1;
+            out.peak_roof = raise(
+                out.peak_roof,
+                [s0.u[top], s1.u[top]],
+                [s0.v[top], s1.v[top]],
+                [s0.a_rel[top], s1.a_rel[top]],
+            );
+            for j in 0..nb {
+                let below = |_: &Floors, x: &[f64]| if j == 0 { 0.0 } else { x[j - 1] };
+                let inv_h = 1.0 / bm.heights[j];
+                let y = [
+                    (s0.u[j] - below(&s0, &s0.u)) * inv_h,
+                    (s1.u[j] - below(&s1, &s1.u)) * inv_h,
+                ];
+                let d = [
+                    (s0.v[j] - below(&s0, &s0.v)) * inv_h,
+                    (s1.v[j] - below(&s1, &s1.v)) * inv_h,
+                ];
+                // The ground's floor 0 moves with the frame: its relative acceleration is 0.
+                let a = [
+                    (s0.a_rel[j] - below(&s0, &s0.a_rel)) * inv_h,
+                    (s1.a_rel[j] - below(&s1, &s1.a_rel)) * inv_h,
+                ];
+                let p = raise(out.peak_drift_ratio, y, d, a);
+                if p > out.peak_drift_ratio {
+                    out.peak_drift_ratio = p;
+                    out.drift_storey = j as u32 + 1;
+                }
+                let p = if free {
+                    raise_cubic_peak(
+                        out.peak_accel,
+                        s0.a_abs[j],
+                        s0.jerk[j],
+                        s1.a_abs[j],
+                        s1.jerk[j],
+                        h,
+                    )
+                } else {
+                    out.peak_accel.max(s0.a_abs[j].abs()).max(s1.a_abs[j].abs())
+                };
+                if p > out.peak_accel {
+                    out.peak_accel = p;
+                    out.accel_floor = j as u32 + 1;
+                }
+            }
+        }
+    }
+
+    /// Account for a piece `t0 -> t0 + h` from `z0` to `z1` in the current modes.
+    fn track(&mut self, t0: f64, h: f64, z0: &[f64], z1: &[f64], ag: (f64, f64)) {
+        let m = self.m;
+        let n = m.n;
+        self.track_buildings(z0, z1, ag, h);
+        let nl = m.levels.len();
+        self.e_peak = self.e_peak.max(self.e_initial + z1[2 * n + nl]);
+        for (l, (lm, ls)) in m.levels.iter().zip(self.levels.iter_mut()).enumerate() {
+            if ls.mode == Mode::Free {
+                continue;
+            }
+            let o = &mut ls.out;
+            o.contact_time += h;
+            let (y0, d0, y1, d1) = (
+                lm.delta(z0),
+                lm.ddelta(n, z0),
+                lm.delta(z1),
+                lm.ddelta(n, z1),
+            );
+            if cubic_max_bound(y0, d0, y1, d1, h) > o.peak_penetration {
+                o.peak_penetration = o.peak_penetration.max(hermite_range(y0, d0, y1, d1, h).1);
+            }
+            o.dissipated_energy = z1[2 * n + l];
+            let f = lm.force(n, ls.mode, ls.v0, z1);
+            ls.imp_peak = ls.hist.sample(ls.imp_peak, t0 + h - ls.t_onset, f);
+        }
+    }
+
+    /// A free record step over `seg` to `z1`, with no possible contact (checked by the caller).
+    pub fn free_step(&mut self, seg: &Segment, z1: Vec<f64>) {
+        let z0 = std::mem::take(&mut self.z);
+        self.track(seg.t0, seg.dt, &z0, &z1, (seg.a0, seg.a1));
+        self.free_steps += 1;
+        self.z = z1;
+    }
+
+    /// Apply the mode changes that the events at state `z` (time `t`) call for; `before` is
+    /// the state at the start of the step in which they were located. Levels whose event value
+    /// is not positive only go back to approach if a restitution closes again.
+    fn transitions(&mut self, t: f64, z: &[f64], before: &[f64]) {
+        let n = self.m.n;
+        for (lm, ls) in self.m.levels.iter().zip(self.levels.iter_mut()) {
+            if lm.event_value(n, ls.mode, ls.v0, z) <= 0.0 {
+                if ls.mode == Mode::Restitution && lm.ddelta(n, z) > 0.0 {
+                    ls.mode = Mode::Approach;
+                }
+                continue;
+            }
+            ls.mode = match ls.mode {
+                Mode::Free => {
+                    let (v0, next) = touch(lm.delta(before), lm.ddelta(n, z), ls.v0);
+                    let f = lm.force(n, next, v0, z);
+                    ls.onset(t, v0, f);
+                    next
+                }
+                Mode::Approach => Mode::Restitution,
+                Mode::Restitution => {
+                    ls.end_impact();
+                    Mode::Free
+                }
+            };
+        }
+    }
+
+    /// Accept `trial`, the step `t -> t + h` over `seg` in the current modes; `step(x)` re-takes
+    /// it with length `x`. As the pair's `Integration::accept`: a touch hidden inside the step
+    /// (at a free level) and any event are located, the step then ends there. Returns the
+    /// length advanced.
+    #[allow(clippy::too_many_arguments)]
+    pub fn accept(
+        &mut self,
+        seg: &Segment,
+        t: f64,
+        h: f64,
+        trial: Vec<f64>,
+        tol_rel: f64,
+        max_iter: u32,
+        mut step: impl FnMut(f64) -> Vec<f64>,
+    ) -> f64 {
+        let n = self.m.n;
+        let z0 = std::mem::take(&mut self.z);
+        let (mut trial, mut h) = (trial, h);
+        let mut f1 = self.event_max(&trial);
+        if f1 <= 0.0 {
+            let hidden = self
+                .m
+                .levels
+                .iter()
+                .zip(&self.levels)
+                .filter(|(_, ls)| ls.mode == Mode::Free)
+                .filter_map(|(lm, _)| {
+                    hidden_rise(
+                        lm.delta(&z0),
+                        lm.ddelta(n, &z0),
+                        lm.delta(&trial),
+                        lm.ddelta(n, &trial),
+                        h,
+                    )
+                })
+                .fold(None, |acc: Option<f64>, s| {
+                    Some(acc.map_or(s, |a| a.min(s)))
+                });
+            if let Some(s) = hidden {
+                let zs = step(s * h);
+                let fs = self.event_max(&zs);
+                if fs > 0.0 {
+                    (trial, f1, h) = (zs, fs, s * h);
+                }
+            }
+        }
+        let ag = |x: f64| seg.at(x);
+        let advanced = if f1 > 0.0 {
+            let f0 = self.event_max(&z0);
+            let tol = (tol_rel * h).max(4.0 * f64::EPSILON * t.abs());
+            let (x, zb) = locate(
+                h,
+                f0,
+                trial,
+                f1,
+                tol,
+                max_iter,
+                &mut step,
+                |s: &Vec<f64>| self.event_max(s),
+            );
+            self.track(t, x, &z0, &zb, (ag(t), ag(t + x)));
+            self.transitions(t + x, &zb, &z0);
+            self.z = zb;
+            x
+        } else {
+            self.track(t, h, &z0, &trial, (ag(t), ag(t + h)));
+            self.z = trial;
+            for (lm, ls) in self.m.levels.iter().zip(self.levels.iter_mut()) {
+                if ls.mode == Mode::Restitution && lm.ddelta(n, &self.z) > 0.0 {
+                    ls.mode = Mode::Approach;
+                }
+            }
+            h
+        };
+        advanced
+    }
+
+    /// End the run with `status`, after `substeps` steps of integration work.
+    pub fn finish(mut self, status: Status, substeps: u64) -> RowOutput {
+        let m = self.m;
+        let n = m.n;
+        let nl = m.levels.len();
+        let energy = self.energy.then(|| {
+            let contact: f64 = (0..nl).map(|l| self.z[2 * n + l]).sum();
+            EnergyBalance::close(
+                self.e_initial,
+                self.z[2 * n + nl],
+                self.z[2 * n + nl + 1],
+                contact,
+                m.mechanical_energy(&self.z),
+                self.e_peak,
+            )
+        });
+        for ls in self.levels.iter_mut() {
+            if ls.mode != Mode::Free {
+                ls.end_impact();
+            }
+        }
+        let mut out = RowOutput {
+            status,
+            levels: self.levels.iter().map(|l| l.out).collect(),
+            buildings: self.buildings,
+            substeps,
+            free_steps: self.free_steps,
+            energy,
+            ..RowOutput::default()
+        };
+        out.gather();
+        out
+    }
+}
+
+/// Which scheme a row run uses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RowScheme {
+    Fast(RowFastOptions),
+    Reference(super::ReferenceOptions),
+}
+
+/// Simulate one run of a row from state `z0` (see [`RowModel::at_rest`],
+/// [`RowModel::state_of_floors`]) over the forcing's whole duration.
+pub fn simulate_row(
+    m: &RowModel,
+    forcing: &Forcing,
+    z0: Vec<f64>,
+    scheme: &RowScheme,
+) -> RowOutput {
+    match scheme {
+        RowScheme::Fast(o) => fast::run(m, forcing, z0, o),
+        RowScheme::Reference(o) => reference::run(m, forcing, z0, o),
+    }
+}

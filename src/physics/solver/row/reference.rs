@@ -1,0 +1,138 @@
+//! The reference scheme for rows: the pair's ([`crate::physics::solver::reference`]) on the
+//! row's state. Adaptive Dormand-Prince 5(4), steps that end on every record sample, every
+//! level's events located, a free step that could hide a touch shortened to the contact time
+//! scale, and steps in an impact capped at `t_c / contact_steps`. The error of each building's
+//! modes is measured against that building's largest modal amplitude (a high mode's own tiny
+//! amplitude would ask for needless accuracy), and of each level in contact against the
+//! impact's scales.
+
+use super::{rhs, LevelState, RowModel, RowRun};
+use crate::physics::model::{Forcing, Status};
+use crate::physics::row::RowOutput;
+use crate::physics::solver::fast::SUSTAINED;
+use crate::physics::solver::reference::{dopri_stages, retry, ReferenceOptions};
+use crate::physics::solver::{impact_step, Mode, Segment};
+
+/// One Dormand-Prince step; returns the 5th-order solution and the scaled error norm
+/// (`<= 1` accepts).
+#[allow(clippy::too_many_arguments)]
+fn dopri(
+    m: &RowModel,
+    lv: &[LevelState],
+    seg: &Segment,
+    t: f64,
+    z: &[f64],
+    h: f64,
+    rtol: f64,
+) -> (Vec<f64>, f64) {
+    let (y, ev) = dopri_stages(&z.to_vec(), t, h, |tt, y: &Vec<f64>| {
+        let mut out = vec![0.0; y.len()];
+        rhs(m, lv, seg.at(tt), y, &mut out);
+        out
+    });
+    let n = m.n;
+    let mut err: f64 = 0.0;
+    for b in &m.buildings {
+        let atol = rtol * 1e-6 * b.scale;
+        for part in [0, n] {
+            let r = part + b.off..part + b.off + b.n();
+            let sc = r
+                .clone()
+                .map(|i| z[i].abs().max(y[i].abs()))
+                .fold(0.0, f64::max);
+            for i in r {
+                err = err.max(ev[i].abs() / (atol + rtol * sc));
+            }
+        }
+    }
+    for (l, (lm, ls)) in m.levels.iter().zip(lv).enumerate() {
+        let i = 2 * n + l;
+        let mut sc = z[i].abs().max(y[i].abs());
+        if ls.mode == Mode::Free {
+            err = err.max(ev[i].abs() / (rtol * 1e-6 + rtol * sc));
+            continue;
+        }
+        let c = &lm.contact;
+        let v0 = ls.v0;
+        sc = sc.max(0.5 * c.m_eff * v0 * v0);
+        err = err.max(ev[i].abs() / (rtol * 1e-6 + rtol * sc));
+        // Floors: a grazing impact's scales can fall below what f64 resolves in u and v.
+        let ua = lm.delta(z) + lm.gap;
+        let ds = (v0 * c.duration_estimate(v0) / 3.0).max(1e-4 * ua.abs());
+        let vs = v0.max(1e-4 * lm.ddelta(n, z).abs());
+        let de = lm.delta(&ev) + lm.gap;
+        err = err.max(de.abs() / (rtol * ds));
+        err = err.max(lm.ddelta(n, &ev).abs() / (rtol * vs));
+    }
+    (y, err)
+}
+
+pub(crate) fn run(
+    m: &RowModel,
+    forcing: &Forcing,
+    z0: Vec<f64>,
+    o: &ReferenceOptions,
+) -> RowOutput {
+    let n = m.n;
+    let mut run = RowRun::start(m, z0, forcing.t0);
+    let mut steps: u64 = 0;
+    let mut h = forcing.dt / 8.0;
+    for i in 0..forcing.intervals() {
+        let seg = Segment::of(forcing, i);
+        let mut t = seg.t0;
+        let t1 = seg.t1();
+        while t1 - t > 1e-12 * seg.dt {
+            steps += 1;
+            if steps > o.max_steps {
+                return run.finish(Status::StepLimit, steps);
+            }
+            let z0 = run.z.clone();
+            let mut hs = h.min(t1 - t);
+            // The cap resolves each impact's force peak; a sustained contact is left to the
+            // error control.
+            for (lm, ls) in m.levels.iter().zip(&run.levels) {
+                let c = &lm.contact;
+                if ls.mode != Mode::Free && t - ls.t_onset <= SUSTAINED * c.duration_estimate(ls.v0)
+                {
+                    let a = lm.structural_rel_accel(m, &z0);
+                    hs = hs.min(impact_step(c, ls.v0, a, o.contact_steps));
+                }
+            }
+            let (trial, err) = dopri(m, &run.levels, &seg, t, &z0, hs, o.rtol);
+            if err.is_nan() || err > 1.0 {
+                let finite = trial.iter().all(|x| x.is_finite());
+                match retry(&seg, t, hs, err, finite) {
+                    Ok(shorter) => h = shorter,
+                    Err(status) => return run.finish(status, steps),
+                }
+                continue;
+            }
+            // A free level that could touch inside a step longer than its contact time scale
+            // shortens the step to that scale.
+            let mut h_touch = f64::INFINITY;
+            for (lm, ls) in m.levels.iter().zip(&run.levels) {
+                if ls.mode != Mode::Free {
+                    continue;
+                }
+                let v_est = 1.5 * lm.ddelta(n, &z0).abs().max(lm.ddelta(n, &trial).abs());
+                let a = lm
+                    .structural_rel_accel(m, &z0)
+                    .abs()
+                    .max(lm.structural_rel_accel(m, &trial).abs());
+                let hl = impact_step(&lm.contact, v_est, a, 8.0);
+                if hs > hl && lm.may_touch(m, &seg, &z0, &trial, hs, ls.v0) {
+                    h_touch = h_touch.min(hl);
+                }
+            }
+            if h_touch < hs {
+                h = h_touch;
+                continue;
+            }
+            let levels = run.levels.clone();
+            let step = |x: f64| dopri(m, &levels, &seg, t, &z0, x, o.rtol).0;
+            t += run.accept(&seg, t, hs, trial, 1e-13, 100, step);
+            h = hs * (0.9 * err.max(1e-12).powf(-0.2)).min(5.0);
+        }
+    }
+    run.finish(Status::Ok, steps)
+}
