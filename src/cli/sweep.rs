@@ -170,6 +170,23 @@ pub fn run(a: Args) -> Result<()> {
     let target = check_outputs(&config_inputs(&config, &records), &[("-o", Some(&output))])?
         .pop()
         .expect("one output");
+    if pounding::plan::row::is_row_config(&config_text) {
+        let refused = [
+            (shard.is_some(), "--shard"),
+            (resume, "--resume"),
+            (aggregate.is_some(), "--aggregate"),
+            (format == FormatArg::Parquet, "--format parquet"),
+            (columns.is_some(), "--columns"),
+            (target_error.is_some(), "--target-error"),
+            (backend.get() == Backend::Gpu, "--backend gpu"),
+        ];
+        if let Some((_, flag)) = refused.iter().find(|(asked, _)| *asked) {
+            bail!("{flag} is not available for rows of multi-storey buildings ([[building]] configs) yet: they run on the CPU into CSV");
+        }
+        let mut plan = config::load_row_text(&config_text, &config)?;
+        plan.base.spec.scheme = scheme_as_run(plan.base.spec.scheme, scheme, energy);
+        return run_row(&config, &plan, target, threads, chunk);
+    }
     let precision = precision.get();
     let mut plan = config::load_text(&config_text, &config)?;
     for w in plan.warnings() {
@@ -348,8 +365,14 @@ pub fn run(a: Args) -> Result<()> {
             pounding::plan::limits::HEIGHT_PER_PERIOD_M
         );
     }
+    finished(&summary, &path, &format!(" ({what})"));
+    Ok(())
+}
+
+/// The one line a finished sweep ends with.
+fn finished(summary: &pounding::engine::Summary, path: &std::path::Path, what: &str) {
     note!(
-        "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {} ({what})",
+        "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {}{what}",
         summary.runs,
         summary.seconds,
         summary.runs_per_second(),
@@ -358,5 +381,108 @@ pub fn run(a: Args) -> Result<()> {
         summary.failures,
         path.display()
     );
+}
+
+/// `pound sweep` of a row config: every run on the CPU, rows written to `OUT.partial` chunk by
+/// chunk and renamed to `OUT` when complete (a stream is written in place).
+fn run_row(
+    config: &std::path::Path,
+    plan: &pounding::plan::row::RowPlan,
+    target: pounding::io::target::Target,
+    threads: Option<usize>,
+    chunk: Option<usize>,
+) -> Result<()> {
+    use pounding::io::atomic::partial_path;
+    use pounding::io::csv::{encode_rows, CsvOut};
+    use pounding::io::provenance::{meta_path, progress_path};
+    use pounding::io::target::{PartialLock, Target};
+    let chunk = chunk.unwrap_or(pounding::engine::CPU_CHUNK);
+    if chunk == 0 || chunk > pounding::plan::limits::MAX_CPU_CHUNK {
+        bail!(EngineError::Chunk {
+            chunk,
+            max: pounding::plan::limits::MAX_CPU_CHUNK,
+            on: "CPU"
+        });
+    }
+    let lock = match &target {
+        Target::File(p) => {
+            // An unfinished CSV sweep's rows are only ever continued, never overwritten.
+            if progress_path(p).exists() {
+                bail!(
+                    "{} belongs to an unfinished CSV sweep: continue it with its own config and --resume, or delete {} and {} to start over",
+                    partial_path(p).display(),
+                    partial_path(p).display(),
+                    progress_path(p).display()
+                );
+            }
+            Some(PartialLock::acquire(&partial_path(p))?)
+        }
+        _ => None,
+    };
+    let header = plan.header();
+    let names: Vec<&str> = header.iter().map(String::as_str).collect();
+    let mut out = CsvOut::create(&target, lock.as_ref(), &names, Some(0))
+        .with_context(|| format!("cannot write {}", target.path().display()))?;
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = threads {
+        pool = pool.num_threads(t);
+    }
+    let pool = pool.build().context("starting worker threads")?;
+    note!(
+        "{}: {} runs of a row of {} buildings ({} storeys, {} contact levels), {} scheme, on the CPU ({} threads; the GPU kernel for rows is not built yet)",
+        config.display(),
+        plan.len(),
+        plan.buildings.len(),
+        plan.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
+        plan.row(&plan.run(0)).levels.len(),
+        plan.scheme().key(),
+        pool.current_num_threads()
+    );
+    let partial = out.partial_path().to_path_buf();
+    let summary = pool
+        .install(|| {
+            pounding::engine::cpu::run_rows(
+                plan,
+                0..plan.len(),
+                chunk,
+                |rows| {
+                    let cells: Vec<Vec<String>> =
+                        rows.iter().map(|(s, o)| plan.cells(s, o)).collect();
+                    out.write_encoded(&encode_rows(&cells))
+                },
+                |_| {},
+            )
+        })
+        .with_context(|| {
+            format!(
+                "writing {} (finished rows are kept there)",
+                partial.display()
+            )
+        })?;
+    let final_path = target.path().to_path_buf();
+    let is_file = target.is_file();
+    let (path, _) = out
+        .finish(Some(plan.len()), |content| {
+            if !is_file {
+                return Ok(());
+            }
+            // The sidecar is written before the rename, as for pairs.
+            let meta = Meta {
+                fingerprint: Fingerprint::of_row(plan),
+                plan_runs: plan.len(),
+                first_run: 0,
+                end_run: plan.len(),
+                shard: None,
+                backend: "cpu".into(),
+                columns: Some(header.clone()),
+                content: Some(content.clone()),
+                target_error: None,
+            };
+            pounding::io::provenance::write_toml(&meta_path(&final_path), &meta)
+                .map_err(std::io::Error::other)
+        })
+        .with_context(|| format!("finishing {}", partial.display()))?;
+    drop(lock);
+    finished(&summary, &path, "");
     Ok(())
 }

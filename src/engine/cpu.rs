@@ -4,7 +4,10 @@
 
 use crate::engine::Summary;
 use crate::physics::model::{Initial, RunOutput};
+use crate::physics::row::RowOutput;
+use crate::physics::solver::row::{simulate_row, RowModel};
 use crate::physics::solver::{simulate, simulate_shared, FreeResponse, Scheme};
+use crate::plan::row::{RowPlan, RowRunSpec};
 use crate::plan::{Plan, RunSpec};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -75,7 +78,49 @@ pub fn run_range<E>(
     runs: std::ops::Range<u64>,
     scheme: &Scheme,
     chunk: usize,
-    mut sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<Summary, E> {
+    let solve = |ids: std::ops::Range<u64>| {
+        let specs: Vec<RunSpec> = ids.map(|i| plan.run(i)).collect();
+        let outs = run_many(plan, &specs, scheme);
+        specs.into_iter().zip(outs).collect()
+    };
+    in_batches(runs, chunk, solve, Summary::count, sink, progress)
+}
+
+/// Run the runs `runs` of the row plan `plan`, `chunk` runs per task, on the current rayon pool;
+/// `sink` gets each chunk's results in run order, `progress` the number of runs done so far
+/// (as [`run_range`]).
+pub fn run_rows<E>(
+    plan: &RowPlan,
+    runs: std::ops::Range<u64>,
+    chunk: usize,
+    sink: impl FnMut(&[(RowRunSpec, RowOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<Summary, E> {
+    let scheme = plan.scheme();
+    let solve = |ids: std::ops::Range<u64>| {
+        ids.map(|i| {
+            let spec = plan.run(i);
+            let model = RowModel::new(&plan.row(&spec));
+            let out = simulate_row(&model, &plan.forcing(&spec), model.at_rest(), &scheme);
+            (spec, out)
+        })
+        .collect()
+    };
+    in_batches(runs, chunk, solve, Summary::count_row, sink, progress)
+}
+
+/// The runs `runs` in chunks of `chunk`, `solve`d in parallel a batch of chunks at a time (a few
+/// per thread, so uneven runs balance); `sink` gets each chunk in run order, `count` adds each
+/// output to the summary, `progress` gets the runs done after each batch.
+fn in_batches<S: Send, O: Send, E>(
+    runs: std::ops::Range<u64>,
+    chunk: usize,
+    solve: impl Fn(std::ops::Range<u64>) -> Vec<(S, O)> + Sync,
+    count: impl Fn(&mut Summary, &O),
+    mut sink: impl FnMut(&[(S, O)]) -> Result<(), E>,
     mut progress: impl FnMut(u64),
 ) -> Result<Summary, E> {
     let start = Instant::now();
@@ -87,19 +132,13 @@ pub fn run_range<E>(
     let mut c0 = 0;
     while c0 < nchunks {
         let c1 = (c0 + batch).min(nchunks);
-        let results: Vec<Vec<(RunSpec, RunOutput)>> = (c0..c1)
+        let results: Vec<Vec<(S, O)>> = (c0..c1)
             .into_par_iter()
-            .map(|c| {
-                let specs: Vec<RunSpec> = (first + c * chunk..(first + (c + 1) * chunk).min(n))
-                    .map(|i| plan.run(i))
-                    .collect();
-                let outs = run_many(plan, &specs, scheme);
-                specs.into_iter().zip(outs).collect()
-            })
+            .map(|c| solve(first + c * chunk..(first + (c + 1) * chunk).min(n)))
             .collect();
         for r in &results {
             for (_, o) in r {
-                s.count(o);
+                count(&mut s, o);
             }
             sink(r)?;
         }

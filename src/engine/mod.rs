@@ -44,14 +44,23 @@ pub struct Summary {
 impl Summary {
     /// Count one finished run.
     pub(crate) fn count(&mut self, o: &RunOutput) {
-        self.runs += 1;
-        self.impacts += o.impacts as u64;
-        self.runs_with_impacts += (o.impacts > 0) as u64;
-        self.failures += (o.status != Status::Ok) as u64;
-        self.free_steps += o.free_steps;
-        self.substeps += o.substeps;
+        self.count_work(o.status, o.impacts, o.free_steps, o.substeps);
         self.shared_steps += o.shared_steps;
         self.runs_sharing += (o.shared_steps > 0) as u64;
+    }
+
+    /// Count one finished run of a row.
+    pub(crate) fn count_row(&mut self, o: &crate::physics::row::RowOutput) {
+        self.count_work(o.status, o.impacts, o.free_steps, o.substeps);
+    }
+
+    fn count_work(&mut self, status: Status, impacts: u32, free_steps: u64, substeps: u64) {
+        self.runs += 1;
+        self.impacts += impacts as u64;
+        self.runs_with_impacts += (impacts > 0) as u64;
+        self.failures += (status != Status::Ok) as u64;
+        self.free_steps += free_steps;
+        self.substeps += substeps;
     }
 
     /// Count the runs of a device partial (handed-back runs are counted when finished).

@@ -43,6 +43,11 @@ where
     w.into_inner().expect("writing to memory")
 }
 
+/// CSV lines of rows of cells, as written.
+pub fn encode_rows(rows: &[Vec<String>]) -> Vec<u8> {
+    lines(rows)
+}
+
 /// The header line of `columns`, as written.
 pub fn header_line(columns: &[&str]) -> Vec<u8> {
     lines([columns])

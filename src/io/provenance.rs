@@ -63,6 +63,16 @@ impl Fingerprint {
         }
     }
 
+    /// The fingerprint of a row sweep: its base plan's, with the buildings' and gaps' axes.
+    pub fn of_row(plan: &crate::plan::row::RowPlan) -> Fingerprint {
+        let base = Fingerprint::of(&plan.base);
+        let text = format!("{}|{:?}|{:?}", base.plan, plan.buildings, plan.gaps);
+        Fingerprint {
+            plan: hex(Sha256::digest(text.as_bytes())),
+            ..base
+        }
+    }
+
     /// The first part that differs from `other`, in words; None if they match.
     pub fn differs(&self, other: &Fingerprint) -> Option<&'static str> {
         if self.engine != other.engine {

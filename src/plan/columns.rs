@@ -61,7 +61,7 @@ pub const SUMMARISED: [&str; 8] = {
 };
 
 /// Shortest round-trip text; scientific notation outside [1e-4, 1e15) so tiny values stay short.
-fn num(x: f64) -> String {
+pub(crate) fn num(x: f64) -> String {
     let a = x.abs();
     if a != 0.0 && !(1e-4..1e15).contains(&a) {
         format!("{x:e}")
@@ -70,8 +70,43 @@ fn num(x: f64) -> String {
     }
 }
 
+/// The columns of the contact and the ground motion: the first [`CONTACT_AND_MOTION`] of
+/// [`HEADER`], which rows of multi-storey buildings share ([`crate::plan::row`]).
+pub const CONTACT_AND_MOTION: usize = 11;
+
 /// The fields of one row, in [`HEADER`] order.
 pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
+    let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+    let mut cells = contact_and_motion(plan, spec);
+    cells.extend([
+        num(spec.m1),
+        num(spec.t1),
+        num(spec.xi1),
+        num(spec.m2),
+        num(spec.t2),
+        num(spec.xi2),
+        num(spec.gap),
+        spec.sample.map(|s| s.to_string()).unwrap_or_default(),
+        out.status.key().to_string(),
+        out.impacts.to_string(),
+        num(out.peak_force),
+        num(out.peak_penetration),
+        num(out.peak_u1),
+        num(out.peak_u2),
+        num(out.impact_velocity),
+        opt(out.first_impact),
+        num(out.contact_time),
+        num(out.dissipated_energy),
+        out.substeps.to_string(),
+        opt(out.energy.map(|e| e.input)),
+        opt(out.energy.map(|e| e.damping)),
+        opt(out.energy.map(|e| e.residual)),
+    ]);
+    cells
+}
+
+/// The first [`CONTACT_AND_MOTION`] fields of a row.
+pub fn contact_and_motion(plan: &Plan, spec: &RunSpec) -> Vec<String> {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
     let hertz = spec.law.is_hertzian();
     vec![
@@ -103,28 +138,6 @@ pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
         },
         num(spec.scale),
         num(spec.pga_g),
-        num(spec.m1),
-        num(spec.t1),
-        num(spec.xi1),
-        num(spec.m2),
-        num(spec.t2),
-        num(spec.xi2),
-        num(spec.gap),
-        spec.sample.map(|s| s.to_string()).unwrap_or_default(),
-        out.status.key().to_string(),
-        out.impacts.to_string(),
-        num(out.peak_force),
-        num(out.peak_penetration),
-        num(out.peak_u1),
-        num(out.peak_u2),
-        num(out.impact_velocity),
-        opt(out.first_impact),
-        num(out.contact_time),
-        num(out.dissipated_energy),
-        out.substeps.to_string(),
-        opt(out.energy.map(|e| e.input)),
-        opt(out.energy.map(|e| e.damping)),
-        opt(out.energy.map(|e| e.residual)),
     ]
 }
 

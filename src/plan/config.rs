@@ -397,12 +397,16 @@ pub fn load_text(text: &str, path: &Path) -> Result<Plan, ConfigError> {
 /// resolved, so a command can refuse to write over one of them. Text that does not parse lists
 /// none (loading it reports the error).
 pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
-    let Ok(raw) = toml::from_str::<RawConfig>(text) else {
-        return Vec::new();
+    let raw_records = match toml::from_str::<RawConfig>(text) {
+        Ok(raw) => raw.records,
+        Err(_) => match toml::from_str::<crate::plan::row::RawRowConfig>(text) {
+            Ok(raw) => raw.records,
+            Err(_) => return Vec::new(),
+        },
     };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let records = records_dir();
-    raw.records
+    raw_records
         .iter()
         .filter_map(|r| r.file_path(&base, &records))
         .collect()
@@ -426,6 +430,12 @@ pub fn changed_records(text: &str, path: &Path, plan: &Plan) -> Vec<String> {
     }
 }
 
+/// Validate the row config `text` read from `path` ([`crate::plan::row`]).
+pub fn load_row_text(text: &str, path: &Path) -> Result<crate::plan::row::RowPlan, ConfigError> {
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    crate::plan::row::parse_row(text, path, &base, &records_dir())
+}
+
 /// A plan from config text that names no record file (synthetic records only), `name` standing
 /// for its file in messages: built-in sweeps (`pound bench`) and tests.
 pub fn parse_builtin(text: &str, name: &str) -> Result<Plan, ConfigError> {
@@ -439,6 +449,16 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
         path: path.into(),
         message: e.to_string(),
     })?;
+    parse_raw(&raw, path, base, records)
+}
+
+/// [`parse`] of a config already read into its raw form.
+pub(crate) fn parse_raw(
+    raw: &RawConfig,
+    path: &Path,
+    base: &Path,
+    records: &Path,
+) -> Result<Plan, ConfigError> {
     let invalid = |key: &str, message: String| ConfigError::Invalid {
         path: path.into(),
         key: key.into(),
@@ -517,7 +537,7 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
         })?);
     }
 
-    check_size(&raw, &laws, &invalid)?;
+    check_size(raw, &laws, &invalid)?;
     let samples = raw
         .sample
         .as_ref()

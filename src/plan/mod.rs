@@ -19,6 +19,7 @@
 pub mod columns;
 pub mod config;
 pub mod limits;
+pub mod row;
 pub mod sample;
 pub mod shard;
 

@@ -1,0 +1,525 @@
+//! Sweeps of rows of multi-storey buildings: a config with `[[building]]` entries (left to
+//! right) instead of `[building1]` and `[building2]`.
+//!
+//! Everything but the buildings and gaps (laws, formulas, `e`, stiffness, records,
+//! intensities, the scheme) is the pair's plan, validated by the same code: the row plan holds
+//! that plan as its `base` (with placeholder buildings) and adds, below each of its runs, the
+//! axes of each building (floor mass, fundamental period, damping ratio) and each adjacent
+//! pair's gap, outermost first, the last gap innermost.
+
+use crate::physics::model::Forcing;
+use crate::physics::row::{Row, RowOutput};
+use crate::physics::shear::{Damping, ShearBuilding, MAX_STOREYS};
+use crate::physics::solver::row::RowScheme;
+use crate::physics::solver::Scheme;
+use crate::plan::columns;
+use crate::plan::config::{
+    parse_raw, Axis, ConfigError, RawBuilding, RawConfig, RawContact, RawIntensity, RawRecord,
+    RawRun, RawSample,
+};
+use crate::plan::{Plan, RunSpec};
+use serde::Deserialize;
+use std::path::Path;
+
+/// One value for every storey, or one per storey (bottom to top).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum PerStorey {
+    One(f64),
+    Each(Vec<f64>),
+}
+
+/// One `[[building]]` as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawShearBuilding {
+    pub storeys: usize,
+    pub storey_height_m: PerStorey,
+    /// Every floor's mass (an axis), or `floor_masses_kg`.
+    pub mass_kg: Option<Axis>,
+    pub floor_masses_kg: Option<Vec<f64>>,
+    /// Relative storey stiffnesses, bottom to top (default uniform), scaled to `period_s`.
+    pub stiffness_profile: Option<Vec<f64>>,
+    pub period_s: Axis,
+    pub damping_ratio: Axis,
+    /// `rayleigh` (the ratio on modes 1 and 2, the default) or `modal` (on every mode).
+    pub damping: Option<String>,
+    /// The gap to the next building (default `contact.gap_m`).
+    pub gap_right_m: Option<Axis>,
+}
+
+/// A row config as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRowConfig {
+    #[serde(default)]
+    pub run: RawRun,
+    pub building: Vec<RawShearBuilding>,
+    pub contact: RawContact,
+    #[serde(rename = "record", default)]
+    pub records: Vec<RawRecord>,
+    #[serde(default)]
+    pub intensity: RawIntensity,
+    pub sample: Option<RawSample>,
+}
+
+/// Does config `text` describe a row (`[[building]]` entries)? Text that is not TOML is not.
+pub fn is_row_config(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("building"))
+}
+
+/// One building's axes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShearAxes {
+    pub heights: Vec<f64>,
+    /// Fixed floor masses, or None where `mass` is swept.
+    pub floor_masses: Option<Vec<f64>>,
+    /// kg, every floor (one placeholder where `floor_masses` is given).
+    pub mass: Vec<f64>,
+    pub profile: Vec<f64>,
+    pub period: Vec<f64>,
+    pub damping: Vec<f64>,
+    pub modal: bool,
+}
+
+impl ShearAxes {
+    pub fn storeys(&self) -> usize {
+        self.heights.len()
+    }
+}
+
+/// A validated row sweep.
+#[derive(Debug, Clone)]
+pub struct RowPlan {
+    /// Laws, formulas, `e`, stiffness, records, intensities and the scheme, with placeholder
+    /// buildings and gap.
+    pub base: Plan,
+    pub buildings: Vec<ShearAxes>,
+    /// m, per adjacent pair.
+    pub gaps: Vec<Vec<f64>>,
+    /// Sizes of the axes below a base run: mass, period, damping per building, then the gaps.
+    dims: Vec<usize>,
+    per_base: u64,
+}
+
+/// One run of a row sweep, decoded.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RowRunSpec {
+    pub index: u64,
+    /// Law, formula, `e`, stiffness, record and intensity (its buildings are placeholders).
+    pub base: RunSpec,
+    /// Per building: floor mass (None where fixed per floor), fundamental period, damping ratio.
+    pub mass: Vec<Option<f64>>,
+    pub period: Vec<f64>,
+    pub damping: Vec<f64>,
+    pub gaps: Vec<f64>,
+}
+
+impl RowPlan {
+    pub fn len(&self) -> u64 {
+        self.base.len() * self.per_base
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    pub fn run(&self, index: u64) -> RowRunSpec {
+        let base = self.base.run(index / self.per_base);
+        let mut rest = index % self.per_base;
+        let mut at = vec![0usize; self.dims.len()];
+        for (k, &d) in self.dims.iter().enumerate().rev() {
+            at[k] = (rest % d as u64) as usize;
+            rest /= d as u64;
+        }
+        let nb = self.buildings.len();
+        RowRunSpec {
+            index,
+            base,
+            mass: (0..nb)
+                .map(|b| {
+                    let a = &self.buildings[b];
+                    a.floor_masses.is_none().then(|| a.mass[at[3 * b]])
+                })
+                .collect(),
+            period: (0..nb)
+                .map(|b| self.buildings[b].period[at[3 * b + 1]])
+                .collect(),
+            damping: (0..nb)
+                .map(|b| self.buildings[b].damping[at[3 * b + 2]])
+                .collect(),
+            gaps: (0..nb - 1).map(|a| self.gaps[a][at[3 * nb + a]]).collect(),
+        }
+    }
+
+    /// The scene of `run`.
+    pub fn row(&self, run: &RowRunSpec) -> Row {
+        let buildings = self
+            .buildings
+            .iter()
+            .enumerate()
+            .map(|(b, a)| {
+                let masses = match (&a.floor_masses, run.mass[b]) {
+                    (Some(m), _) => m.clone(),
+                    (None, m) => vec![m.expect("a swept mass"); a.storeys()],
+                };
+                let damping = if a.modal {
+                    Damping::Modal(run.damping[b])
+                } else {
+                    Damping::Rayleigh(run.damping[b])
+                };
+                ShearBuilding::from_period(
+                    masses,
+                    &a.profile,
+                    a.heights.clone(),
+                    run.period[b],
+                    damping,
+                )
+            })
+            .collect();
+        let s = &run.base;
+        Row::new(buildings, run.gaps.clone(), s.law, s.stiffness, s.damping)
+    }
+
+    pub fn forcing(&self, run: &RowRunSpec) -> Forcing<'_> {
+        self.base.forcing(&run.base)
+    }
+
+    /// The contact levels' column prefixes, `level_b1f3_b2f3` for floor 3 of building 1
+    /// against floor 3 of building 2 (buildings and floors from 1). They depend only on storeys
+    /// and heights, which no axis sweeps, so every run of the plan has the same levels.
+    fn level_names(&self) -> Vec<String> {
+        let first = self.run(0);
+        self.row(&first)
+            .levels
+            .iter()
+            .map(|l| {
+                format!(
+                    "level_b{}f{}_b{}f{}",
+                    l.left + 1,
+                    l.floor_left,
+                    l.left + 2,
+                    l.floor_right
+                )
+            })
+            .collect()
+    }
+
+    /// Every column, in file order: the contact and motion columns of the pair, each
+    /// building's parameters (`b1_...`), each gap, the status and totals, each building's
+    /// peaks, each level's, and the energy balance (empty unless asked for).
+    pub fn header(&self) -> Vec<String> {
+        let mut h: Vec<String> = columns::HEADER[..columns::CONTACT_AND_MOTION]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let nb = self.buildings.len();
+        for b in 1..=nb {
+            for c in ["storeys", "mass_kg", "t1_s", "xi"] {
+                h.push(format!("b{b}_{c}"));
+            }
+        }
+        for a in 1..nb {
+            h.push(format!("gap_{a}_{}_m", a + 1));
+        }
+        for c in [
+            "status",
+            "impacts",
+            "peak_force_n",
+            "peak_penetration_m",
+            "impact_velocity_m_s",
+            "first_impact_s",
+            "contact_time_s",
+            "dissipated_energy_j",
+            "substeps",
+        ] {
+            h.push(c.into());
+        }
+        for b in 1..=nb {
+            for c in BUILDING_OUTPUTS {
+                h.push(format!("b{b}_{c}"));
+            }
+        }
+        for l in self.level_names() {
+            for c in LEVEL_OUTPUTS {
+                h.push(format!("{l}_{c}"));
+            }
+        }
+        for c in ["input_energy_j", "damping_energy_j", "energy_residual"] {
+            h.push(c.into());
+        }
+        h
+    }
+
+    /// The fields of one run, in [`RowPlan::header`] order.
+    pub fn cells(&self, run: &RowRunSpec, out: &RowOutput) -> Vec<String> {
+        let num = columns::num;
+        let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+        let mut c = columns::contact_and_motion(&self.base, &run.base);
+        // The base run's number is its index in the base plan; the row's is its own.
+        c[0] = run.index.to_string();
+        for (b, a) in self.buildings.iter().enumerate() {
+            c.push(a.storeys().to_string());
+            c.push(opt(run.mass[b]));
+            c.push(num(run.period[b]));
+            c.push(num(run.damping[b]));
+        }
+        c.extend(run.gaps.iter().map(|&g| num(g)));
+        let penetration = out
+            .levels
+            .iter()
+            .map(|l| l.peak_penetration)
+            .fold(0.0, f64::max);
+        c.extend([
+            out.status.key().to_string(),
+            out.impacts.to_string(),
+            num(out.peak_force),
+            num(penetration),
+            num(out.impact_velocity),
+            opt(out.first_impact),
+            num(out.contact_time),
+            num(out.dissipated_energy),
+            out.substeps.to_string(),
+        ]);
+        for b in &out.buildings {
+            c.extend([
+                num(b.peak_roof),
+                num(b.peak_drift_ratio),
+                b.drift_storey.to_string(),
+                num(b.peak_accel),
+                b.accel_floor.to_string(),
+            ]);
+        }
+        for l in &out.levels {
+            c.extend([
+                l.impacts.to_string(),
+                num(l.peak_force),
+                num(l.peak_penetration),
+                num(l.impact_velocity),
+            ]);
+        }
+        c.extend([
+            opt(out.energy.map(|e| e.input)),
+            opt(out.energy.map(|e| e.damping)),
+            opt(out.energy.map(|e| e.residual)),
+        ]);
+        c
+    }
+
+    /// The row scheme of the base plan's scheme.
+    pub fn scheme(&self) -> RowScheme {
+        match self.base.spec.scheme {
+            Scheme::Fast(o) => RowScheme::Fast(o),
+            Scheme::Reference(o) => RowScheme::Reference(o),
+        }
+    }
+}
+
+/// Each building's output columns (after its `b1_` prefix).
+pub const BUILDING_OUTPUTS: [&str; 5] = [
+    "peak_roof_m",
+    "peak_drift_ratio",
+    "drift_storey",
+    "peak_accel_m_s2",
+    "accel_floor",
+];
+
+/// Each contact level's output columns (after its `level_b1f3_b2f3_` prefix).
+pub const LEVEL_OUTPUTS: [&str; 4] = [
+    "impacts",
+    "peak_force_n",
+    "peak_penetration_m",
+    "impact_velocity_m_s",
+];
+
+/// Validate a row config read from `path` (records resolved beside it, `base`, and in
+/// `records`).
+pub fn parse_row(
+    text: &str,
+    path: &Path,
+    base: &Path,
+    records: &Path,
+) -> Result<RowPlan, ConfigError> {
+    let raw: RawRowConfig = toml::from_str(text).map_err(|e| ConfigError::Toml {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    let invalid = |key: &str, message: String| ConfigError::Invalid {
+        path: path.into(),
+        key: key.into(),
+        message,
+    };
+    if raw.sample.is_some() {
+        return Err(invalid(
+            "sample",
+            "sampling is not available for [[building]] rows yet: give the axes as lists or ranges"
+                .into(),
+        ));
+    }
+    if raw.building.len() < 2 {
+        return Err(invalid(
+            "building",
+            format!(
+                "{} [[building]] entries: a row needs at least two",
+                raw.building.len()
+            ),
+        ));
+    }
+    let one = |x: f64| Some(Axis::List(vec![x]));
+    let placeholder = RawBuilding {
+        mass_kg: one(1.0),
+        period_s: one(1.0),
+        damping_ratio: one(0.05),
+    };
+    let shared_gap = raw.contact.gap_m.clone();
+    let base_raw = RawConfig {
+        run: raw.run.clone(),
+        building1: placeholder.clone(),
+        building2: placeholder,
+        contact: RawContact {
+            gap_m: one(0.0),
+            ..raw.contact.clone()
+        },
+        records: raw.records.clone(),
+        intensity: raw.intensity.clone(),
+        sample: None,
+    };
+    let base_plan = parse_raw(&base_raw, path, base, records)?;
+    let axis = |key: &str, a: &Axis, ok: &dyn Fn(f64) -> bool, expected: &str| {
+        let v = a.values().map_err(|m| invalid(key, m))?;
+        if v.is_empty() {
+            return Err(invalid(key, "is empty: give at least one value".into()));
+        }
+        if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !ok(**x)) {
+            return Err(invalid(
+                &format!("{key}[{i}]"),
+                format!("{x} is out of range: expected {expected}"),
+            ));
+        }
+        Ok(v)
+    };
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    let per_storey = |key: &str, v: &[f64], n: usize| {
+        if v.len() != n {
+            return Err(invalid(
+                key,
+                format!("{} values for {n} storeys: give one per storey", v.len()),
+            ));
+        }
+        match v.iter().position(|x| !positive(*x)) {
+            Some(i) => Err(invalid(
+                &format!("{key}[{i}]"),
+                format!("{} is out of range: expected a value > 0", v[i]),
+            )),
+            None => Ok(v.to_vec()),
+        }
+    };
+    let nb = raw.building.len();
+    let mut buildings = Vec::new();
+    let mut gaps = Vec::new();
+    for (b, r) in raw.building.iter().enumerate() {
+        let key = |k: &str| format!("building[{b}].{k}");
+        let n = r.storeys;
+        if !(1..=MAX_STOREYS).contains(&n) {
+            return Err(invalid(
+                &key("storeys"),
+                format!("{n}: expected 1 to {MAX_STOREYS}"),
+            ));
+        }
+        let heights = match &r.storey_height_m {
+            PerStorey::One(h) => per_storey(&key("storey_height_m"), &[*h], 1)?.repeat(n),
+            PerStorey::Each(v) => per_storey(&key("storey_height_m"), v, n)?,
+        };
+        let (floor_masses, mass) = match (&r.mass_kg, &r.floor_masses_kg) {
+            (Some(a), None) => (None, axis(&key("mass_kg"), a, &positive, "a mass > 0 kg")?),
+            (None, Some(v)) => (Some(per_storey(&key("floor_masses_kg"), v, n)?), vec![0.0]),
+            _ => {
+                return Err(invalid(
+                    &key("mass_kg"),
+                    "give mass_kg (every floor, an axis) or floor_masses_kg (one per floor), one of them"
+                        .into(),
+                ))
+            }
+        };
+        let profile = match &r.stiffness_profile {
+            Some(v) => per_storey(&key("stiffness_profile"), v, n)?,
+            None => vec![1.0; n],
+        };
+        let modal = match r.damping.as_deref().unwrap_or("rayleigh") {
+            "rayleigh" => false,
+            "modal" => true,
+            other => {
+                return Err(invalid(
+                    &key("damping"),
+                    format!("`{other}`: expected rayleigh or modal"),
+                ))
+            }
+        };
+        buildings.push(ShearAxes {
+            heights,
+            floor_masses,
+            mass,
+            profile,
+            period: axis(
+                &key("period_s"),
+                &r.period_s,
+                &|v| v.is_finite() && v >= crate::plan::limits::MIN_PERIOD_S,
+                "a period >= 1e-4 s",
+            )?,
+            damping: axis(
+                &key("damping_ratio"),
+                &r.damping_ratio,
+                &|v| (0.0..1.0).contains(&v),
+                "0 <= damping ratio < 1",
+            )?,
+            modal,
+        });
+        let gap_ok = |v: f64| v.is_finite() && v >= 0.0;
+        match (&r.gap_right_m, b + 1 < nb, &shared_gap) {
+            (Some(_), false, _) => {
+                return Err(invalid(
+                    &key("gap_right_m"),
+                    "the last building has no neighbour to its right".into(),
+                ))
+            }
+            (Some(a), true, _) => gaps.push(axis(&key("gap_right_m"), a, &gap_ok, "a gap >= 0 m")?),
+            (None, true, Some(a)) => gaps.push(axis("contact.gap_m", a, &gap_ok, "a gap >= 0 m")?),
+            (None, true, None) => {
+                return Err(invalid(
+                    &key("gap_right_m"),
+                    "missing: give contact.gap_m (every pair) or gap_right_m".into(),
+                ))
+            }
+            (None, false, _) => {}
+        }
+    }
+    let mut dims: Vec<usize> = buildings
+        .iter()
+        .flat_map(|a| [a.mass.len(), a.period.len(), a.damping.len()])
+        .collect();
+    dims.extend(gaps.iter().map(Vec::len));
+    let per_base = dims
+        .iter()
+        .try_fold(1u64, |p, &d| p.checked_mul(d as u64))
+        .filter(|&p| {
+            p.checked_mul(base_plan.len())
+                .is_some_and(|n| n <= crate::plan::limits::MAX_RUNS)
+        })
+        .ok_or_else(|| {
+            invalid(
+                "building",
+                format!(
+                    "the sweep has more than 2^53 runs ({})",
+                    crate::plan::limits::WHY_RUNS
+                ),
+            )
+        })?;
+    Ok(RowPlan {
+        base: base_plan,
+        buildings,
+        gaps,
+        dims,
+        per_base,
+    })
+}
