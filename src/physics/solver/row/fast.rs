@@ -15,7 +15,7 @@
 //!    substep ends and events in contact steps, where a contact force's spike makes them
 //!    converge with the substep (as the force peak's samples do).
 
-use super::{rhs, LevelState, RowModel, RowRun};
+use super::{rhs, LevelModes, RowModel, RowRun};
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
 use crate::physics::row::RowOutput;
@@ -25,32 +25,41 @@ use crate::physics::solver::{impact_step, Mode, Segment};
 /// The fast scheme's settings are the pair's.
 pub type RowFastOptions = FastOptions;
 
-/// Classic RK4 over `h` from `(t, z)` in the levels' current modes.
-fn rk4(m: &RowModel, lv: &[LevelState], seg: &Segment, t: f64, z: &[f64], h: f64) -> Vec<f64> {
-    let len = z.len();
+/// The stages of an RK4 step, kept between calls.
+struct Stages {
+    k: [Vec<f64>; 4],
+    y: Vec<f64>,
+}
+
+/// Classic RK4 over `h` from `(t, z)` in the levels' modes `lv`.
+fn rk4(
+    m: &RowModel,
+    lv: &LevelModes,
+    seg: &Segment,
+    t: f64,
+    z: &[f64],
+    h: f64,
+    st: &mut Stages,
+) -> Vec<f64> {
     let (ag0, agm, ag1) = (seg.at(t), seg.at(t + 0.5 * h), seg.at(t + h));
-    let mut k1 = vec![0.0; len];
-    let mut k2 = vec![0.0; len];
-    let mut k3 = vec![0.0; len];
-    let mut k4 = vec![0.0; len];
-    let mut y = vec![0.0; len];
-    rhs(m, lv, ag0, z, &mut k1);
-    for i in 0..len {
-        y[i] = z[i] + 0.5 * h * k1[i];
+    let Stages { k, y } = st;
+    let [k1, k2, k3, k4] = k;
+    rhs(m, lv, ag0, z, k1);
+    for ((y, z), k) in y.iter_mut().zip(z).zip(k1.iter()) {
+        *y = z + 0.5 * h * k;
     }
-    rhs(m, lv, agm, &y, &mut k2);
-    for i in 0..len {
-        y[i] = z[i] + 0.5 * h * k2[i];
+    rhs(m, lv, agm, y, k2);
+    for ((y, z), k) in y.iter_mut().zip(z).zip(k2.iter()) {
+        *y = z + 0.5 * h * k;
     }
-    rhs(m, lv, agm, &y, &mut k3);
-    for i in 0..len {
-        y[i] = z[i] + h * k3[i];
+    rhs(m, lv, agm, y, k3);
+    for ((y, z), k) in y.iter_mut().zip(z).zip(k3.iter()) {
+        *y = z + h * k;
     }
-    rhs(m, lv, ag1, &y, &mut k4);
-    for i in 0..len {
-        y[i] = z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-    }
-    y
+    rhs(m, lv, ag1, y, k4);
+    (0..z.len())
+        .map(|i| z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
+        .collect()
 }
 
 fn mode_oscillator(m: &RowModel, k: usize) -> Oscillator {
@@ -77,6 +86,12 @@ pub(crate) fn run(m: &RowModel, forcing: &Forcing, z0: Vec<f64>, o: &FastOptions
     let mut run = RowRun::start(m, z0, forcing.t0);
     run.energy = o.energy;
     let mut substeps: u32 = 0;
+    let len = m.len();
+    let mut stages = Stages {
+        k: std::array::from_fn(|_| vec![0.0; len]),
+        y: vec![0.0; len],
+    };
+    let mut modes = Vec::with_capacity(nl);
     for i in 0..forcing.intervals() {
         let seg = Segment::of(forcing, i);
         let z = run.z.clone();
@@ -167,8 +182,8 @@ pub(crate) fn run(m: &RowModel, forcing: &Forcing, z0: Vec<f64>, o: &FastOptions
                 }
                 let hs = t_target - t;
                 let z0 = run.z.clone();
-                let levels = run.levels.clone();
-                let step = |x: f64| rk4(m, &levels, &seg, t, &z0, x);
+                run.level_modes(&mut modes);
+                let mut step = |x: f64| rk4(m, &modes, &seg, t, &z0, x, &mut stages);
                 let trial = step(hs);
                 t += run.accept(&seg, t, hs, trial, 1e-9, 16, step);
                 if !run.z.iter().all(|x| x.is_finite()) {

@@ -279,8 +279,11 @@ impl LevelModel {
     }
 }
 
+/// Each level's contact mode and impact speed: what the right-hand side needs of them.
+pub(crate) type LevelModes = [(Mode, f64)];
+
 /// The right-hand side at ground acceleration `ag`, into `out`.
-pub(crate) fn rhs(m: &RowModel, lv: &[LevelState], ag: f64, z: &[f64], out: &mut [f64]) {
+pub(crate) fn rhs(m: &RowModel, lv: &LevelModes, ag: f64, z: &[f64], out: &mut [f64]) {
     let n = m.n;
     let nl = m.levels.len();
     let (mut e_in, mut e_damp) = (0.0, 0.0);
@@ -291,12 +294,12 @@ pub(crate) fn rhs(m: &RowModel, lv: &[LevelState], ag: f64, z: &[f64], out: &mut
         e_in -= ag * m.part[i] * v;
         e_damp += m.two_xi_w[i] * v * v;
     }
-    for (l, (lm, ls)) in m.levels.iter().zip(lv).enumerate() {
-        if ls.mode == Mode::Free {
+    for (l, (lm, &(mode, v0))) in m.levels.iter().zip(lv).enumerate() {
+        if mode == Mode::Free {
             out[2 * n + l] = 0.0;
             continue;
         }
-        let f = lm.force(n, ls.mode, ls.v0, z);
+        let f = lm.force(n, mode, v0, z);
         for (i, p) in lm.phi_a.iter().enumerate() {
             out[n + lm.a.0 + i] -= p * f;
         }
@@ -344,51 +347,59 @@ impl LevelState {
 /// Floor kinematics of one building at one instant: displacements, velocities, relative
 /// accelerations and absolute accelerations (with contact forces), and, in free flight, the
 /// absolute accelerations' rates.
+#[derive(Debug, Clone, Default)]
 struct Floors {
     u: Vec<f64>,
     v: Vec<f64>,
     a_rel: Vec<f64>,
     a_abs: Vec<f64>,
     jerk: Vec<f64>,
+    /// The contact force on each floor (positive to the right).
+    force: Vec<f64>,
+    /// Scratch: modal accelerations and jerks.
+    acc: Vec<f64>,
+    jrk: Vec<f64>,
 }
 
 impl Floors {
-    /// `forces[j]`: the contact force on floor `j` (positive to the right).
+    fn new(nb: usize) -> Floors {
+        let v = vec![0.0; nb];
+        Floors {
+            u: v.clone(),
+            v: v.clone(),
+            a_rel: v.clone(),
+            a_abs: v.clone(),
+            jerk: v.clone(),
+            force: v.clone(),
+            acc: v.clone(),
+            jrk: v,
+        }
+    }
+
+    /// Fill from state `z` at ground acceleration `ag`, with `self.force` already set.
     #[allow(clippy::needless_range_loop)] // floor j of five vectors
-    fn of(m: &RowModel, b: &BuildingModel, z: &[f64], ag: f64, forces: &[f64]) -> Floors {
+    fn fill(&mut self, m: &RowModel, b: &BuildingModel, z: &[f64], ag: f64) {
         let n = m.n;
         let nb = b.n();
         let o = b.off;
-        // Modal accelerations without ground and contact (they enter floor by floor below).
-        let acc: Vec<f64> = (0..nb)
-            .map(|i| -m.two_xi_w[o + i] * z[n + o + i] - m.w2[o + i] * z[o + i])
-            .collect();
-        // Modal jerk of the structural part, with the ground's contribution to q''.
-        let jrk: Vec<f64> = (0..nb)
-            .map(|i| {
-                let qdd = acc[i] - m.part[o + i] * ag;
-                -m.two_xi_w[o + i] * qdd - m.w2[o + i] * z[n + o + i]
-            })
-            .collect();
-        let sh = &b.modes.shape;
-        let row_dot = |j: usize, x: &[f64]| dot(&sh[j], x);
-        let mut f = Floors {
-            u: vec![0.0; nb],
-            v: vec![0.0; nb],
-            a_rel: vec![0.0; nb],
-            a_abs: vec![0.0; nb],
-            jerk: vec![0.0; nb],
-        };
-        for j in 0..nb {
-            f.u[j] = row_dot(j, &z[o..o + nb]);
-            f.v[j] = row_dot(j, &z[n + o..n + o + nb]);
-            // Phi L = 1, so the ground's part of the relative acceleration is -ag on every floor.
-            let a_abs = row_dot(j, &acc) + forces[j] / b.masses[j];
-            f.a_abs[j] = a_abs;
-            f.a_rel[j] = a_abs - ag;
-            f.jerk[j] = row_dot(j, &jrk);
+        // Modal accelerations without ground and contact (they enter floor by floor below), and
+        // the jerk of the structural part, with the ground's contribution to q''.
+        for i in 0..nb {
+            let acc = -m.two_xi_w[o + i] * z[n + o + i] - m.w2[o + i] * z[o + i];
+            self.acc[i] = acc;
+            let qdd = acc - m.part[o + i] * ag;
+            self.jrk[i] = -m.two_xi_w[o + i] * qdd - m.w2[o + i] * z[n + o + i];
         }
-        f
+        let sh = &b.modes.shape;
+        for j in 0..nb {
+            self.u[j] = dot(&sh[j], &z[o..o + nb]);
+            self.v[j] = dot(&sh[j], &z[n + o..n + o + nb]);
+            // Phi L = 1, so the ground's part of the relative acceleration is -ag on every floor.
+            let a_abs = dot(&sh[j], &self.acc) + self.force[j] / b.masses[j];
+            self.a_abs[j] = a_abs;
+            self.a_rel[j] = a_abs - ag;
+            self.jerk[j] = dot(&sh[j], &self.jrk);
+        }
     }
 }
 
@@ -403,6 +414,12 @@ pub(crate) struct RowRun<'m> {
     pub energy: bool,
     e_initial: f64,
     e_peak: f64,
+    /// Each building's floor kinematics at the start and end of the last tracked piece;
+    /// `ends_valid`: the ends describe `z` in the levels' current modes, so the next piece
+    /// starts from them instead of computing them again.
+    floors: Vec<[Floors; 2]>,
+    ends_valid: bool,
+    touched: Vec<bool>,
 }
 
 impl<'m> RowRun<'m> {
@@ -416,11 +433,24 @@ impl<'m> RowRun<'m> {
             energy: true,
             e_initial: m.mechanical_energy(&z),
             e_peak: 0.0,
+            floors: m
+                .buildings
+                .iter()
+                .map(|b| [Floors::new(b.n()), Floors::new(b.n())])
+                .collect(),
+            ends_valid: false,
+            touched: vec![false; m.buildings.len()],
             z,
         };
         let z = run.z.clone();
         run.transitions(t0, &z, &z);
         run
+    }
+
+    /// Each level's mode and impact speed, into `out`.
+    pub fn level_modes(&self, out: &mut Vec<(Mode, f64)>) {
+        out.clear();
+        out.extend(self.levels.iter().map(|l| (l.mode, l.v0)));
     }
 
     pub fn any_contact(&self) -> bool {
@@ -438,16 +468,20 @@ impl<'m> RowRun<'m> {
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
-    /// The contact forces on each building's floors in state `z`.
-    fn floor_forces(&self, z: &[f64]) -> Vec<Vec<f64>> {
+    /// Set the contact forces on each building's floors in state `z` into `floors[.][end]`.
+    fn set_floor_forces(&mut self, z: &[f64], end: usize) {
         let n = self.m.n;
-        let mut f: Vec<Vec<f64>> = self.m.buildings.iter().map(|b| vec![0.0; b.n()]).collect();
-        for (lm, ls) in self.m.levels.iter().zip(&self.levels) {
-            let fl = lm.force(n, ls.mode, ls.v0, z);
-            f[lm.buildings.0][lm.floors.0] -= fl;
-            f[lm.buildings.1][lm.floors.1] += fl;
+        for f in self.floors.iter_mut() {
+            f[end].force.fill(0.0);
         }
-        f
+        for (lm, ls) in self.m.levels.iter().zip(&self.levels) {
+            if ls.mode == Mode::Free {
+                continue;
+            }
+            let fl = lm.force(n, ls.mode, ls.v0, z);
+            self.floors[lm.buildings.0][end].force[lm.floors.0] -= fl;
+            self.floors[lm.buildings.1][end].force[lm.floors.1] += fl;
+        }
     }
 
     /// Raise the buildings' peaks over the piece `z0 -> z1` of length `h` (ground acceleration
@@ -458,18 +492,28 @@ impl<'m> RowRun<'m> {
     /// contact force's spike is not smooth enough for the cubic).
     fn track_buildings(&mut self, z0: &[f64], z1: &[f64], ag: (f64, f64), h: f64) {
         let m = self.m;
-        let (f0, f1) = (self.floor_forces(z0), self.floor_forces(z1));
-        let mut touched = vec![false; m.buildings.len()];
+        if self.ends_valid {
+            for f in self.floors.iter_mut() {
+                f.swap(0, 1);
+            }
+        } else {
+            self.set_floor_forces(z0, 0);
+            for (k, bm) in m.buildings.iter().enumerate() {
+                self.floors[k][0].fill(m, bm, z0, ag.0);
+            }
+        }
+        self.set_floor_forces(z1, 1);
+        self.touched.fill(false);
         for (lm, ls) in m.levels.iter().zip(&self.levels) {
             if ls.mode != Mode::Free {
-                touched[lm.buildings.0] = true;
-                touched[lm.buildings.1] = true;
+                self.touched[lm.buildings.0] = true;
+                self.touched[lm.buildings.1] = true;
             }
         }
         for (k, bm) in m.buildings.iter().enumerate() {
-            let free = !touched[k];
-            let s0 = Floors::of(m, bm, z0, ag.0, &f0[k]);
-            let s1 = Floors::of(m, bm, z1, ag.1, &f1[k]);
+            let free = !self.touched[k];
+            self.floors[k][1].fill(m, bm, z1, ag.1);
+            let [s0, s1] = &self.floors[k];
             let out = &mut self.buildings[k];
             let nb = bm.n();
             let raise = |peak: f64, y: [f64; 2], d: [f64; 2], a: [f64; 2]| -> f64 {
@@ -487,20 +531,20 @@ impl<'m> RowRun<'m> {
                 [s0.a_rel[top], s1.a_rel[top]],
             );
             for j in 0..nb {
-                let below = |_: &Floors, x: &[f64]| if j == 0 { 0.0 } else { x[j - 1] };
+                let below = |x: &[f64]| if j == 0 { 0.0 } else { x[j - 1] };
                 let inv_h = 1.0 / bm.heights[j];
                 let y = [
-                    (s0.u[j] - below(&s0, &s0.u)) * inv_h,
-                    (s1.u[j] - below(&s1, &s1.u)) * inv_h,
+                    (s0.u[j] - below(&s0.u)) * inv_h,
+                    (s1.u[j] - below(&s1.u)) * inv_h,
                 ];
                 let d = [
-                    (s0.v[j] - below(&s0, &s0.v)) * inv_h,
-                    (s1.v[j] - below(&s1, &s1.v)) * inv_h,
+                    (s0.v[j] - below(&s0.v)) * inv_h,
+                    (s1.v[j] - below(&s1.v)) * inv_h,
                 ];
                 // The ground's floor 0 moves with the frame: its relative acceleration is 0.
                 let a = [
-                    (s0.a_rel[j] - below(&s0, &s0.a_rel)) * inv_h,
-                    (s1.a_rel[j] - below(&s1, &s1.a_rel)) * inv_h,
+                    (s0.a_rel[j] - below(&s0.a_rel)) * inv_h,
+                    (s1.a_rel[j] - below(&s1.a_rel)) * inv_h,
                 ];
                 let p = raise(out.peak_drift_ratio, y, d, a);
                 if p > out.peak_drift_ratio {
@@ -532,6 +576,7 @@ impl<'m> RowRun<'m> {
         let m = self.m;
         let n = m.n;
         self.track_buildings(z0, z1, ag, h);
+        self.ends_valid = true;
         let nl = m.levels.len();
         self.e_peak = self.e_peak.max(self.e_initial + z1[2 * n + nl]);
         for (l, (lm, ls)) in m.levels.iter().zip(self.levels.iter_mut()).enumerate() {
@@ -572,9 +617,12 @@ impl<'m> RowRun<'m> {
             if lm.event_value(n, ls.mode, ls.v0, z) <= 0.0 {
                 if ls.mode == Mode::Restitution && lm.ddelta(n, z) > 0.0 {
                     ls.mode = Mode::Approach;
+                    self.ends_valid = false;
                 }
                 continue;
             }
+            // The forces at the end of the last piece were those of the old mode.
+            self.ends_valid = false;
             ls.mode = match ls.mode {
                 Mode::Free => {
                     let (v0, next) = touch(lm.delta(before), lm.ddelta(n, z), ls.v0);
@@ -661,6 +709,7 @@ impl<'m> RowRun<'m> {
             for (lm, ls) in self.m.levels.iter().zip(self.levels.iter_mut()) {
                 if ls.mode == Mode::Restitution && lm.ddelta(n, &self.z) > 0.0 {
                     ls.mode = Mode::Approach;
+                    self.ends_valid = false;
                 }
             }
             h

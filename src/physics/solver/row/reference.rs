@@ -6,7 +6,7 @@
 //! amplitude would ask for needless accuracy), and of each level in contact against the
 //! impact's scales.
 
-use super::{rhs, LevelState, RowModel, RowRun};
+use super::{rhs, LevelModes, RowModel, RowRun};
 use crate::physics::model::{Forcing, Status};
 use crate::physics::row::RowOutput;
 use crate::physics::solver::fast::SUSTAINED;
@@ -18,7 +18,7 @@ use crate::physics::solver::{impact_step, Mode, Segment};
 #[allow(clippy::too_many_arguments)]
 fn dopri(
     m: &RowModel,
-    lv: &[LevelState],
+    lv: &LevelModes,
     seg: &Segment,
     t: f64,
     z: &[f64],
@@ -45,15 +45,14 @@ fn dopri(
             }
         }
     }
-    for (l, (lm, ls)) in m.levels.iter().zip(lv).enumerate() {
+    for (l, (lm, &(mode, v0))) in m.levels.iter().zip(lv).enumerate() {
         let i = 2 * n + l;
         let mut sc = z[i].abs().max(y[i].abs());
-        if ls.mode == Mode::Free {
+        if mode == Mode::Free {
             err = err.max(ev[i].abs() / (rtol * 1e-6 + rtol * sc));
             continue;
         }
         let c = &lm.contact;
-        let v0 = ls.v0;
         sc = sc.max(0.5 * c.m_eff * v0 * v0);
         err = err.max(ev[i].abs() / (rtol * 1e-6 + rtol * sc));
         // Floors: a grazing impact's scales can fall below what f64 resolves in u and v.
@@ -77,6 +76,7 @@ pub(crate) fn run(
     let mut run = RowRun::start(m, z0, forcing.t0);
     let mut steps: u64 = 0;
     let mut h = forcing.dt / 8.0;
+    let mut modes = Vec::with_capacity(m.levels.len());
     for i in 0..forcing.intervals() {
         let seg = Segment::of(forcing, i);
         let mut t = seg.t0;
@@ -98,7 +98,8 @@ pub(crate) fn run(
                     hs = hs.min(impact_step(c, ls.v0, a, o.contact_steps));
                 }
             }
-            let (trial, err) = dopri(m, &run.levels, &seg, t, &z0, hs, o.rtol);
+            run.level_modes(&mut modes);
+            let (trial, err) = dopri(m, &modes, &seg, t, &z0, hs, o.rtol);
             if err.is_nan() || err > 1.0 {
                 let finite = trial.iter().all(|x| x.is_finite());
                 match retry(&seg, t, hs, err, finite) {
@@ -128,8 +129,7 @@ pub(crate) fn run(
                 h = h_touch;
                 continue;
             }
-            let levels = run.levels.clone();
-            let step = |x: f64| dopri(m, &levels, &seg, t, &z0, x, o.rtol).0;
+            let step = |x: f64| dopri(m, &modes, &seg, t, &z0, x, o.rtol).0;
             t += run.accept(&seg, t, hs, trial, 1e-13, 100, step);
             h = hs * (0.9 * err.max(1e-12).powf(-0.2)).min(5.0);
         }
