@@ -33,9 +33,19 @@ pub struct Args {
     /// --target-error`), instead of the default 64 substeps per contact.
     #[arg(long, value_name = "E")]
     target_error: Option<f64>,
+    /// Instead, the multi-storey suite: rows of two buildings of each of these storey counts
+    /// (e.g. 1,3,6,12,20), about `--storey-runs` runs each, on the CPU.
+    #[arg(long, value_delimiter = ',', value_name = "N")]
+    storeys: Option<Vec<usize>>,
+    /// Runs per sweep of the multi-storey suite.
+    #[arg(long, default_value_t = 200)]
+    storey_runs: u64,
 }
 
 pub fn run(a: Args) -> Result<()> {
+    if let Some(storeys) = &a.storeys {
+        return run_storeys(storeys, a.storey_runs, a.output.as_deref());
+    }
     let precision = a.precision.get();
     if let Some(n) = a.sizes.iter().find(|&&n| n == 0 || n > MAX_BENCH_RUNS) {
         bail!("--sizes: {n} runs is out of range: expected 1 to {MAX_BENCH_RUNS}");
@@ -99,6 +109,34 @@ pub fn run(a: Args) -> Result<()> {
     let table = bench::table(&rows);
     write!(std::io::stdout(), "{table}").context("writing to standard output")?;
     if let Some(p) = &a.output {
+        write_file(p, table.as_bytes())?;
+    }
+    Ok(())
+}
+
+/// `--storeys`: the multi-storey suite.
+fn run_storeys(storeys: &[usize], runs: u64, output: Option<&std::path::Path>) -> Result<()> {
+    use pounding::physics::shear::MAX_STOREYS;
+    if let Some(n) = storeys.iter().find(|&&n| n == 0 || n > MAX_STOREYS) {
+        bail!("--storeys: {n} is out of range: expected 1 to {MAX_STOREYS}");
+    }
+    if runs == 0 || runs > MAX_BENCH_RUNS {
+        bail!("--storey-runs: {runs} is out of range: expected 1 to {MAX_BENCH_RUNS}");
+    }
+    check_outputs(&[], &[("-o", output)])?;
+    let mut rows = Vec::new();
+    for &n in storeys {
+        let r = bench::run_storeys(n, &bench::row_plan(n, runs));
+        note!(
+            "{} runs of two {n}-storey buildings on CPU: {:.0} runs/s",
+            r.summary.runs,
+            r.summary.runs_per_second()
+        );
+        rows.push(r);
+    }
+    let table = bench::storey_table(&rows);
+    write!(std::io::stdout(), "{table}").context("writing to standard output")?;
+    if let Some(p) = output {
         write_file(p, table.as_bytes())?;
     }
     Ok(())

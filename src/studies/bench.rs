@@ -1,13 +1,25 @@
 //! `pound bench`: runs per second of the CPU and GPU paths on the same sweeps, with where the
 //! time goes. The sweep is the quickstart physics (nonlinear viscoelastic contact, Ebrahimi
 //! zeta, e = 0.65) on a 20 s synthetic record at dt = 0.01 s, gaps 0..50 mm: most runs pound.
+//! The multi-storey suite ([`row_plan`]) times rows of two N-storey buildings on the CPU.
 
 use crate::engine::aggregate::Aggregator;
 use crate::engine::gpu::{GpuError, GpuTimes};
 use crate::engine::{Engine, Summary};
 use crate::physics::model::RunOutput;
+use crate::plan::row::RowPlan;
 use crate::plan::{Plan, RunSpec};
 use std::time::Instant;
+
+/// The bench's contact (without its gap) and record, as config text: both suites use them.
+const CONTACT: &str = r#"[contact]
+law = "nonlinear_viscoelastic"
+formula = "ebrahimi"
+e = 0.65
+beta_n_per_m1_5 = 2.75e9"#;
+const RECORD: &str = r#"[[record]]
+synthetic = { seed = 1, duration_s = 20.0, dt_s = 0.01, pga_g = 0.35 }
+"#;
 
 /// A sweep of about `n` runs (periods of both buildings x 10 gaps).
 pub fn config(n: u64) -> String {
@@ -25,16 +37,10 @@ mass_kg = 1.0e5
 period_s = {{ from = 0.15, to = 1.5, n = {b} }}
 damping_ratio = 0.05
 
-[contact]
-law = "nonlinear_viscoelastic"
-formula = "ebrahimi"
-e = 0.65
-beta_n_per_m1_5 = 2.75e9
+{CONTACT}
 gap_m = {{ from = 0.0, to = 0.05, n = 10 }}
 
-[[record]]
-synthetic = {{ seed = 1, duration_s = 20.0, dt_s = 0.01, pga_g = 0.35 }}
-"#
+{RECORD}"#
     )
 }
 
@@ -224,6 +230,106 @@ pub fn table(rows: &[Row]) -> String {
             r.handed_off,
             r.csv,
             r.impacts
+        ));
+    }
+    s
+}
+
+/// The multi-storey suite's sweep: two `storeys`-storey shear buildings (3 m storeys, 3e5 kg
+/// floors, uniform stiffness, Rayleigh 5 %), the left one's period swept, 10 gaps from 0 to
+/// 45 mm, the bench's record and contact: about `n` runs.
+pub fn row_config(storeys: usize, n: u64) -> String {
+    let periods = (n as f64 / 10.0).ceil().max(1.0) as u64;
+    let t = 0.1 * storeys as f64;
+    format!(
+        r#"[[building]]
+storeys = {storeys}
+storey_height_m = 3.0
+mass_kg = 3.0e5
+period_s = {{ from = {a}, to = {b}, n = {periods} }}
+damping_ratio = 0.05
+
+[[building]]
+storeys = {storeys}
+storey_height_m = 3.0
+mass_kg = 3.0e5
+period_s = {c}
+damping_ratio = 0.05
+
+{CONTACT}
+gap_m = {{ from = 0.0, to = 0.045, n = 10 }}
+
+{RECORD}"#,
+        a = t + 0.05,
+        b = if periods > 1 { 2.0 * t + 0.1 } else { t + 0.05 },
+        c = 1.5 * t + 0.1,
+    )
+}
+
+/// The multi-storey suite's plan of two `storeys`-storey buildings, about `n` runs.
+pub fn row_plan(storeys: usize, n: u64) -> RowPlan {
+    crate::plan::row::parse_row(
+        &row_config(storeys, n),
+        std::path::Path::new("bench-rows.toml"),
+        std::path::Path::new("."),
+        std::path::Path::new("."),
+    )
+    .expect("row bench config is valid")
+}
+
+/// One measured multi-storey sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StoreyRow {
+    pub storeys: usize,
+    pub summary: Summary,
+    /// Formatting the rows as CSV, s (inside `summary.seconds`).
+    pub csv: f64,
+}
+
+/// Every run of the row plan on the CPU (the current pool), rows formatted as CSV.
+pub fn run_storeys(storeys: usize, plan: &RowPlan) -> StoreyRow {
+    let mut csv = 0.0;
+    let summary = crate::engine::cpu::run_rows(
+        plan,
+        0..plan.len(),
+        crate::engine::CPU_CHUNK,
+        |rows| -> Result<(), std::convert::Infallible> {
+            let t = Instant::now();
+            let cells: Vec<Vec<String>> = rows.iter().map(|(s, o)| plan.cells(s, o)).collect();
+            std::hint::black_box(crate::io::csv::encode_rows(&cells));
+            csv += t.elapsed().as_secs_f64();
+            Ok(())
+        },
+        |_| {},
+    )
+    .unwrap_or_else(|e| match e {});
+    StoreyRow {
+        storeys,
+        summary,
+        csv,
+    }
+}
+
+/// A markdown table of the multi-storey suite.
+pub fn storey_table(rows: &[StoreyRow]) -> String {
+    let mut s = String::from(
+        "| storeys per building | runs | backend | total s | runs/s | storeys x runs/s | free steps/s | RK4 substeps/s | csv s | impacts |\n|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        let m = &r.summary;
+        let per_s = |x: u64| x as f64 / m.seconds.max(1e-12);
+        s.push_str(&format!(
+            "| {} | {} | cpu ({} threads) | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} |\n",
+            r.storeys,
+            m.runs,
+            rayon::current_num_threads(),
+            m.seconds,
+            m.runs_per_second(),
+            2.0 * r.storeys as f64 * m.runs_per_second(),
+            per_s(m.free_steps),
+            per_s(m.substeps),
+            r.csv,
+            m.impacts
         ));
     }
     s

@@ -677,3 +677,26 @@ fn example_row_configs_load() {
         assert_eq!(plan.row(&plan.run(0)).levels.len(), levels, "{file}");
     }
 }
+
+/// `pound bench --storeys`: one line per storey count with every run of its sweep counted, and a
+/// storey count out of range refused.
+#[test]
+fn bench_storeys_suite_times_each_storey_count() {
+    let table = crate::support::ok(&crate::support::pound(&[
+        "bench",
+        "--storeys",
+        "1,4",
+        "--storey-runs",
+        "20",
+    ]));
+    let lines: Vec<&str> = table.lines().filter(|l| l.contains("cpu (")).collect();
+    assert_eq!(lines.len(), 2, "{table}");
+    for (line, n) in lines.iter().zip(["1", "4"]) {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        assert_eq!((cells[1], cells[2]), (n, "20"), "{line}");
+        assert!(cells[5].parse::<f64>().unwrap() > 0.0, "{line}");
+    }
+    let bad = crate::support::pound(&["bench", "--storeys", "0"]);
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--storeys: 0"));
+}
