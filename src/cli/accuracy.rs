@@ -77,6 +77,26 @@ pub fn run(a: Args) -> Result<()> {
         &config_inputs(&config, &records),
         &[("-o", Some(&output)), ("--plot", plot.as_deref())],
     )?;
+    if pounding::plan::row::is_row_config(&text) {
+        // Rows: the CPU paths only, as a table and CSV.
+        if !choices.is_empty() || plot.is_some() || backend.get() == pounding::engine::Backend::Gpu
+        {
+            bail!("--target-error, --plot and --backend gpu are not available for rows of multi-storey buildings ([[building]] configs) yet");
+        }
+        let plan = config::load_row_text(&text, &config)?;
+        note!(
+            "{}: {} runs of a row; reference at tol {tol:e}, then {} settings on the CPU",
+            config.display(),
+            plan.len(),
+            settings.len()
+        );
+        say!("{}", accuracy::ROW_MARKDOWN_HEADER);
+        let points = accuracy::row_study(&plan, &settings, tol, |p| {
+            let _ = writeln!(std::io::stdout(), "{}", accuracy::row_markdown(p));
+        });
+        write_file(&output, accuracy::row_csv(&points).as_bytes())?;
+        return Ok(());
+    }
     let plan = config::load_text(&text, &config)?;
     for w in plan.warnings() {
         note!("warning: {}: {w}", config.display());

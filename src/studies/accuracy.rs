@@ -256,3 +256,152 @@ pub fn markdown_row(p: &Point) -> String {
         100.0 * p.errors.impact_count_differs
     )
 }
+
+/// A row sweep's outputs at one setting (the multi-storey work-precision table).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RowPoint {
+    /// `reference` or `cpu-fast-f64`.
+    pub path: String,
+    pub substeps_per_contact: f64,
+    pub runs_per_second: f64,
+    /// Median and p99 relative errors against the reference, over the runs both end `ok` with
+    /// equal impact counts: peak force (runs that pound), and each building's peak roof
+    /// displacement, drift ratio and absolute floor acceleration.
+    pub force: [f64; 2],
+    pub roof: [f64; 2],
+    pub drift: [f64; 2],
+    pub accel: [f64; 2],
+    pub impact_count_differs: f64,
+    pub failed: u64,
+    /// |energy residual|, median and p99, over the runs that end `ok`.
+    pub residual: [f64; 2],
+}
+
+/// The columns of [`row_markdown`].
+pub const ROW_MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | force med | force p99 | roof med | roof p99 | drift med | drift p99 | accel med | accel p99 | impacts differ | failed | residual med | residual p99 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
+
+impl RowPoint {
+    /// The numbers of a table line and a CSV line, in column order after the path.
+    fn numbers(&self) -> [f64; 14] {
+        [
+            self.substeps_per_contact,
+            self.runs_per_second,
+            self.force[0],
+            self.force[1],
+            self.roof[0],
+            self.roof[1],
+            self.drift[0],
+            self.drift[1],
+            self.accel[0],
+            self.accel[1],
+            self.impact_count_differs,
+            self.failed as f64,
+            self.residual[0],
+            self.residual[1],
+        ]
+    }
+}
+
+/// One line of the multi-storey work-precision table.
+pub fn row_markdown(p: &RowPoint) -> String {
+    let cells: Vec<String> = p
+        .numbers()
+        .iter()
+        .enumerate()
+        .map(|(i, x)| match i {
+            0 | 11 => format!("{x}"),
+            1 => format!("{x:.0}"),
+            10 => format!("{:.2} %", 100.0 * x),
+            _ => format!("{x:.1e}"),
+        })
+        .collect();
+    format!("| {} | {} |", p.path, cells.join(" | "))
+}
+
+/// The multi-storey work-precision study: the row sweep `plan` by the reference at `tol`, then
+/// by the fast scheme (CPU, energy balance on) at each setting, on the current rayon pool;
+/// `each` gets every point as it is measured.
+pub fn row_study(
+    plan: &crate::plan::row::RowPlan,
+    settings: &[f64],
+    tol: f64,
+    mut each: impl FnMut(&RowPoint),
+) -> Vec<RowPoint> {
+    use crate::physics::row::RowOutput;
+    let solve = |scheme: Scheme| -> (Vec<RowOutput>, f64) {
+        let mut p = plan.clone();
+        p.base.spec.scheme = scheme;
+        let mut outs = Vec::with_capacity(plan.len() as usize);
+        let s = crate::engine::cpu::run_rows(
+            &p,
+            0..p.len(),
+            crate::engine::CPU_CHUNK,
+            |rows| -> Result<(), std::convert::Infallible> {
+                outs.extend(rows.iter().map(|(_, o)| o.clone()));
+                Ok(())
+            },
+            |_| {},
+        )
+        .unwrap_or_else(|e| match e {});
+        (outs, s.runs_per_second())
+    };
+    let med_p99 = |mut v: Vec<f64>| [quantile(&mut v, 0.5), quantile(&mut v, 0.99)];
+    let point = |path: &str, setting: f64, rate: f64, truth: &[RowOutput], out: &[RowOutput]| {
+        let (mut f, mut u, mut d, mut a, mut r) = (vec![], vec![], vec![], vec![], vec![]);
+        let (mut differ, mut failed) = (0usize, 0u64);
+        for (t, o) in truth.iter().zip(out) {
+            if o.status != Status::Ok {
+                failed += 1;
+                continue;
+            }
+            r.extend(o.energy.map(|e| e.residual.abs()));
+            if t.status != Status::Ok || t.impacts != o.impacts {
+                differ += (t.impacts != o.impacts) as usize;
+                continue;
+            }
+            if t.impacts > 0 {
+                f.push(rel(o.peak_force, t.peak_force));
+            }
+            for (bt, bo) in t.buildings.iter().zip(&o.buildings) {
+                u.push(rel(bo.peak_roof, bt.peak_roof));
+                d.push(rel(bo.peak_drift_ratio, bt.peak_drift_ratio));
+                a.push(rel(bo.peak_accel, bt.peak_accel));
+            }
+        }
+        RowPoint {
+            path: path.into(),
+            substeps_per_contact: setting,
+            runs_per_second: rate,
+            force: med_p99(f),
+            roof: med_p99(u),
+            drift: med_p99(d),
+            accel: med_p99(a),
+            impact_count_differs: differ as f64 / truth.len().max(1) as f64,
+            failed,
+            residual: med_p99(r),
+        }
+    };
+    let (truth, rate) = solve(Scheme::Reference(ReferenceOptions::with_tol(tol)));
+    let mut points = vec![point("reference", 0.0, rate, &truth, &truth)];
+    each(&points[0]);
+    for &s in settings {
+        let (out, rate) = solve(Scheme::Fast(FastOptions {
+            substeps_per_contact: s,
+            energy: true,
+            ..FastOptions::default()
+        }));
+        points.push(point("cpu-fast-f64", s, rate, &truth, &out));
+        each(points.last().expect("pushed"));
+    }
+    points
+}
+
+/// The multi-storey study's points as CSV.
+pub fn row_csv(points: &[RowPoint]) -> String {
+    let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99\n");
+    for p in points {
+        let cells: Vec<String> = p.numbers().iter().map(f64::to_string).collect();
+        s.push_str(&format!("{},{}\n", p.path, cells.join(",")));
+    }
+    s
+}

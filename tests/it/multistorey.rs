@@ -700,3 +700,48 @@ fn bench_storeys_suite_times_each_storey_count() {
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--storeys: 0"));
 }
+
+/// `pound accuracy` on a row config: the reference, then the fast scheme at each setting, as a
+/// table and CSV; the fast scheme's errors fall with the setting and stay within what the
+/// hard-case test measures at 64.
+#[test]
+fn accuracy_of_a_row_config() {
+    let dir = crate::support::tempdir();
+    let cfg = dir.path().join("row.toml");
+    let text = ROW_CONFIG
+        .replace("mass_kg = [2e5, 3e5]", "mass_kg = 2e5")
+        .replace("duration_s = 5.0", "duration_s = 3.0");
+    std::fs::write(&cfg, text).unwrap();
+    let out = dir.path().join("acc.csv");
+    let table = crate::support::ok(&crate::support::pound(&[
+        "accuracy",
+        cfg.to_str().unwrap(),
+        "--settings",
+        "8,64",
+        "-o",
+        out.to_str().unwrap(),
+    ]));
+    let rows: Vec<Vec<String>> = csv::Reader::from_path(&out)
+        .unwrap()
+        .records()
+        .map(|r| r.unwrap().iter().map(String::from).collect())
+        .collect();
+    assert_eq!(rows.len(), 3, "{table}");
+    assert_eq!(rows[0][0], "reference");
+    let p99 = |r: &[String], col: usize| r[col].parse::<f64>().unwrap();
+    // Columns: force p99 (4), roof p99 (6), drift p99 (8).
+    for col in [4, 6, 8] {
+        assert!(
+            p99(&rows[2], col) <= p99(&rows[1], col),
+            "column {col}: {table}"
+        );
+        assert!(p99(&rows[2], col) < 3e-3, "column {col}: {table}");
+    }
+    assert_eq!(
+        table
+            .lines()
+            .filter(|l| l.starts_with("| cpu-fast-f64"))
+            .count(),
+        2
+    );
+}

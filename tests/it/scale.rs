@@ -218,9 +218,14 @@ fn resume_refuses_a_different_sweep() {
     let d = tempdir();
     let cfg = setup(d.path());
     let out = d.path().join("r.csv");
-    // Leave an unfinished output: kill the sweep early.
+    // Leave an unfinished output: kill the sweep once its journal holds a chunk (waiting for
+    // it rather than a fixed time, which a loaded machine can outlast before the first chunk).
     let mut child = spawn(&cfg, &out, &["--chunk", "1"]);
-    std::thread::sleep(Duration::from_millis(150));
+    let journal = d.path().join("r.csv.progress.toml");
+    let start = std::time::Instant::now();
+    while !journal.exists() && start.elapsed() < Duration::from_secs(30) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(d.path().join("r.csv.progress.toml").exists() && !out.exists());
