@@ -12,34 +12,9 @@
 // lavapipe's f64 pow/exp/sin are wrong, so every transcendental coefficient comes precomputed in
 // `Params`, and the one fifth root is an f32 seed refined by Newton steps in `real`.
 
-// Params, State, Meta, Counters and the MODE_/STATUS_ codes are in types.wgsl.
+// Params, State, Meta, Counters, Dispatch, Tally, Seg and the MODE_/STATUS_ codes are in
+// types.wgsl; the contact laws in contact.wgsl; Hermite interpolation in hermite.wgsl.
 // Keep in sync with src/engine/gpu/layout.rs (the layout test checks sizes and offsets).
-struct Dispatch {
-    budget: u32,
-    nactive: u32,
-    max_substeps_per_step: u32,
-    max_substeps: u32,
-    handoff_substeps_per_step: u32,
-    _pad1: u32,
-    _pad2: u32,
-    _pad3: u32,
-}
-
-// Law codes (keep in sync with LawKind::ALL order).
-const LAW_LINEAR: u32 = 0u;
-const LAW_KELVIN_VOIGT: u32 = 1u;
-const LAW_KELVIN_VOIGT_NO_TENSION: u32 = 2u;
-const LAW_MODIFIED_LINEAR: u32 = 3u;
-const LAW_HERTZ: u32 = 4u;
-const LAW_NONLINEAR_VISCOELASTIC: u32 = 5u;
-// 6..9: the Hunt-Crossley family.
-// contact::HC_V0_MIN, contact::HERTZ floor on v, fast::MAX_PIECES_PER_SUBSTEP, fast::SUSTAINED.
-const HC_V0_MIN: real = 1e-3;
-const V_MIN: real = 1e-6;
-const MAX_PIECES_PER_SUBSTEP: u32 = 64u;
-const SUSTAINED: real = 2.0;
-const LOCATE_TOL: real = 1e-9;
-const LOCATE_ITER: u32 = 16u;
 
 @group(0) @binding(0) var<uniform> disp: Dispatch;
 @group(0) @binding(1) var<storage, read> params: array<Params>;
@@ -47,17 +22,6 @@ const LOCATE_ITER: u32 = 16u;
 @group(0) @binding(3) var<storage, read> records: array<real>;
 @group(0) @binding(4) var<storage, read_write> states: array<State>;
 @group(0) @binding(5) var<storage, read_write> counters: array<Counters>;
-// Runs still integrating after this dispatch: their count, and their indices (in any order)
-// for the next dispatch, which then launches only those. Packing the unfinished runs together
-// keeps lanes busy: runs that pound for long are rare and spread over every workgroup.
-// With them, the lane tally of the dispatch: loop trips that did work, summed over lanes, and
-// the trips the lanes were held for (each workgroup's longest lane times WG). Their ratio is
-// the lane utilisation.
-struct Tally {
-    active_runs: atomic<u32>,
-    lane_units: atomic<u32>,
-    lane_slots: atomic<u32>,
-}
 @group(0) @binding(6) var<storage, read_write> tally: Tally;
 @group(0) @binding(7) var<storage, read> run_ids: array<u32>;
 @group(0) @binding(8) var<storage, read_write> next_ids: array<u32>;
@@ -82,8 +46,6 @@ var<private> R: u32;
 // cpu::State: [u1, v1, u2, v2, w, e_in, e_damp]
 struct Z { u1: real, v1: real, u2: real, v2: real, w: real, ein: real, ed: real }
 
-struct Seg { a0: real, a1: real, dt: real }
-
 fn sample(i: u32) -> real {
     if (i < M.rec_len) {
         return records[M.rec_offset + i] * P.scale;
@@ -91,88 +53,9 @@ fn sample(i: u32) -> real {
     return 0.0;
 }
 
-fn is_hertzian() -> bool {
-    return M.law >= LAW_HERTZ;
-}
-
-fn is_hunt_crossley() -> bool {
-    return M.law > LAW_NONLINEAR_VISCOELASTIC;
-}
-
-// ---- contact.rs ----
-
-fn chi(v0: real) -> real {
-    return P.damping / max(v0, HC_V0_MIN);
-}
-
-fn contact_force(d: real, dd: real, v0: real, approaching: bool) -> real {
-    let k = P.stiffness;
-    let c = P.damping;
-    switch M.law {
-        case LAW_LINEAR: { return k * d; }
-        case LAW_KELVIN_VOIGT, LAW_KELVIN_VOIGT_NO_TENSION: { return k * d + c * dd; }
-        case LAW_MODIFIED_LINEAR: {
-            var f = k * d;
-            if (approaching) { f = f + c * dd; }
-            return f;
-        }
-        case LAW_HERTZ: { return k * d * sqrt(abs(d)); }
-        case LAW_NONLINEAR_VISCOELASTIC: {
-            let r = sqrt(abs(d));
-            var f = k * d * r;
-            if (approaching) { f = f + c * sqrt(r) * dd; }
-            return f;
-        }
-        default: { return k * d * sqrt(abs(d)) * (1.0 + chi(v0) * dd); }
-    }
-}
-
-fn gauge(d: real, dd: real, v0: real) -> real {
-    if (M.law == LAW_KELVIN_VOIGT_NO_TENSION) {
-        return d + min(P.damping / P.stiffness * dd, 0.0);
-    }
-    if (is_hunt_crossley() && d > 0.0) {
-        return d * min(1.0 + chi(v0) * dd, 1.0);
-    }
-    return d;
-}
-
-fn local_rate(delta: real, v0: real) -> real {
-    let d = max(delta, 0.0);
-    let k = P.stiffness;
-    let c = P.damping;
-    var kl = k;
-    var cl: real = 0.0;
-    switch M.law {
-        case LAW_LINEAR: {}
-        case LAW_KELVIN_VOIGT, LAW_KELVIN_VOIGT_NO_TENSION, LAW_MODIFIED_LINEAR: { cl = c; }
-        case LAW_HERTZ: { kl = 1.5 * k * sqrt(d); }
-        case LAW_NONLINEAR_VISCOELASTIC: { kl = 1.5 * k * sqrt(d); cl = c * sqrt(sqrt(d)); }
-        default: { kl = 1.5 * k * sqrt(d); cl = k * d * sqrt(d) * chi(v0); }
-    }
-    return sqrt(kl / P.m_eff) + cl / P.m_eff;
-}
-
-// Two Newton steps, unrolled (every loop iteration counts against lavapipe's limiter).
 // model.rs Pair::structural_rate: the faster oscillator's sqrt(k/m) + c/m.
 fn structural_rate() -> real {
     return max(sqrt(P.k1 / P.m1) + P.c1 / P.m1, sqrt(P.k2 / P.m2) + P.c2 / P.m2);
-}
-
-fn inv_fifth_root(v: real) -> real {
-    var y = real(pow(f32(v), -0.2));
-    var y2 = y * y;
-    y = y * (6.0 - v * (y2 * y2 * y)) / 5.0;
-    y2 = y * y;
-    y = y * (6.0 - v * (y2 * y2 * y)) / 5.0;
-    return y;
-}
-
-fn duration_estimate(v: real) -> real {
-    if (is_hertzian()) {
-        return P.tc_coef * inv_fifth_root(max(v, V_MIN));
-    }
-    return P.tc_coef;
 }
 
 // ---- cpu/mod.rs ----
@@ -208,15 +91,6 @@ fn rhs(mode: u32, v0: real, ag: real, z: Z, r1: real, r2: real) -> Z {
 
 fn structural_rel_accel(z: Z) -> real {
     return -(P.c1 * z.v1 + P.k1 * z.u1) / P.m1 + (P.c2 * z.v2 + P.k2 * z.u2) / P.m2;
-}
-
-fn impact_step(v: real, a: real) -> real {
-    let tc = duration_estimate(v);
-    var t = tc;
-    if (a != 0.0) {
-        t = min(tc, max(2.0 * v / abs(a), tc / 16.0));
-    }
-    return t / (P.substeps_per_contact * (1.0 + 2.0 * P.damping_ratio));
 }
 
 fn event_value(mode: u32, v0: real, z: Z) -> real {
@@ -304,142 +178,11 @@ fn locate(h: real, f0: real, z1: Z, f1: real, tol: real,
     return Located(b, zb);
 }
 
-// Fraction of the step at the maximum of delta's Hermite cubic if it rises above 0 inside; -1 if not.
+// events::hidden_touch: where delta's Hermite cubic rises above 0 inside the step (-1: nowhere).
 fn hidden_touch(z0: Z, z1: Z, h: real) -> real {
-    let y0 = delta(z0);
-    let d0 = ddelta(z0);
-    let y1 = delta(z1);
-    let d1 = ddelta(z1);
-    if (y1 > 0.0 || (d0 <= 0.0 && d1 >= 0.0)) {
-        return -1.0;
-    }
-    let m0 = h * d0;
-    let m1 = h * d1;
-    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
-    let c = 2.0 * (y0 - y1) + m0 + m1;
-    let qa = 3.0 * c;
-    let qb = 2.0 * b;
-    let qc = m0;
-    var best_v: real = 0.0;
-    var best_s: real = -1.0;
-    let disc = qb * qb - 4.0 * qa * qc;
-    if (abs(qa) > TINY && disc >= 0.0) {
-        let r = sqrt(disc);
-        // Both roots, unrolled.
-        let s1 = (-qb + r) / (2.0 * qa);
-        if (s1 > 0.0 && s1 < 1.0) {
-            let v = y0 + s1 * (m0 + s1 * (b + s1 * c));
-            if (v > 0.0) {
-                best_v = v;
-                best_s = s1;
-            }
-        }
-        let s2 = (-qb - r) / (2.0 * qa);
-        if (s2 > 0.0 && s2 < 1.0) {
-            let v = y0 + s2 * (m0 + s2 * (b + s2 * c));
-            if (v > 0.0 && (best_s < 0.0 || v > best_v)) {
-                best_v = v;
-                best_s = s2;
-            }
-        }
-    }
-    return best_s;
+    return hidden_rise(delta(z0), ddelta(z0), delta(z1), ddelta(z1), h);
 }
 
-struct Range { lo: real, hi: real }
-
-fn hermite_eval(y0: real, m0: real, b: real, c: real, s: real) -> real {
-    return y0 + s * (m0 + s * (b + s * c));
-}
-
-fn range_check(r: Range, y0: real, m0: real, b: real, c: real, s: real) -> Range {
-    var o = r;
-    if (s > 0.0 && s < 1.0) {
-        let v = hermite_eval(y0, m0, b, c, s);
-        o.lo = min(o.lo, v);
-        o.hi = max(o.hi, v);
-    }
-    return o;
-}
-
-fn hermite_range(y0: real, d0: real, y1: real, d1: real, h: real) -> Range {
-    let m0 = h * d0;
-    let m1 = h * d1;
-    let b = 3.0 * (y1 - y0) - 2.0 * m0 - m1;
-    let c = 2.0 * (y0 - y1) + m0 + m1;
-    var r = Range(min(y0, y1), max(y0, y1));
-    let ex = hermite_extrema(m0, b, c);
-    r = range_check(r, y0, m0, b, c, ex[0]);
-    r = range_check(r, y0, m0, b, c, ex[1]);
-    return r;
-}
-
-// cpu::hermite_extrema: roots of m0 + 2 b s + 3 c s^2 by the stable formula, -1 where none.
-fn hermite_extrema(m0: real, b: real, c: real) -> array<real, 2> {
-    let qa = 3.0 * c;
-    let qb = 2.0 * b;
-    let qc = m0;
-    if (abs(qa) < TINY) {
-        if (qb != 0.0) {
-            return array<real, 2>(-qc / qb, -1.0);
-        }
-    } else {
-        let disc = qb * qb - 4.0 * qa * qc;
-        if (disc >= 0.0) {
-            // Rust's signum: +1 for +0.
-            var sg: real = 1.0;
-            if (qb < 0.0) { sg = -1.0; }
-            let q = -0.5 * (qb + sg * sqrt(disc));
-            if (q != 0.0) {
-                return array<real, 2>(q / qa, qc / q);
-            }
-        }
-    }
-    return array<real, 2>(-1.0, -1.0);
-}
-
-// cpu::quintic_peak_abs: largest |y| over [0, h] of the quintic Hermite through (y, y', y'')
-// at both ends; each cubic extremum inside the step refined by three Newton steps.
-fn quintic_peak_abs(y0: real, y1: real, d0: real, d1: real, a0: real, a1: real, h: real) -> real {
-    let m0 = h * d0;
-    let m1 = h * d1;
-    let q0 = h * h * a0;
-    let q1 = h * h * a1;
-    let dy = y1 - y0;
-    let c2 = 0.5 * q0;
-    let c3 = 10.0 * dy - 6.0 * m0 - 4.0 * m1 - 1.5 * q0 + 0.5 * q1;
-    let c4 = -15.0 * dy + 8.0 * m0 + 7.0 * m1 + 1.5 * q0 - q1;
-    let c5 = 6.0 * dy - 3.0 * m0 - 3.0 * m1 - 0.5 * q0 + 0.5 * q1;
-    var peak = max(abs(y0), abs(y1));
-    let b = 3.0 * dy - 2.0 * m0 - m1;
-    let c = -2.0 * dy + m0 + m1;
-    var roots = hermite_extrema(m0, b, c);
-    // Unrolled: two candidates, three Newton steps each (no long loops on lavapipe).
-    for (var k = 0u; k < 2u; k = k + 1u) {
-        let s0 = roots[k];
-        if (s0 > 0.0 && s0 < 1.0) {
-            var s = s0;
-            for (var it = 0u; it < 3u; it = it + 1u) {
-                let g1 = m0 + s * (2.0 * c2 + s * (3.0 * c3 + s * (4.0 * c4 + s * 5.0 * c5)));
-                let g2 = 2.0 * c2 + s * (6.0 * c3 + s * (12.0 * c4 + s * 20.0 * c5));
-                if (g2 != 0.0) {
-                    s = clamp(s - g1 / g2, 0.0, 1.0);
-                }
-            }
-            let v = y0 + s * (m0 + s * (c2 + s * (c3 + s * (c4 + s * c5))));
-            peak = max(peak, abs(v));
-        }
-    }
-    return peak;
-}
-
-fn fourth_derivative_bound(m: real, k: real, c: real, u: real, v: real, seg: Seg) -> real {
-    let w2 = k / m;
-    let cm = c / m;
-    let a2 = w2 * u + cm * v + max(abs(seg.a0), abs(seg.a1));
-    let a3 = w2 * v + cm * a2 + abs((seg.a1 - seg.a0) / seg.dt);
-    return w2 * a2 + cm * a3;
-}
 
 fn may_touch(seg: Seg, z0: Z, z1: Z, h: real, v0: real) -> bool {
     let d0 = delta(z0);
@@ -472,16 +215,7 @@ fn force_sample(t: real, f: real) {
         let y0 = S.h_f0;
         let x1 = S.h_t1;
         let y1 = S.h_f1;
-        if (y1 >= y0 && y1 >= f && x1 > x0 && t > x1) {
-            let d1 = (y1 - y0) / (x1 - x0);
-            let d2 = (f - y1) / (t - x1);
-            let a = (d2 - d1) / (t - x0);
-            if (a < 0.0) {
-                let xv = clamp(0.5 * (x0 + x1) - 0.5 * d1 / a, x0, t);
-                let yv = y0 + d1 * (xv - x0) + a * (xv - x0) * (xv - x1);
-                S.imp_peak = max(S.imp_peak, yv);
-            }
-        }
+        S.imp_peak = max(S.imp_peak, parabola_peak(x0, y0, x1, y1, t, f));
         S.h_t0 = x1;
         S.h_f0 = y1;
         S.h_t1 = t;
@@ -737,7 +471,7 @@ fn begin_interval(seg: Seg) {
         // fast.rs: a contact that has lasted SUSTAINED contact durations needs only h_rate.
         var h0 = h_rate;
         if (!(C.mode != MODE_FREE && since_onset(0.0) > SUSTAINED * duration_estimate(S.v0))) {
-            h0 = min(impact_step(v_est, a_est), h_rate);
+            h0 = min(impact_step(v_est, a_est, P.substeps_per_contact), h_rate);
         }
         let mf = max(ceil(dt / h0), 1.0);
         if (!(mf <= real(disp.max_substeps_per_step))) {
@@ -800,24 +534,6 @@ fn piece(seg: Seg) {
     }
 }
 
-var<workgroup> longest_lane: atomic<u32>;
-
-@compute @workgroup_size(WG)
-fn main(
-    @builtin(global_invocation_id) gid: vec3<u32>,
-    @builtin(local_invocation_index) lid: u32,
-) {
-    let units = integrate_run(gid.x);
-    if (units > 0u) {
-        atomicAdd(&tally.lane_units, units);
-        atomicMax(&longest_lane, units);
-    }
-    workgroupBarrier();
-    if (lid == 0u) {
-        atomicAdd(&tally.lane_slots, atomicLoad(&longest_lane) * WG);
-    }
-}
-
 // One lane's work in a dispatch: at most disp.budget units of run run_ids[lane]; returns the
 // units it did.
 fn integrate_run(lane: u32) -> u32 {
@@ -832,6 +548,7 @@ fn integrate_run(lane: u32) -> u32 {
         return 0u;
     }
     P = params[r];
+    K = Law(M.law, P.stiffness, P.damping, P.damping_ratio, P.m_eff, P.tc_coef);
     S = states[r];
     ZS = Z(S.u1, S.v1, S.u2, S.v2, S.w, S.e_in, S.e_damp);
     var budget = disp.budget;

@@ -65,3 +65,38 @@ const STATUS_OK: u32 = 0u;
 const STATUS_NON_FINITE: u32 = 1u;
 const STATUS_STEP_LIMIT: u32 = 2u;
 const STATUS_HANDOFF: u32 = 3u;
+
+// The uniform of a fast or row dispatch (layout::Dispatch).
+struct Dispatch {
+    budget: u32,
+    nactive: u32,
+    max_substeps_per_step: u32,
+    max_substeps: u32,
+    handoff_substeps_per_step: u32,
+    _pad1: u32,
+    _pad2: u32,
+    _pad3: u32,
+}
+
+// Runs still integrating after this dispatch: their count, and their indices (in any order)
+// for the next dispatch, which then launches only those. Packing the unfinished runs together
+// keeps lanes busy: runs that pound for long are rare and spread over every workgroup.
+// With them, the lane tally of the dispatch: loop trips that did work, summed over lanes, and
+// the trips the lanes were held for (each workgroup's longest lane times WG). Their ratio is
+// the lane utilisation.
+struct Tally {
+    active_runs: atomic<u32>,
+    lane_units: atomic<u32>,
+    lane_slots: atomic<u32>,
+}
+
+// A record interval: ground accelerations at its ends and its length.
+struct Seg { a0: real, a1: real, dt: real }
+
+// Settings of the fast scheme both integrating stages share (fast.wgsl, row.wgsl):
+// fast::MAX_PIECES_PER_SUBSTEP, fast::SUSTAINED, and the event location's tolerance and
+// iterations.
+const MAX_PIECES_PER_SUBSTEP: u32 = 64u;
+const SUSTAINED: real = 2.0;
+const LOCATE_TOL: real = 1e-9;
+const LOCATE_ITER: u32 = 16u;

@@ -34,17 +34,27 @@ pub struct Args {
     #[arg(long, value_name = "E")]
     target_error: Option<f64>,
     /// Instead, the multi-storey suite: rows of two buildings of each of these storey counts
-    /// (e.g. 1,3,6,12,20), about `--storey-runs` runs each, on the CPU.
+    /// (e.g. 1,3,6,12,20), about `--storey-runs` runs each on the CPU and `--storey-gpu-runs`
+    /// on a hardware GPU if one is found (in `--precision`).
     #[arg(long, value_delimiter = ',', value_name = "N")]
     storeys: Option<Vec<usize>>,
     /// Runs per sweep of the multi-storey suite.
     #[arg(long, default_value_t = 200)]
     storey_runs: u64,
+    /// Runs per GPU sweep of the multi-storey suite (default: `--storey-runs`).
+    #[arg(long)]
+    storey_gpu_runs: Option<u64>,
 }
 
 pub fn run(a: Args) -> Result<()> {
     if let Some(storeys) = &a.storeys {
-        return run_storeys(storeys, a.storey_runs, a.output.as_deref());
+        let gpu_runs = a.storey_gpu_runs.unwrap_or(a.storey_runs);
+        return run_storeys(
+            storeys,
+            (a.storey_runs, gpu_runs),
+            a.precision.get(),
+            a.output.as_deref(),
+        );
     }
     let precision = a.precision.get();
     if let Some(n) = a.sizes.iter().find(|&&n| n == 0 || n > MAX_BENCH_RUNS) {
@@ -115,15 +125,28 @@ pub fn run(a: Args) -> Result<()> {
 }
 
 /// `--storeys`: the multi-storey suite.
-fn run_storeys(storeys: &[usize], runs: u64, output: Option<&std::path::Path>) -> Result<()> {
+fn run_storeys(
+    storeys: &[usize],
+    (runs, gpu_runs): (u64, u64),
+    precision: pounding::engine::gpu::Precision,
+    output: Option<&std::path::Path>,
+) -> Result<()> {
     use pounding::physics::shear::MAX_STOREYS;
     if let Some(n) = storeys.iter().find(|&&n| n == 0 || n > MAX_STOREYS) {
         bail!("--storeys: {n} is out of range: expected 1 to {MAX_STOREYS}");
     }
-    if runs == 0 || runs > MAX_BENCH_RUNS {
-        bail!("--storey-runs: {runs} is out of range: expected 1 to {MAX_BENCH_RUNS}");
+    for (flag, n) in [("--storey-runs", runs), ("--storey-gpu-runs", gpu_runs)] {
+        if n == 0 || n > MAX_BENCH_RUNS {
+            bail!("{flag}: {n} is out of range: expected 1 to {MAX_BENCH_RUNS}");
+        }
     }
     check_outputs(&[], &[("-o", output)])?;
+    // A software adapter runs the row kernel far slower than the CPU path: hardware only.
+    let ctx = Backend::Auto.acquire("rows on the CPU only", &mut |l| note!("{l}"))?;
+    let opts = GpuOptions {
+        precision,
+        ..Default::default()
+    };
     let mut rows = Vec::new();
     for &n in storeys {
         let r = bench::run_storeys(n, &bench::row_plan(n, runs));
@@ -133,6 +156,15 @@ fn run_storeys(storeys: &[usize], runs: u64, output: Option<&std::path::Path>) -
             r.summary.runs_per_second()
         );
         rows.push(r);
+        if let Some(ctx) = &ctx {
+            let r = bench::run_storeys_gpu(n, &bench::row_plan(n, gpu_runs), ctx, &opts)?;
+            note!(
+                "{} runs of two {n}-storey buildings on GPU: {:.0} runs/s",
+                r.summary.runs,
+                r.summary.runs_per_second()
+            );
+            rows.push(r);
+        }
     }
     let table = bench::storey_table(&rows);
     write!(std::io::stdout(), "{table}").context("writing to standard output")?;

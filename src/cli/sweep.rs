@@ -178,14 +178,32 @@ pub fn run(a: Args) -> Result<()> {
             (format == FormatArg::Parquet, "--format parquet"),
             (columns.is_some(), "--columns"),
             (target_error.is_some(), "--target-error"),
-            (backend.get() == Backend::Gpu, "--backend gpu"),
         ];
         if let Some((_, flag)) = refused.iter().find(|(asked, _)| *asked) {
-            bail!("{flag} is not available for rows of multi-storey buildings ([[building]] configs) yet: they run on the CPU into CSV");
+            bail!("{flag} is not available for rows of multi-storey buildings ([[building]] configs) yet: they run into CSV");
         }
         let mut plan = config::load_row_text(&config_text, &config)?;
         plan.base.spec.scheme = scheme_as_run(plan.base.spec.scheme, scheme, energy);
-        return run_row(&config, &plan, target, threads, chunk);
+        // The row kernel runs the fast scheme without the energy balance.
+        let gpu_fit = match plan.base.spec.scheme {
+            Scheme::Fast(o) if !o.energy => None,
+            Scheme::Fast(_) => Some("the energy balance of rows is integrated on the CPU only"),
+            Scheme::Reference(_) => Some("the reference scheme runs on the CPU only"),
+        };
+        let backend = backend.get();
+        let gpu = match (backend, gpu_fit) {
+            (Backend::Gpu, Some(why)) => bail!("--backend gpu: {why}; use --backend cpu"),
+            (_, Some(_)) => None,
+            _ => backend.acquire("running on the CPU", &mut |l| note!("{l}"))?,
+        };
+        return run_row(
+            &config,
+            &plan,
+            target,
+            threads,
+            chunk,
+            gpu.as_ref().map(|c| (c, precision.get())),
+        );
     }
     let precision = precision.get();
     let mut plan = config::load_text(&config_text, &config)?;
@@ -391,17 +409,33 @@ fn run_row(
     target: pounding::io::target::Target,
     threads: Option<usize>,
     chunk: Option<usize>,
+    gpu: Option<(
+        &pounding::engine::gpu::GpuContext,
+        pounding::engine::gpu::Precision,
+    )>,
 ) -> Result<()> {
     use pounding::io::atomic::partial_path;
     use pounding::io::csv::{encode_rows, CsvOut};
     use pounding::io::provenance::{meta_path, progress_path};
     use pounding::io::target::{PartialLock, Target};
-    let chunk = chunk.unwrap_or(pounding::engine::CPU_CHUNK);
-    if chunk == 0 || chunk > pounding::plan::limits::MAX_CPU_CHUNK {
+    let (default_chunk, max_chunk, on) = match gpu {
+        Some(_) => (
+            pounding::engine::GPU_CHUNK,
+            pounding::plan::limits::MAX_GPU_CHUNK,
+            "GPU",
+        ),
+        None => (
+            pounding::engine::CPU_CHUNK,
+            pounding::plan::limits::MAX_CPU_CHUNK,
+            "CPU",
+        ),
+    };
+    let chunk = chunk.unwrap_or(default_chunk);
+    if chunk == 0 || chunk > max_chunk {
         bail!(EngineError::Chunk {
             chunk,
-            max: pounding::plan::limits::MAX_CPU_CHUNK,
-            on: "CPU"
+            max: max_chunk,
+            on
         });
     }
     let lock = match &target {
@@ -428,30 +462,50 @@ fn run_row(
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("starting worker threads")?;
+    let on = match gpu {
+        Some((ctx, p)) => format!("GPU {} in {}", ctx.describe(), p.key()),
+        None => format!("CPU, {} threads", pool.current_num_threads()),
+    };
     note!(
-        "{}: {} runs of a row of {} buildings ({} storeys, {} contact levels), {} scheme, on the CPU ({} threads; the GPU kernel for rows is not built yet)",
+        "{}: {} runs of a row of {} buildings ({} storeys, {} contact levels), {} scheme, on the {on}",
         config.display(),
         plan.len(),
         plan.buildings.len(),
         plan.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
         plan.row(&plan.run(0)).levels.len(),
         plan.scheme().key(),
-        pool.current_num_threads()
     );
     let partial = out.partial_path().to_path_buf();
+    let write = |rows: &[(
+        pounding::plan::row::RowRunSpec,
+        pounding::physics::row::RowOutput,
+    )]| {
+        let cells: Vec<Vec<String>> = rows.iter().map(|(s, o)| plan.cells(s, o)).collect();
+        out.write_encoded(&encode_rows(&cells))
+            .map_err(anyhow::Error::from)
+    };
     let summary = pool
-        .install(|| {
-            pounding::engine::cpu::run_rows(
-                plan,
-                0..plan.len(),
-                chunk,
-                |rows| {
-                    let cells: Vec<Vec<String>> =
-                        rows.iter().map(|(s, o)| plan.cells(s, o)).collect();
-                    out.write_encoded(&encode_rows(&cells))
-                },
-                |_| {},
-            )
+        .install(|| match gpu {
+            Some((ctx, precision)) => {
+                let Scheme::Fast(fast) = plan.base.spec.scheme else {
+                    unreachable!("the GPU runs the fast scheme")
+                };
+                let opts = pounding::engine::gpu::GpuOptions {
+                    precision,
+                    fast,
+                    ..Default::default()
+                };
+                pounding::engine::gpu::row::sweep_rows(
+                    ctx,
+                    plan,
+                    0..plan.len(),
+                    chunk,
+                    &opts,
+                    write,
+                    |_| {},
+                )
+            }
+            None => pounding::engine::cpu::run_rows(plan, 0..plan.len(), chunk, write, |_| {}),
         })
         .with_context(|| {
             format!(
@@ -473,7 +527,7 @@ fn run_row(
                 first_run: 0,
                 end_run: plan.len(),
                 shard: None,
-                backend: "cpu".into(),
+                backend: gpu.map_or("cpu".into(), |(_, p)| format!("gpu-{}", p.key())),
                 columns: Some(header.clone()),
                 content: Some(content.clone()),
                 target_error: None,

@@ -1,7 +1,8 @@
 //! `pound bench`: runs per second of the CPU and GPU paths on the same sweeps, with where the
 //! time goes. The sweep is the quickstart physics (nonlinear viscoelastic contact, Ebrahimi
 //! zeta, e = 0.65) on a 20 s synthetic record at dt = 0.01 s, gaps 0..50 mm: most runs pound.
-//! The multi-storey suite ([`row_plan`]) times rows of two N-storey buildings on the CPU.
+//! The multi-storey suite ([`row_plan`]) times rows of two N-storey buildings on the CPU and,
+//! where a hardware GPU is found, on it.
 
 use crate::engine::aggregate::Aggregator;
 use crate::engine::gpu::{GpuError, GpuTimes};
@@ -281,9 +282,22 @@ pub fn row_plan(storeys: usize, n: u64) -> RowPlan {
 #[derive(Debug, Clone, PartialEq)]
 pub struct StoreyRow {
     pub storeys: usize,
+    /// `cpu (T threads)` or `gpu PRECISION (ADAPTER)`.
+    pub backend: String,
     pub summary: Summary,
     /// Formatting the rows as CSV, s (inside `summary.seconds`).
     pub csv: f64,
+}
+
+/// Seconds to format a chunk of row results as CSV (the text is thrown away).
+fn csv_seconds(
+    plan: &RowPlan,
+    rows: &[(crate::plan::row::RowRunSpec, crate::physics::row::RowOutput)],
+) -> f64 {
+    let t = Instant::now();
+    let cells: Vec<Vec<String>> = rows.iter().map(|(s, o)| plan.cells(s, o)).collect();
+    std::hint::black_box(crate::io::csv::encode_rows(&cells));
+    t.elapsed().as_secs_f64()
 }
 
 /// Every run of the row plan on the CPU (the current pool), rows formatted as CSV.
@@ -294,10 +308,7 @@ pub fn run_storeys(storeys: usize, plan: &RowPlan) -> StoreyRow {
         0..plan.len(),
         crate::engine::CPU_CHUNK,
         |rows| -> Result<(), std::convert::Infallible> {
-            let t = Instant::now();
-            let cells: Vec<Vec<String>> = rows.iter().map(|(s, o)| plan.cells(s, o)).collect();
-            std::hint::black_box(crate::io::csv::encode_rows(&cells));
-            csv += t.elapsed().as_secs_f64();
+            csv += csv_seconds(plan, rows);
             Ok(())
         },
         |_| {},
@@ -305,9 +316,43 @@ pub fn run_storeys(storeys: usize, plan: &RowPlan) -> StoreyRow {
     .unwrap_or_else(|e| match e {});
     StoreyRow {
         storeys,
+        backend: format!("cpu ({} threads)", rayon::current_num_threads()),
         summary,
         csv,
     }
+}
+
+/// Every run of the row plan on the GPU (`shaders/row.wgsl`, compiled before the clock
+/// starts), rows formatted as CSV.
+pub fn run_storeys_gpu(
+    storeys: usize,
+    plan: &RowPlan,
+    ctx: &crate::engine::gpu::GpuContext,
+    opts: &crate::engine::gpu::GpuOptions,
+) -> Result<StoreyRow, crate::engine::gpu::GpuError> {
+    use crate::engine::gpu::row::{sweep_rows, RowShape};
+    use crate::physics::solver::row::RowModel;
+    let shape = RowShape::of(&RowModel::new(&plan.row(&plan.run(0))));
+    ctx.row_kernel(opts.precision, &shape)?;
+    let mut csv = 0.0;
+    let summary = sweep_rows(
+        ctx,
+        plan,
+        0..plan.len(),
+        crate::engine::GPU_CHUNK,
+        opts,
+        |rows| -> Result<(), crate::engine::gpu::GpuError> {
+            csv += csv_seconds(plan, rows);
+            Ok(())
+        },
+        |_| {},
+    )?;
+    Ok(StoreyRow {
+        storeys,
+        backend: format!("gpu {} ({})", opts.precision.key(), ctx.info.name),
+        summary,
+        csv,
+    })
 }
 
 /// A markdown table of the multi-storey suite.
@@ -319,10 +364,10 @@ pub fn storey_table(rows: &[StoreyRow]) -> String {
         let m = &r.summary;
         let per_s = |x: u64| x as f64 / m.seconds.max(1e-12);
         s.push_str(&format!(
-            "| {} | {} | cpu ({} threads) | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} |\n",
+            "| {} | {} | {} | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} |\n",
             r.storeys,
             m.runs,
-            rayon::current_num_threads(),
+            r.backend,
             m.seconds,
             m.runs_per_second(),
             2.0 * r.storeys as f64 * m.runs_per_second(),

@@ -7,7 +7,7 @@ fn parse(precision: Precision) -> naga::Module {
     parse_source(&fast_source(precision, true))
 }
 
-fn parse_source(src: &str) -> naga::Module {
+pub fn parse_source(src: &str) -> naga::Module {
     let module =
         naga::front::wgsl::parse_str(src).unwrap_or_else(|e| panic!("{}", e.emit_to_string(src)));
     let mut v = naga::valid::Validator::new(

@@ -22,7 +22,7 @@ fn schemes() -> [RowScheme; 2] {
     ]
 }
 
-fn record(seed: u64, duration: f64, pga_g: f64) -> Vec<f64> {
+pub fn record(seed: u64, duration: f64, pga_g: f64) -> Vec<f64> {
     let r = synthetic(&SyntheticSpec {
         seed,
         duration,
@@ -34,7 +34,7 @@ fn record(seed: u64, duration: f64, pga_g: f64) -> Vec<f64> {
     r.accel.clone()
 }
 
-fn forcing(accel: &[f64]) -> Forcing<'_> {
+pub fn forcing(accel: &[f64]) -> Forcing<'_> {
     Forcing {
         accel,
         dt: 0.01,
@@ -44,7 +44,7 @@ fn forcing(accel: &[f64]) -> Forcing<'_> {
     }
 }
 
-fn building(n: usize, period: f64, damping: Damping) -> ShearBuilding {
+pub fn building(n: usize, period: f64, damping: Damping) -> ShearBuilding {
     ShearBuilding::from_period(vec![3e5; n], &vec![1.0; n], vec![3.0; n], period, damping)
 }
 
@@ -648,7 +648,9 @@ fn row_config_errors_name_the_key() {
         &["--resume"][..],
         &["--shard", "0/2"],
         &["--aggregate", "law"],
-        &["--backend", "gpu"],
+        // The row kernel runs the fast scheme without the energy balance.
+        &["--backend", "gpu", "--energy"],
+        &["--backend", "gpu", "--scheme", "reference"],
     ] {
         let mut args = vec!["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()];
         args.extend_from_slice(flag);

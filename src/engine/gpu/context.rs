@@ -2,7 +2,7 @@
 //! the work functions so tests can bring their own device.
 
 use super::layout::{Counters, Dispatch, Meta};
-use super::shader::{aggregate_source, fast_source, Precision};
+use super::shader::{aggregate_source, fast_source, row_source, Precision};
 use std::sync::{Arc, Mutex};
 
 /// What went wrong on the GPU path; each message says what to do next.
@@ -71,6 +71,8 @@ enum Stage {
     Fast { energy: bool },
     /// `aggregate.wgsl`.
     Aggregate,
+    /// `row.wgsl` for one row shape (a hash of its WGSL constants).
+    Row(u64),
 }
 
 type KernelKey = (Stage, Precision);
@@ -203,15 +205,37 @@ impl GpuContext {
     /// The fast-scheme kernel in `precision`, with or without the energy balance, compiled on
     /// first use.
     pub fn kernel(&self, precision: Precision, energy: bool) -> Result<Arc<Kernel>, GpuError> {
-        self.stage(Stage::Fast { energy }, precision)
+        self.stage(Stage::Fast { energy }, precision, || {
+            fast_source(precision, energy)
+        })
     }
 
     /// The aggregation stage in `precision`, compiled on first use.
     pub fn aggregator(&self, precision: Precision) -> Result<Arc<Kernel>, GpuError> {
-        self.stage(Stage::Aggregate, precision)
+        self.stage(Stage::Aggregate, precision, || aggregate_source(precision))
     }
 
-    fn stage(&self, stage: Stage, precision: Precision) -> Result<Arc<Kernel>, GpuError> {
+    /// The row kernel for `shape` in `precision`, compiled on first use.
+    pub fn row_kernel(
+        &self,
+        precision: Precision,
+        shape: &super::row::RowShape,
+    ) -> Result<Arc<Kernel>, GpuError> {
+        use std::hash::{Hash, Hasher};
+        let constants = shape.wgsl_constants();
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        constants.hash(&mut h);
+        self.stage(Stage::Row(h.finish()), precision, || {
+            row_source(precision, &constants)
+        })
+    }
+
+    fn stage(
+        &self,
+        stage: Stage,
+        precision: Precision,
+        source: impl FnOnce() -> String,
+    ) -> Result<Arc<Kernel>, GpuError> {
         let mut ks = self.kernels.lock().unwrap();
         if let Some((_, k)) = ks.iter().find(|(p, _)| *p == (stage, precision)) {
             return Ok(k.clone());
@@ -221,17 +245,23 @@ impl GpuContext {
                 adapter: self.info.name.clone(),
             });
         }
-        let k = Arc::new(self.compile(stage, precision)?);
+        let k = Arc::new(self.compile(stage, precision, source())?);
         ks.push(((stage, precision), k.clone()));
         Ok(k)
     }
 
-    fn compile(&self, stage: Stage, precision: Precision) -> Result<Kernel, GpuError> {
+    fn compile(
+        &self,
+        stage: Stage,
+        precision: Precision,
+        source: String,
+    ) -> Result<Kernel, GpuError> {
         let d = &self.device;
         let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-        let (name, source) = match stage {
-            Stage::Fast { energy } => ("fast", fast_source(precision, energy)),
-            Stage::Aggregate => ("aggregate", aggregate_source(precision)),
+        let name = match stage {
+            Stage::Fast { .. } => "fast",
+            Stage::Aggregate => "aggregate",
+            Stage::Row(_) => "row",
         };
         let label = format!("{name}.wgsl {}", precision.key());
         let desc = wgpu::ShaderModuleDescriptor {
@@ -252,7 +282,8 @@ impl GpuContext {
         };
         // Binding order as declared in each shader.
         let entries: Vec<wgpu::BindGroupLayoutEntry> = match stage {
-            Stage::Fast { .. } => vec![
+            // row.wgsl binds as fast.wgsl, its building models (read only) at 9, no 10.
+            Stage::Fast { .. } | Stage::Row(_) => vec![
                 entry(
                     0,
                     wgpu::BindingType::Buffer {
@@ -271,7 +302,14 @@ impl GpuContext {
                 entry(8, storage(false)),
                 entry(9, storage(true)),
                 entry(10, storage(true)),
-            ],
+            ]
+            .into_iter()
+            .take(if matches!(stage, Stage::Row(_)) {
+                10
+            } else {
+                11
+            })
+            .collect(),
             Stage::Aggregate => (0..9).map(|b| entry(b, storage(b < 5))).collect(),
         };
         let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

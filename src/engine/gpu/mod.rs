@@ -5,6 +5,7 @@
 //! - [`layout`]: the `#[repr(C)]` buffer types both sides share (checked against the WGSL by naga);
 //! - [`shader`]: the WGSL text with its constants filled in from Rust;
 //! - [`run`]: packing runs, dispatching, reading back one chunk;
+//! - [`row`]: rows of multi-storey buildings (`shaders/row.wgsl`), packed, dispatched, read back;
 //! - [`shared`]: the free responses runs of a chunk share, packed for the kernel;
 //! - [`sweep`]: a range of runs chunk after chunk; [`fold`] and [`reduce`]: the device fold.
 //!
@@ -14,6 +15,7 @@ pub mod context;
 pub mod fold;
 pub mod layout;
 pub mod reduce;
+pub mod row;
 pub mod run;
 pub mod shader;
 pub mod shared;

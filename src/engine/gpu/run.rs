@@ -1,7 +1,7 @@
 //! Packing runs into buffers, dispatching the kernel in windows of record intervals, reading
 //! back. The work functions take a [`GpuContext`], so tests can pass their own device.
 
-use super::context::{GpuContext, GpuError};
+use super::context::{GpuContext, GpuError, Kernel};
 use super::layout::{
     self, Counters, Dispatch, Meta, Params32, Params64, State32, State64, MODE_FREE, NO_RESPONSE,
     STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK,
@@ -88,6 +88,15 @@ pub struct GpuRecords {
 }
 
 impl GpuRecords {
+    /// Offset and length of record `i` in the buffer.
+    pub(super) fn record(&self, i: usize) -> (u32, u32) {
+        (self.offsets[i], self.lens[i])
+    }
+
+    pub(super) fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
     pub fn upload(
         ctx: &GpuContext,
         precision: Precision,
@@ -495,46 +504,16 @@ pub fn integrate(
         }),
         wgpu::BufferUsages::empty(),
     )?;
-    // The dispatch's tally: [runs still active, lane units, lane slots].
-    let active = storage(
-        ctx,
-        "active runs and lane tally",
-        &[0; TALLY_BYTES],
-        wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-    )?;
-    // Run ids of the active runs, ping-ponged: a dispatch reads one list and appends the runs it
-    // leaves unfinished to the other.
-    let all: Vec<u32> = (0..n as u32).collect();
-    let ids = [
-        storage(
-            ctx,
-            "run ids a",
-            bytemuck::cast_slice(&all),
-            wgpu::BufferUsages::empty(),
-        )?,
-        // Written by the first dispatch before any dispatch reads it.
-        zeroed(
-            ctx,
-            "run ids b",
-            (n * 4) as u64,
-            wgpu::BufferUsages::empty(),
-        )?,
-    ];
-    let uniform = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("dispatch"),
-        size: size_of::<Dispatch>() as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
+    let lists = WorkLists::new(ctx, n)?;
     let bind = |from: &wgpu::Buffer, to: &wgpu::Buffer, label| {
         let buffers = [
-            &uniform,
+            &lists.uniform,
             &params,
             &metas_buf,
             &recs.buffer,
             &states,
             &counters,
-            &active,
+            &lists.tally,
             from,
             to,
             &forms,
@@ -543,49 +522,16 @@ pub fn integrate(
         bind_group(ctx, &kernel.layout, label, &buffers)
     };
     let binds = [
-        bind(&ids[0], &ids[1], "fast bind group a->b"),
-        bind(&ids[1], &ids[0], "fast bind group b->a"),
+        bind(&lists.ids[0], &lists.ids[1], "fast bind group a->b"),
+        bind(&lists.ids[1], &lists.ids[0], "fast bind group b->a"),
     ];
     wait(ctx)?;
     times.upload = t.elapsed();
-
-    let t = Instant::now();
-    let mut budget = opts.units_per_dispatch.max(1);
-    if ctx.info.device_type == wgpu::DeviceType::Cpu {
-        budget = budget.min(CPU_ADAPTER_BUDGET);
-    }
-    let mut d = Dispatch {
-        budget,
-        nactive: n as u32,
-        max_substeps_per_step: opts.fast.max_substeps_per_step,
-        max_substeps: opts.fast.max_substeps,
-        handoff_substeps_per_step: opts.handoff(),
-        ..Default::default()
-    };
-    let active_staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("tally readback"),
-        size: TALLY_BYTES as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    for parity in (0..2).cycle() {
-        ctx.queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&d));
-        ctx.queue.write_buffer(&active, 0, &[0; TALLY_BYTES]);
-        let groups = (layout::workgroups(d.nactive), 1);
-        ctx.dispatch("fast", &kernel, &binds[parity], groups, |enc| {
-            enc.copy_buffer_to_buffer(&active, 0, &active_staging, 0, TALLY_BYTES as u64)
-        });
-        let v = map_read(ctx, &active_staging)?;
-        let word =
-            |i: usize| u32::from_le_bytes([v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]]);
-        d.nactive = word(0);
-        times.lane_units += word(1) as u64;
-        times.lane_slots += word(2) as u64;
-        if d.nactive == 0 {
-            break;
-        }
-    }
-    times.kernel = t.elapsed();
+    let budget = opts
+        .units_per_dispatch
+        .max(1)
+        .min(unit_cap(ctx, CPU_ADAPTER_BUDGET));
+    lists.run("fast", ctx, &kernel, &binds, budget, opts, &mut times)?;
     Ok((
         Integrated {
             states,
@@ -594,6 +540,114 @@ pub fn integrate(
         },
         times,
     ))
+}
+
+/// On a software adapter, the most units one dispatch may do per run when one unit runs at most
+/// `cap` loop trips' worth (see [`CPU_ADAPTER_BUDGET`]); no cap on a real GPU.
+pub(super) fn unit_cap(ctx: &GpuContext, cap: u32) -> u32 {
+    if ctx.info.device_type == wgpu::DeviceType::Cpu {
+        cap.max(1)
+    } else {
+        u32::MAX
+    }
+}
+
+/// The buffers of the dispatch loop both integrating stages share: the uniform [`Dispatch`],
+/// the tally (runs still active, lane units, lane slots) and the two run-id lists, ping-ponged:
+/// a dispatch reads one list and appends the runs it leaves unfinished to the other.
+pub(super) struct WorkLists {
+    pub uniform: wgpu::Buffer,
+    pub tally: wgpu::Buffer,
+    pub ids: [wgpu::Buffer; 2],
+}
+
+impl WorkLists {
+    pub fn new(ctx: &GpuContext, n: usize) -> Result<WorkLists, GpuError> {
+        let tally = storage(
+            ctx,
+            "active runs and lane tally",
+            &[0; TALLY_BYTES],
+            wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        )?;
+        let all: Vec<u32> = (0..n as u32).collect();
+        let ids = [
+            storage(
+                ctx,
+                "run ids a",
+                bytemuck::cast_slice(&all),
+                wgpu::BufferUsages::empty(),
+            )?,
+            // Written by the first dispatch before any dispatch reads it.
+            zeroed(
+                ctx,
+                "run ids b",
+                (n * 4) as u64,
+                wgpu::BufferUsages::empty(),
+            )?,
+        ];
+        let uniform = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dispatch"),
+            size: size_of::<Dispatch>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(WorkLists {
+            uniform,
+            tally,
+            ids,
+        })
+    }
+
+    /// Dispatch `kernel` over the active runs, `budget` units each, until none is left; `binds`
+    /// read list a (b) and write list b (a). Adds the kernel time and lane tally to `times`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn run(
+        &self,
+        label: &str,
+        ctx: &GpuContext,
+        kernel: &Kernel,
+        binds: &[wgpu::BindGroup; 2],
+        budget: u32,
+        opts: &GpuOptions,
+        times: &mut ChunkTimes,
+    ) -> Result<(), GpuError> {
+        let t = Instant::now();
+        let n = (self.ids[0].size() / 4) as u32;
+        let mut d = Dispatch {
+            budget,
+            nactive: n,
+            max_substeps_per_step: opts.fast.max_substeps_per_step,
+            max_substeps: opts.fast.max_substeps,
+            handoff_substeps_per_step: opts.handoff(),
+            ..Default::default()
+        };
+        let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tally readback"),
+            size: TALLY_BYTES as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        for parity in (0..2).cycle() {
+            ctx.queue
+                .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&d));
+            ctx.queue.write_buffer(&self.tally, 0, &[0; TALLY_BYTES]);
+            let groups = (layout::workgroups(d.nactive), 1);
+            ctx.dispatch(label, kernel, &binds[parity], groups, |enc| {
+                enc.copy_buffer_to_buffer(&self.tally, 0, &staging, 0, TALLY_BYTES as u64)
+            });
+            let v = map_read(ctx, &staging)?;
+            let word =
+                |i: usize| u32::from_le_bytes([v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]]);
+            d.nactive = word(0);
+            times.lane_units += word(1) as u64;
+            times.lane_slots += word(2) as u64;
+            if d.nactive == 0 {
+                break;
+            }
+        }
+        times.kernel += t.elapsed();
+        Ok(())
+    }
 }
 
 /// Each run's state and counters before the first dispatch, the state in `precision`'s bytes:

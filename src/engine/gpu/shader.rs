@@ -47,7 +47,11 @@ impl Precision {
 
 /// Structs and codes every stage shares, then one file per stage, as in `shaders/`.
 pub const TYPES_WGSL: &str = include_str!("../../../shaders/types.wgsl");
+pub const CONTACT_WGSL: &str = include_str!("../../../shaders/contact.wgsl");
+pub const HERMITE_WGSL: &str = include_str!("../../../shaders/hermite.wgsl");
 pub const FAST_WGSL: &str = include_str!("../../../shaders/fast.wgsl");
+pub const ROW_WGSL: &str = include_str!("../../../shaders/row.wgsl");
+pub const LANES_WGSL: &str = include_str!("../../../shaders/lanes.wgsl");
 pub const AGGREGATE_WGSL: &str = include_str!("../../../shaders/aggregate.wgsl");
 
 /// What every stage starts with: the `real` alias, its epsilon, a tiny and a huge number (for
@@ -72,7 +76,16 @@ pub fn fast_source(precision: Precision, energy: bool) -> String {
     format!(
         "{}const FORMS: u32 = {FORMS_PER_RUN}u;\nconst ENERGY: bool = {energy};\n\
          const NO_RESPONSE: u32 = {NO_RESPONSE}u;\nconst SH_HEADER: u32 = {HEADER}u;\n\
-         const SH_CHECK: u32 = {PER_CHECK}u;\nconst SH_EVERY: u32 = {CHECK_EVERY}u;\nconst REACH_SLACK: real = {REACH_SLACK:e};\n{FAST_WGSL}",
+         const SH_CHECK: u32 = {PER_CHECK}u;\nconst SH_EVERY: u32 = {CHECK_EVERY}u;\nconst REACH_SLACK: real = {REACH_SLACK:e};\n{CONTACT_WGSL}{HERMITE_WGSL}{FAST_WGSL}{LANES_WGSL}",
+        prelude(precision)
+    )
+}
+
+/// `shaders/row.wgsl` for `precision`, after the prelude and the row's shape `constants`
+/// ([`super::row::RowShape::wgsl_constants`]).
+pub fn row_source(precision: Precision, constants: &str) -> String {
+    format!(
+        "{}{constants}{CONTACT_WGSL}{HERMITE_WGSL}{ROW_WGSL}{LANES_WGSL}",
         prelude(precision)
     )
 }

@@ -56,6 +56,11 @@ pub struct FastOptions {
 /// the contact's local rate (`h_rate`), not a fresh impact.
 pub const SUSTAINED: f64 = 2.0;
 
+/// Event location in the fast schemes: the relative tolerance on the step and the most
+/// iterations (`LOCATE_TOL` and `LOCATE_ITER` in the shaders).
+pub const LOCATE_TOLERANCE: f64 = 1e-9;
+pub const LOCATE_ITERATIONS: u32 = 16;
+
 /// Accepted pieces one substep may be cut into by events before the run ends with
 /// `step_limit` (a guard against a stalled event search; the shader has the same cap).
 pub const MAX_PIECES_PER_SUBSTEP: u32 = 64;
@@ -226,7 +231,7 @@ pub(crate) fn run(
                 let hs = t_target - t;
                 let (z0, mode, v0) = (run.z, run.mode, run.tr.v0);
                 let step = |x: f64| rk4(pair, mode, v0, &seg, t, &z0, x);
-                t += run.accept(t, hs, step(hs), 1e-9, 16, step);
+                t += run.accept(t, hs, step(hs), LOCATE_TOLERANCE, LOCATE_ITERATIONS, step);
                 if !finite(&run.z) {
                     return run.finish(Status::NonFinite, substeps as u64);
                 }

@@ -19,7 +19,9 @@ use super::{rhs, LevelModes, RowModel, RowRun};
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
 use crate::physics::row::RowOutput;
-use crate::physics::solver::fast::{FastOptions, MAX_PIECES_PER_SUBSTEP, SUSTAINED};
+use crate::physics::solver::fast::{
+    FastOptions, LOCATE_ITERATIONS, LOCATE_TOLERANCE, MAX_PIECES_PER_SUBSTEP, SUSTAINED,
+};
 use crate::physics::solver::{impact_step, Mode, Segment};
 
 /// The fast scheme's settings are the pair's.
@@ -185,7 +187,15 @@ pub(crate) fn run(m: &RowModel, forcing: &Forcing, z0: Vec<f64>, o: &FastOptions
                 run.level_modes(&mut modes);
                 let mut step = |x: f64| rk4(m, &modes, &seg, t, &z0, x, &mut stages);
                 let trial = step(hs);
-                t += run.accept(&seg, t, hs, trial, 1e-9, 16, step);
+                t += run.accept(
+                    &seg,
+                    t,
+                    hs,
+                    trial,
+                    LOCATE_TOLERANCE,
+                    LOCATE_ITERATIONS,
+                    step,
+                );
                 if !run.z.iter().all(|x| x.is_finite()) {
                     return run.finish(Status::NonFinite, substeps as u64);
                 }

@@ -1,0 +1,824 @@
+// Rust twin: src/physics/solver/row/fast.rs (with row/mod.rs), function for function (same
+// names, same operation order). The fast scheme on a row of shear buildings, in modal
+// coordinates, one invocation per run; resumable as fast.wgsl (at most `disp.budget` units of
+// work per run and dispatch: a free record interval, or one piece of an RK4 substep).
+//
+// The host prepends the prelude, then the row's shape (src/engine/gpu/row.rs, `RowShape`): NB
+// buildings, NM modes in all, NL contact levels (NLA = max(NL, 1) sizes their arrays), ZLEN
+// reals of state, MAXN the most storeys; each building's storeys and first mode (B_N, B_OFF);
+// each level's left building and floors (L_A, L_FA, L_FB); the offsets and strides of the
+// per-run blocks (P_*, M_*, S_*, C_*, LS_*, LC_*, BS_*, BC_*, MW). Then contact.wgsl and
+// hermite.wgsl. So a kernel carries exactly the loops its row needs.
+//
+// The state z is [q (NM), q' (NM), w (one per level), e_in, e_damp], as on the CPU; this kernel
+// does not integrate the energy balance (the host refuses to ask for it), so the last two stay 0.
+
+alias ZA = array<real, ZLEN>;
+
+@group(0) @binding(0) var<uniform> disp: Dispatch;
+// Per run: P_STRIDE reals (record and contact settings, gaps, each level's contact), M_STRIDE
+// u32 (law, record, each building's model block).
+@group(0) @binding(1) var<storage, read> rparams: array<real>;
+@group(0) @binding(2) var<storage, read> rmeta: array<u32>;
+@group(0) @binding(3) var<storage, read> records: array<real>;
+// Per run: S_STRIDE reals and C_STRIDE u32 that persist between dispatches.
+@group(0) @binding(4) var<storage, read_write> rstate: array<real>;
+@group(0) @binding(5) var<storage, read_write> rcount: array<u32>;
+@group(0) @binding(6) var<storage, read_write> tally: Tally;
+@group(0) @binding(7) var<storage, read> run_ids: array<u32>;
+@group(0) @binding(8) var<storage, read_write> next_ids: array<u32>;
+// Building models, shared by the runs that use them: per mode MW reals (w^2, 2 xi w, the
+// participation, the 8 propagator coefficients), the mode shapes (floor-major), floor masses
+// and storey heights.
+@group(0) @binding(9) var<storage, read> models: array<real>;
+
+const TWO_PI: real = 6.283185307179586;
+
+// This invocation's run: where its blocks start, and what it reads most.
+var<private> RP: u32;
+var<private> RS: u32;
+var<private> RC: u32;
+var<private> MB: array<u32, NB>;
+var<private> W2: array<real, NM>;
+var<private> TXW: array<real, NM>;
+var<private> PART: array<real, NM>;
+var<private> LMODE: array<u32, NLA>;
+var<private> LV0: array<real, NLA>;
+var<private> LAW: u32;
+var<private> REC_OFF: u32;
+var<private> REC_LEN: u32;
+var<private> INTERVALS: u32;
+var<private> DT: real;
+var<private> T0: real;
+var<private> SCALE: real;
+var<private> PER_CONTACT: real;
+var<private> RATE: real;
+// Counters: the interval i, substep j of m, pieces of this substep, local time in the interval.
+var<private> CI: u32;
+var<private> CJ: u32;
+var<private> CM: u32;
+var<private> PIECES: u32;
+var<private> SUBSTEPS: u32;
+var<private> FREE_STEPS: u32;
+var<private> STATUS: u32;
+var<private> TAU: real;
+// Floor kinematics at the two ends of the last tracked piece (row/mod.rs `Floors`): quantity q
+// (u, v, relative and absolute acceleration, jerk) of floor j of building b at end e is
+// FL[(5 e + q) NM + B_OFF[b] + j]. ENDS_VALID: end 1 describes the state in the current modes,
+// so the next piece starts from it (never across dispatches: recomputing gives the same bits).
+var<private> FL: array<real, FLEN>;
+var<private> ENDS_VALID: bool;
+// The contact force on each floor (positive to the right).
+var<private> FF: array<real, NM>;
+
+fn sample(i: u32) -> real {
+    if (i < REC_LEN) {
+        return records[REC_OFF + i] * SCALE;
+    }
+    return 0.0;
+}
+
+// Segment::at, at local time tau of the interval.
+fn seg_at(seg: Seg, tau: real) -> real {
+    return seg.a0 + (seg.a1 - seg.a0) * (tau / seg.dt);
+}
+
+fn rp(k: u32) -> real {
+    return rparams[RP + k];
+}
+
+// The contact element of level l into K (contact.wgsl).
+fn use_level(l: u32) {
+    let b = RP + P_LEVELS + 3u * l;
+    K = Law(LAW, rp(P_STIFFNESS), rparams[b], rp(P_RATIO), rparams[b + 1u], rparams[b + 2u]);
+}
+
+fn shape_at(b: u32, j: u32, i: u32) -> real {
+    let n = B_N[b];
+    return models[MB[b] + MW * n + j * n + i];
+}
+
+fn mass_at(b: u32, j: u32) -> real {
+    let n = B_N[b];
+    return models[MB[b] + MW * n + n * n + j];
+}
+
+fn height_at(b: u32, j: u32) -> real {
+    let n = B_N[b];
+    return models[MB[b] + MW * n + n * n + n + j];
+}
+
+// Level l's reals and u32 in the run's blocks.
+fn lsi(l: u32, f: u32) -> u32 {
+    return RS + S_LEVELS + LS_STRIDE * l + f;
+}
+
+fn lci(l: u32, f: u32) -> u32 {
+    return RC + C_LEVELS + LC_STRIDE * l + f;
+}
+
+fn fli(e: u32, q: u32, k: u32) -> u32 {
+    return (5u * e + q) * NM + k;
+}
+
+// ---- row/mod.rs: LevelModel ----
+
+// phi . q of floor `f` of building `b`, from z at offset `at` (0: displacements, NM: velocities).
+fn floor_of(b: u32, f: u32, z: ptr<function, ZA>, at: u32) -> real {
+    var s: real = 0.0;
+    let o = at + B_OFF[b];
+    for (var i = 0u; i < B_N[b]; i++) {
+        s += shape_at(b, f, i) * (*z)[o + i];
+    }
+    return s;
+}
+
+fn delta(l: u32, z: ptr<function, ZA>) -> real {
+    let a = L_A[l];
+    return floor_of(a, L_FA[l], z, 0u) - floor_of(a + 1u, L_FB[l], z, 0u) - rp(P_GAPS + a);
+}
+
+fn ddelta(l: u32, z: ptr<function, ZA>) -> real {
+    let a = L_A[l];
+    return floor_of(a, L_FA[l], z, NM) - floor_of(a + 1u, L_FB[l], z, NM);
+}
+
+// The structural acceleration of floor f of building b (no ground, no contact).
+fn floor_accel(b: u32, f: u32, z: ptr<function, ZA>) -> real {
+    var s: real = 0.0;
+    let o = B_OFF[b];
+    for (var i = 0u; i < B_N[b]; i++) {
+        let k = o + i;
+        s += shape_at(b, f, i) * (-TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k]);
+    }
+    return s;
+}
+
+fn structural_rel_accel(l: u32, z: ptr<function, ZA>) -> real {
+    let a = L_A[l];
+    return floor_accel(a, L_FA[l], z) - floor_accel(a + 1u, L_FB[l], z);
+}
+
+fn force(l: u32, mode: u32, v0: real, z: ptr<function, ZA>) -> real {
+    if (mode == MODE_FREE) {
+        return 0.0;
+    }
+    let d = delta(l, z);
+    let r = ddelta(l, z);
+    use_level(l);
+    return contact_force(d, r, v0, mode == MODE_APPROACH);
+}
+
+fn event_value(l: u32, mode: u32, v0: real, z: ptr<function, ZA>) -> real {
+    let d = delta(l, z);
+    let r = ddelta(l, z);
+    use_level(l);
+    let g = gauge(d, r, v0);
+    switch mode {
+        case MODE_FREE: { return g; }
+        case MODE_APPROACH: { return -r; }
+        default: { return -g; }
+    }
+}
+
+// The fourth-derivative bound of one side's floor, mode by mode.
+fn side_bound(b: u32, f: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>) -> real {
+    var s: real = 0.0;
+    let o = B_OFF[b];
+    for (var i = 0u; i < B_N[b]; i++) {
+        let k = o + i;
+        let sk = Seg(seg.a0 * PART[k], seg.a1 * PART[k], seg.dt);
+        let q = max(abs((*z0)[k]), abs((*z1)[k]));
+        let qd = max(abs((*z0)[NM + k]), abs((*z1)[NM + k]));
+        s += abs(shape_at(b, f, i)) * fourth_derivative_bound(1.0, W2[k], TXW[k], q, qd, sk);
+    }
+    return s;
+}
+
+fn may_touch(l: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real, v0: real) -> bool {
+    let d0 = delta(l, z0);
+    let d1 = delta(l, z1);
+    let r0 = ddelta(l, z0);
+    let r1 = ddelta(l, z1);
+    let a = L_A[l];
+    let bound = side_bound(a, L_FA[l], seg, z0, z1) + side_bound(a + 1u, L_FB[l], seg, z0, z1);
+    let margin = -error_margin(bound, h);
+    if (cubic_max_bound(d0, r0, d1, r1, h) <= margin) {
+        return false;
+    }
+    use_level(l);
+    if (gauge(d0, r0, v0) > 0.0 || gauge(d1, r1, v0) > 0.0) {
+        return true;
+    }
+    return hermite_range(d0, r0, d1, r1, h).hi > margin;
+}
+
+// row::rhs at ground acceleration ag, into `out`.
+fn rhs(ag: real, z: ptr<function, ZA>, out: ptr<function, ZA>) {
+    for (var i = 0u; i < NM; i++) {
+        let v = (*z)[NM + i];
+        (*out)[i] = v;
+        (*out)[NM + i] = -TXW[i] * v - W2[i] * (*z)[i] - PART[i] * ag;
+    }
+    for (var l = 0u; l < NL; l++) {
+        if (LMODE[l] == MODE_FREE) {
+            (*out)[2u * NM + l] = 0.0;
+            continue;
+        }
+        let f = force(l, LMODE[l], LV0[l], z);
+        let a = L_A[l];
+        let oa = NM + B_OFF[a];
+        for (var i = 0u; i < B_N[a]; i++) {
+            (*out)[oa + i] -= shape_at(a, L_FA[l], i) * f;
+        }
+        let ob = NM + B_OFF[a + 1u];
+        for (var i = 0u; i < B_N[a + 1u]; i++) {
+            (*out)[ob + i] += shape_at(a + 1u, L_FB[l], i) * f;
+        }
+        (*out)[2u * NM + l] = f * ddelta(l, z);
+    }
+    (*out)[2u * NM + NL] = 0.0;
+    (*out)[2u * NM + NL + 1u] = 0.0;
+}
+
+// fast.rs `rk4`: classic RK4 over h from local time tau, into `out`.
+fn rk4(seg: Seg, tau: real, z: ptr<function, ZA>, h: real, out: ptr<function, ZA>) {
+    let ag0 = seg_at(seg, tau);
+    let agm = seg_at(seg, tau + 0.5 * h);
+    let ag1 = seg_at(seg, tau + h);
+    var k1: ZA;
+    var k2: ZA;
+    var k3: ZA;
+    var k4: ZA;
+    var y: ZA;
+    rhs(ag0, z, &k1);
+    for (var i = 0u; i < ZLEN; i++) { y[i] = (*z)[i] + 0.5 * h * k1[i]; }
+    rhs(agm, &y, &k2);
+    for (var i = 0u; i < ZLEN; i++) { y[i] = (*z)[i] + 0.5 * h * k2[i]; }
+    rhs(agm, &y, &k3);
+    for (var i = 0u; i < ZLEN; i++) { y[i] = (*z)[i] + h * k3[i]; }
+    rhs(ag1, &y, &k4);
+    for (var i = 0u; i < ZLEN; i++) {
+        (*out)[i] = (*z)[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+    }
+}
+
+// RowRun::event_max: the largest of the levels' event values.
+fn event_max(z: ptr<function, ZA>) -> real {
+    var m = -BIG;
+    for (var l = 0u; l < NL; l++) {
+        m = max(m, event_value(l, LMODE[l], LV0[l], z));
+    }
+    return m;
+}
+
+// ---- row/mod.rs: RowRun ----
+
+fn set_floor_forces(z: ptr<function, ZA>) {
+    for (var k = 0u; k < NM; k++) { FF[k] = 0.0; }
+    for (var l = 0u; l < NL; l++) {
+        if (LMODE[l] == MODE_FREE) {
+            continue;
+        }
+        let f = force(l, LMODE[l], LV0[l], z);
+        let a = L_A[l];
+        FF[B_OFF[a] + L_FA[l]] -= f;
+        FF[B_OFF[a + 1u] + L_FB[l]] += f;
+    }
+}
+
+// Floors::fill of building b at end e from z at ground acceleration ag, with FF set.
+fn fill(b: u32, e: u32, z: ptr<function, ZA>, ag: real) {
+    let n = B_N[b];
+    let o = B_OFF[b];
+    var acc: array<real, MAXN>;
+    var jrk: array<real, MAXN>;
+    for (var i = 0u; i < n; i++) {
+        let k = o + i;
+        let a = -TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k];
+        acc[i] = a;
+        let qdd = a - PART[k] * ag;
+        jrk[i] = -TXW[k] * qdd - W2[k] * (*z)[NM + k];
+    }
+    for (var j = 0u; j < n; j++) {
+        var u: real = 0.0;
+        var v: real = 0.0;
+        var aa: real = 0.0;
+        var je: real = 0.0;
+        for (var i = 0u; i < n; i++) {
+            let s = shape_at(b, j, i);
+            u += s * (*z)[o + i];
+            v += s * (*z)[NM + o + i];
+            aa += s * acc[i];
+            je += s * jrk[i];
+        }
+        aa = aa + FF[o + j] / mass_at(b, j);
+        FL[fli(e, 0u, o + j)] = u;
+        FL[fli(e, 1u, o + j)] = v;
+        FL[fli(e, 2u, o + j)] = aa - ag;
+        FL[fli(e, 3u, o + j)] = aa;
+        FL[fli(e, 4u, o + j)] = je;
+    }
+}
+
+fn raise(free: bool, peak: real, y0: real, y1: real, d0: real, d1: real, a0: real, a1: real, h: real) -> real {
+    if (free) {
+        return raise_quintic_peak(peak, y0, y1, d0, d1, a0, a1, h);
+    }
+    return raise_cubic_peak(peak, y0, d0, y1, d1, h);
+}
+
+// RowRun::track_buildings over the piece z0 -> z1 of length h.
+fn track_buildings(z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1: real, h: real) {
+    if (ENDS_VALID) {
+        for (var x = 0u; x < 5u * NM; x++) { FL[x] = FL[5u * NM + x]; }
+    } else {
+        set_floor_forces(z0);
+        for (var b = 0u; b < NB; b++) { fill(b, 0u, z0, ag0); }
+    }
+    set_floor_forces(z1);
+    var touched: array<bool, NB>;
+    for (var l = 0u; l < NL; l++) {
+        if (LMODE[l] != MODE_FREE) {
+            touched[L_A[l]] = true;
+            touched[L_A[l] + 1u] = true;
+        }
+    }
+    for (var b = 0u; b < NB; b++) {
+        let free = !touched[b];
+        fill(b, 1u, z1, ag1);
+        let n = B_N[b];
+        let o = B_OFF[b];
+        let sb = RS + S_BUILDINGS + BS_STRIDE * b;
+        let cb = RC + C_BUILDINGS + BC_STRIDE * b;
+        let top = o + n - 1u;
+        rstate[sb + BS_ROOF] = raise(free, rstate[sb + BS_ROOF],
+            FL[fli(0u, 0u, top)], FL[fli(1u, 0u, top)], FL[fli(0u, 1u, top)], FL[fli(1u, 1u, top)],
+            FL[fli(0u, 2u, top)], FL[fli(1u, 2u, top)], h);
+        var drift = rstate[sb + BS_DRIFT];
+        var accel = rstate[sb + BS_ACCEL];
+        for (var j = 0u; j < n; j++) {
+            let k = o + j;
+            // Floor 0 is the ground: it moves with the frame.
+            var bu0: real = 0.0; var bu1: real = 0.0; var bv0: real = 0.0; var bv1: real = 0.0;
+            var ba0: real = 0.0; var ba1: real = 0.0;
+            if (j > 0u) {
+                bu0 = FL[fli(0u, 0u, k - 1u)]; bu1 = FL[fli(1u, 0u, k - 1u)];
+                bv0 = FL[fli(0u, 1u, k - 1u)]; bv1 = FL[fli(1u, 1u, k - 1u)];
+                ba0 = FL[fli(0u, 2u, k - 1u)]; ba1 = FL[fli(1u, 2u, k - 1u)];
+            }
+            let inv_h = 1.0 / height_at(b, j);
+            let p = raise(free, drift,
+                (FL[fli(0u, 0u, k)] - bu0) * inv_h, (FL[fli(1u, 0u, k)] - bu1) * inv_h,
+                (FL[fli(0u, 1u, k)] - bv0) * inv_h, (FL[fli(1u, 1u, k)] - bv1) * inv_h,
+                (FL[fli(0u, 2u, k)] - ba0) * inv_h, (FL[fli(1u, 2u, k)] - ba1) * inv_h, h);
+            if (p > drift) {
+                drift = p;
+                rcount[cb + BC_DRIFT_STOREY] = j + 1u;
+            }
+            var pa: real;
+            if (free) {
+                pa = raise_cubic_peak(accel, FL[fli(0u, 3u, k)], FL[fli(0u, 4u, k)],
+                    FL[fli(1u, 3u, k)], FL[fli(1u, 4u, k)], h);
+            } else {
+                pa = max(max(accel, abs(FL[fli(0u, 3u, k)])), abs(FL[fli(1u, 3u, k)]));
+            }
+            if (pa > accel) {
+                accel = pa;
+                rcount[cb + BC_ACCEL_FLOOR] = j + 1u;
+            }
+        }
+        rstate[sb + BS_DRIFT] = drift;
+        rstate[sb + BS_ACCEL] = accel;
+    }
+}
+
+// Time since level l's impact began, at local time tau of the current interval.
+fn since_onset(l: u32, tau: real) -> real {
+    return real(CI - rcount[lci(l, LC_I_ONSET)]) * DT + (tau - rstate[lsi(l, LS_TAU_ONSET)]);
+}
+
+// ForceHistory::sample for level l.
+fn force_sample(l: u32, t: real, f: real) {
+    var peak = max(rstate[lsi(l, LS_IMP_PEAK)], f);
+    let nh = rcount[lci(l, LC_NHIST)];
+    if (nh == 2u) {
+        let x0 = rstate[lsi(l, LS_H_T0)];
+        let y0 = rstate[lsi(l, LS_H_F0)];
+        let x1 = rstate[lsi(l, LS_H_T1)];
+        let y1 = rstate[lsi(l, LS_H_F1)];
+        peak = max(peak, parabola_peak(x0, y0, x1, y1, t, f));
+        rstate[lsi(l, LS_H_T0)] = x1;
+        rstate[lsi(l, LS_H_F0)] = y1;
+        rstate[lsi(l, LS_H_T1)] = t;
+        rstate[lsi(l, LS_H_F1)] = f;
+    } else if (nh == 1u) {
+        rstate[lsi(l, LS_H_T1)] = t;
+        rstate[lsi(l, LS_H_F1)] = f;
+        rcount[lci(l, LC_NHIST)] = 2u;
+    } else {
+        rstate[lsi(l, LS_H_T0)] = t;
+        rstate[lsi(l, LS_H_F0)] = f;
+        rcount[lci(l, LC_NHIST)] = 1u;
+    }
+    rstate[lsi(l, LS_IMP_PEAK)] = peak;
+}
+
+// RowRun::track: a piece tau0 -> tau0 + h from z0 to z1 in the current modes.
+fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1: real) {
+    track_buildings(z0, z1, ag0, ag1, h);
+    ENDS_VALID = true;
+    for (var l = 0u; l < NL; l++) {
+        let mode = LMODE[l];
+        if (mode == MODE_FREE) {
+            continue;
+        }
+        rstate[lsi(l, LS_CONTACT_TIME)] += h;
+        let y0 = delta(l, z0);
+        let d0 = ddelta(l, z0);
+        let y1 = delta(l, z1);
+        let d1 = ddelta(l, z1);
+        let pen = rstate[lsi(l, LS_PENETRATION)];
+        if (cubic_max_bound(y0, d0, y1, d1, h) > pen) {
+            rstate[lsi(l, LS_PENETRATION)] = max(pen, hermite_range(y0, d0, y1, d1, h).hi);
+        }
+        rstate[lsi(l, LS_DISSIPATED)] = (*z1)[2u * NM + l];
+        let f = force(l, mode, LV0[l], z1);
+        force_sample(l, since_onset(l, tau0 + h), f);
+    }
+}
+
+fn onset(l: u32, tau: real, v0: real, f: real) {
+    let impacts = rcount[lci(l, LC_IMPACTS)] + 1u;
+    rcount[lci(l, LC_IMPACTS)] = impacts;
+    if (impacts == 1u) {
+        rstate[lsi(l, LS_FIRST_IMPACT)] = T0 + real(CI) * DT + tau;
+    }
+    LV0[l] = v0;
+    rstate[lsi(l, LS_TAU_ONSET)] = tau;
+    rcount[lci(l, LC_I_ONSET)] = CI;
+    rstate[lsi(l, LS_IMP_PEAK)] = 0.0;
+    rcount[lci(l, LC_NHIST)] = 0u;
+    force_sample(l, 0.0, f);
+}
+
+fn end_impact(l: u32) {
+    let imp = rstate[lsi(l, LS_IMP_PEAK)];
+    if (imp > rstate[lsi(l, LS_PEAK_FORCE)]) {
+        rstate[lsi(l, LS_PEAK_FORCE)] = imp;
+        rstate[lsi(l, LS_IMPACT_VELOCITY)] = LV0[l];
+    }
+}
+
+// RowRun::transitions at state z (local time tau); `before`: the state at the step's start.
+fn transitions(tau: real, z: ptr<function, ZA>, before: ptr<function, ZA>) {
+    for (var l = 0u; l < NL; l++) {
+        let mode = LMODE[l];
+        let v0 = LV0[l];
+        if (event_value(l, mode, v0, z) <= 0.0) {
+            if (mode == MODE_RESTITUTION && ddelta(l, z) > 0.0) {
+                LMODE[l] = MODE_APPROACH;
+                ENDS_VALID = false;
+            }
+            continue;
+        }
+        ENDS_VALID = false;
+        if (mode == MODE_FREE) {
+            // events::touch
+            let r = ddelta(l, z);
+            var nv0 = v0;
+            if (delta(l, before) <= 0.0 || v0 <= 0.0) {
+                nv0 = abs(r);
+            }
+            nv0 = max(nv0, 1e-12);
+            var next = MODE_RESTITUTION;
+            if (r > 0.0) { next = MODE_APPROACH; }
+            let f = force(l, next, nv0, z);
+            onset(l, tau, nv0, f);
+            LMODE[l] = next;
+        } else if (mode == MODE_APPROACH) {
+            LMODE[l] = MODE_RESTITUTION;
+        } else {
+            end_impact(l);
+            LMODE[l] = MODE_FREE;
+        }
+    }
+}
+
+// events::locate (Illinois regula falsi with a guard probe) on the largest event value; the
+// step is re-taken by rk4 from (tau, z0). Returns the length, the state at it in `zb`.
+fn locate(h: real, f0: real, f1: real, tol: real, seg: Seg, tau: real, z0: ptr<function, ZA>,
+          zb: ptr<function, ZA>) -> real {
+    var a: real = 0.0;
+    var fa = min(f0, 0.0);
+    var b = h;
+    var fb = f1;
+    var last = 0;
+    var zx: ZA;
+    for (var it = 0u; it < LOCATE_ITER; it++) {
+        if (b - a <= tol) { break; }
+        var x = 0.5 * (a + b);
+        if (fb != fa) {
+            x = b - fb * (b - a) / (fb - fa);
+        }
+        if (!(x > a && x < b)) {
+            x = 0.5 * (a + b);
+        }
+        rk4(seg, tau, z0, x, &zx);
+        let fx = event_max(&zx);
+        var g: real;
+        if (fx > 0.0) {
+            b = x; fb = fx; *zb = zx;
+            if (last == 1) { fa = fa * 0.5; }
+            last = 1;
+            g = x - 0.5 * tol;
+        } else {
+            a = x; fa = fx;
+            if (last == -1) { fb = fb * 0.5; }
+            last = -1;
+            g = x + 0.5 * tol;
+        }
+        if (g > a && g < b) {
+            rk4(seg, tau, z0, g, &zx);
+            let fg = event_max(&zx);
+            if (fg > 0.0) {
+                b = g; fb = fg; *zb = zx;
+            } else {
+                a = g; fa = fg;
+            }
+        }
+    }
+    return b;
+}
+
+// RowRun::accept for the RK4 trial step tau -> tau + h from z0; returns the length advanced
+// and leaves the new state in `out`.
+fn accept(tau: real, h_in: real, trial_in: ptr<function, ZA>, seg: Seg, z0: ptr<function, ZA>,
+          out: ptr<function, ZA>) -> real {
+    var trial = *trial_in;
+    var h = h_in;
+    var f1 = event_max(&trial);
+    if (f1 <= 0.0) {
+        // The earliest touch hidden inside the step at a free level.
+        var best: real = -1.0;
+        for (var l = 0u; l < NL; l++) {
+            if (LMODE[l] != MODE_FREE) {
+                continue;
+            }
+            let s = hidden_rise(delta(l, z0), ddelta(l, z0), delta(l, &trial), ddelta(l, &trial), h);
+            if (s >= 0.0 && (best < 0.0 || s < best)) {
+                best = s;
+            }
+        }
+        if (best >= 0.0) {
+            var zs: ZA;
+            rk4(seg, tau, z0, best * h, &zs);
+            let fs = event_max(&zs);
+            if (fs > 0.0) {
+                trial = zs;
+                f1 = fs;
+                h = best * h;
+            }
+        }
+    }
+    if (f1 > 0.0) {
+        let f0 = event_max(z0);
+        let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
+        *out = trial;
+        let x = locate(h, f0, f1, tol, seg, tau, z0, out);
+        track(tau, x, z0, out, seg_at(seg, tau), seg_at(seg, tau + x));
+        transitions(tau + x, out, z0);
+        return x;
+    }
+    track(tau, h, z0, &trial, seg_at(seg, tau), seg_at(seg, tau + h));
+    *out = trial;
+    for (var l = 0u; l < NL; l++) {
+        if (LMODE[l] == MODE_RESTITUTION && ddelta(l, out) > 0.0) {
+            LMODE[l] = MODE_APPROACH;
+            ENDS_VALID = false;
+        }
+    }
+    return h;
+}
+
+fn finite(z: ptr<function, ZA>) -> bool {
+    // abs(x) <= BIG is false for NaN and for +-inf.
+    for (var i = 0u; i < 2u * NM + NL; i++) {
+        if (!(abs((*z)[i]) <= BIG)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// ---- fast.rs `run`, loop body ----
+
+// The substep a contact level asks for to stay stable at penetration d_est (K set to it).
+fn h_rate_of(d_est: real, v0: real) -> real {
+    return TWO_PI / PER_CONTACT / max(local_rate(2.0 * d_est, v0), RATE);
+}
+
+// The start of the current record interval: take it with the exact modal propagators if no
+// level can touch inside, else set up its M RK4 substeps.
+fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
+    let dt = DT;
+    var h = TWO_PI / PER_CONTACT / RATE;
+    var contact = false;
+    for (var l = 0u; l < NL; l++) {
+        contact = contact || LMODE[l] != MODE_FREE;
+    }
+    if (!contact) {
+        var z1 = *z;
+        for (var b = 0u; b < NB; b++) {
+            for (var i = 0u; i < B_N[b]; i++) {
+                let k = B_OFF[b] + i;
+                let c = MB[b] + MW * i + 3u;
+                let a0 = PART[k] * seg.a0;
+                let a1 = PART[k] * seg.a1;
+                let u = (*z)[k];
+                let v = (*z)[NM + k];
+                z1[k] = models[c] * u + models[c + 1u] * v + models[c + 2u] * a0 + models[c + 3u] * a1;
+                z1[NM + k] = models[c + 4u] * u + models[c + 5u] * v + models[c + 6u] * a0
+                    + models[c + 7u] * a1;
+            }
+        }
+        var touching = false;
+        for (var l = 0u; l < NL; l++) {
+            if (!may_touch(l, seg, z, &z1, dt, LV0[l])) {
+                continue;
+            }
+            touching = true;
+            let v_est = 1.5 * max(abs(ddelta(l, z)), abs(ddelta(l, &z1)));
+            let d_est = max(delta(l, z), delta(l, &z1));
+            let a_est = max(abs(structural_rel_accel(l, z)), abs(structural_rel_accel(l, &z1)));
+            use_level(l);
+            h = min(h, min(impact_step(v_est, a_est, PER_CONTACT), h_rate_of(d_est, LV0[l])));
+        }
+        if (!touching) {
+            track(0.0, dt, z, &z1, seg.a0, seg.a1);
+            FREE_STEPS = FREE_STEPS + 1u;
+            *z = z1;
+            if (!finite(z)) {
+                STATUS = STATUS_NON_FINITE;
+            }
+            CI = CI + 1u;
+            return;
+        }
+    } else {
+        for (var l = 0u; l < NL; l++) {
+            let d = delta(l, z);
+            let r = ddelta(l, z);
+            let a = abs(structural_rel_accel(l, z));
+            use_level(l);
+            if (LMODE[l] == MODE_FREE) {
+                // A free level beside a contact: size for its touch if it could close within
+                // the step at its present rate.
+                if (d + 2.0 * max(r, 0.0) * dt > 0.0) {
+                    h = min(h, impact_step(1.5 * abs(r), a, PER_CONTACT));
+                }
+                continue;
+            }
+            let v0 = LV0[l];
+            let h_rate = h_rate_of(d, v0);
+            if (since_onset(l, 0.0) > SUSTAINED * duration_estimate(v0)) {
+                h = min(h, h_rate);
+            } else {
+                h = min(h, min(impact_step(max(v0, abs(r)), a, PER_CONTACT), h_rate));
+            }
+        }
+    }
+    let mf = max(ceil(dt / h), 1.0);
+    if (!(mf <= real(disp.max_substeps_per_step))) {
+        STATUS = STATUS_STEP_LIMIT;
+    } else if (mf > real(disp.handoff_substeps_per_step)) {
+        // More substeps than this precision resolves: the host finishes the run on the CPU.
+        STATUS = STATUS_HANDOFF;
+    } else {
+        CM = u32(mf);
+        CJ = 1u;
+        PIECES = 0u;
+        TAU = 0.0;
+    }
+}
+
+fn end_substep(tau_target: real) {
+    TAU = tau_target;
+    CJ = CJ + 1u;
+    PIECES = 0u;
+    if (CJ > CM) {
+        CJ = 0u;
+        CI = CI + 1u;
+    }
+}
+
+// One piece of substep j of the current interval (as fast.wgsl `piece`).
+fn piece(seg: Seg, z: ptr<function, ZA>) {
+    let h = DT / real(CM);
+    var tau_target = DT;
+    if (CJ < CM) {
+        tau_target = real(CJ) * h;
+    }
+    let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
+    if (tau_target - TAU > tol) {
+        SUBSTEPS = SUBSTEPS + 1u;
+        PIECES = PIECES + 1u;
+        if (SUBSTEPS > disp.max_substeps || PIECES > MAX_PIECES_PER_SUBSTEP) {
+            STATUS = STATUS_STEP_LIMIT;
+        } else {
+            var z0 = *z;
+            let hs = tau_target - TAU;
+            var trial: ZA;
+            rk4(seg, TAU, &z0, hs, &trial);
+            var znew: ZA;
+            TAU = TAU + accept(TAU, hs, &trial, seg, &z0, &znew);
+            *z = znew;
+            if (!finite(z)) {
+                STATUS = STATUS_NON_FINITE;
+            } else if (!(tau_target - TAU > tol)) {
+                end_substep(tau_target);
+            }
+        }
+    } else {
+        end_substep(tau_target);
+    }
+}
+
+// One lane's work in a dispatch: at most disp.budget units of run run_ids[lane]; returns the
+// units it did.
+fn integrate_run(lane: u32) -> u32 {
+    if (lane >= disp.nactive) {
+        return 0u;
+    }
+    let r = run_ids[lane];
+    RC = r * C_STRIDE;
+    let rm = r * M_STRIDE;
+    STATUS = rcount[RC + C_STATUS];
+    CI = rcount[RC + C_I];
+    INTERVALS = rmeta[rm + M_INTERVALS];
+    if (STATUS != STATUS_OK || CI >= INTERVALS) {
+        return 0u;
+    }
+    RP = r * P_STRIDE;
+    RS = r * S_STRIDE;
+    LAW = rmeta[rm + M_LAW];
+    REC_OFF = rmeta[rm + M_REC_OFFSET];
+    REC_LEN = rmeta[rm + M_REC_LEN];
+    DT = rp(P_DT);
+    T0 = rp(P_T0);
+    SCALE = rp(P_SCALE);
+    PER_CONTACT = rp(P_PER_CONTACT);
+    RATE = rp(P_RATE);
+    for (var b = 0u; b < NB; b++) {
+        let mb = rmeta[rm + M_MODELS + b];
+        MB[b] = mb;
+        for (var i = 0u; i < B_N[b]; i++) {
+            let k = B_OFF[b] + i;
+            W2[k] = models[mb + MW * i];
+            TXW[k] = models[mb + MW * i + 1u];
+            PART[k] = models[mb + MW * i + 2u];
+        }
+    }
+    for (var l = 0u; l < NL; l++) {
+        LMODE[l] = rcount[lci(l, LC_MODE)];
+        LV0[l] = rstate[lsi(l, LS_V0)];
+    }
+    CJ = rcount[RC + C_J];
+    CM = rcount[RC + C_M];
+    PIECES = rcount[RC + C_PIECES];
+    SUBSTEPS = rcount[RC + C_SUBSTEPS];
+    FREE_STEPS = rcount[RC + C_FREE_STEPS];
+    TAU = rstate[RS + S_TAU];
+    ENDS_VALID = false;
+    var z: ZA;
+    for (var i = 0u; i < ZLEN; i++) { z[i] = rstate[RS + i]; }
+    var budget = disp.budget;
+    loop {
+        if (STATUS != STATUS_OK || CI >= INTERVALS || budget == 0u) {
+            break;
+        }
+        budget = budget - 1u;
+        let seg = Seg(sample(CI), sample(CI + 1u), DT);
+        if (CJ == 0u) {
+            begin_interval(seg, &z);
+        } else {
+            piece(seg, &z);
+        }
+    }
+    for (var i = 0u; i < ZLEN; i++) { rstate[RS + i] = z[i]; }
+    rstate[RS + S_TAU] = TAU;
+    for (var l = 0u; l < NL; l++) {
+        rcount[lci(l, LC_MODE)] = LMODE[l];
+        rstate[lsi(l, LS_V0)] = LV0[l];
+    }
+    rcount[RC + C_STATUS] = STATUS;
+    rcount[RC + C_I] = CI;
+    rcount[RC + C_J] = CJ;
+    rcount[RC + C_M] = CM;
+    rcount[RC + C_PIECES] = PIECES;
+    rcount[RC + C_SUBSTEPS] = SUBSTEPS;
+    rcount[RC + C_FREE_STEPS] = FREE_STEPS;
+    if (STATUS == STATUS_OK && CI < INTERVALS) {
+        next_ids[atomicAdd(&tally.active_runs, 1u)] = r;
+    }
+    return disp.budget - budget;
+}

@@ -1,0 +1,657 @@
+//! Rows of shear buildings on the GPU (`shaders/row.wgsl`, the twin of
+//! [`crate::physics::solver::row::fast`]): the row's shape, which the kernel is built for
+//! (storey counts and contact levels become WGSL constants, so a kernel loops over exactly the
+//! modes and levels its row has); packing runs and their building models into flat buffers;
+//! the dispatch loop; reading results back.
+//!
+//! Buffers, per run: a block of reals (`P_*`: record and contact settings, the gaps, each
+//! level's contact), a block of u32 (`M_*`: law, record, each building's model), and the state
+//! that persists between dispatches (`S_*` reals, `C_*` u32). Building models (modes, shapes,
+//! masses, heights, propagators) are shared by the runs that use the same one.
+
+use super::context::{GpuContext, GpuError};
+use super::layout::{MODE_FREE, STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK};
+use super::run::{
+    bind_group, read, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions, GpuRecords,
+    WorkLists,
+};
+use super::shader::Precision;
+use crate::engine::Summary;
+use crate::physics::contact::LawKind;
+use crate::physics::model::{Forcing, Oscillator, Status};
+use crate::physics::propagator::Propagator;
+use crate::physics::row::{BuildingOutput, LevelOutput, RowOutput};
+use crate::physics::solver::fast::LOCATE_ITERATIONS;
+use crate::physics::solver::row::{simulate_row, RowModel, RowScheme};
+use crate::physics::solver::FastOptions;
+use crate::plan::row::{RowPlan, RowRunSpec};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::time::Instant;
+
+// A run's parameter block (reals).
+pub const P_DT: usize = 0;
+pub const P_T0: usize = 1;
+pub const P_SCALE: usize = 2;
+pub const P_PER_CONTACT: usize = 3;
+pub const P_STIFFNESS: usize = 4;
+pub const P_RATIO: usize = 5;
+/// The row's structural rate (`RowModel::structural_rate`).
+pub const P_RATE: usize = 6;
+/// Then one gap per adjacent pair, then per level: contact damping, `m_eff`, `tc_coef`.
+pub const P_GAPS: usize = 7;
+// A run's meta block (u32), then each building's model block offset.
+pub const M_LAW: usize = 0;
+pub const M_REC_OFFSET: usize = 1;
+pub const M_REC_LEN: usize = 2;
+pub const M_INTERVALS: usize = 3;
+pub const M_MODELS: usize = 4;
+// A run's counters (u32), then each level's (LC_*), then each building's (BC_*).
+pub const C_STATUS: usize = 0;
+pub const C_SUBSTEPS: usize = 1;
+pub const C_I: usize = 2;
+pub const C_J: usize = 3;
+pub const C_M: usize = 4;
+pub const C_PIECES: usize = 5;
+pub const C_FREE_STEPS: usize = 6;
+pub const C_LEVELS: usize = 7;
+pub const LC_MODE: usize = 0;
+pub const LC_IMPACTS: usize = 1;
+pub const LC_NHIST: usize = 2;
+pub const LC_I_ONSET: usize = 3;
+pub const LC_STRIDE: usize = 4;
+pub const BC_DRIFT_STOREY: usize = 0;
+pub const BC_ACCEL_FLOOR: usize = 1;
+pub const BC_STRIDE: usize = 2;
+// A run's state (reals): z, the local time, then each level's (LS_*), then each building's.
+pub const LS_V0: usize = 0;
+pub const LS_TAU_ONSET: usize = 1;
+pub const LS_IMP_PEAK: usize = 2;
+pub const LS_H_T0: usize = 3;
+pub const LS_H_F0: usize = 4;
+pub const LS_H_T1: usize = 5;
+pub const LS_H_F1: usize = 6;
+pub const LS_PEAK_FORCE: usize = 7;
+pub const LS_IMPACT_VELOCITY: usize = 8;
+pub const LS_PENETRATION: usize = 9;
+pub const LS_FIRST_IMPACT: usize = 10;
+pub const LS_CONTACT_TIME: usize = 11;
+pub const LS_DISSIPATED: usize = 12;
+pub const LS_STRIDE: usize = 13;
+pub const BS_ROOF: usize = 0;
+pub const BS_DRIFT: usize = 1;
+pub const BS_ACCEL: usize = 2;
+pub const BS_STRIDE: usize = 3;
+/// Reals per mode in a building model: `w^2`, `2 xi w`, the participation, then the
+/// propagator's `uu, uv, ua0, ua1, vu, vv, va0, va1`.
+pub const MW: usize = 11;
+
+/// lavapipe ends a shader's loops after about 65,535 back edges per invocation, counted over
+/// all its loops (see [`super::run::CPU_ADAPTER_BUDGET`]): a dispatch's units on a software
+/// adapter are capped to stay below this many loop trips.
+const SOFTWARE_LOOP_TRIPS: u64 = 60_000;
+
+/// What a row kernel is built for: each building's storeys, and each contact level's left
+/// building and floors (from 0).
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct RowShape {
+    pub storeys: Vec<usize>,
+    pub levels: Vec<[usize; 3]>,
+}
+
+impl RowShape {
+    pub fn of(m: &RowModel) -> RowShape {
+        RowShape {
+            storeys: m.buildings.iter().map(|b| b.n()).collect(),
+            levels: m
+                .levels
+                .iter()
+                .map(|l| [l.buildings.0, l.floors.0, l.floors.1])
+                .collect(),
+        }
+    }
+
+    fn modes(&self) -> usize {
+        self.storeys.iter().sum()
+    }
+
+    fn zlen(&self) -> usize {
+        2 * self.modes() + self.levels.len() + 2
+    }
+
+    fn p_stride(&self) -> usize {
+        P_GAPS + self.storeys.len() - 1 + 3 * self.levels.len()
+    }
+
+    fn m_stride(&self) -> usize {
+        M_MODELS + self.storeys.len()
+    }
+
+    fn s_levels(&self) -> usize {
+        self.zlen() + 1
+    }
+
+    fn s_buildings(&self) -> usize {
+        self.s_levels() + LS_STRIDE * self.levels.len()
+    }
+
+    fn s_stride(&self) -> usize {
+        self.s_buildings() + BS_STRIDE * self.storeys.len()
+    }
+
+    fn c_buildings(&self) -> usize {
+        C_LEVELS + LC_STRIDE * self.levels.len()
+    }
+
+    fn c_stride(&self) -> usize {
+        self.c_buildings() + BC_STRIDE * self.storeys.len()
+    }
+
+    /// Reals of one building's model block.
+    fn model_len(n: usize) -> usize {
+        MW * n + n * n + 2 * n
+    }
+
+    /// The shape and layout as WGSL constants, prepended to `row.wgsl`.
+    pub fn wgsl_constants(&self) -> String {
+        let list = |v: &[usize]| -> String {
+            let items: Vec<String> = v.iter().map(|x| format!("{x}u")).collect();
+            items.join(", ")
+        };
+        let nb = self.storeys.len();
+        let nl = self.levels.len();
+        let nla = nl.max(1);
+        let offs: Vec<usize> = self
+            .storeys
+            .iter()
+            .scan(0, |o, &n| {
+                let at = *o;
+                *o += n;
+                Some(at)
+            })
+            .collect();
+        let pick = |k: usize| -> Vec<usize> {
+            let v: Vec<usize> = self.levels.iter().map(|l| l[k]).collect();
+            if v.is_empty() {
+                vec![0]
+            } else {
+                v
+            }
+        };
+        let mut s = String::new();
+        let mut c = |name: &str, v: usize| s.push_str(&format!("const {name}: u32 = {v}u;\n"));
+        c("NB", nb);
+        c("NM", self.modes());
+        c("NL", nl);
+        c("NLA", nla);
+        c("ZLEN", self.zlen());
+        c("MAXN", *self.storeys.iter().max().unwrap_or(&1));
+        c("FLEN", 10 * self.modes());
+        c("MW", MW);
+        for (name, v) in [
+            ("P_DT", P_DT),
+            ("P_T0", P_T0),
+            ("P_SCALE", P_SCALE),
+            ("P_PER_CONTACT", P_PER_CONTACT),
+            ("P_STIFFNESS", P_STIFFNESS),
+            ("P_RATIO", P_RATIO),
+            ("P_RATE", P_RATE),
+            ("P_GAPS", P_GAPS),
+            ("P_LEVELS", P_GAPS + nb - 1),
+            ("P_STRIDE", self.p_stride()),
+            ("M_LAW", M_LAW),
+            ("M_REC_OFFSET", M_REC_OFFSET),
+            ("M_REC_LEN", M_REC_LEN),
+            ("M_INTERVALS", M_INTERVALS),
+            ("M_MODELS", M_MODELS),
+            ("M_STRIDE", self.m_stride()),
+            ("C_STATUS", C_STATUS),
+            ("C_SUBSTEPS", C_SUBSTEPS),
+            ("C_I", C_I),
+            ("C_J", C_J),
+            ("C_M", C_M),
+            ("C_PIECES", C_PIECES),
+            ("C_FREE_STEPS", C_FREE_STEPS),
+            ("C_LEVELS", C_LEVELS),
+            ("C_BUILDINGS", self.c_buildings()),
+            ("C_STRIDE", self.c_stride()),
+            ("LC_MODE", LC_MODE),
+            ("LC_IMPACTS", LC_IMPACTS),
+            ("LC_NHIST", LC_NHIST),
+            ("LC_I_ONSET", LC_I_ONSET),
+            ("LC_STRIDE", LC_STRIDE),
+            ("BC_DRIFT_STOREY", BC_DRIFT_STOREY),
+            ("BC_ACCEL_FLOOR", BC_ACCEL_FLOOR),
+            ("BC_STRIDE", BC_STRIDE),
+            ("S_TAU", self.zlen()),
+            ("S_LEVELS", self.s_levels()),
+            ("S_BUILDINGS", self.s_buildings()),
+            ("S_STRIDE", self.s_stride()),
+            ("LS_V0", LS_V0),
+            ("LS_TAU_ONSET", LS_TAU_ONSET),
+            ("LS_IMP_PEAK", LS_IMP_PEAK),
+            ("LS_H_T0", LS_H_T0),
+            ("LS_H_F0", LS_H_F0),
+            ("LS_H_T1", LS_H_T1),
+            ("LS_H_F1", LS_H_F1),
+            ("LS_PEAK_FORCE", LS_PEAK_FORCE),
+            ("LS_IMPACT_VELOCITY", LS_IMPACT_VELOCITY),
+            ("LS_PENETRATION", LS_PENETRATION),
+            ("LS_FIRST_IMPACT", LS_FIRST_IMPACT),
+            ("LS_CONTACT_TIME", LS_CONTACT_TIME),
+            ("LS_DISSIPATED", LS_DISSIPATED),
+            ("LS_STRIDE", LS_STRIDE),
+            ("BS_ROOF", BS_ROOF),
+            ("BS_DRIFT", BS_DRIFT),
+            ("BS_ACCEL", BS_ACCEL),
+            ("BS_STRIDE", BS_STRIDE),
+        ] {
+            c(name, v);
+        }
+        // Private arrays, not `const` ones: they are indexed at run time.
+        let mut a = |name: &str, len: &str, v: &[usize]| {
+            s.push_str(&format!(
+                "var<private> {name}: array<u32, {len}> = array<u32, {len}>({});\n",
+                list(v)
+            ))
+        };
+        a("B_N", "NB", &self.storeys);
+        a("B_OFF", "NB", &offs);
+        a("L_A", "NLA", &pick(0));
+        a("L_FA", "NLA", &pick(1));
+        a("L_FB", "NLA", &pick(2));
+        s
+    }
+
+    /// An upper bound on the loop trips of one unit of work (a free interval, or an RK4 piece
+    /// with its event location and tracking), counted as the kernel's loops run.
+    pub fn loop_trips_per_unit(&self) -> u64 {
+        let nm = self.modes() as u64;
+        let nl = self.levels.len() as u64;
+        let nmax = *self.storeys.iter().max().unwrap_or(&1) as u64;
+        let zlen = self.zlen() as u64;
+        let sq: u64 = self.storeys.iter().map(|&n| (n * n + 2 * n) as u64).sum();
+        let level = 4 * nmax + 1;
+        let rhs = nm + nl * (2 * level + 2 * nmax) + 1;
+        let rk4 = 4 * rhs + 4 * zlen;
+        let event_max = nl * level;
+        let forces = nm + nl * level;
+        let track = 5 * nm + 2 * forces + 2 * sq + nl + nm + nl * (3 * level);
+        let transitions = nl * (3 * level);
+        let locate = LOCATE_ITERATIONS as u64 * (2 * (rk4 + event_max) + 1);
+        let accept = 4 * event_max + nl * (2 * level) + rk4 + locate + track + transitions;
+        let piece = rk4 + accept + zlen;
+        let begin = nl + nm + nl * (6 * level + 2 * nmax) + track + zlen;
+        piece.max(begin) + 1
+    }
+}
+
+/// The building models of a chunk, each stored once.
+#[derive(Debug, Default)]
+struct ModelTable {
+    reals: Vec<f64>,
+    index: HashMap<Vec<u64>, u32>,
+}
+
+impl ModelTable {
+    fn add(&mut self, block: Vec<f64>) -> u32 {
+        let key: Vec<u64> = block.iter().map(|x| x.to_bits()).collect();
+        let reals = &mut self.reals;
+        *self.index.entry(key).or_insert_with(|| {
+            let at = reals.len() as u32;
+            reals.extend_from_slice(&block);
+            at
+        })
+    }
+}
+
+/// A chunk of row runs packed for the kernel.
+#[derive(Debug)]
+pub struct PackedRows {
+    pub shape: RowShape,
+    params: Vec<f64>,
+    meta: Vec<u32>,
+    models: ModelTable,
+    runs: usize,
+}
+
+fn law_code(l: LawKind) -> u32 {
+    LawKind::ALL.iter().position(|&k| k == l).unwrap() as u32
+}
+
+impl PackedRows {
+    pub fn new(shape: RowShape) -> PackedRows {
+        PackedRows {
+            shape,
+            params: Vec::new(),
+            meta: Vec::new(),
+            models: ModelTable::default(),
+            runs: 0,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.runs
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.runs == 0
+    }
+
+    /// Add one run of model `m` (of this chunk's shape) on `forcing`, the `record`-th of `recs`.
+    pub fn push(
+        &mut self,
+        m: &RowModel,
+        forcing: &Forcing,
+        record: usize,
+        recs: &GpuRecords,
+        fast: &FastOptions,
+    ) {
+        assert_eq!(
+            RowShape::of(m),
+            self.shape,
+            "a chunk holds rows of one shape"
+        );
+        let dt = forcing.dt;
+        let first = m.levels.first().map(|l| l.contact);
+        self.params.extend([
+            dt,
+            forcing.t0,
+            forcing.scale,
+            fast.substeps_per_contact,
+            first.map_or(0.0, |c| c.stiffness),
+            first.map_or(0.0, |c| c.damping_ratio),
+            m.structural_rate(),
+        ]);
+        let mut gaps = vec![0.0; self.shape.storeys.len() - 1];
+        for l in &m.levels {
+            gaps[l.buildings.0] = l.gap;
+        }
+        self.params.extend(gaps);
+        for l in &m.levels {
+            let c = &l.contact;
+            self.params.extend([c.damping, c.m_eff, c.tc_coef()]);
+        }
+        let (offset, len) = recs.record(record);
+        debug_assert_eq!(forcing.accel.len(), len as usize);
+        self.meta.extend([
+            first.map_or(0, |c| law_code(c.kind)),
+            offset,
+            len,
+            forcing.intervals() as u32,
+        ]);
+        for block in model_blocks(m, dt) {
+            let at = self.models.add(block);
+            self.meta.push(at);
+        }
+        self.runs += 1;
+    }
+}
+
+/// Each building's model block for the kernel at record step `dt`: per mode `w^2`, `2 xi w`,
+/// the participation and the exact propagator; the mode shapes, floor masses, storey heights.
+fn model_blocks(m: &RowModel, dt: f64) -> Vec<Vec<f64>> {
+    m.buildings
+        .iter()
+        .map(|b| {
+            let n = b.n();
+            let mut block = Vec::with_capacity(RowShape::model_len(n));
+            for i in 0..n {
+                let k = b.off + i;
+                let osc = Oscillator {
+                    m: 1.0,
+                    k: m.w2[k],
+                    c: m.two_xi_w[k],
+                };
+                let p = Propagator::new(&osc, dt);
+                block.extend([
+                    m.w2[k],
+                    m.two_xi_w[k],
+                    m.part[k],
+                    p.uu,
+                    p.uv,
+                    p.ua0,
+                    p.ua1,
+                    p.vu,
+                    p.vv,
+                    p.va0,
+                    p.va1,
+                ]);
+            }
+            for row in &b.modes.shape {
+                block.extend_from_slice(row);
+            }
+            block.extend_from_slice(&b.masses);
+            block.extend_from_slice(&b.heights);
+            block
+        })
+        .collect()
+}
+
+/// Integrate a chunk of packed rows over their whole records; results in input order, None
+/// for runs handed back to the host (more substeps per record step than `opts` allows the
+/// precision).
+pub fn run_rows(
+    ctx: &GpuContext,
+    recs: &GpuRecords,
+    chunk: &PackedRows,
+    opts: &GpuOptions,
+) -> Result<(Vec<Option<RowOutput>>, ChunkTimes), GpuError> {
+    let mut times = ChunkTimes::default();
+    let n = chunk.runs;
+    if n == 0 {
+        return Ok((Vec::new(), times));
+    }
+    if opts.fast.energy {
+        return Err(GpuError::Other {
+            message: "the GPU row kernel does not integrate the energy balance".into(),
+        });
+    }
+    let shape = &chunk.shape;
+    let trips = shape.loop_trips_per_unit();
+    let cap = SOFTWARE_LOOP_TRIPS / trips;
+    if ctx.is_software() && cap == 0 {
+        return Err(GpuError::Other {
+            message: format!(
+                "a row of {} storeys and {} contact levels is too large for the software adapter's loop limit",
+                shape.modes(),
+                shape.levels.len()
+            ),
+        });
+    }
+    let kernel = ctx.row_kernel(opts.precision, shape)?;
+    let t = Instant::now();
+    let p = opts.precision;
+    let params = storage(
+        ctx,
+        "row params",
+        &p.reals(&chunk.params),
+        wgpu::BufferUsages::empty(),
+    )?;
+    let meta = storage(
+        ctx,
+        "row metas",
+        bytemuck::cast_slice(&chunk.meta),
+        wgpu::BufferUsages::empty(),
+    )?;
+    let models = storage(
+        ctx,
+        "building models",
+        &p.reals(&chunk.models.reals),
+        wgpu::BufferUsages::empty(),
+    )?;
+    // Runs start at rest: a new buffer is zeroed, which is the state at rest, every level
+    // free and every counter 0.
+    let states = zeroed(
+        ctx,
+        "row states",
+        (n * shape.s_stride() * p.bytes()) as u64,
+        wgpu::BufferUsages::COPY_SRC,
+    )?;
+    let counters = zeroed(
+        ctx,
+        "row counters",
+        (n * shape.c_stride() * 4) as u64,
+        wgpu::BufferUsages::COPY_SRC,
+    )?;
+    let lists = WorkLists::new(ctx, n)?;
+    let bind = |from: &wgpu::Buffer, to: &wgpu::Buffer, label| {
+        let buffers = [
+            &lists.uniform,
+            &params,
+            &meta,
+            recs.buffer(),
+            &states,
+            &counters,
+            &lists.tally,
+            from,
+            to,
+            &models,
+        ];
+        bind_group(ctx, &kernel.layout, label, &buffers)
+    };
+    let binds = [
+        bind(&lists.ids[0], &lists.ids[1], "row bind group a->b"),
+        bind(&lists.ids[1], &lists.ids[0], "row bind group b->a"),
+    ];
+    wait(ctx)?;
+    times.upload = t.elapsed();
+    let budget = opts
+        .units_per_dispatch
+        .max(1)
+        .min(unit_cap(ctx, cap.min(u32::MAX as u64) as u32));
+    lists.run("row", ctx, &kernel, &binds, budget, opts, &mut times)?;
+    let t = Instant::now();
+    let sbytes = read(ctx, &states)?;
+    let cbytes = read(ctx, &counters)?;
+    let reals: Vec<f64> = match p {
+        Precision::F64 => bytemuck::cast_slice::<u8, f64>(&sbytes).to_vec(),
+        Precision::F32 => bytemuck::cast_slice::<u8, f32>(&sbytes)
+            .iter()
+            .map(|&x| x as f64)
+            .collect(),
+    };
+    let words: &[u32] = bytemuck::cast_slice(&cbytes);
+    let out = (0..n)
+        .map(|r| {
+            let s = &reals[r * shape.s_stride()..(r + 1) * shape.s_stride()];
+            let c = &words[r * shape.c_stride()..(r + 1) * shape.c_stride()];
+            output(shape, s, c)
+        })
+        .collect();
+    times.readback = t.elapsed();
+    Ok((out, times))
+}
+
+/// A run's results from its final state and counters (what `RowRun::finish` does on the CPU,
+/// without the energy balance); None for a run handed back.
+fn output(shape: &RowShape, s: &[f64], c: &[u32]) -> Option<RowOutput> {
+    let status = match c[C_STATUS] {
+        STATUS_HANDOFF => return None,
+        STATUS_OK => Status::Ok,
+        STATUS_NON_FINITE => Status::NonFinite,
+        _ => Status::StepLimit,
+    };
+    let levels = (0..shape.levels.len())
+        .map(|l| {
+            let ls = &s[shape.s_levels() + LS_STRIDE * l..];
+            let lc = &c[C_LEVELS + LC_STRIDE * l..];
+            let (mut peak_force, mut impact_velocity) = (ls[LS_PEAK_FORCE], ls[LS_IMPACT_VELOCITY]);
+            // An impact still under way ends with the run.
+            if lc[LC_MODE] != MODE_FREE && ls[LS_IMP_PEAK] > peak_force {
+                peak_force = ls[LS_IMP_PEAK];
+                impact_velocity = ls[LS_V0];
+            }
+            LevelOutput {
+                impacts: lc[LC_IMPACTS],
+                peak_force,
+                peak_penetration: ls[LS_PENETRATION],
+                impact_velocity,
+                first_impact: (lc[LC_IMPACTS] > 0).then_some(ls[LS_FIRST_IMPACT]),
+                contact_time: ls[LS_CONTACT_TIME],
+                dissipated_energy: ls[LS_DISSIPATED],
+            }
+        })
+        .collect();
+    let buildings = (0..shape.storeys.len())
+        .map(|b| {
+            let bs = &s[shape.s_buildings() + BS_STRIDE * b..];
+            let bc = &c[shape.c_buildings() + BC_STRIDE * b..];
+            BuildingOutput {
+                peak_roof: bs[BS_ROOF],
+                peak_drift_ratio: bs[BS_DRIFT],
+                drift_storey: bc[BC_DRIFT_STOREY],
+                peak_accel: bs[BS_ACCEL],
+                accel_floor: bc[BC_ACCEL_FLOOR],
+            }
+        })
+        .collect();
+    let mut out = RowOutput {
+        status,
+        levels,
+        buildings,
+        substeps: c[C_SUBSTEPS] as u64,
+        free_steps: c[C_FREE_STEPS] as u64,
+        ..RowOutput::default()
+    };
+    out.gather();
+    Some(out)
+}
+
+/// The runs `runs` of a row plan on the GPU in chunks of `chunk`, each chunk's runs handed back
+/// by the kernel finished on the CPU in f64 (as for pairs); `sink` gets each chunk in run order,
+/// `progress` the runs done after each.
+pub fn sweep_rows<E: From<GpuError>>(
+    ctx: &GpuContext,
+    plan: &RowPlan,
+    runs: std::ops::Range<u64>,
+    chunk: usize,
+    opts: &GpuOptions,
+    mut sink: impl FnMut(&[(RowRunSpec, RowOutput)]) -> Result<(), E>,
+    mut progress: impl FnMut(u64),
+) -> Result<Summary, E> {
+    let start = Instant::now();
+    let accels: Vec<&[f64]> = plan
+        .base
+        .spec
+        .records
+        .iter()
+        .map(|r| &r.accel[..])
+        .collect();
+    let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
+    let chunk = chunk.max(1) as u64;
+    let cpu = RowScheme::Fast(opts.fast);
+    let mut summary = Summary::default();
+    let mut first = runs.start;
+    while first < runs.end {
+        let end = (first + chunk).min(runs.end);
+        let specs: Vec<RowRunSpec> = (first..end).map(|i| plan.run(i)).collect();
+        // Modes (a Jacobi decomposition per building) on every thread.
+        let models: Vec<RowModel> = specs
+            .par_iter()
+            .map(|s| RowModel::new(&plan.row(s)))
+            .collect();
+        let mut packed = PackedRows::new(RowShape::of(&models[0]));
+        for (s, m) in specs.iter().zip(&models) {
+            packed.push(m, &plan.forcing(s), s.base.record, &recs, &opts.fast);
+        }
+        let (outs, _) = run_rows(ctx, &recs, &packed, opts)?;
+        let rows: Vec<(RowRunSpec, RowOutput)> = specs
+            .into_iter()
+            .zip(outs)
+            .zip(&models)
+            .map(|((s, o), m)| {
+                let o = o.unwrap_or_else(|| simulate_row(m, &plan.forcing(&s), m.at_rest(), &cpu));
+                (s, o)
+            })
+            .collect();
+        for (_, o) in &rows {
+            summary.count_row(o);
+        }
+        sink(&rows)?;
+        progress(summary.runs);
+        first = end;
+    }
+    summary.seconds = start.elapsed().as_secs_f64();
+    Ok(summary)
+}

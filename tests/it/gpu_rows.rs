@@ -1,0 +1,315 @@
+//! Rows of multi-storey buildings on the GPU (`shaders/row.wgsl`) against their CPU twin
+//! (`physics::solver::row::fast`) on the test device (lavapipe in CI), in f64 and f32.
+
+use crate::multistorey::{building, forcing, record};
+use crate::support::gpu::ctx;
+use crate::support::rel;
+use pounding::engine::gpu::row::{run_rows, PackedRows, RowShape};
+use pounding::engine::gpu::{GpuOptions, GpuRecords, Precision};
+use pounding::physics::contact::LawKind;
+use pounding::physics::model::Status;
+use pounding::physics::row::{Row, RowOutput};
+use pounding::physics::shear::Damping;
+use pounding::physics::solver::row::{simulate_row, RowModel, RowScheme};
+use pounding::physics::solver::FastOptions;
+
+/// Every model on the test device, each on its own record of `records`.
+fn on_gpu(models: &[RowModel], records: &[Vec<f64>], opts: &GpuOptions) -> Vec<Option<RowOutput>> {
+    let ctx = ctx().unwrap();
+    let refs: Vec<&[f64]> = records.iter().map(|r| &r[..]).collect();
+    let recs = GpuRecords::upload(ctx, opts.precision, &refs).unwrap();
+    let mut packed = PackedRows::new(RowShape::of(&models[0]));
+    for (i, m) in models.iter().enumerate() {
+        packed.push(m, &forcing(&records[i]), i, &recs, &opts.fast);
+    }
+    run_rows(ctx, &recs, &packed, opts).unwrap().0
+}
+
+fn on_cpu(models: &[RowModel], records: &[Vec<f64>]) -> Vec<RowOutput> {
+    let scheme = RowScheme::Fast(FastOptions::default());
+    models
+        .iter()
+        .zip(records)
+        .map(|(m, r)| simulate_row(m, &forcing(r), m.at_rest(), &scheme))
+        .collect()
+}
+
+/// Largest relative difference of the peaks of two results of one run (force, every level's
+/// force, roofs, drifts, floor accelerations).
+fn peak_diff(a: &RowOutput, b: &RowOutput) -> f64 {
+    let mut d = rel(a.peak_force, b.peak_force);
+    for (x, y) in a.levels.iter().zip(&b.levels) {
+        d = d.max(rel(x.peak_force, y.peak_force));
+    }
+    for (x, y) in a.buildings.iter().zip(&b.buildings) {
+        d = d
+            .max(rel(x.peak_roof, y.peak_roof))
+            .max(rel(x.peak_drift_ratio, y.peak_drift_ratio))
+            .max(rel(x.peak_accel, y.peak_accel));
+    }
+    d
+}
+
+/// A 2- beside a 3-storey building and a row of three small buildings, across the laws and
+/// gaps: small enough for lavapipe's loop limit at a useful budget.
+fn scenes() -> (Vec<RowModel>, Vec<Vec<f64>>) {
+    let laws = LawKind::ALL;
+    let mut models = Vec::new();
+    for k in 0..5 {
+        let law = laws[(2 * k) % laws.len()];
+        let stiffness = if law.is_hertzian() { 2.75e9 } else { 1e9 };
+        let row = Row::new(
+            vec![
+                building(2, 0.2 + 0.03 * k as f64, Damping::Rayleigh(0.05)),
+                building(3, 0.45, Damping::Modal(0.05)),
+            ],
+            vec![0.003 * k as f64],
+            law,
+            stiffness,
+            0.35,
+        );
+        models.push(RowModel::new(&row));
+    }
+    let three = Row::new(
+        vec![
+            building(2, 0.25, Damping::Rayleigh(0.05)),
+            building(3, 0.5, Damping::Rayleigh(0.05)),
+            building(2, 0.2, Damping::Modal(0.03)),
+        ],
+        vec![0.004, 0.002],
+        LawKind::NonlinearViscoelastic,
+        2.75e9,
+        0.35,
+    );
+    let records = (0..6).map(|s| record(60 + s, 4.0, 0.45)).collect();
+    ([models, vec![RowModel::new(&three)]].concat(), records)
+}
+
+/// f64 on the device is the CPU twin's arithmetic: the same impacts and substeps, peaks to
+/// rounding. f32 keeps the peaks within 1e-3 where the impact sequence is the same.
+#[test]
+fn row_kernel_matches_the_cpu_twin() {
+    if ctx().is_none() {
+        return;
+    }
+    let (models, records) = scenes();
+    let (two, three): (Vec<_>, Vec<_>) = models
+        .iter()
+        .zip(&records)
+        .partition(|(m, _)| RowShape::of(m).storeys.len() == 2);
+    for group in [two, three] {
+        let models: Vec<RowModel> = group.iter().map(|(m, _)| (*m).clone()).collect();
+        let records: Vec<Vec<f64>> = group.iter().map(|(_, r)| (*r).clone()).collect();
+        let cpu = on_cpu(&models, &records);
+        assert!(cpu.iter().filter(|o| o.impacts > 0).count() >= models.len().min(3));
+        for precision in [Precision::F64, Precision::F32] {
+            let opts = GpuOptions {
+                precision,
+                ..GpuOptions::default()
+            };
+            let gpu = on_gpu(&models, &records, &opts);
+            for (k, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+                let g = g.as_ref().expect("not handed back");
+                let d = peak_diff(g, c);
+                assert_eq!(g.status, Status::Ok, "{precision:?} run {k}");
+                if precision == Precision::F64 {
+                    // Measured on lavapipe: 1e-14 to 1e-11 beside two buildings; 3.1e-6 in the
+                    // row of three (44 impacts), whose events the kernel locates in time
+                    // local to the record step (the CPU in absolute time): 1e-9 s apart at
+                    // first, grown through the impact sequence.
+                    assert_eq!((g.impacts, g.substeps), (c.impacts, c.substeps), "run {k}");
+                    assert!(d < 1e-5, "f64 run {k}: {d:e}\n{g:?}\n{c:?}");
+                    assert_eq!(
+                        g.buildings
+                            .iter()
+                            .map(|b| (b.drift_storey, b.accel_floor))
+                            .collect::<Vec<_>>(),
+                        c.buildings
+                            .iter()
+                            .map(|b| (b.drift_storey, b.accel_floor))
+                            .collect::<Vec<_>>()
+                    );
+                } else if g.impacts == c.impacts {
+                    // Measured on lavapipe: up to 4e-5.
+                    assert!(d < 1e-3, "f32 run {k}: {d:e}");
+                }
+            }
+        }
+    }
+}
+
+/// A dispatch of one unit per run gives what a dispatch of many gives: the kernel's state
+/// carries everything between dispatches.
+#[test]
+fn row_kernel_resumes_between_dispatches() {
+    if ctx().is_none() {
+        return;
+    }
+    let (models, records) = scenes();
+    let (models, records) = (&models[1..3], &records[1..3]);
+    let run = |units: u32| {
+        on_gpu(
+            models,
+            records,
+            &GpuOptions {
+                precision: Precision::F64,
+                units_per_dispatch: units,
+                ..GpuOptions::default()
+            },
+        )
+    };
+    assert_eq!(run(1), run(4096));
+}
+
+/// With a hand-off above one substep per record step, every run that needs substeps comes back
+/// to the host (None) and the others finish on the device.
+#[test]
+fn row_kernel_hands_back_runs_past_its_substep_limit() {
+    if ctx().is_none() {
+        return;
+    }
+    let (models, records) = scenes();
+    let cpu = on_cpu(&models[..3], &records[..3]);
+    let opts = GpuOptions {
+        precision: Precision::F32,
+        handoff_substeps_per_step: Some(1),
+        ..GpuOptions::default()
+    };
+    let gpu = on_gpu(&models[..3], &records[..3], &opts);
+    for (g, c) in gpu.iter().zip(&cpu) {
+        assert_eq!(g.is_none(), c.substeps > 0, "{c:?}");
+    }
+    assert!(gpu.iter().any(|g| g.is_none()));
+}
+
+/// On a software adapter a row whose unit of work could run past lavapipe's loop limit (which
+/// silently ends loops) is refused with a clear error instead of wrong results.
+#[test]
+fn rows_too_large_for_the_software_loop_limit_are_refused() {
+    let Some(ctx) = ctx() else { return };
+    if !ctx.is_software() {
+        return;
+    }
+    let row = Row::new(
+        vec![
+            building(12, 1.2, Damping::Rayleigh(0.05)),
+            building(12, 1.0, Damping::Rayleigh(0.05)),
+        ],
+        vec![0.01],
+        LawKind::Linear,
+        1e9,
+        0.0,
+    );
+    let accel = record(1, 1.0, 0.3);
+    let recs = GpuRecords::upload(ctx, Precision::F32, &[&accel[..]]).unwrap();
+    let m = RowModel::new(&row);
+    let mut packed = PackedRows::new(RowShape::of(&m));
+    packed.push(&m, &forcing(&accel), 0, &recs, &FastOptions::default());
+    let err = run_rows(ctx, &recs, &packed, &GpuOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("loop limit"), "{err}");
+}
+
+/// The row kernel's source parses and validates (naga, f32 and f64) for shapes from single
+/// storeys to a row of five and a row with no common floor level: the constants the host
+/// prepends make a complete module for every shape.
+#[test]
+fn row_kernel_builds_for_every_shape() {
+    use pounding::engine::gpu::shader::row_source;
+    let shapes = [
+        RowShape {
+            storeys: vec![1, 1],
+            levels: vec![[0, 0, 0]],
+        },
+        RowShape {
+            storeys: vec![3, 6],
+            levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2]],
+        },
+        RowShape {
+            storeys: vec![20, 2],
+            levels: vec![[0, 0, 0], [0, 1, 1]],
+        },
+        RowShape {
+            storeys: vec![3, 5, 2],
+            levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [1, 0, 0], [1, 1, 1]],
+        },
+        RowShape {
+            storeys: vec![3, 3],
+            levels: vec![],
+        },
+    ];
+    for shape in &shapes {
+        for precision in [Precision::F32, Precision::F64] {
+            let src = row_source(precision, &shape.wgsl_constants());
+            crate::gpu::parse_source(&src);
+        }
+    }
+}
+
+/// `pound sweep --backend gpu` on a row config writes the CPU's CSV: the same columns and
+/// labels, every number within 1e-6 in f64 (energy columns aside: rows on the GPU do not
+/// integrate the balance), and says where it ran in the sidecar.
+#[test]
+fn row_sweep_on_the_gpu_writes_the_cpu_csv() {
+    if ctx().is_none() {
+        return;
+    }
+    let dir = crate::support::tempdir();
+    let cfg = dir.path().join("row.toml");
+    std::fs::write(
+        &cfg,
+        r#"[[building]]
+storeys = 2
+storey_height_m = 3.0
+mass_kg = 3.0e5
+period_s = [0.2, 0.3]
+damping_ratio = 0.05
+
+[[building]]
+storeys = 3
+storey_height_m = 3.0
+mass_kg = 3.0e5
+period_s = 0.5
+damping_ratio = 0.05
+damping = "modal"
+
+[contact]
+law = "lankarani_nikravesh"
+formula = "khatami"
+e = 0.6
+beta_n_per_m1_5 = 2.75e9
+gap_m = [0.0, 0.005, 0.02]
+
+[[record]]
+synthetic = { seed = 9, duration_s = 3.0, dt_s = 0.01, pga_g = 0.5 }
+"#,
+    )
+    .unwrap();
+    let csv = |backend: &str| {
+        let out = dir.path().join(format!("{backend}.csv"));
+        let mut args = vec!["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend_from_slice(&["--backend", backend, "--precision", "f64"]);
+        crate::support::run::ok(&crate::support::pound(&args));
+        (std::fs::read_to_string(&out).unwrap(), out)
+    };
+    let (cpu, _) = csv("cpu");
+    let (gpu, gpu_path) = csv("gpu");
+    let (cpu, gpu): (Vec<&str>, Vec<&str>) = (cpu.lines().collect(), gpu.lines().collect());
+    assert_eq!(cpu.len(), 7);
+    assert_eq!(cpu[0], gpu[0]);
+    let mut pounded = 0;
+    for (a, b) in cpu[1..].iter().zip(&gpu[1..]) {
+        for (x, y) in a.split(',').zip(b.split(',')) {
+            match (x.parse::<f64>(), y.parse::<f64>()) {
+                (Ok(u), Ok(v)) => assert!(rel(u, v) < 1e-6, "{x} vs {y}\n{a}\n{b}"),
+                _ => assert_eq!(x, y),
+            }
+        }
+        pounded += (a
+            .split(',')
+            .nth(cpu[0].split(',').position(|c| c == "impacts").unwrap())
+            != Some("0")) as usize;
+    }
+    assert!(pounded >= 2);
+    let meta = std::fs::read_to_string(pounding::io::provenance::meta_path(&gpu_path)).unwrap();
+    assert!(meta.contains("backend = \"gpu-f64\""), "{meta}");
+}
