@@ -149,20 +149,6 @@ pub fn run(a: Args) -> Result<()> {
         bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
     }
     let threads = threads.map(check_threads).transpose()?;
-    let picked = columns
-        .as_ref()
-        .map(|c| pounding::plan::columns::select(c))
-        .transpose()
-        .map_err(|bad| {
-            anyhow::anyhow!(
-                "--columns: `{bad}` is not a column; the columns are: {}",
-                pounding::plan::columns::header().join(", ")
-            )
-        })?;
-    let picked_names: Option<Vec<String>> = picked.as_ref().map(|ix| {
-        let h = pounding::plan::columns::header();
-        ix.iter().map(|&i| h[i].to_string()).collect()
-    });
     // The output is checked before anything runs: not a directory, not one of the inputs, and
     // writable.
     let config_text = config::read_text(&config)?;
@@ -176,7 +162,6 @@ pub fn run(a: Args) -> Result<()> {
             (resume, "--resume"),
             (aggregate.is_some(), "--aggregate"),
             (format == FormatArg::Parquet, "--format parquet"),
-            (columns.is_some(), "--columns"),
             (target_error.is_some(), "--target-error"),
         ];
         if let Some((_, flag)) = refused.iter().find(|(asked, _)| *asked) {
@@ -196,6 +181,17 @@ pub fn run(a: Args) -> Result<()> {
             (_, Some(_)) => None,
             _ => backend.acquire("running on the CPU", &mut |l| note!("{l}"))?,
         };
+        let header = plan.header();
+        let picked = columns
+            .as_ref()
+            .map(|c| pounding::plan::columns::select_in(&header, c))
+            .transpose()
+            .map_err(|bad| {
+                anyhow::anyhow!(
+                    "--columns: `{bad}` is not a column of this row sweep; its columns are: {}",
+                    header.join(", ")
+                )
+            })?;
         return run_row(
             &config,
             &plan,
@@ -203,8 +199,23 @@ pub fn run(a: Args) -> Result<()> {
             threads,
             chunk,
             gpu.as_ref().map(|c| (c, precision.get())),
+            picked,
         );
     }
+    let picked = columns
+        .as_ref()
+        .map(|c| pounding::plan::columns::select(c))
+        .transpose()
+        .map_err(|bad| {
+            anyhow::anyhow!(
+                "--columns: `{bad}` is not a column; the columns are: {}",
+                pounding::plan::columns::header().join(", ")
+            )
+        })?;
+    let picked_names: Option<Vec<String>> = picked.as_ref().map(|ix| {
+        let h = pounding::plan::columns::header();
+        ix.iter().map(|&i| h[i].to_string()).collect()
+    });
     let precision = precision.get();
     let mut plan = config::load_text(&config_text, &config)?;
     for w in plan.warnings() {
@@ -413,6 +424,7 @@ fn run_row(
         &pounding::engine::gpu::GpuContext,
         pounding::engine::gpu::Precision,
     )>,
+    picked: Option<Vec<usize>>,
 ) -> Result<()> {
     use pounding::io::atomic::partial_path;
     use pounding::io::csv::{encode_rows, CsvOut};
@@ -453,7 +465,14 @@ fn run_row(
         }
         _ => None,
     };
-    let header = plan.header();
+    // `--columns`: the chosen columns, in the order given (`run` first).
+    let pick = |all: Vec<String>| -> Vec<String> {
+        match &picked {
+            Some(ix) => ix.iter().map(|&i| all[i].clone()).collect(),
+            None => all,
+        }
+    };
+    let header = pick(plan.header());
     let names: Vec<&str> = header.iter().map(String::as_str).collect();
     let mut out = CsvOut::create(&target, lock.as_ref(), &names, Some(0))
         .with_context(|| format!("cannot write {}", target.path().display()))?;
@@ -480,7 +499,7 @@ fn run_row(
         pounding::plan::row::RowRunSpec,
         pounding::physics::row::RowOutput,
     )]| {
-        let cells: Vec<Vec<String>> = rows.iter().map(|(s, o)| plan.cells(s, o)).collect();
+        let cells: Vec<Vec<String>> = rows.iter().map(|(s, o)| pick(plan.cells(s, o))).collect();
         out.write_encoded(&encode_rows(&cells))
             .map_err(anyhow::Error::from)
     };

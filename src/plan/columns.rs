@@ -144,7 +144,14 @@ pub fn contact_and_motion(plan: &Plan, spec: &RunSpec) -> Vec<String> {
 /// Indices into [`header`] of `names` (`run` first, added if missing), or the first name that is
 /// not a column.
 pub fn select(names: &[String]) -> Result<Vec<usize>, String> {
-    let h = header();
+    select_in(&header(), names)
+}
+
+/// Indices into `h` (whose first column is `run`) of `names`, `run` first and added if
+/// missing, or the first name that is not a column (rows of multi-storey buildings have their
+/// own header).
+pub fn select_in<S: AsRef<str>>(h: &[S], names: &[String]) -> Result<Vec<usize>, String> {
+    let h: Vec<&str> = h.iter().map(|c| c.as_ref()).collect();
     let mut idx = vec![0];
     for n in names {
         let i = h.iter().position(|c| c == n).ok_or_else(|| n.clone())?;

@@ -824,3 +824,58 @@ fn single_storey_rows_are_the_pair_fast_scheme_to_rounding() {
         .collect();
     assert_rows_are_the_pair_fast("cpu", &scenes, &rows, &accel, 1e-8);
 }
+
+/// `--columns` on a row sweep writes the chosen columns (`run` first, in the order given) with
+/// the full sweep's values; a name that is not one of the row's columns is refused with the list.
+#[test]
+fn row_sweep_writes_the_chosen_columns() {
+    let dir = crate::support::tempdir();
+    let cfg = dir.path().join("row.toml");
+    std::fs::write(&cfg, ROW_CONFIG).unwrap();
+    let sweep = |name: &str, extra: &[&str]| -> Vec<Vec<String>> {
+        let out = dir.path().join(name);
+        let mut args = vec!["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        crate::support::run::ok(&crate::support::pound(&args));
+        std::fs::read_to_string(&out)
+            .unwrap()
+            .lines()
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect()
+    };
+    let full = sweep("full.csv", &[]);
+    let level = full[0]
+        .iter()
+        .rev()
+        .find(|c| c.starts_with("level_"))
+        .unwrap()
+        .clone();
+    let chosen = ["b2_peak_drift_ratio", "impacts", level.as_str()];
+    let sub = sweep("sub.csv", &["--columns", &chosen.join(",")]);
+    let want: Vec<&str> = ["run"].into_iter().chain(chosen).collect();
+    assert_eq!(sub[0], want);
+    assert_eq!(sub.len(), full.len());
+    for (s, f) in sub[1..].iter().zip(&full[1..]) {
+        for (k, name) in want.iter().enumerate() {
+            let at = full[0].iter().position(|c| c == name).unwrap();
+            assert_eq!(s[k], f[at], "{name}");
+        }
+    }
+    let out = dir.path().join("bad.csv");
+    let o = crate::support::pound(&[
+        "sweep",
+        cfg.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--columns",
+        "peak_u1_m",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("`peak_u1_m` is not a column of this row sweep")
+            && err.contains("b1_peak_roof_m"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
