@@ -349,13 +349,20 @@ impl GpuContext {
 
     /// Largest number of runs one chunk may hold on this device at `precision`.
     pub fn max_runs_per_chunk(&self, precision: Precision) -> u64 {
-        let l = self.device.limits();
-        let binding = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
         let largest = (super::layout::params_bytes(precision))
             .max(super::layout::state_bytes(precision))
             .max(size_of::<Meta>())
-            .max(size_of::<Counters>()) as u64;
-        let by_binding = binding / largest;
+            .max(size_of::<Counters>());
+        self.runs_fitting(largest)
+    }
+
+    /// Largest number of runs one chunk may hold on this device when a run takes at most
+    /// `largest` bytes of any one per-run buffer: every such buffer must fit one binding, and
+    /// one invocation per run must fit the dispatch grid.
+    pub fn runs_fitting(&self, largest: usize) -> u64 {
+        let l = self.device.limits();
+        let binding = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
+        let by_binding = binding / largest.max(1) as u64;
         let by_groups =
             l.max_compute_workgroups_per_dimension as u64 * super::layout::WORKGROUP_SIZE as u64;
         by_binding.min(by_groups)

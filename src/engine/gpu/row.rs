@@ -147,6 +147,12 @@ impl RowShape {
         self.c_buildings() + BC_STRIDE * self.storeys.len()
     }
 
+    /// Bytes of a run's largest per-run block in `precision` (the chunk's cap follows from it).
+    pub fn largest_block_bytes(&self, precision: Precision) -> usize {
+        let reals = self.s_stride().max(self.p_stride()) * precision.bytes();
+        reals.max(4 * self.c_stride().max(self.m_stride()))
+    }
+
     /// Reals of one building's model block.
     fn model_len(n: usize) -> usize {
         MW * n + n * n + 2 * n
@@ -611,6 +617,9 @@ pub fn sweep_rows<E: From<GpuError>>(
     mut progress: impl FnMut(u64),
 ) -> Result<Summary, E> {
     let start = Instant::now();
+    if runs.is_empty() {
+        return Ok(Summary::default());
+    }
     let accels: Vec<&[f64]> = plan
         .base
         .spec
@@ -619,7 +628,10 @@ pub fn sweep_rows<E: From<GpuError>>(
         .map(|r| &r.accel[..])
         .collect();
     let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
-    let chunk = chunk.max(1) as u64;
+    // Every per-run buffer of a chunk must fit one binding (tall rows carry large blocks).
+    let shape = RowShape::of(&RowModel::new(&plan.row(&plan.run(runs.start))));
+    let chunk =
+        (chunk.max(1) as u64).min(ctx.runs_fitting(shape.largest_block_bytes(opts.precision)));
     let cpu = RowScheme::Fast(opts.fast);
     let mut summary = Summary::default();
     let mut first = runs.start;
@@ -631,7 +643,7 @@ pub fn sweep_rows<E: From<GpuError>>(
             .par_iter()
             .map(|s| RowModel::new(&plan.row(s)))
             .collect();
-        let mut packed = PackedRows::new(RowShape::of(&models[0]));
+        let mut packed = PackedRows::new(shape.clone());
         for (s, m) in specs.iter().zip(&models) {
             packed.push(m, &plan.forcing(s), s.base.record, &recs, &opts.fast);
         }
