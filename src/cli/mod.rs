@@ -187,19 +187,29 @@ pub fn e_values(e: &str) -> Result<Vec<f64>> {
 /// `--target-error E`: the cheapest calibrated accuracy setting of the fast scheme whose p99
 /// peak-force error is at most `E`, said on stderr.
 pub fn target_error(target: f64) -> Result<pounding::physics::solver::calibration::Choice> {
-    use pounding::physics::solver::calibration::for_target;
+    target_error_in(pounding::physics::solver::calibration::Suite::Pairs, target)
+}
+
+/// [`target_error`] from the calibration of `suite` (pairs or rows).
+pub fn target_error_in(
+    suite: pounding::physics::solver::calibration::Suite,
+    target: f64,
+) -> Result<pounding::physics::solver::calibration::Choice> {
+    use pounding::physics::solver::calibration::for_target_in;
     if !(target > 0.0 && target.is_finite()) {
         bail!("--target-error {target}: expected a relative peak-force error above 0, e.g. 1e-2");
     }
-    let c = for_target(target).map_err(|best| {
+    let c = for_target_in(suite, target).map_err(|best| {
         anyhow::anyhow!(
-            "--target-error {target:e}: below what the fast scheme is calibrated for (its smallest p99 peak-force error is {best:.1e}); use a larger target, or the reference scheme (--scheme reference)"
+            "--target-error {target:e}: below what the fast scheme is calibrated for on {} (its smallest p99 peak-force error is {best:.1e}); use a larger target, or the reference scheme (--scheme reference)",
+            suite.config()
         )
     })?;
     note!(
-        "--target-error {target:e}: {} RK4 substeps per contact (p99 peak-force error {:.1e} on configs/accuracy.toml, measured by pound accuracy)",
+        "--target-error {target:e}: {} RK4 substeps per contact (p99 peak-force error {:.1e} on {}, measured by pound accuracy)",
         c.substeps_per_contact,
-        c.calibrated_p99
+        c.calibrated_p99,
+        suite.config()
     );
     Ok(c)
 }

@@ -157,22 +157,35 @@ pub fn run(a: Args) -> Result<()> {
         .pop()
         .expect("one output");
     if pounding::plan::row::is_row_config(&config_text) {
-        let refused = [
-            (shard.is_some(), "--shard"),
-            (resume, "--resume"),
-            (aggregate.is_some(), "--aggregate"),
-            (format == FormatArg::Parquet, "--format parquet"),
-            (target_error.is_some(), "--target-error"),
-        ];
-        if let Some((_, flag)) = refused.iter().find(|(asked, _)| *asked) {
-            bail!("{flag} is not available for rows of multi-storey buildings ([[building]] configs) yet: they run into CSV");
-        }
         let mut plan = config::load_row_text(&config_text, &config)?;
         plan.base.spec.scheme = scheme_as_run(plan.base.spec.scheme, scheme, energy);
-        // The row kernel runs the fast scheme without the energy balance.
+        let chosen = match (target_error, &mut plan.base.spec.scheme) {
+            (None, _) => None,
+            (Some(_), Scheme::Reference(_)) => bail!(
+                "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.rtol)"
+            ),
+            (Some(e), Scheme::Fast(o)) => {
+                let c = super::target_error_in(
+                    pounding::physics::solver::calibration::Suite::Rows,
+                    e,
+                )?;
+                o.substeps_per_contact = c.substeps_per_contact;
+                Some(c)
+            }
+        };
+        // The row kernel runs the fast scheme without the energy balance; the rows' calibration
+        // is of the CPU's f64 (the GPU in f64 agrees with it to 3.7e-6, BENCHMARKS.md; f32
+        // adds up to 7.2e-5).
         let gpu_fit = match plan.base.spec.scheme {
-            Scheme::Fast(o) if !o.energy => None,
-            Scheme::Fast(_) => Some("the energy balance of rows is integrated on the CPU only"),
+            Scheme::Fast(o) if o.energy => {
+                Some("the energy balance of rows is integrated on the CPU only")
+            }
+            Scheme::Fast(_)
+                if chosen.is_some() && precision.get() == pounding::engine::gpu::Precision::F32 =>
+            {
+                Some("--target-error on rows is calibrated in f64 (add --precision f64)")
+            }
+            Scheme::Fast(_) => None,
             Scheme::Reference(_) => Some("the reference scheme runs on the CPU only"),
         };
         let backend = backend.get();
@@ -192,14 +205,34 @@ pub fn run(a: Args) -> Result<()> {
                     header.join(", ")
                 )
             })?;
+        let fmt = match &aggregate {
+            Some(by) => {
+                Format::Summary(Box::new(pounding::engine::aggregate::Aggregator::of_cells(
+                    &header,
+                    plan.parameter_columns(),
+                    &plan.summarised(),
+                    by,
+                    &exceed,
+                )?))
+            }
+            None if format == FormatArg::Parquet => Format::Parquet,
+            None => Format::Csv,
+        };
         return run_row(
             &config,
+            &config_text,
             &plan,
-            target,
-            threads,
-            chunk,
-            gpu.as_ref().map(|c| (c, precision.get())),
-            picked,
+            RowSettings {
+                target,
+                threads,
+                chunk,
+                gpu: gpu.as_ref().map(|c| (c, precision.get())),
+                picked,
+                shard,
+                resume,
+                format: fmt,
+                target_error: chosen,
+            },
         );
     }
     let picked = columns
@@ -265,11 +298,7 @@ pub fn run(a: Args) -> Result<()> {
         backend: engine.key(),
         columns: picked_names.clone(),
         content: None,
-        target_error: chosen.map(|c| pounding::io::provenance::TargetError {
-            target: c.target,
-            substeps_per_contact: c.substeps_per_contact,
-            calibrated_p99: c.calibrated_p99,
-        }),
+        target_error: chosen.map(pounding::io::provenance::TargetError::of),
     };
     let fmt = match &aggregate {
         Some(by) => Format::Summary(Box::new(pounding::engine::aggregate::Aggregator::new(
@@ -278,39 +307,12 @@ pub fn run(a: Args) -> Result<()> {
         None if format == FormatArg::Parquet => Format::Parquet,
         None => Format::Csv,
     };
-    let mut out = match SweepOutput::open(target, meta, fmt, picked, resume, &mut |l| note!("{l}"))?
-    {
-        Opened::Ready(o) => o,
-        Opened::Complete(_) => return Ok(()),
+    let Some(mut out) = open_output(target, meta, fmt, picked, resume)? else {
+        return Ok(());
     };
     let todo = out.todo();
-    let done = out.done();
     let partial = out.partial_path();
-    if let Some(s) = shard {
-        note!(
-            "shard {}/{}: runs {}..{} of {}",
-            s.index,
-            s.count,
-            range.start,
-            range.end,
-            plan.len()
-        );
-    }
-    if done > 0 {
-        note!("resuming {}: {done} runs already on disk", output.display());
-    }
-    let bar = if std::io::stderr().is_terminal() {
-        let b = indicatif::ProgressBar::new(todo.end - todo.start);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{bar:40} {pos}/{len} runs  {per_sec}  eta {eta}",
-            )
-            .expect("valid template"),
-        );
-        b
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = progress_bar(todo.end - todo.start);
     note!(
         "{}: {} runs, {} scheme, {}",
         config.display(),
@@ -374,20 +376,7 @@ pub fn run(a: Args) -> Result<()> {
     // Records are read once, at the start: a file changed since then no longer matches the rows
     // (or the fingerprint), so the output is not put in place.
     let changed = config::changed_records(&config_text, &config, &plan);
-    if !changed.is_empty() {
-        let summary_only = out.aggregator().is_some();
-        drop(out);
-        bail!(
-            "{} changed on disk during the sweep; the runs were computed from the content read at the start ({}); rerun the sweep (without --resume) to use the new content",
-            changed.join(", "),
-            if summary_only {
-                "no summary was written".to_string()
-            } else {
-                format!("their rows are left in {}", partial.display())
-            }
-        );
-    }
-    let (path, what) = out.finish()?;
+    let (path, what) = finish_unless_changed(*out, &changed)?;
     if absurd > 0 {
         note!(
             "warning: {absurd} runs have a peak displacement above the building's height estimated from its period ({} m per s: T ~ 0.1 s per 3 m storey): check the record's units and the intensity",
@@ -412,24 +401,44 @@ fn finished(summary: &pounding::engine::Summary, path: &std::path::Path, what: &
     );
 }
 
-/// `pound sweep` of a row config: every run on the CPU, rows written to `OUT.partial` chunk by
-/// chunk and renamed to `OUT` when complete (a stream is written in place).
-fn run_row(
-    config: &std::path::Path,
-    plan: &pounding::plan::row::RowPlan,
+/// How a row sweep runs and where it goes.
+struct RowSettings<'a> {
     target: pounding::io::target::Target,
     threads: Option<usize>,
     chunk: Option<usize>,
     gpu: Option<(
-        &pounding::engine::gpu::GpuContext,
+        &'a pounding::engine::gpu::GpuContext,
         pounding::engine::gpu::Precision,
     )>,
+    /// `--columns`, as indices into the row's header.
     picked: Option<Vec<usize>>,
+    shard: Option<Shard>,
+    resume: bool,
+    format: Format,
+    /// `--target-error`, and the setting it chose.
+    target_error: Option<pounding::physics::solver::calibration::Choice>,
+}
+
+/// `pound sweep` of a row config, on the CPU or the GPU, through the same output protocol as
+/// the pair's: CSV (journaled, resumable), Parquet or a summary, written to `OUT.partial` and
+/// renamed when complete with its sidecar.
+fn run_row(
+    config: &std::path::Path,
+    config_text: &str,
+    plan: &pounding::plan::row::RowPlan,
+    settings: RowSettings,
 ) -> Result<()> {
-    use pounding::io::atomic::partial_path;
-    use pounding::io::csv::{encode_rows, CsvOut};
-    use pounding::io::provenance::{meta_path, progress_path};
-    use pounding::io::target::{PartialLock, Target};
+    let RowSettings {
+        target,
+        threads,
+        chunk,
+        gpu,
+        picked,
+        shard,
+        resume,
+        format,
+        target_error,
+    } = settings;
     let (default_chunk, max_chunk, on) = match gpu {
         Some(_) => (
             pounding::engine::GPU_CHUNK,
@@ -450,32 +459,33 @@ fn run_row(
             on
         });
     }
-    let lock = match &target {
-        Target::File(p) => {
-            // An unfinished CSV sweep's rows are only ever continued, never overwritten.
-            if progress_path(p).exists() {
-                bail!(
-                    "{} belongs to an unfinished CSV sweep: continue it with its own config and --resume, or delete {} and {} to start over",
-                    partial_path(p).display(),
-                    partial_path(p).display(),
-                    progress_path(p).display()
-                );
-            }
-            Some(PartialLock::acquire(&partial_path(p))?)
-        }
-        _ => None,
+    let header = plan.header();
+    let names: Vec<String> = match &picked {
+        Some(ix) => ix.iter().map(|&i| header[i].clone()).collect(),
+        None => header.clone(),
     };
-    // `--columns`: the chosen columns, in the order given (`run` first).
-    let pick = |all: Vec<String>| -> Vec<String> {
-        match &picked {
-            Some(ix) => ix.iter().map(|&i| all[i].clone()).collect(),
-            None => all,
-        }
+    let range = match shard {
+        Some(s) => pounding::plan::shard::row_shard_range(plan, s),
+        None => 0..plan.len(),
     };
-    let header = pick(plan.header());
-    let names: Vec<&str> = header.iter().map(String::as_str).collect();
-    let mut out = CsvOut::create(&target, lock.as_ref(), &names, Some(0))
-        .with_context(|| format!("cannot write {}", target.path().display()))?;
+    let summary_only = matches!(format, Format::Summary(_));
+    let meta = Meta {
+        fingerprint: Fingerprint::of_row(plan),
+        plan_runs: plan.len(),
+        first_run: range.start,
+        end_run: range.end,
+        shard,
+        backend: gpu.map_or("cpu".into(), |(_, p)| format!("gpu-{}", p.key())),
+        // A row's columns depend on its buildings, so they are always named.
+        columns: (!summary_only).then_some(names),
+        content: None,
+        target_error: target_error.map(pounding::io::provenance::TargetError::of),
+    };
+    let Some(mut out) = open_output(target, meta, format, picked, resume)? else {
+        return Ok(());
+    };
+    let todo = out.todo();
+    let partial = out.partial_path();
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = threads {
         pool = pool.num_threads(t);
@@ -488,21 +498,18 @@ fn run_row(
     note!(
         "{}: {} runs of a row of {} buildings ({} storeys, {} contact levels), {} scheme, on the {on}",
         config.display(),
-        plan.len(),
+        todo.end - todo.start,
         plan.buildings.len(),
         plan.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
         plan.row(&plan.run(0)).levels.len(),
         plan.scheme().key(),
     );
-    let partial = out.partial_path().to_path_buf();
+    let bar = progress_bar(todo.end - todo.start);
     let write = |rows: &[(
         pounding::plan::row::RowRunSpec,
         pounding::physics::row::RowOutput,
-    )]| {
-        let cells: Vec<Vec<String>> = rows.iter().map(|(s, o)| pick(plan.cells(s, o))).collect();
-        out.write_encoded(&encode_rows(&cells))
-            .map_err(anyhow::Error::from)
-    };
+    )]| { out.take(plan, rows).map_err(anyhow::Error::from) };
+    let progress = |done| bar.set_position(done);
     let summary = pool
         .install(|| match gpu {
             Some((ctx, precision)) => {
@@ -517,14 +524,14 @@ fn run_row(
                 pounding::engine::gpu::row::sweep_rows(
                     ctx,
                     plan,
-                    0..plan.len(),
+                    todo.clone(),
                     chunk,
                     &opts,
                     write,
-                    |_| {},
+                    progress,
                 )
             }
-            None => pounding::engine::cpu::run_rows(plan, 0..plan.len(), chunk, write, |_| {}),
+            None => pounding::engine::cpu::run_rows(plan, todo.clone(), chunk, write, progress),
         })
         .with_context(|| {
             format!(
@@ -532,30 +539,85 @@ fn run_row(
                 partial.display()
             )
         })?;
-    let final_path = target.path().to_path_buf();
-    let is_file = target.is_file();
-    let (path, _) = out
-        .finish(Some(plan.len()), |content| {
-            if !is_file {
-                return Ok(());
-            }
-            // The sidecar is written before the rename, as for pairs.
-            let meta = Meta {
-                fingerprint: Fingerprint::of_row(plan),
-                plan_runs: plan.len(),
-                first_run: 0,
-                end_run: plan.len(),
-                shard: None,
-                backend: gpu.map_or("cpu".into(), |(_, p)| format!("gpu-{}", p.key())),
-                columns: Some(header.clone()),
-                content: Some(content.clone()),
-                target_error: None,
-            };
-            pounding::io::provenance::write_toml(&meta_path(&final_path), &meta)
-                .map_err(std::io::Error::other)
-        })
-        .with_context(|| format!("finishing {}", partial.display()))?;
-    drop(lock);
-    finished(&summary, &path, "");
+    bar.finish_and_clear();
+    // Records are read once, at the start, as for pairs.
+    let changed = config::changed_records(config_text, config, &plan.base);
+    let (path, what) = finish_unless_changed(*out, &changed)?;
+    finished(&summary, &path, &format!(" ({what})"));
     Ok(())
+}
+
+/// Open the sweep's output (fresh, or resumed) and say which runs it takes: None when a resume
+/// found it already complete.
+fn open_output(
+    target: pounding::io::target::Target,
+    meta: Meta,
+    format: Format,
+    picked: Option<Vec<usize>>,
+    resume: bool,
+) -> Result<Option<Box<SweepOutput>>> {
+    let output = target.path().to_path_buf();
+    let (shard, range, plan_runs) = (meta.shard, meta.first_run..meta.end_run, meta.plan_runs);
+    let out = match SweepOutput::open(target, meta, format, picked, resume, &mut |l| note!("{l}"))?
+    {
+        Opened::Ready(o) => o,
+        Opened::Complete(_) => return Ok(None),
+    };
+    if let Some(s) = shard {
+        note!(
+            "shard {}/{}: runs {}..{} of {plan_runs}",
+            s.index,
+            s.count,
+            range.start,
+            range.end,
+        );
+    }
+    if out.done() > 0 {
+        note!(
+            "resuming {}: {} runs already on disk",
+            output.display(),
+            out.done()
+        );
+    }
+    Ok(Some(out))
+}
+
+/// Put the output in place, unless a record (`changed`, by name) changed on disk during the
+/// sweep: the runs were computed from the content read at the start, so they no longer match
+/// the records (or the fingerprint) and stay in the `.partial`.
+fn finish_unless_changed(
+    mut out: SweepOutput,
+    changed: &[String],
+) -> Result<(std::path::PathBuf, String)> {
+    if !changed.is_empty() {
+        let summary_only = out.aggregator().is_some();
+        let partial = out.partial_path();
+        drop(out);
+        bail!(
+            "{} changed on disk during the sweep; the runs were computed from the content read at the start ({}); rerun the sweep (without --resume) to use the new content",
+            changed.join(", "),
+            if summary_only {
+                "no summary was written".to_string()
+            } else {
+                format!("their rows are left in {}", partial.display())
+            }
+        );
+    }
+    Ok(out.finish()?)
+}
+
+/// A progress bar on a terminal, hidden otherwise.
+fn progress_bar(runs: u64) -> indicatif::ProgressBar {
+    if std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(runs);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} runs  {per_sec}  eta {eta}",
+            )
+            .expect("valid template"),
+        );
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    }
 }

@@ -145,10 +145,10 @@ pub struct Group {
 }
 
 impl Group {
-    fn new(nexceed: usize) -> Group {
+    fn new(nexceed: usize, noutputs: usize) -> Group {
         Group {
             exceed: vec![0; nexceed],
-            stats: vec![Sketch::default(); NOUT],
+            stats: vec![Sketch::default(); noutputs],
             ..Default::default()
         }
     }
@@ -156,16 +156,20 @@ impl Group {
     /// Fold in one run: `exceed` holds (output index, threshold) pairs. Failed runs are
     /// counted, not summarised. The per-run body of `shaders/aggregate.wgsl`, line for line.
     pub fn add(&mut self, o: &RunOutput, exceed: &[(usize, f64)]) {
+        self.add_values(o.status == Status::Ok, &outputs(o), exceed);
+    }
+
+    /// Fold in one run's summarised outputs `x` (magnitudes, in the aggregator's output order).
+    fn add_values(&mut self, ok: bool, x: &[f64], exceed: &[(usize, f64)]) {
         self.runs += 1;
-        if o.status != Status::Ok {
+        if !ok {
             self.failures += 1;
             return;
         }
-        let x = outputs(o);
         for (k, &(i, t)) in exceed.iter().enumerate() {
             self.exceed[k] += (x[i] > t) as u64;
         }
-        for (s, &v) in self.stats.iter_mut().zip(&x) {
+        for (s, &v) in self.stats.iter_mut().zip(x) {
             s.add(v);
         }
     }
@@ -209,10 +213,14 @@ pub struct Partial {
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AggregateError {
-    #[error("--aggregate: `{0}` is not a swept-parameter column; group by columns such as record, pga_g, gap_m, t1_s, law, e")]
-    NoColumn(String),
-    #[error("--exceed `{0}`: expected COLUMN=THRESHOLD with an output column ({cols}), e.g. peak_force_n=1e6", cols = OUTPUTS.join(", "))]
-    BadExceed(String),
+    #[error("--aggregate: `{column}` is not a swept-parameter column; group by columns such as {examples}")]
+    NoColumn { column: String, examples: String },
+    #[error("--exceed `{given}`: expected COLUMN=THRESHOLD with an output column ({columns}), e.g. {example}=1e6")]
+    BadExceed {
+        given: String,
+        columns: String,
+        example: String,
+    },
     #[error("--exceed: at most {MAX_EXCEED} thresholds, {0} given")]
     TooManyExceed(usize),
 }
@@ -299,22 +307,28 @@ impl Param {
     }
 }
 
-/// Groups runs and folds their outputs in.
+/// Groups runs and folds their outputs in: the pair's runs by their typed parameters (the
+/// device fold's keys), or any sweep's rows by the text of their cells.
 #[derive(Debug, Clone)]
 pub struct Aggregator {
-    /// Column name, its index in the CSV header, its key.
-    by: Vec<(String, usize, Param)>,
+    /// Column name, its index in the header, its key (None: keyed by the cell's text).
+    by: Vec<(String, usize, Option<Param>)>,
+    /// The summarised outputs: name and index in the header.
+    outputs: Vec<(String, usize)>,
     /// Column name of each `--exceed`.
     exceed_names: Vec<String>,
     /// Output index and threshold of each `--exceed`.
     exceed: Vec<(usize, f64)>,
     ids: HashMap<Vec<u64>, u32>,
+    /// Groups keyed by their labels' text ([`Aggregator::add_cells`]).
+    label_ids: HashMap<Vec<String>, u32>,
     /// In the order of each group's first run (the summary's row order), with its labels.
     groups: Vec<(Vec<String>, Group)>,
 }
 
 impl Aggregator {
-    /// Group by the columns `by`; count runs whose `column > threshold` for each `exceed`.
+    /// Group the pair's runs by the columns `by`; count runs whose `column > threshold` for
+    /// each `exceed`.
     pub fn new(by: &[String], exceed: &[String]) -> Result<Aggregator, AggregateError> {
         let h = header();
         let by = by
@@ -324,22 +338,91 @@ impl Aggregator {
                 Param::from_column(b)
                     .map(|p| {
                         let i = h.iter().position(|c| *c == b).expect("parameter column");
-                        (b.to_string(), i, p)
+                        (b.to_string(), i, Some(p))
                     })
-                    .ok_or_else(|| AggregateError::NoColumn(b.to_string()))
+                    .ok_or_else(|| AggregateError::NoColumn {
+                        column: b.to_string(),
+                        examples: "record, pga_g, gap_m, t1_s, law, e".into(),
+                    })
             })
             .collect::<Result<_, _>>()?;
+        let outputs = OUTPUTS
+            .iter()
+            .map(|o| {
+                (
+                    o.to_string(),
+                    h.iter().position(|c| c == o).expect("output"),
+                )
+            })
+            .collect();
+        Self::with(by, outputs, exceed)
+    }
+
+    /// Group the rows of a table with columns `header` by the columns `by`, which must be
+    /// among its first `parameters` columns (the swept parameters), and summarise `outputs`
+    /// (magnitudes of numeric cells); rows are folded in by [`Aggregator::add_cells`].
+    pub fn of_cells(
+        header: &[String],
+        parameters: usize,
+        outputs: &[String],
+        by: &[String],
+        exceed: &[String],
+    ) -> Result<Aggregator, AggregateError> {
+        let by = by
+            .iter()
+            .map(|b| {
+                let b = b.trim();
+                header[..parameters]
+                    .iter()
+                    .position(|c| c == b)
+                    .map(|i| (b.to_string(), i, None))
+                    .ok_or_else(|| AggregateError::NoColumn {
+                        column: b.to_string(),
+                        examples: header[..parameters].join(", "),
+                    })
+            })
+            .collect::<Result<_, _>>()?;
+        let outputs = outputs
+            .iter()
+            .map(|o| {
+                let i = header
+                    .iter()
+                    .position(|c| c == o)
+                    .expect("an output column");
+                (o.clone(), i)
+            })
+            .collect();
+        Self::with(by, outputs, exceed)
+    }
+
+    fn with(
+        by: Vec<(String, usize, Option<Param>)>,
+        outputs: Vec<(String, usize)>,
+        exceed: &[String],
+    ) -> Result<Aggregator, AggregateError> {
         if exceed.len() > MAX_EXCEED {
             return Err(AggregateError::TooManyExceed(exceed.len()));
         }
         let parsed: Vec<(String, usize, f64)> = exceed
             .iter()
             .map(|e| {
-                let bad = || AggregateError::BadExceed(e.clone());
+                let bad = || AggregateError::BadExceed {
+                    given: e.clone(),
+                    columns: outputs
+                        .iter()
+                        .map(|(o, _)| o.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    example: outputs
+                        .iter()
+                        .find(|(o, _)| o.ends_with("peak_force_n"))
+                        .map_or("peak_force_n", |(o, _)| o.as_str())
+                        .to_string(),
+                };
                 let (c, t) = e.split_once('=').ok_or_else(bad)?;
-                let i = OUTPUTS
+                let i = outputs
                     .iter()
-                    .position(|o| *o == c.trim())
+                    .position(|(o, _)| *o == c.trim())
                     .ok_or_else(bad)?;
                 let t: f64 = t.trim().parse().map_err(|_| bad())?;
                 Ok((c.trim().to_string(), i, t))
@@ -347,11 +430,40 @@ impl Aggregator {
             .collect::<Result<_, _>>()?;
         Ok(Aggregator {
             by,
+            outputs,
             exceed: parsed.iter().map(|&(_, i, t)| (i, t)).collect(),
             exceed_names: parsed.into_iter().map(|(c, _, _)| c).collect(),
             ids: HashMap::new(),
+            label_ids: HashMap::new(),
             groups: Vec::new(),
         })
+    }
+
+    /// The summarised outputs' names, in the summary's order.
+    pub fn outputs(&self) -> impl Iterator<Item = &str> {
+        self.outputs.iter().map(|(o, _)| o.as_str())
+    }
+
+    /// Fold in one row given as its cells (in the header's order): grouped by the text of its
+    /// `by` cells; a row whose status is not `ok` is a failure. An empty or unreadable output
+    /// cell of an `ok` row counts as NaN (the zero bucket).
+    pub fn add_cells(&mut self, cells: &[String], status_at: usize) {
+        let label: Vec<String> = self.by.iter().map(|(_, i, _)| cells[*i].clone()).collect();
+        let next = self.groups.len() as u32;
+        let nout = self.outputs.len();
+        let nexceed = self.exceed.len();
+        let id = *self.label_ids.entry(label.clone()).or_insert(next);
+        if id == next {
+            self.groups.push((label, Group::new(nexceed, nout)));
+        }
+        let x: Vec<f64> = self
+            .outputs
+            .iter()
+            .map(|(_, i)| cells[*i].parse::<f64>().map_or(f64::NAN, f64::abs))
+            .collect();
+        let ok = cells[status_at] == Status::Ok.key();
+        let exceed = &self.exceed;
+        self.groups[id as usize].1.add_values(ok, &x, exceed);
     }
 
     /// The (output index, threshold) pairs of `--exceed`.
@@ -361,13 +473,18 @@ impl Aggregator {
 
     /// The group of a run (numbered in the order of first appearance).
     pub fn group_of(&mut self, plan: &Plan, spec: &RunSpec) -> u32 {
-        let key: Vec<u64> = self.by.iter().map(|(_, _, p)| p.key(spec)).collect();
+        let key: Vec<u64> = self
+            .by
+            .iter()
+            .map(|(_, _, p)| p.expect("a pair's aggregator").key(spec))
+            .collect();
         let next = self.groups.len() as u32;
         let id = *self.ids.entry(key).or_insert(next);
         if id == next {
             let r = row(plan, spec, &RunOutput::default());
             let label = self.by.iter().map(|(_, i, _)| r[*i].clone()).collect();
-            self.groups.push((label, Group::new(self.exceed.len())));
+            self.groups
+                .push((label, Group::new(self.exceed.len(), self.outputs.len())));
         }
         id
     }

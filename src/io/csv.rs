@@ -2,11 +2,14 @@
 //! when the sweep is complete (after flush and fsync). A failed sweep leaves the `.partial`
 //! file with every finished row.
 
+use crate::engine::aggregate::Aggregator;
 use crate::io::atomic::{empty, open_stream};
 use crate::io::journal::{Content, ContentHasher};
 use crate::io::target::{PartialLock, Target};
 use crate::physics::model::RunOutput;
+use crate::physics::row::RowOutput;
 use crate::plan::columns::{header, row};
+use crate::plan::row::{RowPlan, RowRunSpec};
 use crate::plan::{Plan, RunSpec};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -196,30 +199,74 @@ pub fn pick(row: Vec<String>, columns: Option<&[usize]>) -> Vec<String> {
     }
 }
 
+/// A sweep whose finished runs become rows: the pair's plan, or a row of buildings' plan. The
+/// sweep output ([`crate::io::sweep_output`]) writes either through this.
+pub trait RunRows: Sync {
+    type Spec: Sync;
+    type Output: Sync;
+    /// The run number a spec holds.
+    fn run_index(spec: &Self::Spec) -> u64;
+    /// The fields of one run, in header order.
+    fn cells(&self, spec: &Self::Spec, out: &Self::Output) -> Vec<String>;
+    /// Fold finished runs into a summary built for this sweep's columns.
+    fn fold(&self, agg: &mut Aggregator, rows: &[(Self::Spec, Self::Output)]);
+}
+
+impl RunRows for Plan {
+    type Spec = RunSpec;
+    type Output = RunOutput;
+    fn run_index(spec: &RunSpec) -> u64 {
+        spec.index
+    }
+    fn cells(&self, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
+        row(self, spec, out)
+    }
+    fn fold(&self, agg: &mut Aggregator, rows: &[(RunSpec, RunOutput)]) {
+        agg.add_rows(self, rows)
+    }
+}
+
+impl RunRows for RowPlan {
+    type Spec = RowRunSpec;
+    type Output = RowOutput;
+    fn run_index(spec: &RowRunSpec) -> u64 {
+        spec.index
+    }
+    fn cells(&self, spec: &RowRunSpec, out: &RowOutput) -> Vec<String> {
+        RowPlan::cells(self, spec, out)
+    }
+    fn fold(&self, agg: &mut Aggregator, rows: &[(RowRunSpec, RowOutput)]) {
+        let status = self.parameter_columns();
+        for (s, o) in rows {
+            agg.add_cells(&RowPlan::cells(self, s, o), status);
+        }
+    }
+}
+
 /// The cells of each run's row (`columns` as in [`pick`]), formatted in parallel.
-pub fn cells(
-    plan: &Plan,
-    rows: &[(RunSpec, RunOutput)],
+pub fn cells<T: RunRows>(
+    table: &T,
+    rows: &[(T::Spec, T::Output)],
     columns: Option<&[usize]>,
 ) -> Vec<Vec<String>> {
     use rayon::prelude::*;
     rows.par_iter()
-        .map(|(s, o)| pick(row(plan, s, o), columns))
+        .map(|(s, o)| pick(table.cells(s, o), columns))
         .collect()
 }
 
 /// Rows as CSV lines (`columns` as in [`pick`]): formatted in parallel blocks, the same bytes
 /// as writing them one by one. Formatting, not the GPU, limited a 1e6-run sweep on an H100
 /// (BENCHMARKS.md).
-pub fn encode_csv(
-    plan: &Plan,
-    rows: &[(RunSpec, RunOutput)],
+pub fn encode_csv<T: RunRows>(
+    table: &T,
+    rows: &[(T::Spec, T::Output)],
     columns: Option<&[usize]>,
 ) -> Vec<u8> {
     use rayon::prelude::*;
     let blocks: Vec<Vec<u8>> = rows
         .par_chunks(512)
-        .map(|block| lines(block.iter().map(|(s, o)| pick(row(plan, s, o), columns))))
+        .map(|block| lines(block.iter().map(|(s, o)| pick(table.cells(s, o), columns))))
         .collect();
     blocks.concat()
 }

@@ -25,10 +25,19 @@ enum Kind {
     Real,
 }
 
+/// A column's type, from its name: counts and numbers of storeys and floors are integers (a
+/// row's per-building and per-level columns end as the pair's do: `b2_drift_storey`,
+/// `level_b1f3_b2f3_impacts`).
 fn kind(column: &str) -> Kind {
     match column {
         "run" | "impacts" | "substeps" | "sample" => Kind::Int,
         "law" | "formula" | "record" | "status" => Kind::Text,
+        c if ["_impacts", "_storeys", "_drift_storey", "_accel_floor"]
+            .iter()
+            .any(|end| c.ends_with(end)) =>
+        {
+            Kind::Int
+        }
         _ => Kind::Real,
     }
 }

@@ -66,7 +66,10 @@ impl Fingerprint {
     /// The fingerprint of a row sweep: its base plan's, with the buildings' and gaps' axes.
     pub fn of_row(plan: &crate::plan::row::RowPlan) -> Fingerprint {
         let base = Fingerprint::of(&plan.base);
-        let text = format!("{}|{:?}|{:?}", base.plan, plan.buildings, plan.gaps);
+        let text = format!(
+            "{}|{:?}|{:?}|{:?}",
+            base.plan, plan.buildings, plan.gaps, plan.samples
+        );
         Fingerprint {
             plan: hex(Sha256::digest(text.as_bytes())),
             ..base
@@ -118,6 +121,17 @@ pub struct TargetError {
     pub target: f64,
     pub substeps_per_contact: f64,
     pub calibrated_p99: f64,
+}
+
+impl TargetError {
+    /// The sidecar's record of a setting chosen for a target.
+    pub fn of(c: crate::physics::solver::calibration::Choice) -> TargetError {
+        TargetError {
+            target: c.target,
+            substeps_per_contact: c.substeps_per_contact,
+            calibrated_p99: c.calibrated_p99,
+        }
+    }
 }
 
 /// `OUT.meta.toml` for the output `OUT`.

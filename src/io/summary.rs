@@ -1,7 +1,7 @@
 //! An `--aggregate` summary as CSV: one row per group, in the order of the group's first run,
 //! with run and failure counts, `--exceed` counts, and max, mean and quantiles of each output.
 
-use crate::engine::aggregate::{Aggregator, OUTPUTS, QUANTILES};
+use crate::engine::aggregate::{Aggregator, QUANTILES};
 
 /// The summary of `agg` as CSV text.
 pub fn csv(agg: &Aggregator) -> String {
@@ -11,7 +11,7 @@ pub fn csv(agg: &Aggregator) -> String {
     for (c, t) in agg.exceed() {
         head.push(format!("exceed_{c}>{t}"));
     }
-    for o in OUTPUTS {
+    for o in agg.outputs() {
         head.push(format!("{o}_max"));
         head.push(format!("{o}_mean"));
         for q in QUANTILES {

@@ -8,13 +8,11 @@
 
 use crate::engine::aggregate::Aggregator;
 use crate::io::atomic::partial_path;
-use crate::io::csv::{header_for, header_line, CsvOut};
+use crate::io::csv::{header_for, header_line, CsvOut, RunRows};
 use crate::io::journal::{verify_file, verify_prefix, Content};
 use crate::io::parquet::ParquetOut;
 use crate::io::provenance::{meta_path, progress_path, read_toml, write_toml, Meta, Progress};
 use crate::io::target::{PartialLock, Target};
-use crate::physics::model::RunOutput;
-use crate::plan::{Plan, RunSpec};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
@@ -310,15 +308,20 @@ impl SweepOutput {
 
     /// Write a chunk of finished runs, which must be the next runs in order. CSV rows are
     /// fsynced before the journal counts them, so a crash leaves a consistent prefix.
-    pub fn take(&mut self, plan: &Plan, rows: &[(RunSpec, RunOutput)]) -> Result<(), OutputError> {
+    pub fn take<T: RunRows>(
+        &mut self,
+        plan: &T,
+        rows: &[(T::Spec, T::Output)],
+    ) -> Result<(), OutputError> {
         let path = self.partial_path();
         for (k, (s, _)) in rows.iter().enumerate() {
-            if s.index != self.next_run + k as u64 {
+            let index = T::run_index(s);
+            if index != self.next_run + k as u64 {
                 return Err(at(
                     &path,
                     format!(
                         "run {} came where run {} was due: refusing to write rows out of order",
-                        s.index,
+                        index,
                         self.next_run + k as u64
                     ),
                 ));
@@ -346,7 +349,7 @@ impl SweepOutput {
                 let cells = crate::io::csv::cells(plan, rows, columns);
                 out.write(&cells).map_err(|e| at(&path, e))?;
             }
-            Sink::Summary(agg) => agg.add_rows(plan, rows),
+            Sink::Summary(agg) => plan.fold(agg, rows),
         }
         Ok(())
     }
@@ -482,6 +485,8 @@ fn write_summary(
 mod tests {
     use super::*;
     use crate::io::provenance::Fingerprint;
+    use crate::physics::model::RunOutput;
+    use crate::plan::{Plan, RunSpec};
 
     const CFG: &str = r#"
 [building1]

@@ -412,12 +412,17 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-/// The records of `plan` (from the config `text` at `path`) whose files no longer hold what was
-/// read, by name; or why they cannot be read again. A sweep reads its records once, so this
+/// The records of `plan` (from the config `text` at `path`; a row's base plan for a row config)
+/// whose files no longer hold what was read, by name; or why they cannot be read again. A sweep reads its records once, so this
 /// finds files changed while it ran.
 pub fn changed_records(text: &str, path: &Path, plan: &Plan) -> Vec<String> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    match parse(text, path, &base, &records_dir()) {
+    let now = if crate::plan::row::is_row_config(text) {
+        crate::plan::row::parse_row(text, path, &base, &records_dir()).map(|row| row.base)
+    } else {
+        parse(text, path, &base, &records_dir())
+    };
+    match now {
         Err(e) => vec![format!("the records can no longer be read ({e})")],
         Ok(now) => plan
             .spec
@@ -657,6 +662,20 @@ fn samples(
     s: &RawSample,
     invalid: &dyn Fn(&str, String) -> ConfigError,
 ) -> Result<Samples, ConfigError> {
+    let keys = SampledAxis::ALL.map(|x| x.key()).join(", ");
+    let (axes, points) = draw_sampled(s, invalid, &SampledAxis::from_key, &keys)?;
+    Ok(Samples { axes, points })
+}
+
+/// The `[[sample.axis]]` entries of `s` resolved by `resolve` (`keys` lists the keys it
+/// knows, for the error), their distributions checked, and `s.n` points drawn: `points[s][j]`
+/// is axis `j`'s value in sample `s`.
+pub(crate) fn draw_sampled<A: PartialEq>(
+    s: &RawSample,
+    invalid: &dyn Fn(&str, String) -> ConfigError,
+    resolve: &dyn Fn(&str) -> Option<A>,
+    keys: &str,
+) -> Result<(Vec<A>, Vec<Vec<f64>>), ConfigError> {
     let method = match s.method.as_deref().unwrap_or("latin_hypercube") {
         "latin_hypercube" => Method::LatinHypercube,
         "monte_carlo" => Method::MonteCarlo,
@@ -694,14 +713,10 @@ fn samples(
     let mut dists = Vec::new();
     for (i, a) in s.axes.iter().enumerate() {
         let key = format!("sample.axis[{i}]");
-        let axis = SampledAxis::from_key(&a.key).ok_or_else(|| {
+        let axis = resolve(&a.key).ok_or_else(|| {
             invalid(
                 &format!("{key}.key"),
-                format!(
-                    "`{}`: expected one of {}",
-                    a.key,
-                    SampledAxis::ALL.map(|x| x.key()).join(", ")
-                ),
+                format!("`{}`: expected one of {keys}", a.key),
             )
         })?;
         if axes.contains(&axis) {
@@ -785,10 +800,7 @@ fn samples(
         axes.push(axis);
         dists.push(d);
     }
-    Ok(Samples {
-        axes,
-        points: draw(method, s.n, &dists, s.seed),
-    })
+    Ok((axes, draw(method, s.n, &dists, s.seed)))
 }
 
 enum LoadError {

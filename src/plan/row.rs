@@ -14,8 +14,8 @@ use crate::physics::solver::row::RowScheme;
 use crate::physics::solver::Scheme;
 use crate::plan::columns;
 use crate::plan::config::{
-    parse_raw, Axis, ConfigError, RawBuilding, RawConfig, RawContact, RawIntensity, RawRecord,
-    RawRun, RawSample,
+    draw_sampled, parse_raw, Axis, ConfigError, RawBuilding, RawConfig, RawContact, RawIntensity,
+    RawRecord, RawRun, RawSample,
 };
 use crate::plan::{Plan, RunSpec};
 use serde::Deserialize;
@@ -40,8 +40,9 @@ pub struct RawShearBuilding {
     pub floor_masses_kg: Option<Vec<f64>>,
     /// Relative storey stiffnesses, bottom to top (default uniform), scaled to `period_s`.
     pub stiffness_profile: Option<Vec<f64>>,
-    pub period_s: Axis,
-    pub damping_ratio: Axis,
+    /// May be left out when sampled, as may `mass_kg`.
+    pub period_s: Option<Axis>,
+    pub damping_ratio: Option<Axis>,
     /// `rayleigh` (the ratio on modes 1 and 2, the default) or `modal` (on every mode).
     pub damping: Option<String>,
     /// The gap to the next building (default `contact.gap_m`).
@@ -89,6 +90,73 @@ impl ShearAxes {
     }
 }
 
+/// A parameter of a row that `[sample]` can set (buildings numbered from 0, as in the keys).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RowSampled {
+    /// `building[b].mass_kg`: every floor of building `b`.
+    Mass(usize),
+    /// `building[b].period_s`.
+    Period(usize),
+    /// `building[b].damping_ratio`.
+    Damping(usize),
+    /// `building[b].gap_right_m`: the gap between buildings `b` and `b + 1`.
+    Gap(usize),
+    /// `contact.gap_m`: every gap not given per building.
+    SharedGap,
+    /// `contact.k_n_per_m`, for linear laws.
+    KLinear,
+    /// `contact.beta_n_per_m1_5`, for Hertz-type laws.
+    Beta,
+}
+
+impl RowSampled {
+    /// The config key.
+    pub fn key(self) -> String {
+        match self {
+            RowSampled::Mass(b) => format!("building[{b}].mass_kg"),
+            RowSampled::Period(b) => format!("building[{b}].period_s"),
+            RowSampled::Damping(b) => format!("building[{b}].damping_ratio"),
+            RowSampled::Gap(b) => format!("building[{b}].gap_right_m"),
+            RowSampled::SharedGap => "contact.gap_m".into(),
+            RowSampled::KLinear => "contact.k_n_per_m".into(),
+            RowSampled::Beta => "contact.beta_n_per_m1_5".into(),
+        }
+    }
+
+    /// Every key of a row of `nb` buildings.
+    fn all(nb: usize) -> Vec<RowSampled> {
+        let mut all: Vec<RowSampled> = (0..nb)
+            .flat_map(|b| [Self::Mass(b), Self::Period(b), Self::Damping(b)])
+            .collect();
+        all.extend((0..nb - 1).map(Self::Gap));
+        all.extend([Self::SharedGap, Self::KLinear, Self::Beta]);
+        all
+    }
+
+    /// What a drawn value must be.
+    fn check(self) -> (fn(f64) -> bool, &'static str) {
+        match self {
+            RowSampled::Period(_) => (
+                |v| v.is_finite() && v >= crate::plan::limits::MIN_PERIOD_S,
+                "a period >= 1e-4 s",
+            ),
+            RowSampled::Damping(_) => (|v| (0.0..1.0).contains(&v), "0 <= damping ratio < 1"),
+            RowSampled::Gap(_) | RowSampled::SharedGap => {
+                (|v| v.is_finite() && v >= 0.0, "a gap >= 0 m")
+            }
+            _ => (|v| v.is_finite() && v > 0.0, "a value > 0"),
+        }
+    }
+}
+
+/// Joint samples of some of a row's parameters: `points[s][j]` is the value of `axes[j]` in
+/// sample `s`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RowSamples {
+    pub axes: Vec<RowSampled>,
+    pub points: Vec<Vec<f64>>,
+}
+
 /// A validated row sweep.
 #[derive(Debug, Clone)]
 pub struct RowPlan {
@@ -98,7 +166,12 @@ pub struct RowPlan {
     pub buildings: Vec<ShearAxes>,
     /// m, per adjacent pair.
     pub gaps: Vec<Vec<f64>>,
-    /// Sizes of the axes below a base run: mass, period, damping per building, then the gaps.
+    /// Sampled parameters, crossed with every grid axis (their grid axes hold a placeholder).
+    pub samples: Option<RowSamples>,
+    /// Which gaps `contact.gap_m` gives (the others are given per building).
+    shared_gap: Vec<bool>,
+    /// Sizes of the axes below a base run: the samples, then mass, period, damping per
+    /// building, then the gaps.
     dims: Vec<usize>,
     per_base: u64,
 }
@@ -114,6 +187,8 @@ pub struct RowRunSpec {
     pub period: Vec<f64>,
     pub damping: Vec<f64>,
     pub gaps: Vec<f64>,
+    /// Index of the sample that set the sampled parameters (None without sampling).
+    pub sample: Option<usize>,
 }
 
 impl RowPlan {
@@ -134,23 +209,60 @@ impl RowPlan {
             rest /= d as u64;
         }
         let nb = self.buildings.len();
-        RowRunSpec {
+        let mut run = RowRunSpec {
             index,
             base,
             mass: (0..nb)
                 .map(|b| {
                     let a = &self.buildings[b];
-                    a.floor_masses.is_none().then(|| a.mass[at[3 * b]])
+                    a.floor_masses.is_none().then(|| a.mass[at[1 + 3 * b]])
                 })
                 .collect(),
             period: (0..nb)
-                .map(|b| self.buildings[b].period[at[3 * b + 1]])
+                .map(|b| self.buildings[b].period[at[2 + 3 * b]])
                 .collect(),
             damping: (0..nb)
-                .map(|b| self.buildings[b].damping[at[3 * b + 2]])
+                .map(|b| self.buildings[b].damping[at[3 + 3 * b]])
                 .collect(),
-            gaps: (0..nb - 1).map(|a| self.gaps[a][at[3 * nb + a]]).collect(),
+            gaps: (0..nb - 1)
+                .map(|a| self.gaps[a][at[1 + 3 * nb + a]])
+                .collect(),
+            sample: None,
+        };
+        if let Some(smp) = &self.samples {
+            run.sample = Some(at[0]);
+            let law = run.base.law;
+            for (a, &v) in smp.axes.iter().zip(&smp.points[at[0]]) {
+                match *a {
+                    RowSampled::Mass(b) => run.mass[b] = Some(v),
+                    RowSampled::Period(b) => run.period[b] = v,
+                    RowSampled::Damping(b) => run.damping[b] = v,
+                    RowSampled::Gap(b) => run.gaps[b] = v,
+                    RowSampled::SharedGap => {
+                        for (g, shared) in run.gaps.iter_mut().zip(&self.shared_gap) {
+                            if *shared {
+                                *g = v;
+                            }
+                        }
+                    }
+                    RowSampled::KLinear if !law.is_hertzian() => run.base.stiffness = v,
+                    RowSampled::Beta if law.is_hertzian() => run.base.stiffness = v,
+                    RowSampled::KLinear | RowSampled::Beta => {}
+                }
+            }
         }
+        run
+    }
+
+    /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`
+    /// ([`Plan::cost_before`] of the base runs, each repeated for the row's own axes).
+    pub fn cost_before(&self, end: u64, record_cost: &[u64]) -> u128 {
+        let (whole, part) = (end / self.per_base, end % self.per_base);
+        let mut cost = self.base.cost_before(whole, record_cost) * self.per_base as u128;
+        if part > 0 {
+            cost += part as u128 * record_cost[self.base.run(whole).record] as u128;
+        }
+        cost
     }
 
     /// The scene of `run`.
@@ -223,6 +335,7 @@ impl RowPlan {
         for a in 1..nb {
             h.push(format!("gap_{a}_{}_m", a + 1));
         }
+        h.push("sample".into());
         for c in [
             "status",
             "impacts",
@@ -252,6 +365,33 @@ impl RowPlan {
         h
     }
 
+    /// The number of parameter columns, which lead the header: the status column's index.
+    pub fn parameter_columns(&self) -> usize {
+        columns::CONTACT_AND_MOTION + 4 * self.buildings.len() + self.gaps.len() + 1
+    }
+
+    /// The outputs an `--aggregate` summary folds per group (as magnitudes): the row's totals,
+    /// each building's peaks and each contact level's; not the storey and floor numbers, the
+    /// first impact's time, the step count or the energy balance.
+    pub fn summarised(&self) -> Vec<String> {
+        let skip = [
+            "first_impact_s",
+            "substeps",
+            "input_energy_j",
+            "damping_energy_j",
+            "energy_residual",
+        ];
+        self.header()
+            .into_iter()
+            .skip(self.parameter_columns() + 1)
+            .filter(|c| {
+                !skip.contains(&c.as_str())
+                    && !c.ends_with("_drift_storey")
+                    && !c.ends_with("_accel_floor")
+            })
+            .collect()
+    }
+
     /// The fields of one run, in [`RowPlan::header`] order.
     pub fn cells(&self, run: &RowRunSpec, out: &RowOutput) -> Vec<String> {
         let num = columns::num;
@@ -266,6 +406,7 @@ impl RowPlan {
             c.push(num(run.damping[b]));
         }
         c.extend(run.gaps.iter().map(|&g| num(g)));
+        c.push(run.sample.map(|s| s.to_string()).unwrap_or_default());
         let penetration = out
             .levels
             .iter()
@@ -350,13 +491,6 @@ pub fn parse_row(
         key: key.into(),
         message,
     };
-    if raw.sample.is_some() {
-        return Err(invalid(
-            "sample",
-            "sampling is not available for [[building]] rows yet: give the axes as lists or ranges"
-                .into(),
-        ));
-    }
     if raw.building.len() < 2 {
         return Err(invalid(
             "building",
@@ -366,19 +500,66 @@ pub fn parse_row(
             ),
         ));
     }
+    let nb = raw.building.len();
+    let samples = match &raw.sample {
+        Some(smp) => {
+            let all = RowSampled::all(nb);
+            let keys = all.iter().map(|a| a.key()).collect::<Vec<_>>().join(", ");
+            let (axes, points) = draw_sampled(
+                smp,
+                &invalid,
+                &|k| all.iter().copied().find(|a| a.key() == k),
+                &keys,
+            )?;
+            for (j, a) in axes.iter().enumerate() {
+                let (ok, expected) = a.check();
+                if let Some((i, v)) = points
+                    .iter()
+                    .map(|p| p[j])
+                    .enumerate()
+                    .find(|(_, v)| !ok(*v))
+                {
+                    return Err(invalid(
+                        &format!("sample.axis[{j}] ({})", a.key()),
+                        format!("sample {i} drew {v}: expected {expected}; truncate the distribution with min/max"),
+                    ));
+                }
+            }
+            Some(RowSamples { axes, points })
+        }
+        None => None,
+    };
+    let sampled = |a: RowSampled| samples.as_ref().is_some_and(|s| s.axes.contains(&a));
     let one = |x: f64| Some(Axis::List(vec![x]));
+    // A grid axis or a sampled one, not both; a sampled axis holds one placeholder in the grid
+    // (0.5: valid for every axis, never used).
+    let grid_or_sampled =
+        |a: RowSampled, given: Option<&Axis>| -> Result<Option<Axis>, ConfigError> {
+            match (given, sampled(a)) {
+                (Some(_), true) => Err(invalid(
+                    &a.key(),
+                    "is sampled under [sample]: remove it from the grid".into(),
+                )),
+                (None, true) => Ok(one(0.5)),
+                (g, false) => Ok(g.cloned()),
+            }
+        };
+    let k_grid = grid_or_sampled(RowSampled::KLinear, raw.contact.k_n_per_m.as_ref())?;
+    let beta_grid = grid_or_sampled(RowSampled::Beta, raw.contact.beta_n_per_m1_5.as_ref())?;
+    let shared_gap = grid_or_sampled(RowSampled::SharedGap, raw.contact.gap_m.as_ref())?;
     let placeholder = RawBuilding {
         mass_kg: one(1.0),
         period_s: one(1.0),
         damping_ratio: one(0.05),
     };
-    let shared_gap = raw.contact.gap_m.clone();
     let base_raw = RawConfig {
         run: raw.run.clone(),
         building1: placeholder.clone(),
         building2: placeholder,
         contact: RawContact {
             gap_m: one(0.0),
+            k_n_per_m: k_grid,
+            beta_n_per_m1_5: beta_grid,
             ..raw.contact.clone()
         },
         records: raw.records.clone(),
@@ -415,9 +596,9 @@ pub fn parse_row(
             None => Ok(v.to_vec()),
         }
     };
-    let nb = raw.building.len();
     let mut buildings = Vec::new();
     let mut gaps = Vec::new();
+    let mut shared = Vec::new();
     for (b, r) in raw.building.iter().enumerate() {
         let key = |k: &str| format!("building[{b}].{k}");
         let n = r.storeys;
@@ -431,7 +612,15 @@ pub fn parse_row(
             PerStorey::One(h) => per_storey(&key("storey_height_m"), &[*h], 1)?.repeat(n),
             PerStorey::Each(v) => per_storey(&key("storey_height_m"), v, n)?,
         };
-        let (floor_masses, mass) = match (&r.mass_kg, &r.floor_masses_kg) {
+        let mass_kg = grid_or_sampled(RowSampled::Mass(b), r.mass_kg.as_ref())?;
+        if sampled(RowSampled::Mass(b)) && r.floor_masses_kg.is_some() {
+            return Err(invalid(
+                &key("floor_masses_kg"),
+                "building[b].mass_kg is sampled under [sample]: remove floor_masses_kg"
+                    .replace("[b]", &format!("[{b}]")),
+            ));
+        }
+        let (floor_masses, mass) = match (&mass_kg, &r.floor_masses_kg) {
             (Some(a), None) => (None, axis(&key("mass_kg"), a, &positive, "a mass > 0 kg")?),
             (None, Some(v)) => (Some(per_storey(&key("floor_masses_kg"), v, n)?), vec![0.0]),
             _ => {
@@ -456,6 +645,12 @@ pub fn parse_row(
                 ))
             }
         };
+        let required = |a: RowSampled, given: Option<&Axis>| {
+            grid_or_sampled(a, given)?
+                .ok_or_else(|| invalid(&a.key(), "missing: give values or sample it".into()))
+        };
+        let period_s = required(RowSampled::Period(b), r.period_s.as_ref())?;
+        let damping_ratio = required(RowSampled::Damping(b), r.damping_ratio.as_ref())?;
         buildings.push(ShearAxes {
             heights,
             floor_masses,
@@ -463,20 +658,26 @@ pub fn parse_row(
             profile,
             period: axis(
                 &key("period_s"),
-                &r.period_s,
+                &period_s,
                 &|v| v.is_finite() && v >= crate::plan::limits::MIN_PERIOD_S,
                 "a period >= 1e-4 s",
             )?,
             damping: axis(
                 &key("damping_ratio"),
-                &r.damping_ratio,
+                &damping_ratio,
                 &|v| (0.0..1.0).contains(&v),
                 "0 <= damping ratio < 1",
             )?,
             modal,
         });
         let gap_ok = |v: f64| v.is_finite() && v >= 0.0;
-        match (&r.gap_right_m, b + 1 < nb, &shared_gap) {
+        let gap_right = if b + 1 < nb {
+            grid_or_sampled(RowSampled::Gap(b), r.gap_right_m.as_ref())?
+        } else {
+            r.gap_right_m.clone()
+        };
+        shared.push(gap_right.is_none());
+        match (&gap_right, b + 1 < nb, &shared_gap) {
             (Some(_), false, _) => {
                 return Err(invalid(
                     &key("gap_right_m"),
@@ -494,10 +695,20 @@ pub fn parse_row(
             (None, false, _) => {}
         }
     }
-    let mut dims: Vec<usize> = buildings
-        .iter()
-        .flat_map(|a| [a.mass.len(), a.period.len(), a.damping.len()])
-        .collect();
+    shared.truncate(nb - 1);
+    if sampled(RowSampled::SharedGap) && !shared.contains(&true) {
+        return Err(invalid(
+            "contact.gap_m",
+            "is sampled, but every gap is given per building (gap_right_m): sample those instead"
+                .into(),
+        ));
+    }
+    let mut dims = vec![samples.as_ref().map_or(1, |s| s.points.len())];
+    dims.extend(
+        buildings
+            .iter()
+            .flat_map(|a| [a.mass.len(), a.period.len(), a.damping.len()]),
+    );
     dims.extend(gaps.iter().map(Vec::len));
     let per_base = dims
         .iter()
@@ -519,6 +730,8 @@ pub fn parse_row(
         base: base_plan,
         buildings,
         gaps,
+        samples,
+        shared_gap: shared,
         dims,
         per_base,
     })

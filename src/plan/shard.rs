@@ -1,6 +1,7 @@
 //! Deterministic cost-balanced shards of a plan (`--shard I/N`, for Slurm job arrays or
 //! Kubernetes Indexed Jobs): contiguous run ranges that tile the plan.
 
+use crate::plan::row::RowPlan;
 use crate::plan::Plan;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
@@ -27,14 +28,29 @@ impl Shard {
 /// plan tile `0..len` exactly. Each cut is a binary search over [`Plan::cost_before`], so a
 /// shard of 1e8 runs is planned in microseconds.
 pub fn shard_range(plan: &Plan, shard: Shard) -> Range<u64> {
-    let n = plan.len();
-    let costs: Vec<u64> = plan
-        .spec
+    let costs = record_costs(plan);
+    cut_by_cost(plan.len(), |end| plan.cost_before(end, &costs), shard)
+}
+
+/// [`shard_range`] for a row of multi-storey buildings: every run of a row has the same
+/// buildings' storeys, so a run's cost is again its record's intervals.
+pub fn row_shard_range(plan: &RowPlan, shard: Shard) -> Range<u64> {
+    let costs = record_costs(&plan.base);
+    cut_by_cost(plan.len(), |end| plan.cost_before(end, &costs), shard)
+}
+
+/// Each record's intervals (record plus tail), at least 1.
+fn record_costs(plan: &Plan) -> Vec<u64> {
+    plan.spec
         .records
         .iter()
         .map(|r| r.forcing(1.0, plan.spec.tail).intervals().max(1) as u64)
-        .collect();
-    let total = plan.cost_before(n, &costs);
+        .collect()
+}
+
+/// Shard `shard` of `0..n`, given the summed cost of the runs before each run.
+fn cut_by_cost(n: u64, cost_before: impl Fn(u64) -> u128, shard: Shard) -> Range<u64> {
+    let total = cost_before(n);
     // Cut k: the first run i whose preceding cost reaches k / N of the total (exact integers).
     let cut = |k: u64| -> u64 {
         if k == 0 {
@@ -47,7 +63,7 @@ pub fn shard_range(plan: &Plan, shard: Shard) -> Range<u64> {
         let (mut lo, mut hi) = (0u64, n);
         while lo < hi {
             let mid = lo + (hi - lo) / 2;
-            if plan.cost_before(mid, &costs) * shard.count as u128 >= target {
+            if cost_before(mid) * shard.count as u128 >= target {
                 hi = mid;
             } else {
                 lo = mid + 1;

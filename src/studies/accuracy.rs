@@ -275,14 +275,18 @@ pub struct RowPoint {
     pub failed: u64,
     /// |energy residual|, median and p99, over the runs that end `ok`.
     pub residual: [f64; 2],
+    /// Over the runs whose impact count differs from the reference's (left out of the errors
+    /// above): the largest count difference, and the largest relative peak-force error.
+    pub count_gap_max: u32,
+    pub differing_force_max: f64,
 }
 
 /// The columns of [`row_markdown`].
-pub const ROW_MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | force med | force p99 | roof med | roof p99 | drift med | drift p99 | accel med | accel p99 | impacts differ | failed | residual med | residual p99 |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
+pub const ROW_MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | force med | force p99 | roof med | roof p99 | drift med | drift p99 | accel med | accel p99 | impacts differ | failed | residual med | residual p99 | count gap max | differing force max |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
 
 impl RowPoint {
     /// The numbers of a table line and a CSV line, in column order after the path.
-    fn numbers(&self) -> [f64; 14] {
+    fn numbers(&self) -> [f64; 16] {
         [
             self.substeps_per_contact,
             self.runs_per_second,
@@ -298,6 +302,8 @@ impl RowPoint {
             self.failed as f64,
             self.residual[0],
             self.residual[1],
+            self.count_gap_max as f64,
+            self.differing_force_max,
         ]
     }
 }
@@ -309,7 +315,7 @@ pub fn row_markdown(p: &RowPoint) -> String {
         .iter()
         .enumerate()
         .map(|(i, x)| match i {
-            0 | 11 => format!("{x}"),
+            0 | 11 | 14 => format!("{x}"),
             1 => format!("{x:.0}"),
             10 => format!("{:.2} %", 100.0 * x),
             _ => format!("{x:.1e}"),
@@ -349,6 +355,7 @@ pub fn row_study(
     let point = |path: &str, setting: f64, rate: f64, truth: &[RowOutput], out: &[RowOutput]| {
         let (mut f, mut u, mut d, mut a, mut r) = (vec![], vec![], vec![], vec![], vec![]);
         let (mut differ, mut failed) = (0usize, 0u64);
+        let (mut gap_max, mut differing_force) = (0u32, 0.0f64);
         for (t, o) in truth.iter().zip(out) {
             if o.status != Status::Ok {
                 failed += 1;
@@ -356,7 +363,13 @@ pub fn row_study(
             }
             r.extend(o.energy.map(|e| e.residual.abs()));
             if t.status != Status::Ok || t.impacts != o.impacts {
-                differ += (t.impacts != o.impacts) as usize;
+                if t.status == Status::Ok {
+                    differ += 1;
+                    gap_max = gap_max.max(t.impacts.abs_diff(o.impacts));
+                    if t.impacts > 0 && o.impacts > 0 {
+                        differing_force = differing_force.max(rel(o.peak_force, t.peak_force));
+                    }
+                }
                 continue;
             }
             if t.impacts > 0 {
@@ -379,6 +392,8 @@ pub fn row_study(
             impact_count_differs: differ as f64 / truth.len().max(1) as f64,
             failed,
             residual: med_p99(r),
+            count_gap_max: gap_max,
+            differing_force_max: differing_force,
         }
     };
     let (truth, rate) = solve(Scheme::Reference(ReferenceOptions::with_tol(tol)));
@@ -398,7 +413,7 @@ pub fn row_study(
 
 /// The multi-storey study's points as CSV.
 pub fn row_csv(points: &[RowPoint]) -> String {
-    let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99\n");
+    let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99,count_gap_max,differing_force_max\n");
     for p in points {
         let cells: Vec<String> = p.numbers().iter().map(f64::to_string).collect();
         s.push_str(&format!("{},{}\n", p.path, cells.join(",")));

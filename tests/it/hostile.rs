@@ -83,7 +83,7 @@ impl Scene {
 
 /// A sweep of `cfg` into `out` cut off by a file-size limit at `fraction` of the whole output
 /// (`whole_len` bytes): it leaves `out.partial` and its journal, as a kill or a full disk does.
-fn interrupt(cfg: &Path, whole_len: usize, out: &Path, fraction: f64) {
+pub fn interrupt(cfg: &Path, whole_len: usize, out: &Path, fraction: f64) {
     let limit = (whole_len as f64 * fraction) as u64;
     let r = crate::support::pound_with_file_limit(
         &[

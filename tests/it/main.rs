@@ -13,6 +13,7 @@ mod layers;
 pub mod multistorey;
 mod oracles;
 mod records;
+mod row_sweeps;
 mod scale;
 mod shared;
 mod studies;

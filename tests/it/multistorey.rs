@@ -460,7 +460,7 @@ fn opensees_cross_check() {
     }
 }
 
-const ROW_CONFIG: &str = r#"
+pub const ROW_CONFIG: &str = r#"
 [[building]]
 storeys = 2
 storey_height_m = 3.0
@@ -573,7 +573,7 @@ fn row_config_sweeps_to_csv_matching_the_library() {
 }
 
 /// Bad row configs: each error names the file, the key and what was expected; flags that
-/// rows do not support yet are refused by name before anything runs.
+/// rows do not support are refused by name before anything runs.
 #[test]
 fn row_config_errors_name_the_key() {
     let dir = crate::support::tempdir();
@@ -626,11 +626,8 @@ fn row_config_errors_name_the_key() {
     std::fs::write(&cfg, ROW_CONFIG).unwrap();
     let out = dir.path().join("row.csv");
     for flag in [
-        &["--resume"][..],
-        &["--shard", "0/2"],
-        &["--aggregate", "law"],
         // The row kernel runs the fast scheme without the energy balance.
-        &["--backend", "gpu", "--energy"],
+        &["--backend", "gpu", "--energy"][..],
         &["--backend", "gpu", "--scheme", "reference"],
     ] {
         let mut args = vec!["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()];
@@ -711,6 +708,14 @@ fn accuracy_of_a_row_config() {
         .collect();
     assert_eq!(rows.len(), 3, "{table}");
     assert_eq!(rows[0][0], "reference");
+    // Runs whose impact count differs are reported by their largest count difference and
+    // peak-force error (none for the reference against itself).
+    assert_eq!(&rows[0][15..], ["0", "0"]);
+    for r in &rows[1..] {
+        let gap: u32 = r[15].parse().unwrap();
+        let force: f64 = r[16].parse().unwrap();
+        assert_eq!(gap == 0, force == 0.0 && r[11] == "0", "{table}");
+    }
     let p99 = |r: &[String], col: usize| r[col].parse::<f64>().unwrap();
     // Columns: force p99 (4), roof p99 (6), drift p99 (8).
     for col in [4, 6, 8] {
@@ -727,6 +732,30 @@ fn accuracy_of_a_row_config() {
             .count(),
         2
     );
+    // `--target-error` runs the setting the rows' calibration chooses and fails exactly when
+    // the error it measures is above the target.
+    let o = crate::support::pound(&[
+        "accuracy",
+        cfg.to_str().unwrap(),
+        "--target-error",
+        "1e-3",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let said = String::from_utf8_lossy(&o.stdout);
+    let line = said
+        .lines()
+        .find(|l| l.starts_with("--target-error 1e-3: 24 substeps per contact, cpu-fast-f64"))
+        .unwrap_or_else(|| panic!("{said}"));
+    let measured: f64 = line
+        .split("p99 peak-force error ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(o.status.success(), measured <= 1e-3, "{said}");
+    assert_eq!(line.ends_with("(met)"), o.status.success(), "{line}");
 }
 
 /// The single-storey scenes of [`single_storey_rows_are_the_pair`]: the pair, and the same pair
