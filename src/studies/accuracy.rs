@@ -411,6 +411,40 @@ pub fn row_study(
     points
 }
 
+/// The multi-storey work-precision plot: runs/s against the median (left) and p99 (right)
+/// relative error of each quantity, one series per quantity over the fast scheme's settings
+/// (errors of 0, which a log axis cannot show, are left out).
+pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
+    type Pick = fn(&RowPoint) -> [f64; 2];
+    let quantities: [(&str, Pick); 4] = [
+        ("peak force", |p| p.force),
+        ("roof displacement", |p| p.roof),
+        ("drift ratio", |p| p.drift),
+        ("floor acceleration", |p| p.accel),
+    ];
+    let panel = |title: &str, at: usize| Panel {
+        title: title.into(),
+        x_label: "relative error".into(),
+        y_label: "runs/s".into(),
+        log_x: true,
+        log_y: true,
+        series: quantities
+            .iter()
+            .map(|(name, pick)| Series {
+                name: name.to_string(),
+                points: points
+                    .iter()
+                    .filter(|p| p.path != "reference")
+                    .map(|p| (pick(p)[at], p.runs_per_second))
+                    .filter(|&(e, _)| e > 0.0)
+                    .collect(),
+                scatter: false,
+            })
+            .collect(),
+    };
+    vec![panel("median error", 0), panel("99th percentile error", 1)]
+}
+
 /// The multi-storey study's points as CSV.
 pub fn row_csv(points: &[RowPoint]) -> String {
     let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99,count_gap_max,differing_force_max\n");

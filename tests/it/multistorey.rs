@@ -693,6 +693,7 @@ fn accuracy_of_a_row_config() {
         .replace("duration_s = 5.0", "duration_s = 3.0");
     std::fs::write(&cfg, text).unwrap();
     let out = dir.path().join("acc.csv");
+    let svg = dir.path().join("acc.svg");
     let table = crate::support::ok(&crate::support::pound(&[
         "accuracy",
         cfg.to_str().unwrap(),
@@ -700,7 +701,19 @@ fn accuracy_of_a_row_config() {
         "8,64",
         "-o",
         out.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
     ]));
+    // The work-precision plot: a series per quantity in each panel.
+    let drawn = std::fs::read_to_string(&svg).unwrap();
+    for name in [
+        "peak force",
+        "drift ratio",
+        "floor acceleration",
+        "99th percentile error",
+    ] {
+        assert!(drawn.contains(name), "{name} missing from the plot");
+    }
     let rows: Vec<Vec<String>> = csv::Reader::from_path(&out)
         .unwrap()
         .records()
