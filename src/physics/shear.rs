@@ -191,6 +191,20 @@ impl ShearBuilding {
         (w2, vecs)
     }
 
+    /// Rayleigh's `(a0, a1)` of `C = a0 M + a1 K` for the circular frequencies `omega`
+    /// (ascending): the ratio on modes 1 and 2, or `(2 xi w1, 0)` for one storey; None for
+    /// modal damping.
+    pub fn rayleigh(&self, omega: &[f64]) -> Option<(f64, f64)> {
+        match self.damping {
+            Damping::Modal(_) => None,
+            Damping::Rayleigh(x) if omega.len() == 1 => Some((2.0 * x * omega[0], 0.0)),
+            Damping::Rayleigh(x) => {
+                let (w1, w2) = (omega[0], omega[1]);
+                Some((2.0 * x * w1 * w2 / (w1 + w2), 2.0 * x / (w1 + w2)))
+            }
+        }
+    }
+
     /// The building's modes (see the module docs).
     pub fn modes(&self) -> Modes {
         let n = self.storeys();
@@ -204,15 +218,10 @@ impl ShearBuilding {
                 shape[j][i] = sign * v[j][i] / self.masses[j].sqrt();
             }
         }
-        let xi = match self.damping {
-            Damping::Modal(x) => vec![x; n],
-            Damping::Rayleigh(x) if n == 1 => vec![x],
-            Damping::Rayleigh(x) => {
-                let (w1, w2) = (omega[0], omega[1]);
-                let a0 = 2.0 * x * w1 * w2 / (w1 + w2);
-                let a1 = 2.0 * x / (w1 + w2);
-                omega.iter().map(|w| 0.5 * (a0 / w + a1 * w)).collect()
-            }
+        let xi = match (self.damping, self.rayleigh(&omega)) {
+            (Damping::Rayleigh(x), _) if n == 1 => vec![x],
+            (_, Some((a0, a1))) => omega.iter().map(|w| 0.5 * (a0 / w + a1 * w)).collect(),
+            (Damping::Modal(x), _) | (Damping::Rayleigh(x), None) => vec![x; n],
         };
         let participation = (0..n)
             .map(|i| (0..n).map(|j| self.masses[j] * shape[j][i]).sum())

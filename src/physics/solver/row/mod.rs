@@ -12,7 +12,8 @@
 //!
 //! Two schemes, as for the pair ([`super`]): [`reference`](mod@reference) (adaptive
 //! Dormand-Prince, the truth) and [`fast`] (exact modal free steps at the record's `dt`, RK4
-//! substeps sized to the contact only in record steps where some level may touch).
+//! substeps sized to the contact only in record steps where some level may touch, in floor
+//! coordinates for the buildings whose damping allows it: `RowModel::substep_model`).
 
 pub mod fast;
 pub mod reference;
@@ -39,6 +40,43 @@ pub(crate) struct BuildingModel {
     pub masses: Vec<f64>,
     /// `sqrt` of the total mass: modal coordinates of a 1 m motion are this large.
     pub scale: f64,
+    /// Its floor-coordinate form (Rayleigh damping only: `C` is then tridiagonal like `K`).
+    pub floor_form: Option<FloorForm>,
+    /// Its slice of the state holds floor displacements and velocities instead of modes
+    /// (in the fast scheme's contact substeps, [`RowModel::substep_model`]).
+    pub in_floors: bool,
+}
+
+/// Buildings of this many storeys or more take their contact substeps in floor coordinates.
+/// Below it the modes cost no more and the change of coordinates is overhead (`pound bench
+/// --storeys 1,3,6,12,20`: 0.9x at one storey, even at three, 1.1x at six; BENCHMARKS.md).
+pub(crate) const FLOOR_SUBSTEPS_FROM: usize = 4;
+
+/// A shear building in floor coordinates: `M u'' + C u' + K u = -M 1 ag + F` with tridiagonal
+/// `K` and `C = a0 M + a1 K`, so its right-hand side costs `O(N)`.
+#[derive(Debug, Clone)]
+pub(crate) struct FloorForm {
+    /// Storey stiffnesses, N/m: `k[j]` joins floor `j - 1` (the ground for `j = 0`) and `j`.
+    pub k: Vec<f64>,
+    pub a0: f64,
+    pub a1: f64,
+    pub inv_m: Vec<f64>,
+}
+
+impl FloorForm {
+    /// `out[j] = (K x)_j / m_j`.
+    #[inline]
+    #[allow(clippy::needless_range_loop)] // floor j of `out`, `k`, `inv_m` and `x`
+    fn k_over_m(&self, x: impl Fn(usize) -> f64, out: &mut [f64]) {
+        let nb = self.k.len();
+        let storey = |j: usize| self.k[j] * (x(j) - if j == 0 { 0.0 } else { x(j - 1) });
+        let mut s = storey(0);
+        for j in 0..nb {
+            let above = if j + 1 < nb { storey(j + 1) } else { 0.0 };
+            out[j] = (s - above) * self.inv_m[j];
+            s = above;
+        }
+    }
 }
 
 impl BuildingModel {
@@ -59,6 +97,10 @@ pub(crate) struct LevelModel {
     /// Mode-shape rows of the two floors: `u_left = phi_a . q[a]`.
     pub phi_a: Vec<f64>,
     pub phi_b: Vec<f64>,
+    /// How the level's force enters the two buildings' accelerations: the mode-shape rows
+    /// again (`phi^T F`), or `1 / m` of the floor in floor coordinates.
+    pub psi_a: Vec<f64>,
+    pub psi_b: Vec<f64>,
     pub gap: f64,
     pub contact: Contact,
 }
@@ -98,12 +140,20 @@ impl RowModel {
                 part.push(modes.participation[i]);
             }
             let n = modes.count();
+            let floor_form = b.rayleigh(&modes.omega).map(|(a0, a1)| FloorForm {
+                k: b.stiffness.clone(),
+                a0,
+                a1,
+                inv_m: b.masses.iter().map(|m| 1.0 / m).collect(),
+            });
             buildings.push(BuildingModel {
                 off,
                 modes,
                 heights: b.heights.clone(),
                 masses: b.masses.clone(),
                 scale: b.masses.iter().sum::<f64>().sqrt(),
+                floor_form,
+                in_floors: false,
             });
             off += n;
         }
@@ -120,6 +170,8 @@ impl RowModel {
                     floors: (fa, fb),
                     phi_a: ba.modes.shape[fa].clone(),
                     phi_b: bb.modes.shape[fb].clone(),
+                    psi_a: ba.modes.shape[fa].clone(),
+                    psi_b: bb.modes.shape[fb].clone(),
                     gap: row.gaps[l.left],
                     contact: l.contact,
                 }
@@ -132,6 +184,62 @@ impl RowModel {
             part,
             buildings,
             levels,
+        }
+    }
+
+    /// The model of the fast scheme's contact substeps: every building of
+    /// [`FLOOR_SUBSTEPS_FROM`] storeys or more with Rayleigh damping in floor coordinates
+    /// (each level then reads and pushes one floor of it, `O(1)`), the others in modes. RK4 is affine-invariant, so its steps in either coordinates are the
+    /// same motion to rounding; the floor form costs `O(N)` per right-hand side where the
+    /// modes cost `O(N)` per level.
+    /// None when no building would change coordinates.
+    pub(crate) fn substep_model(&self) -> Option<RowModel> {
+        let floors = |b: &BuildingModel| b.floor_form.is_some() && b.n() >= FLOOR_SUBSTEPS_FROM;
+        if !self.buildings.iter().any(floors) {
+            return None;
+        }
+        let mut m = self.clone();
+        for b in m.buildings.iter_mut() {
+            b.in_floors = floors(b);
+        }
+        for l in m.levels.iter_mut() {
+            let (ba, bb) = (&m.buildings[l.buildings.0], &m.buildings[l.buildings.1]);
+            if ba.in_floors {
+                l.a = (ba.off + l.floors.0, 1);
+                l.phi_a = vec![1.0];
+                l.psi_a = vec![1.0 / ba.masses[l.floors.0]];
+            }
+            if bb.in_floors {
+                l.b = (bb.off + l.floors.1, 1);
+                l.phi_b = vec![1.0];
+                l.psi_b = vec![1.0 / bb.masses[l.floors.1]];
+            }
+        }
+        Some(m)
+    }
+
+    /// Express `z`, a state of `modal` (this model's modal twin), in this model's
+    /// coordinates: `u = Phi q` for the buildings in floors.
+    pub(crate) fn modes_to_substeps(&self, z: &mut [f64]) {
+        let n = self.n;
+        for b in self.buildings.iter().filter(|b| b.in_floors) {
+            let (o, nb) = (b.off, b.n());
+            let u = b.modes.to_floors(&z[o..o + nb]);
+            let v = b.modes.to_floors(&z[n + o..n + o + nb]);
+            z[o..o + nb].copy_from_slice(&u);
+            z[n + o..n + o + nb].copy_from_slice(&v);
+        }
+    }
+
+    /// Back to modes: `q = Phi^T M u` for the buildings in floors.
+    pub(crate) fn substeps_to_modes(&self, z: &mut [f64]) {
+        let n = self.n;
+        for b in self.buildings.iter().filter(|b| b.in_floors) {
+            let (o, nb) = (b.off, b.n());
+            let q = b.modes.to_modes(&b.masses, &z[o..o + nb]);
+            let qd = b.modes.to_modes(&b.masses, &z[n + o..n + o + nb]);
+            z[o..o + nb].copy_from_slice(&q);
+            z[n + o..n + o + nb].copy_from_slice(&qd);
         }
     }
 
@@ -287,12 +395,34 @@ pub(crate) fn rhs(m: &RowModel, lv: &LevelModes, ag: f64, z: &[f64], out: &mut [
     let n = m.n;
     let nl = m.levels.len();
     let (mut e_in, mut e_damp) = (0.0, 0.0);
-    for i in 0..n {
-        let v = z[n + i];
-        out[i] = v;
-        out[n + i] = -m.two_xi_w[i] * v - m.w2[i] * z[i] - m.part[i] * ag;
-        e_in -= ag * m.part[i] * v;
-        e_damp += m.two_xi_w[i] * v * v;
+    for b in &m.buildings {
+        let (o, nb) = (b.off, b.n());
+        match (&b.floor_form, b.in_floors) {
+            (Some(f), true) => {
+                // u'' = -a0 u' - M^-1 K (u + a1 u') - ag; the input is -ag 1^T M u', the
+                // damping work u'^T C u'.
+                let (u, v) = (&z[o..o + nb], &z[n + o..n + o + nb]);
+                out[o..o + nb].copy_from_slice(v);
+                let acc = &mut out[n + o..n + o + nb];
+                f.k_over_m(|j| u[j] + f.a1 * v[j], acc);
+                for j in 0..nb {
+                    acc[j] = -f.a0 * v[j] - acc[j] - ag;
+                    let mv = b.masses[j] * v[j];
+                    let dv = v[j] - if j == 0 { 0.0 } else { v[j - 1] };
+                    e_in -= ag * mv;
+                    e_damp += f.a0 * mv * v[j] + f.a1 * f.k[j] * dv * dv;
+                }
+            }
+            _ => {
+                for i in o..o + nb {
+                    let v = z[n + i];
+                    out[i] = v;
+                    out[n + i] = -m.two_xi_w[i] * v - m.w2[i] * z[i] - m.part[i] * ag;
+                    e_in -= ag * m.part[i] * v;
+                    e_damp += m.two_xi_w[i] * v * v;
+                }
+            }
+        }
     }
     for (l, (lm, &(mode, v0))) in m.levels.iter().zip(lv).enumerate() {
         if mode == Mode::Free {
@@ -300,10 +430,10 @@ pub(crate) fn rhs(m: &RowModel, lv: &LevelModes, ag: f64, z: &[f64], out: &mut [
             continue;
         }
         let f = lm.force(n, mode, v0, z);
-        for (i, p) in lm.phi_a.iter().enumerate() {
+        for (i, p) in lm.psi_a.iter().enumerate() {
             out[n + lm.a.0 + i] -= p * f;
         }
-        for (i, p) in lm.phi_b.iter().enumerate() {
+        for (i, p) in lm.psi_b.iter().enumerate() {
             out[n + lm.b.0 + i] += p * f;
         }
         out[2 * n + l] = f * lm.ddelta(n, z);
@@ -382,6 +512,28 @@ impl Floors {
         let n = m.n;
         let nb = b.n();
         let o = b.off;
+        if let (Some(f), true) = (&b.floor_form, b.in_floors) {
+            // Floor coordinates: the structural acceleration (no ground, no contact)
+            // `-a0 u' - M^-1 K (u + a1 u')`, and the jerk `-a0 u''_s - M^-1 K (u' + a1 u''_s)`
+            // of the structural-and-ground acceleration `u''_s`, as the modes give them.
+            self.u.copy_from_slice(&z[o..o + nb]);
+            self.v.copy_from_slice(&z[n + o..n + o + nb]);
+            let (u, v) = (&self.u, &self.v);
+            f.k_over_m(|j| u[j] + f.a1 * v[j], &mut self.acc);
+            for j in 0..nb {
+                let acc = -f.a0 * v[j] - self.acc[j];
+                self.acc[j] = acc;
+                let a_abs = acc + self.force[j] / b.masses[j];
+                self.a_abs[j] = a_abs;
+                self.a_rel[j] = a_abs - ag;
+            }
+            let (acc, v) = (&self.acc, &self.v);
+            f.k_over_m(|j| v[j] + f.a1 * (acc[j] - ag), &mut self.jrk);
+            for j in 0..nb {
+                self.jerk[j] = -f.a0 * (self.acc[j] - ag) - self.jrk[j];
+            }
+            return;
+        }
         // Modal accelerations without ground and contact (they enter floor by floor below), and
         // the jerk of the structural part, with the ground's contribution to q''.
         for i in 0..nb {
@@ -405,7 +557,10 @@ impl Floors {
 
 /// One run of a row being integrated, shared by both schemes (as the pair's `Integration`).
 pub(crate) struct RowRun<'m> {
+    /// The model the state is in: `modal`, or its substep model between
+    /// [`RowRun::enter_substeps`] and [`RowRun::leave_substeps`].
     pub m: &'m RowModel,
+    modal: &'m RowModel,
     pub z: Vec<f64>,
     pub levels: Vec<LevelState>,
     pub buildings: Vec<BuildingOutput>,
@@ -427,6 +582,7 @@ impl<'m> RowRun<'m> {
     pub fn start(m: &'m RowModel, z: Vec<f64>, t0: f64) -> Self {
         let mut run = RowRun {
             m,
+            modal: m,
             levels: vec![LevelState::default(); m.levels.len()],
             buildings: vec![BuildingOutput::default(); m.buildings.len()],
             free_steps: 0,
@@ -445,6 +601,23 @@ impl<'m> RowRun<'m> {
         let z = run.z.clone();
         run.transitions(t0, &z, &z);
         run
+    }
+
+    /// Take the state into `sub` (the modal model's [`RowModel::substep_model`]) for a record
+    /// step of substeps.
+    /// The floors' kinematics at the last piece's end stay valid: they are the same motion
+    /// in either coordinates.
+    pub fn enter_substeps(&mut self, sub: &'m RowModel) {
+        sub.modes_to_substeps(&mut self.z);
+        self.m = sub;
+    }
+
+    /// Back to the modal model after the substeps.
+    pub fn leave_substeps(&mut self) {
+        if !std::ptr::eq(self.m, self.modal) {
+            self.m.substeps_to_modes(&mut self.z);
+            self.m = self.modal;
+        }
     }
 
     /// Each level's mode and impact speed, into `out`.
@@ -719,6 +892,7 @@ impl<'m> RowRun<'m> {
 
     /// End the run with `status`, after `substeps` steps of integration work.
     pub fn finish(mut self, status: Status, substeps: u64) -> RowOutput {
+        self.leave_substeps();
         let m = self.m;
         let n = m.n;
         let nl = m.levels.len();
