@@ -8,7 +8,9 @@
 //! 3. Such a step, and every step while a level is in contact, is redone with `M` fixed RK4
 //!    substeps of the whole row, sized as the pair's from each level that is in contact or may
 //!    touch (its impact duration and local rate) and from the fastest mode of the row. Every
-//!    level's events are located inside the substeps.
+//!    level's events are located inside the substeps. Buildings of
+//!    `FLOOR_SUBSTEPS_FROM` (4) storeys or more with Rayleigh damping take them in floor
+//!    coordinates (`O(N)` per right-hand side; the same motion, `RowModel::substep_model`).
 //! 4. Peaks: as the pair's (force samples refined by a parabola; displacements and drifts from
 //!    the quintic Hermite over free record steps, the cubic inside contact steps). Floor
 //!    accelerations: the cubic Hermite with their rates over free record steps, the samples at
