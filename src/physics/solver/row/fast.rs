@@ -108,6 +108,7 @@ fn run_with(
         y: vec![0.0; len],
     };
     let mut modes = Vec::with_capacity(nl);
+    let mut bounds = Vec::with_capacity(n);
     for i in 0..forcing.intervals() {
         let seg = Segment::of(forcing, i);
         let z = run.z.clone();
@@ -130,8 +131,9 @@ fn run_with(
                 }
             }
             let mut touching = false;
+            m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
             for (lm, ls) in m.levels.iter().zip(&run.levels) {
-                if !lm.may_touch(m, &seg, &z, &z1, dt, ls.v0) {
+                if !lm.may_touch_bounded(n, &bounds, &z, &z1, dt, ls.v0) {
                     continue;
                 }
                 touching = true;

@@ -353,28 +353,27 @@ impl LevelModel {
         h: f64,
         v0: f64,
     ) -> bool {
-        let n = m.n;
+        let mut bounds = Vec::new();
+        m.fourth_derivative_bounds(seg, z0, z1, &mut bounds);
+        self.may_touch_bounded(m.n, &bounds, z0, z1, h, v0)
+    }
+
+    /// [`LevelModel::may_touch`] with each mode's `|q''''|` bound over the step already
+    /// computed ([`RowModel::fourth_derivative_bounds`]): a free step checks every level
+    /// against the same bounds, so they are computed once per step, not once per level.
+    pub(crate) fn may_touch_bounded(
+        &self,
+        n: usize,
+        bounds: &[f64],
+        z0: &[f64],
+        z1: &[f64],
+        h: f64,
+        v0: f64,
+    ) -> bool {
         let (d0, d1) = (self.delta(z0), self.delta(z1));
         let (r0, r1) = (self.ddelta(n, z0), self.ddelta(n, z1));
         let bound = |phi: &[f64], (o, len): (usize, usize)| -> f64 {
-            (0..len)
-                .map(|i| {
-                    let k = o + i;
-                    let osc = crate::physics::model::Oscillator {
-                        m: 1.0,
-                        k: m.w2[k],
-                        c: m.two_xi_w[k],
-                    };
-                    let s = Segment {
-                        a0: seg.a0 * m.part[k],
-                        a1: seg.a1 * m.part[k],
-                        ..*seg
-                    };
-                    let q = z0[k].abs().max(z1[k].abs());
-                    let qd = z0[n + k].abs().max(z1[n + k].abs());
-                    phi[i].abs() * fourth_derivative_bound(&osc, q, qd, &s)
-                })
-                .sum()
+            (0..len).map(|i| phi[i].abs() * bounds[o + i]).sum()
         };
         let margin = -error_margin(bound(&self.phi_a, self.a) + bound(&self.phi_b, self.b), h);
         if cubic_max_bound(d0, r0, d1, r1, h) <= margin {
@@ -384,6 +383,37 @@ impl LevelModel {
             return true;
         }
         hermite_range(d0, r0, d1, r1, h).1 > margin
+    }
+}
+
+impl RowModel {
+    /// Each mode's bound on `|q''''|` over a free step from `z0` to `z1` in `seg`
+    /// ([`fourth_derivative_bound`] of the mode's oscillator under its share of the ground
+    /// motion), into `out`.
+    pub(crate) fn fourth_derivative_bounds(
+        &self,
+        seg: &Segment,
+        z0: &[f64],
+        z1: &[f64],
+        out: &mut Vec<f64>,
+    ) {
+        let n = self.n;
+        out.clear();
+        out.extend((0..n).map(|k| {
+            let osc = crate::physics::model::Oscillator {
+                m: 1.0,
+                k: self.w2[k],
+                c: self.two_xi_w[k],
+            };
+            let s = Segment {
+                a0: seg.a0 * self.part[k],
+                a1: seg.a1 * self.part[k],
+                ..*seg
+            };
+            let q = z0[k].abs().max(z1[k].abs());
+            let qd = z0[n + k].abs().max(z1[n + k].abs());
+            fourth_derivative_bound(&osc, q, qd, &s)
+        }));
     }
 }
 
