@@ -1,9 +1,11 @@
 // Rust twin: src/physics/solver/row/fast.rs (with row/mod.rs), function for function (same
 // names, same operation order), except that the CPU takes the contact substeps of buildings of
 // 4 or more storeys with Rayleigh damping in floor coordinates (the same motion, O(N) per
-// right-hand side) where this kernel stays in modes. The fast scheme on a row of shear
-// buildings, in modal coordinates, one invocation per run; resumable as fast.wgsl (at most `disp.budget` units of
-// work per run and dispatch: a free record interval, or one piece of an RK4 substep).
+// right-hand side) where this kernel stays in modes, and that the CPU bounds each mode's
+// |q''''| once per free step for every level's may_touch where this kernel bounds them per
+// level (the same values). The fast scheme on a row of shear buildings, in modal coordinates,
+// one invocation per run; resumable as fast.wgsl (at most `disp.budget` units of work per run
+// and dispatch: a free record interval, or one piece of an RK4 substep).
 //
 // The host prepends the prelude, then the row's shape (src/engine/gpu/row.rs, `RowShape`): NB
 // buildings, NM modes in all, NL contact levels (NLA = max(NL, 1) sizes their arrays), ZLEN

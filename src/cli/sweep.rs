@@ -205,19 +205,18 @@ pub fn run(a: Args) -> Result<()> {
                     header.join(", ")
                 )
             })?;
-        let fmt = match &aggregate {
-            Some(by) => {
-                Format::Summary(Box::new(pounding::engine::aggregate::Aggregator::of_cells(
+        let summary = aggregate
+            .as_ref()
+            .map(|by| {
+                pounding::engine::aggregate::Aggregator::of_cells(
                     &header,
                     plan.parameter_columns(),
                     &plan.summarised(),
                     by,
                     &exceed,
-                )?))
-            }
-            None if format == FormatArg::Parquet => Format::Parquet,
-            None => Format::Csv,
-        };
+                )
+            })
+            .transpose()?;
         return run_row(
             &config,
             &config_text,
@@ -227,10 +226,11 @@ pub fn run(a: Args) -> Result<()> {
                 threads,
                 chunk,
                 gpu: gpu.as_ref().map(|c| (c, precision.get())),
+                header,
                 picked,
                 shard,
                 resume,
-                format: fmt,
+                format: output_format(summary, format),
                 target_error: chosen,
             },
         );
@@ -300,13 +300,11 @@ pub fn run(a: Args) -> Result<()> {
         content: None,
         target_error: chosen.map(pounding::io::provenance::TargetError::of),
     };
-    let fmt = match &aggregate {
-        Some(by) => Format::Summary(Box::new(pounding::engine::aggregate::Aggregator::new(
-            by, &exceed,
-        )?)),
-        None if format == FormatArg::Parquet => Format::Parquet,
-        None => Format::Csv,
-    };
+    let summary = aggregate
+        .as_ref()
+        .map(|by| pounding::engine::aggregate::Aggregator::new(by, &exceed))
+        .transpose()?;
+    let fmt = output_format(summary, format);
     let Some(mut out) = open_output(target, meta, fmt, picked, resume)? else {
         return Ok(());
     };
@@ -410,7 +408,9 @@ struct RowSettings<'a> {
         &'a pounding::engine::gpu::GpuContext,
         pounding::engine::gpu::Precision,
     )>,
-    /// `--columns`, as indices into the row's header.
+    /// The row's columns ([`pounding::plan::row::RowPlan::header`]), and `--columns` as
+    /// indices into them.
+    header: Vec<String>,
     picked: Option<Vec<usize>>,
     shard: Option<Shard>,
     resume: bool,
@@ -433,6 +433,7 @@ fn run_row(
         threads,
         chunk,
         gpu,
+        header,
         picked,
         shard,
         resume,
@@ -459,10 +460,9 @@ fn run_row(
             on
         });
     }
-    let header = plan.header();
     let names: Vec<String> = match &picked {
         Some(ix) => ix.iter().map(|&i| header[i].clone()).collect(),
-        None => header.clone(),
+        None => header,
     };
     let range = match shard {
         Some(s) => pounding::plan::shard::row_shard_range(plan, s),
@@ -545,6 +545,18 @@ fn run_row(
     let (path, what) = finish_unless_changed(*out, &changed)?;
     finished(&summary, &path, &format!(" ({what})"));
     Ok(())
+}
+
+/// How rows are written: a summary (`--aggregate`), Parquet or CSV.
+fn output_format(
+    summary: Option<pounding::engine::aggregate::Aggregator>,
+    format: FormatArg,
+) -> Format {
+    match summary {
+        Some(agg) => Format::Summary(Box::new(agg)),
+        None if format == FormatArg::Parquet => Format::Parquet,
+        None => Format::Csv,
+    }
 }
 
 /// Open the sweep's output (fresh, or resumed) and say which runs it takes: None when a resume

@@ -553,17 +553,10 @@ pub(crate) fn parse_raw(
             .as_ref()
             .is_some_and(|s| s.axes.iter().any(|a| a.key() == key))
     };
-    // A grid axis or a sampled one, not both; a sampled axis holds one placeholder in the grid
-    // (0.5: valid for every axis, never used).
     let grid = |key: &str, a: &Option<Axis>| -> Result<Vec<f64>, ConfigError> {
-        match (a, sampled(key)) {
-            (Some(a), false) => axis(key, a),
-            (None, true) => Ok(vec![0.5]),
-            (Some(_), true) => Err(invalid(
-                key,
-                "is sampled under [sample]: remove it from the grid".into(),
-            )),
-            (None, false) => Err(invalid(key, "missing: give values or sample it".into())),
+        match grid_or_sampled(a.as_ref(), sampled(key)).map_err(|m| invalid(key, m))? {
+            Some(a) => axis(key, &a),
+            None => Err(invalid(key, MISSING.into())),
         }
     };
     let building = |name: &str, b: &RawBuilding| -> Result<BuildingAxes, ConfigError> {
@@ -656,6 +649,21 @@ fn check_size(
         .map(|_| ())
         .map_err(|e| invalid(&e.key, e.message))
 }
+
+/// A grid axis or a sampled one, not both: a sampled parameter's grid axis holds one placeholder
+/// (0.5: valid for every axis, never used). `Err` says why `given` cannot stand; `Ok(None)`: a
+/// parameter neither given nor sampled ([`MISSING`] where it is required). Shared by the pair's
+/// config and the row's ([`crate::plan::row`]).
+pub(crate) fn grid_or_sampled(given: Option<&Axis>, sampled: bool) -> Result<Option<Axis>, String> {
+    match (given, sampled) {
+        (Some(_), true) => Err("is sampled under [sample]: remove it from the grid".into()),
+        (None, true) => Ok(Some(Axis::List(vec![0.5]))),
+        (given, false) => Ok(given.cloned()),
+    }
+}
+
+/// The error of a required parameter that is neither given nor sampled.
+pub(crate) const MISSING: &str = "missing: give values or sample it";
 
 /// Stage 2 of `[sample]`: distributions checked, points drawn.
 fn samples(

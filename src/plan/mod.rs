@@ -286,7 +286,18 @@ fn period_ok(v: f64) -> bool {
 
 const PERIOD_EXPECTED: &str = "a period >= 1e-4 s (stiffer is a rigid body, not a building: contact substeps resolve the structure's period, so runs would crawl)";
 
-fn check_axis(
+/// What a swept or sampled value must be, and the words an error gives for it: shared by the
+/// pair's plan and the row's ([`crate::plan::row`]).
+pub(crate) type Check = (fn(f64) -> bool, &'static str);
+pub(crate) const PERIOD: Check = (period_ok, PERIOD_EXPECTED);
+pub(crate) const DAMPING: Check = (|v| (0.0..1.0).contains(&v), "0 <= damping ratio < 1");
+pub(crate) const GAP: Check = (|v| v.is_finite() && v >= 0.0, "a gap >= 0 m");
+pub(crate) const MASS: Check = (|v| v.is_finite() && v > 0.0, "a mass > 0 kg");
+pub(crate) const POSITIVE: Check = (|v| v.is_finite() && v > 0.0, "a value > 0");
+
+/// `values` of the axis `key`: not empty, each passing `ok` (else an error naming the value and
+/// its index, `expected` saying what it must be).
+pub(crate) fn check_axis(
     key: &str,
     values: &[f64],
     ok: impl Fn(f64) -> bool,
@@ -308,53 +319,34 @@ fn check_axis(
 
 impl Plan {
     pub fn new(spec: PlanSpec) -> Result<Plan, PlanError> {
-        let pos = |v: f64| v.is_finite() && v > 0.0;
+        let pos = POSITIVE.0;
         for (name, b) in [
             ("building1", &spec.building1),
             ("building2", &spec.building2),
         ] {
-            check_axis(&format!("{name}.mass_kg"), &b.mass, pos, "a mass > 0 kg")?;
-            check_axis(
-                &format!("{name}.period_s"),
-                &b.period,
-                period_ok,
-                PERIOD_EXPECTED,
-            )?;
+            check_axis(&format!("{name}.mass_kg"), &b.mass, MASS.0, MASS.1)?;
+            check_axis(&format!("{name}.period_s"), &b.period, PERIOD.0, PERIOD.1)?;
             check_axis(
                 &format!("{name}.damping_ratio"),
                 &b.damping,
-                |v| (0.0..1.0).contains(&v),
-                "0 <= damping ratio < 1",
+                DAMPING.0,
+                DAMPING.1,
             )?;
         }
-        check_axis(
-            "contact.gap_m",
-            &spec.gaps,
-            |v| v.is_finite() && v >= 0.0,
-            "a gap >= 0 m",
-        )?;
+        check_axis("contact.gap_m", &spec.gaps, GAP.0, GAP.1)?;
         if let Some(s) = &spec.samples {
             if s.points.is_empty() {
                 return Err(err("sample.n", "is 0: expected at least one sample"));
             }
             for (j, a) in s.axes.iter().enumerate() {
-                let col: Vec<f64> = s.points.iter().map(|p| p[j]).collect();
-                let (ok, expected): (fn(f64) -> bool, &str) = match a {
-                    SampledAxis::Damping1 | SampledAxis::Damping2 => {
-                        (|v| (0.0..1.0).contains(&v), "0 <= damping ratio < 1")
-                    }
-                    SampledAxis::Gap => (|v| v.is_finite() && v >= 0.0, "a gap >= 0 m"),
-                    SampledAxis::Period1 | SampledAxis::Period2 => (period_ok, PERIOD_EXPECTED),
-                    _ => (|v| v.is_finite() && v > 0.0, "a value > 0"),
+                let check = match a {
+                    SampledAxis::Damping1 | SampledAxis::Damping2 => DAMPING,
+                    SampledAxis::Gap => GAP,
+                    SampledAxis::Period1 | SampledAxis::Period2 => PERIOD,
+                    _ => POSITIVE,
                 };
-                if let Some(i) = col.iter().position(|&v| !ok(v)) {
-                    return Err(err(
-                        format!("sample.axis[{j}] ({})", a.key()),
-                        format!(
-                            "sample {i} drew {}: expected {expected}; truncate the distribution with min/max",
-                            col[i]
-                        ),
-                    ));
+                if let Some(m) = sample::refused_draw(&s.points, j, check) {
+                    return Err(err(format!("sample.axis[{j}] ({})", a.key()), m));
                 }
             }
         }

@@ -17,7 +17,8 @@ use crate::plan::config::{
     draw_sampled, parse_raw, Axis, ConfigError, RawBuilding, RawConfig, RawContact, RawIntensity,
     RawRecord, RawRun, RawSample,
 };
-use crate::plan::{Plan, RunSpec};
+use crate::plan::sample::refused_draw;
+use crate::plan::{check_axis, config, Check, Plan, RunSpec, DAMPING, GAP, MASS, PERIOD, POSITIVE};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -134,17 +135,12 @@ impl RowSampled {
     }
 
     /// What a drawn value must be.
-    fn check(self) -> (fn(f64) -> bool, &'static str) {
+    fn check(self) -> Check {
         match self {
-            RowSampled::Period(_) => (
-                |v| v.is_finite() && v >= crate::plan::limits::MIN_PERIOD_S,
-                "a period >= 1e-4 s",
-            ),
-            RowSampled::Damping(_) => (|v| (0.0..1.0).contains(&v), "0 <= damping ratio < 1"),
-            RowSampled::Gap(_) | RowSampled::SharedGap => {
-                (|v| v.is_finite() && v >= 0.0, "a gap >= 0 m")
-            }
-            _ => (|v| v.is_finite() && v > 0.0, "a value > 0"),
+            RowSampled::Period(_) => PERIOD,
+            RowSampled::Damping(_) => DAMPING,
+            RowSampled::Gap(_) | RowSampled::SharedGap => GAP,
+            _ => POSITIVE,
         }
     }
 }
@@ -512,17 +508,8 @@ pub fn parse_row(
                 &keys,
             )?;
             for (j, a) in axes.iter().enumerate() {
-                let (ok, expected) = a.check();
-                if let Some((i, v)) = points
-                    .iter()
-                    .map(|p| p[j])
-                    .enumerate()
-                    .find(|(_, v)| !ok(*v))
-                {
-                    return Err(invalid(
-                        &format!("sample.axis[{j}] ({})", a.key()),
-                        format!("sample {i} drew {v}: expected {expected}; truncate the distribution with min/max"),
-                    ));
+                if let Some(m) = refused_draw(&points, j, a.check()) {
+                    return Err(invalid(&format!("sample.axis[{j}] ({})", a.key()), m));
                 }
             }
             Some(RowSamples { axes, points })
@@ -531,19 +518,9 @@ pub fn parse_row(
     };
     let sampled = |a: RowSampled| samples.as_ref().is_some_and(|s| s.axes.contains(&a));
     let one = |x: f64| Some(Axis::List(vec![x]));
-    // A grid axis or a sampled one, not both; a sampled axis holds one placeholder in the grid
-    // (0.5: valid for every axis, never used).
-    let grid_or_sampled =
-        |a: RowSampled, given: Option<&Axis>| -> Result<Option<Axis>, ConfigError> {
-            match (given, sampled(a)) {
-                (Some(_), true) => Err(invalid(
-                    &a.key(),
-                    "is sampled under [sample]: remove it from the grid".into(),
-                )),
-                (None, true) => Ok(one(0.5)),
-                (g, false) => Ok(g.cloned()),
-            }
-        };
+    let grid_or_sampled = |a: RowSampled, given: Option<&Axis>| {
+        config::grid_or_sampled(given, sampled(a)).map_err(|m| invalid(&a.key(), m))
+    };
     let k_grid = grid_or_sampled(RowSampled::KLinear, raw.contact.k_n_per_m.as_ref())?;
     let beta_grid = grid_or_sampled(RowSampled::Beta, raw.contact.beta_n_per_m1_5.as_ref())?;
     let shared_gap = grid_or_sampled(RowSampled::SharedGap, raw.contact.gap_m.as_ref())?;
@@ -567,20 +544,12 @@ pub fn parse_row(
         sample: None,
     };
     let base_plan = parse_raw(&base_raw, path, base, records)?;
-    let axis = |key: &str, a: &Axis, ok: &dyn Fn(f64) -> bool, expected: &str| {
+    let axis = |key: &str, a: &Axis, (ok, expected): Check| {
         let v = a.values().map_err(|m| invalid(key, m))?;
-        if v.is_empty() {
-            return Err(invalid(key, "is empty: give at least one value".into()));
-        }
-        if let Some((i, x)) = v.iter().enumerate().find(|(_, x)| !ok(**x)) {
-            return Err(invalid(
-                &format!("{key}[{i}]"),
-                format!("{x} is out of range: expected {expected}"),
-            ));
-        }
+        check_axis(key, &v, ok, expected).map_err(|e| invalid(&e.key, e.message))?;
         Ok(v)
     };
-    let positive = |x: f64| x.is_finite() && x > 0.0;
+    let positive = POSITIVE.0;
     let per_storey = |key: &str, v: &[f64], n: usize| {
         if v.len() != n {
             return Err(invalid(
@@ -616,12 +585,14 @@ pub fn parse_row(
         if sampled(RowSampled::Mass(b)) && r.floor_masses_kg.is_some() {
             return Err(invalid(
                 &key("floor_masses_kg"),
-                "building[b].mass_kg is sampled under [sample]: remove floor_masses_kg"
-                    .replace("[b]", &format!("[{b}]")),
+                format!(
+                    "{} is sampled under [sample]: remove floor_masses_kg",
+                    key("mass_kg")
+                ),
             ));
         }
         let (floor_masses, mass) = match (&mass_kg, &r.floor_masses_kg) {
-            (Some(a), None) => (None, axis(&key("mass_kg"), a, &positive, "a mass > 0 kg")?),
+            (Some(a), None) => (None, axis(&key("mass_kg"), a, MASS)?),
             (None, Some(v)) => (Some(per_storey(&key("floor_masses_kg"), v, n)?), vec![0.0]),
             _ => {
                 return Err(invalid(
@@ -646,8 +617,7 @@ pub fn parse_row(
             }
         };
         let required = |a: RowSampled, given: Option<&Axis>| {
-            grid_or_sampled(a, given)?
-                .ok_or_else(|| invalid(&a.key(), "missing: give values or sample it".into()))
+            grid_or_sampled(a, given)?.ok_or_else(|| invalid(&a.key(), config::MISSING.into()))
         };
         let period_s = required(RowSampled::Period(b), r.period_s.as_ref())?;
         let damping_ratio = required(RowSampled::Damping(b), r.damping_ratio.as_ref())?;
@@ -656,21 +626,10 @@ pub fn parse_row(
             floor_masses,
             mass,
             profile,
-            period: axis(
-                &key("period_s"),
-                &period_s,
-                &|v| v.is_finite() && v >= crate::plan::limits::MIN_PERIOD_S,
-                "a period >= 1e-4 s",
-            )?,
-            damping: axis(
-                &key("damping_ratio"),
-                &damping_ratio,
-                &|v| (0.0..1.0).contains(&v),
-                "0 <= damping ratio < 1",
-            )?,
+            period: axis(&key("period_s"), &period_s, PERIOD)?,
+            damping: axis(&key("damping_ratio"), &damping_ratio, DAMPING)?,
             modal,
         });
-        let gap_ok = |v: f64| v.is_finite() && v >= 0.0;
         let gap_right = if b + 1 < nb {
             grid_or_sampled(RowSampled::Gap(b), r.gap_right_m.as_ref())?
         } else {
@@ -684,8 +643,8 @@ pub fn parse_row(
                     "the last building has no neighbour to its right".into(),
                 ))
             }
-            (Some(a), true, _) => gaps.push(axis(&key("gap_right_m"), a, &gap_ok, "a gap >= 0 m")?),
-            (None, true, Some(a)) => gaps.push(axis("contact.gap_m", a, &gap_ok, "a gap >= 0 m")?),
+            (Some(a), true, _) => gaps.push(axis(&key("gap_right_m"), a, GAP)?),
+            (None, true, Some(a)) => gaps.push(axis("contact.gap_m", a, GAP)?),
             (None, true, None) => {
                 return Err(invalid(
                     &key("gap_right_m"),

@@ -123,6 +123,26 @@ pub fn draw(method: Method, n: usize, dists: &[Dist], seed: u64) -> Vec<Vec<f64>
         .collect()
 }
 
+/// Why column `j` of drawn `points` is refused: the first value `check` refuses, in the words
+/// both plans' errors use; None if every value passes.
+pub(crate) fn refused_draw(
+    points: &[Vec<f64>],
+    j: usize,
+    check: crate::plan::Check,
+) -> Option<String> {
+    let (ok, expected) = check;
+    points
+        .iter()
+        .map(|p| p[j])
+        .enumerate()
+        .find(|&(_, v)| !ok(v))
+        .map(|(i, v)| {
+            format!(
+                "sample {i} drew {v}: expected {expected}; truncate the distribution with min/max"
+            )
+        })
+}
+
 /// Standard normal CDF (via `erfc`, relative error below 1.2e-7 everywhere).
 pub fn phi(x: f64) -> f64 {
     if x == f64::NEG_INFINITY {
