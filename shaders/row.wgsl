@@ -3,7 +3,9 @@
 // 4 or more storeys with Rayleigh damping in floor coordinates (the same motion, O(N) per
 // right-hand side) where this kernel stays in modes, and that the CPU bounds each mode's
 // |q''''| once per free step for every level's may_touch where this kernel bounds them per
-// level (the same values). The fast scheme on a row of shear buildings, in modal coordinates,
+// level (the same values), and that the CPU lets the buildings no contact reaches stand still
+// through a step's substeps and steps them exactly at its end where this kernel substeps the
+// whole row (the CPU's `simulate_whole_row` is this kernel's twin step for step). The fast scheme on a row of shear buildings, in modal coordinates,
 // one invocation per run; resumable as fast.wgsl (at most `disp.budget` units of work per run
 // and dispatch: a free record interval, or one piece of an RK4 substep).
 //

@@ -42,6 +42,8 @@ pub(crate) struct BuildingModel {
     pub scale: f64,
     /// Its floor-coordinate form (Rayleigh damping only: `C` is then tridiagonal like `K`).
     pub floor_form: Option<FloorForm>,
+    /// Per mode, its largest `|phi|` over the floors: a bound on any floor's share of it.
+    pub shape_max: Vec<f64>,
     /// Its slice of the state holds floor displacements and velocities instead of modes
     /// (in the fast scheme's contact substeps, [`RowModel::substep_model`]).
     pub in_floors: bool,
@@ -146,8 +148,17 @@ impl RowModel {
                 a1,
                 inv_m: b.masses.iter().map(|m| 1.0 / m).collect(),
             });
+            let shape_max = (0..n)
+                .map(|i| {
+                    modes
+                        .shape
+                        .iter()
+                        .fold(0.0, |a: f64, row| a.max(row[i].abs()))
+                })
+                .collect();
             buildings.push(BuildingModel {
                 off,
+                shape_max,
                 modes,
                 heights: b.heights.clone(),
                 masses: b.masses.clone(),
@@ -220,9 +231,25 @@ impl RowModel {
 
     /// Express `z`, a state of `modal` (this model's modal twin), in this model's
     /// coordinates: `u = Phi q` for the buildings in floors.
+    #[cfg(test)]
     pub(crate) fn modes_to_substeps(&self, z: &mut [f64]) {
-        let n = self.n;
-        for b in self.buildings.iter().filter(|b| b.in_floors) {
+        for k in 0..self.buildings.len() {
+            self.building_to_substeps(k, z);
+        }
+    }
+
+    /// Back to modes: `q = Phi^T M u` for the buildings in floors.
+    #[cfg(test)]
+    pub(crate) fn substeps_to_modes(&self, z: &mut [f64]) {
+        for k in 0..self.buildings.len() {
+            self.building_to_modes(k, z);
+        }
+    }
+
+    /// [`RowModel::modes_to_substeps`] for building `k` alone.
+    pub(crate) fn building_to_substeps(&self, k: usize, z: &mut [f64]) {
+        let (n, b) = (self.n, &self.buildings[k]);
+        if b.in_floors {
             let (o, nb) = (b.off, b.n());
             let u = b.modes.to_floors(&z[o..o + nb]);
             let v = b.modes.to_floors(&z[n + o..n + o + nb]);
@@ -231,16 +258,28 @@ impl RowModel {
         }
     }
 
-    /// Back to modes: `q = Phi^T M u` for the buildings in floors.
-    pub(crate) fn substeps_to_modes(&self, z: &mut [f64]) {
-        let n = self.n;
-        for b in self.buildings.iter().filter(|b| b.in_floors) {
+    /// [`RowModel::substeps_to_modes`] for building `k` alone.
+    pub(crate) fn building_to_modes(&self, k: usize, z: &mut [f64]) {
+        let (n, b) = (self.n, &self.buildings[k]);
+        if b.in_floors {
             let (o, nb) = (b.off, b.n());
             let q = b.modes.to_modes(&b.masses, &z[o..o + nb]);
             let qd = b.modes.to_modes(&b.masses, &z[n + o..n + o + nb]);
             z[o..o + nb].copy_from_slice(&q);
             z[n + o..n + o + nb].copy_from_slice(&qd);
         }
+    }
+
+    /// Each building's largest modal rate, `w + 2 xi w` (1/s).
+    pub(crate) fn building_rates(&self) -> Vec<f64> {
+        self.buildings
+            .iter()
+            .map(|b| {
+                (b.off..b.off + b.n())
+                    .map(|i| self.w2[i].sqrt() + self.two_xi_w[i])
+                    .fold(0.0, f64::max)
+            })
+            .collect()
     }
 
     /// Length of the state vector.
@@ -308,6 +347,18 @@ impl LevelModel {
         dot(&self.phi_a, &z[n + a.0..n + a.0 + a.1]) - dot(&self.phi_b, &z[n + b.0..n + b.0 + b.1])
     }
 
+    /// The left floor's displacement (`n = 0`) or velocity (`n` the mode count).
+    #[inline]
+    pub(crate) fn left(&self, z: &[f64], n: usize) -> f64 {
+        dot(&self.phi_a, &z[n + self.a.0..n + self.a.0 + self.a.1])
+    }
+
+    /// The right floor's displacement (`n = 0`) or velocity (`n` the mode count).
+    #[inline]
+    pub(crate) fn right(&self, z: &[f64], n: usize) -> f64 {
+        dot(&self.phi_b, &z[n + self.b.0..n + self.b.0 + self.b.1])
+    }
+
     /// `delta''` from the structures alone (no contact force; the ground motion cancels).
     pub(crate) fn structural_rel_accel(&self, m: &RowModel, z: &[f64]) -> f64 {
         let n = m.n;
@@ -370,12 +421,30 @@ impl LevelModel {
         h: f64,
         v0: f64,
     ) -> bool {
-        let (d0, d1) = (self.delta(z0), self.delta(z1));
-        let (r0, r1) = (self.ddelta(n, z0), self.ddelta(n, z1));
+        let ends = [
+            self.delta(z0),
+            self.ddelta(n, z0),
+            self.delta(z1),
+            self.ddelta(n, z1),
+        ];
+        self.may_touch_within(ends, self.fourth_derivative_bound(bounds), h, v0)
+    }
+
+    /// The bound on `|delta''''|` over a free step from each mode's bound on `|q''''|`.
+    pub(crate) fn fourth_derivative_bound(&self, bounds: &[f64]) -> f64 {
         let bound = |phi: &[f64], (o, len): (usize, usize)| -> f64 {
             (0..len).map(|i| phi[i].abs() * bounds[o + i]).sum()
         };
-        let margin = -error_margin(bound(&self.phi_a, self.a) + bound(&self.phi_b, self.b), h);
+        bound(&self.phi_a, self.a) + bound(&self.phi_b, self.b)
+    }
+
+    /// [`LevelModel::may_touch`] from the penetration and its rate at the step's ends,
+    /// `[delta0, delta0', delta1, delta1']`, and a bound on `|delta''''|` over it. A larger bound
+    /// only answers yes more often, so a "no" under a coarse bound is a "no" under the exact
+    /// one.
+    pub(crate) fn may_touch_within(&self, ends: [f64; 4], bound: f64, h: f64, v0: f64) -> bool {
+        let [d0, r0, d1, r1] = ends;
+        let margin = -error_margin(bound, h);
         if cubic_max_bound(d0, r0, d1, r1, h) <= margin {
             return false;
         }
@@ -387,6 +456,20 @@ impl LevelModel {
 }
 
 impl RowModel {
+    /// Each building's bound on the `|u''''|` of any of its floors over a free step, from each
+    /// mode's bound on `|q''''|` (`bounds`): `sum_i max_j |phi_ji| bound_i`, `O(N)` per
+    /// building where each level's own bound costs `O(N)` per level.
+    pub(crate) fn coarse_floor_bounds(&self, bounds: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(self.buildings.iter().map(|b| {
+            b.shape_max
+                .iter()
+                .zip(&bounds[b.off..b.off + b.n()])
+                .map(|(p, q)| p * q)
+                .sum::<f64>()
+        }));
+    }
+
     /// Each mode's bound on `|q''''|` over a free step from `z0` to `z1` in `seg`
     /// ([`fourth_derivative_bound`] of the mode's oscillator under its share of the ground
     /// motion), into `out`.
@@ -420,13 +503,30 @@ impl RowModel {
 /// Each level's contact mode and impact speed: what the right-hand side needs of them.
 pub(crate) type LevelModes = [(Mode, f64)];
 
+/// What the right-hand side needs of a run besides its state.
+pub(crate) struct Motion<'a> {
+    /// Each level's contact mode and impact speed.
+    pub levels: &'a LevelModes,
+    /// The buildings that move; the others stand still (derivative 0): the fast scheme steps
+    /// them exactly after a record step's substeps, and none of their levels is in contact.
+    pub active: &'a [bool],
+    /// Integrate the input and damping work (the energy balance); else their slots stay.
+    pub energy: bool,
+}
+
 /// The right-hand side at ground acceleration `ag`, into `out`.
-pub(crate) fn rhs(m: &RowModel, lv: &LevelModes, ag: f64, z: &[f64], out: &mut [f64]) {
+pub(crate) fn rhs(m: &RowModel, motion: &Motion, ag: f64, z: &[f64], out: &mut [f64]) {
+    let (lv, active, energy) = (motion.levels, motion.active, motion.energy);
     let n = m.n;
     let nl = m.levels.len();
     let (mut e_in, mut e_damp) = (0.0, 0.0);
-    for b in &m.buildings {
+    for (b, &on) in m.buildings.iter().zip(active) {
         let (o, nb) = (b.off, b.n());
+        if !on {
+            out[o..o + nb].fill(0.0);
+            out[n + o..n + o + nb].fill(0.0);
+            continue;
+        }
         match (&b.floor_form, b.in_floors) {
             (Some(f), true) => {
                 // u'' = -a0 u' - M^-1 K (u + a1 u') - ag; the input is -ag 1^T M u', the
@@ -437,10 +537,14 @@ pub(crate) fn rhs(m: &RowModel, lv: &LevelModes, ag: f64, z: &[f64], out: &mut [
                 f.k_over_m(|j| u[j] + f.a1 * v[j], acc);
                 for j in 0..nb {
                     acc[j] = -f.a0 * v[j] - acc[j] - ag;
-                    let mv = b.masses[j] * v[j];
-                    let dv = v[j] - if j == 0 { 0.0 } else { v[j - 1] };
-                    e_in -= ag * mv;
-                    e_damp += f.a0 * mv * v[j] + f.a1 * f.k[j] * dv * dv;
+                }
+                if energy {
+                    for j in 0..nb {
+                        let mv = b.masses[j] * v[j];
+                        let dv = v[j] - if j == 0 { 0.0 } else { v[j - 1] };
+                        e_in -= ag * mv;
+                        e_damp += f.a0 * mv * v[j] + f.a1 * f.k[j] * dv * dv;
+                    }
                 }
             }
             _ => {
@@ -448,8 +552,13 @@ pub(crate) fn rhs(m: &RowModel, lv: &LevelModes, ag: f64, z: &[f64], out: &mut [
                     let v = z[n + i];
                     out[i] = v;
                     out[n + i] = -m.two_xi_w[i] * v - m.w2[i] * z[i] - m.part[i] * ag;
-                    e_in -= ag * m.part[i] * v;
-                    e_damp += m.two_xi_w[i] * v * v;
+                }
+                if energy {
+                    for i in o..o + nb {
+                        let v = z[n + i];
+                        e_in -= ag * m.part[i] * v;
+                        e_damp += m.two_xi_w[i] * v * v;
+                    }
                 }
             }
         }
@@ -542,12 +651,24 @@ impl Floors {
         let n = m.n;
         let nb = b.n();
         let o = b.off;
-        if let (Some(f), true) = (&b.floor_form, b.in_floors) {
-            // Floor coordinates: the structural acceleration (no ground, no contact)
-            // `-a0 u' - M^-1 K (u + a1 u')`, and the jerk `-a0 u''_s - M^-1 K (u' + a1 u''_s)`
-            // of the structural-and-ground acceleration `u''_s`, as the modes give them.
-            self.u.copy_from_slice(&z[o..o + nb]);
-            self.v.copy_from_slice(&z[n + o..n + o + nb]);
+        // Below FLOOR_SUBSTEPS_FROM storeys the modes' four products cost no more.
+        if let Some(f) = b.floor_form.as_ref().filter(|_| nb >= FLOOR_SUBSTEPS_FROM) {
+            // With Rayleigh damping, from the floors' motion: the structural acceleration (no
+            // ground, no contact) `-a0 u' - M^-1 K (u + a1 u')`, and the jerk
+            // `-a0 u''_s - M^-1 K (u' + a1 u''_s)` of the structural-and-ground acceleration
+            // `u''_s`, as the modes give them, at O(N) once the floors' displacements and
+            // velocities are known (two products with the mode shapes from modes, where the
+            // accelerations and jerks would take two more).
+            if b.in_floors {
+                self.u.copy_from_slice(&z[o..o + nb]);
+                self.v.copy_from_slice(&z[n + o..n + o + nb]);
+            } else {
+                let sh = &b.modes.shape;
+                for j in 0..nb {
+                    self.u[j] = dot(&sh[j], &z[o..o + nb]);
+                    self.v[j] = dot(&sh[j], &z[n + o..n + o + nb]);
+                }
+            }
             let (u, v) = (&self.u, &self.v);
             f.k_over_m(|j| u[j] + f.a1 * v[j], &mut self.acc);
             for j in 0..nb {
@@ -604,7 +725,16 @@ pub(crate) struct RowRun<'m> {
     /// starts from them instead of computing them again.
     floors: Vec<[Floors; 2]>,
     ends_valid: bool,
+    /// The floors hold a prepared free step's ends ([`RowRun::prepare_free_ends`]), and
+    /// `ends_valid` before it.
+    ends_ready: bool,
+    valid_before: bool,
     touched: Vec<bool>,
+    /// The buildings that move in the current substeps (all, outside the fast scheme's
+    /// contact steps), and the levels between two of them: only those are integrated, checked
+    /// for events and tracked ([`RowRun::set_active`]).
+    pub active: Vec<bool>,
+    level_on: Vec<bool>,
 }
 
 impl<'m> RowRun<'m> {
@@ -625,7 +755,11 @@ impl<'m> RowRun<'m> {
                 .map(|b| [Floors::new(b.n()), Floors::new(b.n())])
                 .collect(),
             ends_valid: false,
+            ends_ready: false,
+            valid_before: false,
             touched: vec![false; m.buildings.len()],
+            active: vec![true; m.buildings.len()],
+            level_on: vec![true; m.levels.len()],
             z,
         };
         let z = run.z.clone();
@@ -637,17 +771,125 @@ impl<'m> RowRun<'m> {
     /// step of substeps.
     /// The floors' kinematics at the last piece's end stay valid: they are the same motion
     /// in either coordinates.
+    /// Only the active buildings change coordinates: the others keep their modal state at the
+    /// step's start until they are activated or stepped exactly.
     pub fn enter_substeps(&mut self, sub: &'m RowModel) {
-        sub.modes_to_substeps(&mut self.z);
+        for k in 0..sub.buildings.len() {
+            if self.active[k] {
+                sub.building_to_substeps(k, &mut self.z);
+            }
+        }
         self.m = sub;
     }
 
     /// Back to the modal model after the substeps.
     pub fn leave_substeps(&mut self) {
         if !std::ptr::eq(self.m, self.modal) {
-            self.m.substeps_to_modes(&mut self.z);
+            for k in 0..self.m.buildings.len() {
+                if self.active[k] {
+                    self.m.building_to_modes(k, &mut self.z);
+                }
+            }
             self.m = self.modal;
         }
+    }
+
+    /// Let only the `active` buildings move in the substeps to come (and the levels between
+    /// two of them be checked).
+    pub fn set_active(&mut self, active: &[bool]) {
+        self.active.copy_from_slice(active);
+        for (on, lm) in self.level_on.iter_mut().zip(&self.m.levels) {
+            *on = active[lm.buildings.0] && active[lm.buildings.1];
+        }
+    }
+
+    /// Whether level `l` is checked: both its buildings move.
+    pub fn level_on(&self, l: usize) -> bool {
+        self.level_on[l]
+    }
+
+    /// Every building moves again (after a record step with some standing still).
+    pub fn all_active(&mut self) {
+        self.active.fill(true);
+        self.level_on.fill(true);
+    }
+
+    /// A building that stood still since `seg.t0` joins the substeps at `t`: its modes are
+    /// stepped exactly from the step's start (`Propagator` over `t - seg.t0`, with the input and
+    /// damping work), its peaks tracked over that free piece, and its state moved into the
+    /// substeps' coordinates.
+    pub fn activate(&mut self, k: usize, seg: &Segment, t: f64) {
+        let modal = self.modal;
+        let b = &modal.buildings[k];
+        let (n, nl) = (modal.n, modal.levels.len());
+        let h = t - seg.t0;
+        let z0 = self.z.clone();
+        if h > 0.0 {
+            for i in b.off..b.off + b.n() {
+                let osc = crate::physics::model::Oscillator {
+                    m: 1.0,
+                    k: modal.w2[i],
+                    c: modal.two_xi_w[i],
+                };
+                let (a0, a1) = (modal.part[i] * seg.a0, modal.part[i] * seg.at(t));
+                let p = crate::physics::propagator::Propagator::new(&osc, h);
+                (self.z[i], self.z[n + i]) = p.step(z0[i], z0[n + i], a0, a1);
+                if self.energy {
+                    let f = crate::physics::propagator::EnergyForms::new(&osc, h);
+                    let (vv, agv) = f.integrals(z0[i], z0[n + i], a0, a1);
+                    self.z[2 * n + nl] -= agv;
+                    self.z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
+                }
+            }
+            let z1 = self.z.clone();
+            self.track_still(k, &z0, &z1, (seg.a0, seg.at(t)), h);
+        }
+        self.active[k] = true;
+        for (on, lm) in self.level_on.iter_mut().zip(&self.m.levels) {
+            *on = self.active[lm.buildings.0] && self.active[lm.buildings.1];
+        }
+        if !std::ptr::eq(self.m, modal) {
+            self.m.building_to_substeps(k, &mut self.z);
+        }
+    }
+
+    /// End a record step over `seg` for the buildings that stood still through it: their
+    /// exact free step `z1` (modal, the whole row's), with `work` (each mode's input and
+    /// damping work over the step, when the energy is kept), and their peaks over it. Call in
+    /// modal coordinates ([`RowRun::leave_substeps`]).
+    pub fn finish_still(&mut self, seg: &Segment, z0: &[f64], z1: &[f64], work: &[(f64, f64)]) {
+        let modal = self.modal;
+        let (n, nl) = (modal.n, modal.levels.len());
+        for k in 0..modal.buildings.len() {
+            if self.active[k] {
+                continue;
+            }
+            let b = &modal.buildings[k];
+            for i in b.off..b.off + b.n() {
+                self.z[i] = z1[i];
+                self.z[n + i] = z1[n + i];
+                if let Some(&(agv, vv)) = work.get(i) {
+                    self.z[2 * n + nl] -= agv;
+                    self.z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
+                }
+            }
+            self.track_still(k, z0, z1, (seg.a0, seg.a1), seg.dt);
+        }
+        self.e_peak = self.e_peak.max(self.e_initial + self.z[2 * n + nl]);
+        self.all_active();
+    }
+
+    /// Raise building `k`'s peaks over a free piece of length `h` from `z0` to `z1` (modal
+    /// states; no contact acts on it), leaving its floor kinematics at `z1` as the piece's end.
+    fn track_still(&mut self, k: usize, z0: &[f64], z1: &[f64], ag: (f64, f64), h: f64) {
+        let modal = self.modal;
+        let bm = &modal.buildings[k];
+        for (end, z, a) in [(0, z0, ag.0), (1, z1, ag.1)] {
+            let f = &mut self.floors[k][end];
+            f.force.fill(0.0);
+            f.fill(modal, bm, z, a);
+        }
+        self.raise_building(k, bm, h, true);
     }
 
     /// Each level's mode and impact speed, into `out`.
@@ -667,7 +909,9 @@ impl<'m> RowRun<'m> {
             .levels
             .iter()
             .zip(&self.levels)
-            .map(|(lm, ls)| lm.event_value(n, ls.mode, ls.v0, z))
+            .zip(&self.level_on)
+            .filter(|(_, &on)| on)
+            .map(|((lm, ls), _)| lm.event_value(n, ls.mode, ls.v0, z))
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
@@ -695,17 +939,11 @@ impl<'m> RowRun<'m> {
     /// contact force's spike is not smooth enough for the cubic).
     fn track_buildings(&mut self, z0: &[f64], z1: &[f64], ag: (f64, f64), h: f64) {
         let m = self.m;
-        if self.ends_valid {
-            for f in self.floors.iter_mut() {
-                f.swap(0, 1);
-            }
+        if self.ends_ready {
+            self.ends_ready = false;
         } else {
-            self.set_floor_forces(z0, 0);
-            for (k, bm) in m.buildings.iter().enumerate() {
-                self.floors[k][0].fill(m, bm, z0, ag.0);
-            }
+            self.floor_ends(z0, z1, ag);
         }
-        self.set_floor_forces(z1, 1);
         self.touched.fill(false);
         for (lm, ls) in m.levels.iter().zip(&self.levels) {
             if ls.mode != Mode::Free {
@@ -714,8 +952,81 @@ impl<'m> RowRun<'m> {
             }
         }
         for (k, bm) in m.buildings.iter().enumerate() {
-            let free = !self.touched[k];
-            self.floors[k][1].fill(m, bm, z1, ag.1);
+            if self.active[k] {
+                self.raise_building(k, bm, h, !self.touched[k]);
+            }
+        }
+    }
+
+    /// The moving buildings' floor kinematics at both ends of the piece `z0 -> z1` into
+    /// `floors[.][0]` and `[1]` (the start's from the last piece's end while still valid).
+    #[inline(always)]
+    fn floor_ends(&mut self, z0: &[f64], z1: &[f64], ag: (f64, f64)) {
+        let m = self.m;
+        if self.ends_valid {
+            for (f, _) in self.floors.iter_mut().zip(&self.active).filter(|(_, &a)| a) {
+                f.swap(0, 1);
+            }
+        } else {
+            self.set_floor_forces(z0, 0);
+            for (k, bm) in m.buildings.iter().enumerate() {
+                if self.active[k] {
+                    self.floors[k][0].fill(m, bm, z0, ag.0);
+                }
+            }
+        }
+        self.set_floor_forces(z1, 1);
+        for (k, bm) in m.buildings.iter().enumerate() {
+            if self.active[k] {
+                self.floors[k][1].fill(m, bm, z1, ag.1);
+            }
+        }
+    }
+
+    /// The floors' kinematics at both ends of a free record step `z0 -> z1` (ground
+    /// acceleration `ag` at its ends), computed before the step is taken so that the levels'
+    /// checks read them ([`RowRun::level_ends`]): [`RowRun::free_step`] then tracks the peaks
+    /// from them, and [`RowRun::drop_free_ends`] puts the floors back when the step is redone in
+    /// substeps instead.
+    pub fn prepare_free_ends(&mut self, z0: &[f64], z1: &[f64], ag: (f64, f64)) {
+        self.valid_before = self.ends_valid;
+        self.floor_ends(z0, z1, ag);
+        self.ends_ready = true;
+    }
+
+    /// Undo [`RowRun::prepare_free_ends`]: the start's kinematics are the last piece's end
+    /// again.
+    pub fn drop_free_ends(&mut self) {
+        if self.ends_ready {
+            for f in self.floors.iter_mut() {
+                f.swap(0, 1);
+            }
+            self.ends_valid = self.valid_before;
+            self.ends_ready = false;
+        }
+    }
+
+    /// Level `l`'s penetration and its rate at the start and end of the prepared free step,
+    /// `[delta0, delta0', delta1, delta1']`, from the floors (the same products as
+    /// [`LevelModel::delta`] from the modes).
+    pub fn level_ends(&self, l: usize) -> [f64; 4] {
+        let lm = &self.m.levels[l];
+        let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+        let [a0, a1] = &self.floors[a];
+        let [b0, b1] = &self.floors[b];
+        [
+            a0.u[fa] - b0.u[fb] - lm.gap,
+            a0.v[fa] - b0.v[fb],
+            a1.u[fa] - b1.u[fb] - lm.gap,
+            a1.v[fa] - b1.v[fb],
+        ]
+    }
+
+    /// Raise building `k`'s peaks over a piece of length `h` between its floor kinematics
+    /// `floors[k]`: `free` when no contact acts on it.
+    #[inline(always)]
+    fn raise_building(&mut self, k: usize, bm: &BuildingModel, h: f64, free: bool) {
+        {
             let [s0, s1] = &self.floors[k];
             let out = &mut self.buildings[k];
             let nb = bm.n();
@@ -816,7 +1127,15 @@ impl<'m> RowRun<'m> {
     /// is not positive only go back to approach if a restitution closes again.
     fn transitions(&mut self, t: f64, z: &[f64], before: &[f64]) {
         let n = self.m.n;
-        for (lm, ls) in self.m.levels.iter().zip(self.levels.iter_mut()) {
+        let on = self.level_on.iter();
+        for ((lm, ls), _) in self
+            .m
+            .levels
+            .iter()
+            .zip(self.levels.iter_mut())
+            .zip(on)
+            .filter(|(_, &on)| on)
+        {
             if lm.event_value(n, ls.mode, ls.v0, z) <= 0.0 {
                 if ls.mode == Mode::Restitution && lm.ddelta(n, z) > 0.0 {
                     ls.mode = Mode::Approach;
@@ -867,8 +1186,9 @@ impl<'m> RowRun<'m> {
                 .levels
                 .iter()
                 .zip(&self.levels)
-                .filter(|(_, ls)| ls.mode == Mode::Free)
-                .filter_map(|(lm, _)| {
+                .zip(&self.level_on)
+                .filter(|((_, ls), &on)| on && ls.mode == Mode::Free)
+                .filter_map(|((lm, _), _)| {
                     hidden_rise(
                         lm.delta(&z0),
                         lm.ddelta(n, &z0),

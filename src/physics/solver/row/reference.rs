@@ -6,7 +6,7 @@
 //! amplitude would ask for needless accuracy), and of each level in contact against the
 //! impact's scales.
 
-use super::{rhs, LevelModes, RowModel, RowRun};
+use super::{rhs, LevelModes, Motion, RowModel, RowRun};
 use crate::physics::model::{Forcing, Status};
 use crate::physics::row::RowOutput;
 use crate::physics::solver::fast::SUSTAINED;
@@ -25,9 +25,16 @@ fn dopri(
     h: f64,
     rtol: f64,
 ) -> (Vec<f64>, f64) {
+    // Every building moves in every step of the reference.
+    let active = vec![true; m.buildings.len()];
     let (y, ev) = dopri_stages(&z.to_vec(), t, h, |tt, y: &Vec<f64>| {
         let mut out = vec![0.0; y.len()];
-        rhs(m, lv, seg.at(tt), y, &mut out);
+        let motion = Motion {
+            levels: lv,
+            active: &active,
+            energy: true,
+        };
+        rhs(m, &motion, seg.at(tt), y, &mut out);
         out
     });
     let n = m.n;
