@@ -192,6 +192,12 @@ pub fn run(a: Args) -> Result<()> {
         let gpu = match (backend, gpu_fit) {
             (Backend::Gpu, Some(why)) => bail!("--backend gpu: {why}; use --backend cpu"),
             (_, Some(_)) => None,
+            // Measured on an H100: the row kernel beats 16 CPU threads only for rows of
+            // one-storey buildings (2.4x); 0.59x at 3 storeys, 0.17x at 6 (BENCHMARKS.md).
+            (Backend::Auto, None) if plan.buildings.iter().any(|b| b.storeys() > 1) => {
+                note!("notice: running on the CPU: the row kernel is slower than the CPU path for buildings of more than one storey (BENCHMARKS.md, \"Rows on the GPU\"); --backend gpu uses it");
+                None
+            }
             _ => backend.acquire("running on the CPU", &mut |l| note!("{l}"))?,
         };
         let header = plan.header();

@@ -396,3 +396,22 @@ fn row_target_error_takes_the_rows_calibrated_setting() {
         "{err}"
     );
 }
+
+/// Without `--backend`, rows of multi-storey buildings run on the CPU, whatever adapter there is,
+/// and say why: the row kernel is slower than the CPU path beyond one storey (BENCHMARKS.md).
+#[test]
+fn auto_runs_multistorey_rows_on_the_cpu() {
+    let dir = tempdir();
+    let cfg = dir.path().join("row.toml");
+    std::fs::write(&cfg, ROW_CONFIG).unwrap();
+    let out = dir.path().join("auto.csv");
+    let r = pound(&["sweep", s(&cfg), "-o", s(&out)]);
+    ok(&r);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        err.contains("the row kernel is slower than the CPU path") && err.contains("on the CPU"),
+        "{err}"
+    );
+    let meta = std::fs::read_to_string(pounding::io::provenance::meta_path(&out)).unwrap();
+    assert!(meta.contains("backend = \"cpu\""), "{meta}");
+}
