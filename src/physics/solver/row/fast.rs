@@ -96,23 +96,16 @@ impl Lookout {
     ) -> Lookout {
         let lm = &m.levels[l];
         let n = m.n;
-        let (phi, (o, len)) = if left_moves {
-            (&lm.phi_b, lm.b)
-        } else {
-            (&lm.phi_a, lm.a)
-        };
-        let floor = |z: &[f64], s: usize| -> f64 {
-            phi.iter()
-                .zip(&z[s + o..s + o + len])
-                .map(|(p, q)| p * q)
-                .sum()
+        // The still floor: the right one when the left moves.
+        let floor = |z: &[f64], s: usize| {
+            if left_moves {
+                lm.right(z, s)
+            } else {
+                lm.left(z, s)
+            }
         };
         let (lo, hi) = hermite_range(floor(z, 0), floor(z, n), floor(z1, 0), floor(z1, n), dt);
-        let bound: f64 = phi
-            .iter()
-            .zip(&bounds[o..o + len])
-            .map(|(p, b)| p.abs() * b)
-            .sum();
+        let bound = lm.side_fourth_derivative_bound(!left_moves, bounds);
         let margin = error_margin(bound, dt);
         Lookout {
             level: l,
@@ -256,29 +249,29 @@ fn run_with(
         let any_contact = run.any_contact();
         z1.copy_from_slice(&z);
         work.clear();
-        for k in (0..n).filter(|_| can_stand || !any_contact) {
-            let (a0, a1) = (m.part[k] * seg.a0, m.part[k] * seg.a1);
-            (z1[k], z1[n + k]) = props[k].step(z[k], z[n + k], a0, a1);
-            if let Some(f) = &forms {
-                let (vv, agv) = f[k].integrals(z[k], z[n + k], a0, a1);
-                z1[2 * n + nl] -= agv;
-                z1[2 * n + nl + 1] += m.two_xi_w[k] * vv;
-                work.push((agv, vv));
+        if can_stand || !any_contact {
+            for k in 0..n {
+                let (a0, a1) = (m.part[k] * seg.a0, m.part[k] * seg.a1);
+                (z1[k], z1[n + k]) = props[k].step(z[k], z[n + k], a0, a1);
+                if let Some(f) = &forms {
+                    let (vv, agv) = f[k].integrals(z[k], z[n + k], a0, a1);
+                    z1[2 * n + nl] -= agv;
+                    z1[2 * n + nl + 1] += m.two_xi_w[k] * vv;
+                    work.push((agv, vv));
+                }
             }
         }
         may_touch.fill(None);
         let mut bounded = false;
         if !any_contact {
             m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
-            if prepare_ends {
-                m.coarse_floor_bounds(&bounds, &mut coarse);
-            }
             bounded = true;
             // The floors at both ends are needed for the peaks if the step is free; the levels
             // read their penetrations from them (O(1) each), and weigh each mode's bound only
             // where the building's coarse bound leaves the touch open.
             let mut touching = false;
             if prepare_ends {
+                m.coarse_floor_bounds(&bounds, &mut coarse);
                 run.prepare_free_ends(&z, &z1, (seg.a0, seg.a1));
                 for (l, ((lm, ls), may)) in m
                     .levels
@@ -320,13 +313,12 @@ fn run_with(
         // free flight, and from them outwards each neighbour whose level may close within the
         // step at its present rate. The others stand still and are stepped exactly.
         active.fill(!can_stand);
-        for ((lm, ls), may) in m.levels.iter().zip(&run.levels).zip(&may_touch) {
-            if !can_stand {
-                break;
-            }
-            if ls.mode != Mode::Free || *may == Some(true) {
-                active[lm.buildings.0] = true;
-                active[lm.buildings.1] = true;
+        if can_stand {
+            for ((lm, ls), may) in m.levels.iter().zip(&run.levels).zip(&may_touch) {
+                if ls.mode != Mode::Free || *may == Some(true) {
+                    active[lm.buildings.0] = true;
+                    active[lm.buildings.1] = true;
+                }
             }
         }
         let mut grew = can_stand;

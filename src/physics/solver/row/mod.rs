@@ -276,7 +276,7 @@ impl RowModel {
             .iter()
             .map(|b| {
                 (b.off..b.off + b.n())
-                    .map(|i| self.w2[i].sqrt() + self.two_xi_w[i])
+                    .map(|i| self.mode_rate(i))
                     .fold(0.0, f64::max)
             })
             .collect()
@@ -313,9 +313,12 @@ impl RowModel {
 
     /// The largest rate of any mode (1/s): `w + 2 xi w`, as [`crate::physics::model::Oscillator::rate`].
     pub(crate) fn structural_rate(&self) -> f64 {
-        (0..self.n)
-            .map(|i| self.w2[i].sqrt() + self.two_xi_w[i])
-            .fold(0.0, f64::max)
+        (0..self.n).map(|i| self.mode_rate(i)).fold(0.0, f64::max)
+    }
+
+    /// Mode `i`'s rate, `w + 2 xi w` (1/s).
+    fn mode_rate(&self, i: usize) -> f64 {
+        self.w2[i].sqrt() + self.two_xi_w[i]
     }
 
     /// Kinetic plus strain energy, J.
@@ -432,10 +435,18 @@ impl LevelModel {
 
     /// The bound on `|delta''''|` over a free step from each mode's bound on `|q''''|`.
     pub(crate) fn fourth_derivative_bound(&self, bounds: &[f64]) -> f64 {
-        let bound = |phi: &[f64], (o, len): (usize, usize)| -> f64 {
-            (0..len).map(|i| phi[i].abs() * bounds[o + i]).sum()
+        self.side_fourth_derivative_bound(true, bounds)
+            + self.side_fourth_derivative_bound(false, bounds)
+    }
+
+    /// The bound on the left (or right) floor's `|u''''|`: `sum_i |phi_i| bound_i`.
+    pub(crate) fn side_fourth_derivative_bound(&self, left: bool, bounds: &[f64]) -> f64 {
+        let (phi, (o, len)) = if left {
+            (&self.phi_a, self.a)
+        } else {
+            (&self.phi_b, self.b)
         };
-        bound(&self.phi_a, self.a) + bound(&self.phi_b, self.b)
+        (0..len).map(|i| phi[i].abs() * bounds[o + i]).sum()
     }
 
     /// [`LevelModel::may_touch`] from the penetration and its rate at the step's ends,
@@ -798,8 +809,13 @@ impl<'m> RowRun<'m> {
     /// two of them be checked).
     pub fn set_active(&mut self, active: &[bool]) {
         self.active.copy_from_slice(active);
+        self.refresh_levels_on();
+    }
+
+    /// A level is checked when both its buildings move.
+    fn refresh_levels_on(&mut self) {
         for (on, lm) in self.level_on.iter_mut().zip(&self.m.levels) {
-            *on = active[lm.buildings.0] && active[lm.buildings.1];
+            *on = self.active[lm.buildings.0] && self.active[lm.buildings.1];
         }
     }
 
@@ -845,9 +861,7 @@ impl<'m> RowRun<'m> {
             self.track_still(k, &z0, &z1, (seg.a0, seg.at(t)), h);
         }
         self.active[k] = true;
-        for (on, lm) in self.level_on.iter_mut().zip(&self.m.levels) {
-            *on = self.active[lm.buildings.0] && self.active[lm.buildings.1];
-        }
+        self.refresh_levels_on();
         if !std::ptr::eq(self.m, modal) {
             self.m.building_to_substeps(k, &mut self.z);
         }
