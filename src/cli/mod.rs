@@ -29,6 +29,7 @@ pub mod accuracy;
 pub mod bench;
 pub mod formulas;
 pub mod fragility;
+pub mod gap;
 pub mod gpu;
 pub mod hysteresis;
 pub mod merge;
@@ -60,6 +61,10 @@ pub enum Cmd {
     /// Fragility curves from a results CSV: the share of runs whose EDP exceeds each threshold
     /// at each intensity level, and a lognormal curve fitted by maximum likelihood.
     Fragility(fragility::Args),
+    /// The separation each adjacent pair of a sweep's buildings needs: exactly from the time
+    /// histories (the largest closing of the uncoupled responses), and by the ABS, SRSS and DDC
+    /// rules from the same peaks; their ratios, and the probability of pounding against the gap.
+    Gap(gap::Args),
     /// Combine the outputs of `pound sweep --shard I/N` into one CSV, checking that they come
     /// from one sweep (same fingerprint) and hold every run exactly once.
     Merge(merge::Args),

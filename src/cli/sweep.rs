@@ -110,7 +110,7 @@ fn scheme_as_run(configured: Scheme, asked: Option<SchemeArg>, energy: bool) -> 
 }
 
 /// `--threads`, checked.
-fn check_threads(t: usize) -> Result<usize> {
+pub fn check_threads(t: usize) -> Result<usize> {
     use pounding::plan::limits::{MAX_THREADS, WHY_THREADS};
     if t == 0 || t > MAX_THREADS {
         bail!(

@@ -11,5 +11,6 @@ pub mod model;
 pub mod propagator;
 pub mod restitution;
 pub mod row;
+pub mod separation;
 pub mod shear;
 pub mod solver;

@@ -50,21 +50,15 @@ impl Row {
         assert_eq!(gaps.len() + 1, buildings.len(), "one gap per adjacent pair");
         let mut levels = Vec::new();
         for (a, pair) in buildings.windows(2).enumerate() {
-            let (za, zb) = (pair[0].elevations(), pair[1].elevations());
-            for (fa, &ea) in za.iter().enumerate() {
-                if let Some(fb) = zb
-                    .iter()
-                    .position(|&eb| (ea - eb).abs() <= LEVEL_TOLERANCE_M)
-                {
-                    let (ma, mb) = (pair[0].masses[fa], pair[1].masses[fb]);
-                    levels.push(Level {
-                        left: a,
-                        floor_left: fa + 1,
-                        floor_right: fb + 1,
-                        elevation: ea,
-                        contact: Contact::new(law, stiffness, damping_ratio, ma * mb / (ma + mb)),
-                    });
-                }
+            for (fa, fb, elevation) in common_levels(&pair[0], &pair[1]) {
+                let (ma, mb) = (pair[0].masses[fa - 1], pair[1].masses[fb - 1]);
+                levels.push(Level {
+                    left: a,
+                    floor_left: fa,
+                    floor_right: fb,
+                    elevation,
+                    contact: Contact::new(law, stiffness, damping_ratio, ma * mb / (ma + mb)),
+                });
             }
         }
         Row {
@@ -78,6 +72,20 @@ impl Row {
     pub fn storeys(&self) -> usize {
         self.buildings.iter().map(|b| b.storeys()).sum()
     }
+}
+
+/// The floors of `left` and `right` at the same elevation (within [`LEVEL_TOLERANCE_M`]),
+/// lowest first: `(floor of left, floor of right, elevation)`, floors counted from 1.
+pub fn common_levels(left: &ShearBuilding, right: &ShearBuilding) -> Vec<(usize, usize, f64)> {
+    let (za, zb) = (left.elevations(), right.elevations());
+    za.iter()
+        .enumerate()
+        .filter_map(|(fa, &ea)| {
+            zb.iter()
+                .position(|&eb| (ea - eb).abs() <= LEVEL_TOLERANCE_M)
+                .map(|fb| (fa + 1, fb + 1, ea))
+        })
+        .collect()
 }
 
 /// What one contact level reports. Peaks are over the whole simulated time.

@@ -44,6 +44,9 @@ pub const WHY_RUNS: &str =
 /// Values of `--e` for the single-collision studies.
 pub const MAX_E_VALUES: usize = 10_000;
 
+/// Gaps of `pound gap --gaps` (each is a row of the probability table, per pair and intensity).
+pub const MAX_CURVE_GAPS: usize = 10_000;
+
 /// Runs of one `pound bench` size.
 pub const MAX_BENCH_RUNS: u64 = 1_000_000_000;
 

@@ -122,6 +122,48 @@ impl SampledAxis {
     }
 }
 
+impl SampledAxis {
+    /// Does it set a building's mass, period or damping?
+    pub fn moves_buildings(self) -> bool {
+        !matches!(
+            self,
+            SampledAxis::Gap | SampledAxis::KLinear | SampledAxis::Beta
+        )
+    }
+}
+
+/// The motions of a sweep ([`Plan::motions`]): `records x intensities x inner`, the record
+/// outermost, then the intensity; `inner` counts the samples and building values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Motions {
+    pub records: usize,
+    pub intensities: usize,
+    pub inner: u64,
+}
+
+impl Motions {
+    pub fn len(&self) -> u64 {
+        (self.records * self.intensities) as u64 * self.inner
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Motion `m`'s record and intensity indices.
+    pub fn record_and_intensity(&self, m: u64) -> (usize, usize) {
+        let ri = (m / self.inner) as usize;
+        (ri / self.intensities, ri % self.intensities)
+    }
+
+    /// The motions that differ only in intensity share one response at unit scale: motion
+    /// `m`'s index among those `records x inner` responses.
+    pub fn response(&self, m: u64) -> u64 {
+        let (r, _) = self.record_and_intensity(m);
+        r as u64 * self.inner + m % self.inner
+    }
+}
+
 /// Joint samples of some parameters: `points[s][j]` is the value of `axes[j]` in sample `s`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Samples {
@@ -615,6 +657,49 @@ impl Plan {
                     SampledAxis::KLinear | SampledAxis::Beta => {}
                 }
             }
+        }
+        run
+    }
+
+    /// The runs that differ in their motion before any contact: one per record, intensity,
+    /// sample and building values, with the first law's first contact values and the first gap
+    /// (what a separation study needs: [`Plan::motion_run`]). A sample axis that sets no
+    /// building value moves nothing and counts once.
+    pub fn motions(&self) -> Motions {
+        let d = &self.blocks[0].dims;
+        Motions {
+            records: d[3],
+            intensities: d[4],
+            inner: self.motion_samples() as u64
+                * d[6..12].iter().map(|&x| x as u64).product::<u64>(),
+        }
+    }
+
+    /// Samples that move the buildings: all of them, or one where they set no building value.
+    fn motion_samples(&self) -> usize {
+        match &self.spec.samples {
+            Some(s) if s.axes.iter().any(|a| a.moves_buildings()) => s.points.len(),
+            _ => 1,
+        }
+    }
+
+    /// Motion `m` of [`Plan::motions`], as the run of the plan that has it (its sample `None`
+    /// where the samples move nothing).
+    pub fn motion_run(&self, m: u64) -> RunSpec {
+        let b = &self.blocks[0];
+        let mut dims = b.dims;
+        dims[5] = self.motion_samples();
+        // Decode over the motion axes (record to xi2), the others at 0.
+        let mut ix = [0usize; NAXES];
+        let mut rem = m;
+        for a in (3..12).rev() {
+            ix[a] = (rem % dims[a] as u64) as usize;
+            rem /= dims[a] as u64;
+        }
+        let index = (0..NAXES).fold(0u64, |acc, a| acc * b.dims[a] as u64 + ix[a] as u64);
+        let mut run = self.run(b.start + index);
+        if dims[5] == 1 {
+            run.sample = None;
         }
         run
     }

@@ -145,6 +145,16 @@ impl RowSampled {
     }
 }
 
+impl RowSampled {
+    /// Does it set a building's mass, period or damping?
+    pub fn moves_buildings(self) -> bool {
+        matches!(
+            self,
+            RowSampled::Mass(_) | RowSampled::Period(_) | RowSampled::Damping(_)
+        )
+    }
+}
+
 /// Joint samples of some of a row's parameters: `points[s][j]` is the value of `axes[j]` in
 /// sample `s`.
 #[derive(Debug, Clone, PartialEq)]
@@ -246,6 +256,52 @@ impl RowPlan {
                     RowSampled::KLinear | RowSampled::Beta => {}
                 }
             }
+        }
+        run
+    }
+
+    /// The runs that differ in their motion before any contact ([`Plan::motions`]): per
+    /// record and intensity, the samples (one where they set no building value) and every
+    /// building's values, the gaps at their first values.
+    pub fn motions(&self) -> crate::plan::Motions {
+        let nb = self.buildings.len();
+        let base = self.base.motions();
+        crate::plan::Motions {
+            inner: self.motion_samples() as u64
+                * self.dims[1..1 + 3 * nb]
+                    .iter()
+                    .map(|&d| d as u64)
+                    .product::<u64>(),
+            ..base
+        }
+    }
+
+    fn motion_samples(&self) -> usize {
+        match &self.samples {
+            Some(s) if s.axes.iter().any(|a| a.moves_buildings()) => s.points.len(),
+            _ => 1,
+        }
+    }
+
+    /// Motion `m` of [`RowPlan::motions`], as the run of the plan that has it (its sample
+    /// `None` where the samples move nothing).
+    pub fn motion_run(&self, m: u64) -> RowRunSpec {
+        let nb = self.buildings.len();
+        let mut dims = self.dims.clone();
+        dims[0] = self.motion_samples();
+        let inner: u64 = dims[..1 + 3 * nb].iter().map(|&d| d as u64).product();
+        let base = self.base.motion_run(m / inner);
+        let mut rem = m % inner;
+        let mut at = vec![0usize; self.dims.len()];
+        for k in (0..1 + 3 * nb).rev() {
+            at[k] = (rem % dims[k] as u64) as usize;
+            rem /= dims[k] as u64;
+        }
+        let within =
+            (0..self.dims.len()).fold(0u64, |acc, k| acc * self.dims[k] as u64 + at[k] as u64);
+        let mut run = self.run(base.index * self.per_base + within);
+        if dims[0] == 1 {
+            run.sample = None;
         }
         run
     }

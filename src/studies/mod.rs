@@ -10,6 +10,7 @@ pub mod bench;
 pub mod fidelity;
 pub mod formulas;
 pub mod fragility;
+pub mod gap;
 pub mod paper;
 pub mod plot;
 pub mod sensitivity;

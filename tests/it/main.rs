@@ -5,6 +5,7 @@ mod cli;
 mod config;
 mod fast_vs_reference;
 mod fidelity;
+mod gap;
 mod gpu;
 mod gpu_rows;
 mod hard;

@@ -193,7 +193,7 @@ fn row_summaries_count_what_the_rows_say() {
 }
 
 /// The row's config with `[sample]` instead of some grid axes.
-fn sampled_config() -> String {
+pub(crate) fn sampled_config() -> String {
     ROW_CONFIG
         .replacen("period_s = 0.25\n", "", 1)
         .replacen("gap_m = 0.008\n", "", 1)

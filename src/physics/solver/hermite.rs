@@ -96,17 +96,53 @@ pub(crate) fn raise_quintic_peak(peak: f64, y: [f64; 2], d: [f64; 2], a: [f64; 2
 /// is refined by three Newton steps on the quintic's derivative.
 #[inline]
 pub(crate) fn quintic_peak_abs(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) -> f64 {
+    let mut peak = y[0].abs().max(y[1].abs());
+    for (_, v) in quintic_interior(y, d, a, h).into_iter().flatten() {
+        peak = peak.max(v.abs());
+    }
+    peak
+}
+
+/// Min and max over `[0, h]` of the quintic Hermite through `(y, y', y'')` at both ends, each
+/// with where it lies as a fraction `s` of the step: `[(lo, s_lo), (hi, s_hi)]`.
+#[inline]
+pub(crate) fn quintic_range(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) -> [(f64, f64); 2] {
+    let (mut lo, mut hi) = if y[0] <= y[1] {
+        ((y[0], 0.0), (y[1], 1.0))
+    } else {
+        ((y[1], 1.0), (y[0], 0.0))
+    };
+    for (s, v) in quintic_interior(y, d, a, h).into_iter().flatten() {
+        if v < lo.0 {
+            lo = (v, s);
+        }
+        if v > hi.0 {
+            hi = (v, s);
+        }
+    }
+    [lo, hi]
+}
+
+/// The quintic Hermite's extrema inside the step, `(s, value)`: each extremum of the cubic
+/// Hermite inside it, refined by three Newton steps on the quintic's derivative.
+#[inline(always)]
+fn quintic_interior(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) -> [Option<(f64, f64)>; 2] {
     let (m0, m1, q0, q1) = (h * d[0], h * d[1], h * h * a[0], h * h * a[1]);
     let dy = y[1] - y[0];
+    let b = 3.0 * dy - 2.0 * m0 - m1;
+    let c = -2.0 * dy + m0 + m1;
+    let starts = hermite_extrema(m0, b, c);
+    let inside = |s: f64| s > 0.0 && s < 1.0;
+    let mut out = [None, None];
+    if !inside(starts[0]) && !inside(starts[1]) {
+        return out;
+    }
     let c2 = 0.5 * q0;
     let c3 = 10.0 * dy - 6.0 * m0 - 4.0 * m1 - 1.5 * q0 + 0.5 * q1;
     let c4 = -15.0 * dy + 8.0 * m0 + 7.0 * m1 + 1.5 * q0 - q1;
     let c5 = 6.0 * dy - 3.0 * m0 - 3.0 * m1 - 0.5 * q0 + 0.5 * q1;
-    let mut peak = y[0].abs().max(y[1].abs());
-    let b = 3.0 * dy - 2.0 * m0 - m1;
-    let c = -2.0 * dy + m0 + m1;
-    for s0 in hermite_extrema(m0, b, c) {
-        if !(s0 > 0.0 && s0 < 1.0) {
+    for (o, s0) in out.iter_mut().zip(starts) {
+        if !inside(s0) {
             continue;
         }
         let mut s = s0;
@@ -117,10 +153,18 @@ pub(crate) fn quintic_peak_abs(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) ->
                 s = (s - d1 / d2).clamp(0.0, 1.0);
             }
         }
-        let v = y[0] + s * (m0 + s * (c2 + s * (c3 + s * (c4 + s * c5))));
-        peak = peak.max(v.abs());
+        *o = Some((s, y[0] + s * (m0 + s * (c2 + s * (c3 + s * (c4 + s * c5))))));
     }
-    peak
+    out
+}
+
+/// Upper bound on the quintic Hermite through `(y, y', y'')` at both ends over `[0, h]`
+/// (and, negated, a lower bound): [`quintic_max_bound`] without the absolute values of `y`.
+#[inline]
+pub(crate) fn quintic_signed_bounds(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f64) -> (f64, f64) {
+    let m = QUINTIC_SLOPE_WEIGHT * h * (d[0].abs() + d[1].abs())
+        + QUINTIC_CURVATURE_WEIGHT * h * h * (a[0].abs() + a[1].abs());
+    (y[0].min(y[1]) - m, y[0].max(y[1]) + m)
 }
 
 #[cfg(test)]

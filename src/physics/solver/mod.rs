@@ -23,6 +23,7 @@ pub mod fast;
 mod hermite;
 pub mod reference;
 pub mod row;
+pub mod separation;
 pub mod shared;
 mod tracker;
 

@@ -1,0 +1,202 @@
+//! `pound gap`: the separation each adjacent pair of a sweep's buildings needs, exactly and by
+//! the code rules, with the probability of pounding against the gap.
+
+use super::{check_outputs, config_inputs, write_file};
+use anyhow::{bail, Context, Result};
+use pounding::plan::config;
+use pounding::studies::gap::{GapStudy, PoundingCurve, Scenes};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// A sweep config (pair or row): its contact and gap axes are left out; the gaps, where
+    /// the config has two or more, are where the probability of pounding is counted.
+    config: PathBuf,
+    /// One row per run: the required gap of each adjacent pair (and of each shared floor
+    /// level of multi-storey buildings), the rules' gaps and their ratios to it.
+    #[arg(short, long, default_value = "gaps.csv")]
+    output: PathBuf,
+    /// Per pair: required gap and rule ratios against the period ratio, and the probability of
+    /// pounding against the gap (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    /// The probability of pounding at each gap, per pair and intensity, with the fitted curve
+    /// (CSV).
+    #[arg(long)]
+    curve: Option<PathBuf>,
+    /// Gaps (m) at which to count the probability of pounding: start:stop:step or a,b,c
+    /// (default: the config's gap axis, or 21 round values up to the largest required gap).
+    #[arg(long)]
+    gaps: Option<String>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let text = config::read_text(&a.config)?;
+    let records = config::input_files(&text, &a.config);
+    check_outputs(
+        &config_inputs(&a.config, &records),
+        &[
+            ("-o", Some(&a.output)),
+            ("--plot", a.plot.as_deref()),
+            ("--curve", a.curve.as_deref()),
+        ],
+    )?;
+    let gaps = a.gaps.as_deref().map(parse_gaps).transpose()?;
+    let threads = a.threads.map(super::sweep::check_threads).transpose()?;
+    let row_plan;
+    let pair_plan;
+    let scenes = if pounding::plan::row::is_row_config(&text) {
+        row_plan = config::load_row_text(&text, &a.config)?;
+        Scenes::Rows(&row_plan)
+    } else {
+        pair_plan = config::load_text(&text, &a.config)?;
+        for w in pair_plan.warnings() {
+            note!("warning: {}: {w}", a.config.display());
+        }
+        Scenes::Pairs(&pair_plan)
+    };
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = threads {
+        pool = pool.num_threads(t);
+    }
+    let pool = pool.build().context("starting worker threads")?;
+    let started = Instant::now();
+    let study = pool.install(|| GapStudy::run(scenes));
+    let seconds = started.elapsed().as_secs_f64();
+    let runs = study.len();
+    say!(
+        "{runs} runs ({} responses, each serving every intensity) in {seconds:.3} s on {} threads: {:.0} runs/s; {} record steps refined",
+        study.responses(),
+        pool.current_num_threads(),
+        runs as f64 / seconds.max(1e-9),
+        study.refined_steps()
+    );
+    let summary = study.summary();
+    say!("\n| pair | rule | runs | floors close | median rule / exact | p10 | p90 | unconservative |\n|---|---|---:|---:|---:|---:|---:|---:|");
+    for s in &summary {
+        say!(
+            "| {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {} ({:.1} %) |",
+            study.pair_name(s.pair),
+            s.rule.key().to_uppercase(),
+            s.runs,
+            s.closing,
+            s.median,
+            s.p10,
+            s.p90,
+            s.unconservative,
+            100.0 * s.unconservative as f64 / s.runs.max(1) as f64
+        );
+    }
+    let curves: Vec<Vec<PoundingCurve>> = (0..study.pairs())
+        .map(|p| {
+            let at = study.gaps_for(p, gaps.as_deref());
+            let (top, need) = (at.iter().cloned().fold(0.0, f64::max), study.largest_required(p));
+            if top < need {
+                note!(
+                    "notice: pair {}: the gaps counted end at {:.2} mm, below the largest required gap ({:.2} mm); --gaps reaches further",
+                    study.pair_name(p),
+                    top * 1e3,
+                    need * 1e3
+                );
+            }
+            study.pounding(p, &at)
+        })
+        .collect();
+    say!("\n| pair | intensity | median required gap (fit) | beta | gap for P(pounding) = 10 % | 5 % | 1 % |\n|---|---|---:|---:|---:|---:|---:|");
+    for c in curves.iter().flatten() {
+        let g = |p: f64| {
+            c.gap_for(p)
+                .map_or("".into(), |g| format!("{:.2} mm", g * 1e3))
+        };
+        match &c.fit {
+            Ok(f) => say!(
+                "| {} | {} | {:.2} mm | {:.3} | {} | {} | {} |",
+                study.pair_name(c.pair),
+                study.intensity_label(c.intensity),
+                f.median * 1e3,
+                f.beta,
+                g(0.10),
+                g(0.05),
+                g(0.01)
+            ),
+            Err(e) => say!(
+                "| {} | {} | no fit: {} | | | | |",
+                study.pair_name(c.pair),
+                study.intensity_label(c.intensity),
+                no_fit(e)
+            ),
+        }
+    }
+    write_file(&a.output, &study.csv())?;
+    if let Some(p) = &a.curve {
+        write_file(p, curve_csv(&study, &curves).as_bytes())?;
+    }
+    if let Some(p) = &a.plot {
+        pounding::studies::plot::save(p, &study.panels(&curves), 3)?;
+    }
+    Ok(())
+}
+
+/// Why no lognormal could be fitted, in the words of a gap study (the fit's "exceeding" is a
+/// run needing no more than the gap).
+fn no_fit(e: &pounding::studies::fragility::NoFit) -> String {
+    use pounding::studies::fragility::NoFit;
+    match e {
+        NoFit::NoneExceed => {
+            "every run pounds at every gap counted above 0 (--gaps reaches further)".into()
+        }
+        NoFit::AllExceed => {
+            "no run pounds at any gap counted above 0 (--gaps can start lower)".into()
+        }
+        other => other.to_string(),
+    }
+}
+
+/// `--gaps`: start:stop:step, a list a,b,c, or one value; each >= 0 m.
+fn parse_gaps(text: &str) -> Result<Vec<f64>> {
+    let gaps = if text.contains(',') {
+        text.split(',')
+            .map(|x| x.trim().parse::<f64>().ok())
+            .collect()
+    } else {
+        config::parse_colon_range(text)
+    }
+    .with_context(|| {
+        format!("--gaps `{text}`: expected start:stop:step, a list a,b,c or one value (m)")
+    })?;
+    if gaps.len() > pounding::plan::limits::MAX_CURVE_GAPS {
+        bail!(
+            "--gaps `{text}` gives {} values: expected at most {}",
+            gaps.len(),
+            pounding::plan::limits::MAX_CURVE_GAPS
+        );
+    }
+    if let Some(bad) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
+        bail!("--gaps: {bad} is out of range: expected gaps >= 0 m");
+    }
+    Ok(gaps)
+}
+
+/// The probability of pounding per pair, intensity and gap, with the fitted curve's value.
+fn curve_csv(study: &GapStudy, curves: &[Vec<PoundingCurve>]) -> String {
+    let mut s = String::from("pair,intensity,gap_m,runs,pounding,share,fitted\n");
+    for c in curves.iter().flatten() {
+        for &(g, n, k) in &c.points {
+            let fitted = match &c.fit {
+                Ok(f) if g > 0.0 => format!("{}", 1.0 - f.probability(g)),
+                _ => String::new(),
+            };
+            s.push_str(&format!(
+                "{},{},{g},{n},{k},{},{fitted}\n",
+                study.pair_name(c.pair),
+                study.intensity_label(c.intensity),
+                k as f64 / n.max(1) as f64
+            ));
+        }
+    }
+    s
+}

@@ -1,0 +1,780 @@
+//! The separation-gap study (`pound gap`): for every run of a sweep without its contact and gap
+//! axes (buildings x records x intensities x samples), the gap each adjacent pair needs, exactly
+//! from the time histories ([`crate::physics::solver::separation`]), against what the code rules
+//! say from the same peak displacements ([`crate::physics::separation`]); a summary per rule;
+//! and the probability of pounding against the gap, with a lognormal fit (the fragility fit of
+//! [`crate::studies::fragility`], the gap in the place of the intensity).
+//!
+//! Responses are linear in the record's scale, so one response per record and building values
+//! serves every intensity.
+
+use crate::physics::model::Oscillator;
+use crate::physics::separation::{cqc_rho, Rule};
+use crate::physics::shear::ShearBuilding;
+use crate::physics::solver::separation::{separation, LevelSeparation, Separation};
+use crate::plan::columns::{contact_and_motion, num};
+use crate::plan::row::RowPlan;
+use crate::plan::{Motions, Plan};
+use crate::studies::fragility::{fit, Fit, Level, NoFit};
+use crate::studies::plot::{Panel, Series};
+use rayon::prelude::*;
+
+/// Runs per CSV chunk encoded in parallel.
+const CSV_CHUNK: u64 = 4096;
+
+/// The storey height a pair's one-storey buildings are given: they share their one level.
+const PAIR_STOREY_M: f64 = 3.0;
+
+/// The sweep a study runs over: a pair config or a row config.
+#[derive(Clone, Copy)]
+pub enum Scenes<'a> {
+    Pairs(&'a Plan),
+    Rows(&'a RowPlan),
+}
+
+impl Scenes<'_> {
+    fn base(&self) -> &Plan {
+        match self {
+            Scenes::Pairs(p) => p,
+            Scenes::Rows(r) => &r.base,
+        }
+    }
+
+    pub fn motions(&self) -> Motions {
+        match self {
+            Scenes::Pairs(p) => p.motions(),
+            Scenes::Rows(r) => r.motions(),
+        }
+    }
+
+    /// Buildings in a scene.
+    pub fn building_count(&self) -> usize {
+        match self {
+            Scenes::Pairs(_) => 2,
+            Scenes::Rows(r) => r.buildings.len(),
+        }
+    }
+
+    /// The gaps a config gives pair `a` (placeholders where sampled).
+    fn gap_axis(&self, a: usize) -> &[f64] {
+        match self {
+            Scenes::Pairs(p) => &p.spec.gaps,
+            Scenes::Rows(r) => &r.gaps[a],
+        }
+    }
+
+    /// Does a sample set pair `a`'s gap (so that its axis holds a placeholder)?
+    fn gap_sampled(&self, a: usize) -> bool {
+        use crate::plan::row::RowSampled;
+        use crate::plan::SampledAxis;
+        match self {
+            Scenes::Pairs(p) => p
+                .spec
+                .samples
+                .as_ref()
+                .is_some_and(|s| s.axes.contains(&SampledAxis::Gap)),
+            Scenes::Rows(r) => r.samples.as_ref().is_some_and(|s| {
+                s.axes
+                    .iter()
+                    .any(|x| *x == RowSampled::Gap(a) || *x == RowSampled::SharedGap)
+            }),
+        }
+    }
+
+    /// The parameter columns: the run, the ground motion, the buildings, the sample.
+    fn parameter_header(&self) -> Vec<String> {
+        let mut h: Vec<String> = ["run", "record", "target_pga_g", "scale_factor", "pga_g"]
+            .map(String::from)
+            .to_vec();
+        match self {
+            Scenes::Pairs(_) => {
+                h.extend(["m1_kg", "t1_s", "xi1", "m2_kg", "t2_s", "xi2"].map(String::from))
+            }
+            Scenes::Rows(r) => {
+                for b in 1..=r.buildings.len() {
+                    for c in ["storeys", "mass_kg", "t1_s", "xi"] {
+                        h.push(format!("b{b}_{c}"));
+                    }
+                }
+            }
+        }
+        h.push("sample".into());
+        h
+    }
+
+    /// Motion `m`'s parameter cells, in [`Scenes::parameter_header`] order.
+    fn cells(&self, m: u64) -> Vec<String> {
+        let motion_cells = |plan: &Plan, spec: &crate::plan::RunSpec| {
+            let mut c = vec![m.to_string()];
+            // record, target_pga_g, scale_factor, pga_g
+            c.extend(contact_and_motion(plan, spec).drain(7..11));
+            c
+        };
+        let sample = |s: Option<usize>| s.map(|s| s.to_string()).unwrap_or_default();
+        match self {
+            Scenes::Pairs(p) => {
+                let r = p.motion_run(m);
+                let mut cells = motion_cells(p, &r);
+                cells.extend([r.m1, r.t1, r.xi1, r.m2, r.t2, r.xi2].map(num));
+                cells.push(sample(r.sample));
+                cells
+            }
+            Scenes::Rows(plan) => {
+                let r = plan.motion_run(m);
+                let mut cells = motion_cells(&plan.base, &r.base);
+                for (b, a) in plan.buildings.iter().enumerate() {
+                    cells.push(a.storeys().to_string());
+                    cells.push(r.mass[b].map(num).unwrap_or_default());
+                    cells.push(num(r.period[b]));
+                    cells.push(num(r.damping[b]));
+                }
+                cells.push(sample(r.sample));
+                cells
+            }
+        }
+    }
+
+    /// Motion `m`'s fundamental periods as given (s), record and scale.
+    fn periods(&self, m: u64) -> (Vec<f64>, usize, f64) {
+        match self {
+            Scenes::Pairs(p) => {
+                let r = p.motion_run(m);
+                (vec![r.t1, r.t2], r.record, r.scale)
+            }
+            Scenes::Rows(plan) => {
+                let r = plan.motion_run(m);
+                (r.period, r.base.record, r.base.scale)
+            }
+        }
+    }
+
+    /// Motion `m`'s buildings, left to right.
+    fn buildings(&self, m: u64) -> Vec<ShearBuilding> {
+        match self {
+            Scenes::Pairs(p) => {
+                let r = p.motion_run(m);
+                let single = |m: f64, t: f64, xi: f64| {
+                    ShearBuilding::single(&Oscillator::from_period(m, t, xi), xi, PAIR_STOREY_M)
+                };
+                vec![single(r.m1, r.t1, r.xi1), single(r.m2, r.t2, r.xi2)]
+            }
+            Scenes::Rows(plan) => plan.row(&plan.motion_run(m)).buildings,
+        }
+    }
+}
+
+/// What one adjacent pair needs in one run: the exact gap at its governing level (the level
+/// that needs the most) and, per rule, the largest over its levels of the rule's gap.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairGap {
+    /// Index into the run's levels.
+    pub level: usize,
+    /// m
+    pub required: f64,
+    /// s
+    pub time: Option<f64>,
+    /// m, at the governing level.
+    pub peak_left: f64,
+    pub peak_right: f64,
+    /// m, in the order of [`Rule::ALL`].
+    pub rules: [f64; 3],
+    /// Right building's fundamental period over the left one's.
+    pub period_ratio: f64,
+    /// CQC correlation of the two fundamental modes.
+    pub rho: f64,
+}
+
+impl PairGap {
+    /// A rule's gap over the exact one (None where the floors never close).
+    pub fn ratio(&self, rule: usize) -> Option<f64> {
+        (self.required > 0.0).then(|| self.rules[rule] / self.required)
+    }
+}
+
+/// One run of the study.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GapRun {
+    pub motion: u64,
+    pub record: usize,
+    pub intensity: usize,
+    pub separation: Separation,
+    /// Per adjacent pair (None where the two share no floor level).
+    pub pairs: Vec<Option<PairGap>>,
+}
+
+/// A study, run.
+pub struct GapStudy<'a> {
+    scenes: Scenes<'a>,
+    motions: Motions,
+    /// One per record and inner motion, at unit scale.
+    responses: Vec<Separation>,
+    /// Per record and intensity.
+    scales: Vec<Vec<f64>>,
+    /// Per run, what each adjacent pair needs.
+    pair_gaps: Vec<Vec<Option<PairGap>>>,
+    /// The contact levels' column prefixes (the same in every run).
+    level_names: Vec<String>,
+    /// Per level, its pair.
+    level_pairs: Vec<usize>,
+}
+
+impl<'a> GapStudy<'a> {
+    /// Compute every response (in parallel on the current rayon pool).
+    pub fn run(scenes: Scenes<'a>) -> GapStudy<'a> {
+        let motions = scenes.motions();
+        let inner = motions.inner;
+        let per_record = inner * motions.intensities as u64;
+        let responses: Vec<Separation> = (0..motions.records as u64 * inner)
+            .into_par_iter()
+            .map(|u| {
+                // The response's first intensity, at unit scale.
+                let m = (u / inner) * per_record + u % inner;
+                let (_, record, _) = scenes.periods(m);
+                let spec = &scenes.base().spec;
+                separation(
+                    &scenes.buildings(m),
+                    &spec.records[record].forcing(1.0, spec.tail),
+                )
+            })
+            .collect();
+        let scales = (0..motions.records)
+            .map(|r| {
+                (0..motions.intensities)
+                    .map(|i| {
+                        scenes
+                            .periods((r * motions.intensities + i) as u64 * inner)
+                            .2
+                    })
+                    .collect()
+            })
+            .collect();
+        let first = responses.first();
+        let level_names = first.map_or(Vec::new(), |s| {
+            s.levels
+                .iter()
+                .map(|l| {
+                    format!(
+                        "level_b{}f{}_b{}f{}",
+                        l.pair + 1,
+                        l.floor_left,
+                        l.pair + 2,
+                        l.floor_right
+                    )
+                })
+                .collect()
+        });
+        let level_pairs = first.map_or(Vec::new(), |s| s.levels.iter().map(|l| l.pair).collect());
+        let mut study = GapStudy {
+            scenes,
+            motions,
+            responses,
+            scales,
+            level_names,
+            level_pairs,
+            pair_gaps: Vec::new(),
+        };
+        study.pair_gaps = (0..study.len())
+            .into_par_iter()
+            .map(|m| study.pairs_of(m, &study.separation(m)))
+            .collect();
+        study
+    }
+
+    /// Run `m`'s separation: its response, scaled to its intensity.
+    fn separation(&self, m: u64) -> Separation {
+        let (record, intensity) = self.motions.record_and_intensity(m);
+        self.responses[self.motions.response(m) as usize].scaled(self.scales[record][intensity])
+    }
+
+    /// Runs in the study.
+    pub fn len(&self) -> u64 {
+        self.motions.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Responses computed (runs differing only in intensity share one).
+    pub fn responses(&self) -> usize {
+        self.responses.len()
+    }
+
+    /// Record steps stepped again in parts, over all responses.
+    pub fn refined_steps(&self) -> u64 {
+        self.responses.iter().map(|s| s.refined_steps).sum()
+    }
+
+    /// Adjacent pairs.
+    pub fn pairs(&self) -> usize {
+        self.scenes.building_count() - 1
+    }
+
+    /// A pair's name in column names and tables: empty for a scene of two buildings, else
+    /// `_1_2` for buildings 1 and 2.
+    fn suffix(&self, a: usize) -> String {
+        if self.scenes.building_count() == 2 {
+            String::new()
+        } else {
+            format!("_{}_{}", a + 1, a + 2)
+        }
+    }
+
+    /// Buildings `a + 1` and `a + 2`, for tables.
+    pub fn pair_name(&self, a: usize) -> String {
+        format!("{}-{}", a + 1, a + 2)
+    }
+
+    /// Are there per-level columns (some pair shares more than one level)?
+    fn per_level(&self) -> bool {
+        (0..self.pairs()).any(|a| self.level_pairs.iter().filter(|&&p| p == a).count() > 1)
+    }
+
+    /// Run `m`.
+    pub fn get(&self, m: u64) -> GapRun {
+        let (record, intensity) = self.motions.record_and_intensity(m);
+        GapRun {
+            motion: m,
+            record,
+            intensity,
+            separation: self.separation(m),
+            pairs: self.pair_gaps[m as usize].clone(),
+        }
+    }
+
+    /// What each adjacent pair needs in run `m`, of separation `sep`.
+    fn pairs_of(&self, m: u64, sep: &Separation) -> Vec<Option<PairGap>> {
+        let (periods, _, _) = self.scenes.periods(m);
+        (0..self.pairs())
+            .map(|a| {
+                let (wa, xa) = sep.fundamental[a];
+                let (wb, xb) = sep.fundamental[a + 1];
+                let rho = cqc_rho(wa, xa, wb, xb);
+                let rules_at =
+                    |l: &LevelSeparation| Rule::ALL.map(|r| r.gap(l.peak_left, l.peak_right, rho));
+                let mut best: Option<PairGap> = None;
+                for (k, l) in sep.levels.iter().enumerate().filter(|(_, l)| l.pair == a) {
+                    let rules = rules_at(l);
+                    match &mut best {
+                        None => {
+                            best = Some(PairGap {
+                                level: k,
+                                required: l.required,
+                                time: l.time,
+                                peak_left: l.peak_left,
+                                peak_right: l.peak_right,
+                                rules,
+                                period_ratio: periods[a + 1] / periods[a],
+                                rho,
+                            })
+                        }
+                        Some(b) => {
+                            for (x, y) in b.rules.iter_mut().zip(rules) {
+                                *x = x.max(y);
+                            }
+                            if l.required > b.required {
+                                (b.level, b.required, b.time) = (k, l.required, l.time);
+                                (b.peak_left, b.peak_right) = (l.peak_left, l.peak_right);
+                            }
+                        }
+                    }
+                }
+                best
+            })
+            .collect()
+    }
+
+    /// Every column, in file order.
+    pub fn header(&self) -> Vec<String> {
+        let mut h = self.scenes.parameter_header();
+        for a in 0..self.pairs() {
+            let s = self.suffix(a);
+            h.push(format!("period_ratio{s}"));
+            h.push(format!("rho{s}"));
+            h.push(format!("required_gap{s}_m"));
+            h.push(format!("required_at{s}_s"));
+            h.push(format!("peak_left{s}_m"));
+            h.push(format!("peak_right{s}_m"));
+            for r in Rule::ALL {
+                h.push(format!("{}_gap{s}_m", r.key()));
+            }
+            for r in Rule::ALL {
+                h.push(format!("{}_ratio{s}", r.key()));
+            }
+            if self.per_level() {
+                h.push(format!("governing_level{s}"));
+            }
+        }
+        if self.per_level() {
+            for l in &self.level_names {
+                for c in ["required_m", "peak_left_m", "peak_right_m"] {
+                    h.push(format!("{l}_{c}"));
+                }
+                for r in Rule::ALL {
+                    h.push(format!("{l}_{}_m", r.key()));
+                }
+            }
+        }
+        h.push("error_bound_m".into());
+        h
+    }
+
+    /// The cells of a run, in [`GapStudy::header`] order.
+    pub fn cells(&self, run: &GapRun) -> Vec<String> {
+        let mut c = self.scenes.cells(run.motion);
+        let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+        for p in &run.pairs {
+            match p {
+                Some(p) => {
+                    c.extend([p.period_ratio, p.rho, p.required].map(num));
+                    c.push(opt(p.time));
+                    c.extend([p.peak_left, p.peak_right].map(num));
+                    c.extend(p.rules.map(num));
+                    c.extend((0..3).map(|r| opt(p.ratio(r))));
+                    if self.per_level() {
+                        c.push(self.level_names[p.level].clone());
+                    }
+                }
+                None => {
+                    let n = 12 + usize::from(self.per_level());
+                    c.extend(std::iter::repeat_n(String::new(), n));
+                }
+            }
+        }
+        if self.per_level() {
+            for l in &run.separation.levels {
+                let (wa, xa) = run.separation.fundamental[l.pair];
+                let (wb, xb) = run.separation.fundamental[l.pair + 1];
+                let rho = cqc_rho(wa, xa, wb, xb);
+                c.extend([l.required, l.peak_left, l.peak_right].map(num));
+                c.extend(Rule::ALL.map(|r| num(r.gap(l.peak_left, l.peak_right, rho))));
+            }
+        }
+        c.push(num(run.separation.error_bound));
+        c
+    }
+
+    /// The whole study as CSV (rows computed in parallel, in run order).
+    pub fn csv(&self) -> Vec<u8> {
+        use crate::io::csv::{encode_rows, header_line};
+        let header = self.header();
+        let mut out = header_line(&header.iter().map(String::as_str).collect::<Vec<_>>());
+        let chunks: Vec<Vec<u8>> = (0..self.len().div_ceil(CSV_CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let end = ((c + 1) * CSV_CHUNK).min(self.len());
+                let rows: Vec<Vec<String>> = (c * CSV_CHUNK..end)
+                    .map(|m| self.cells(&self.get(m)))
+                    .collect();
+                encode_rows(&rows)
+            })
+            .collect();
+        for c in chunks {
+            out.extend(c);
+        }
+        out
+    }
+
+    /// Per pair and rule: the ratio of the rule's gap to the exact one over the runs whose
+    /// floors close, and how often the rule is unconservative (asks for less than the exact
+    /// gap), over all runs.
+    pub fn summary(&self) -> Vec<RuleSummary> {
+        let mut out = Vec::new();
+        for a in 0..self.pairs() {
+            let pairs: Vec<&PairGap> = self
+                .pair_gaps
+                .iter()
+                .filter_map(|r| r[a].as_ref())
+                .collect();
+            for (k, rule) in Rule::ALL.into_iter().enumerate() {
+                let mut ratios: Vec<f64> = pairs.iter().filter_map(|p| p.ratio(k)).collect();
+                ratios.sort_by(f64::total_cmp);
+                let unconservative = pairs.iter().filter(|p| p.rules[k] < p.required).count();
+                out.push(RuleSummary {
+                    pair: a,
+                    rule,
+                    runs: pairs.len(),
+                    closing: ratios.len(),
+                    median: quantile(&ratios, 0.5),
+                    p10: quantile(&ratios, 0.1),
+                    p90: quantile(&ratios, 0.9),
+                    unconservative,
+                });
+            }
+        }
+        out
+    }
+
+    /// The largest required gap of pair `a` over the study's runs, m.
+    pub fn largest_required(&self, a: usize) -> f64 {
+        self.pair_gaps
+            .iter()
+            .filter_map(|r| r[a].map(|p| p.required))
+            .fold(0.0, f64::max)
+    }
+
+    /// The gaps the probability of pounding of pair `a` is counted at: `given`, else the
+    /// config's gap axis where it has two values or more, else 21 round values from 0 to the
+    /// largest required gap.
+    pub fn gaps_for(&self, a: usize, given: Option<&[f64]>) -> Vec<f64> {
+        if let Some(g) = given {
+            return g.to_vec();
+        }
+        let axis = self.scenes.gap_axis(a);
+        if axis.len() >= 2 && !self.scenes.gap_sampled(a) {
+            return axis.to_vec();
+        }
+        let top = self.largest_required(a);
+        let step = round_step(top / 20.0);
+        (0..=((top / step).ceil() as usize).max(1))
+            .map(|i| i as f64 * step)
+            .collect()
+    }
+
+    /// Per intensity, the share of runs of pair `a` that pound at each of `gaps` (their
+    /// required gap exceeds it), and the lognormal fit of the required gap.
+    pub fn pounding(&self, a: usize, gaps: &[f64]) -> Vec<PoundingCurve> {
+        let required: Vec<(usize, f64)> = (0..self.len())
+            .filter_map(|m| {
+                let (_, intensity) = self.motions.record_and_intensity(m);
+                self.pair_gaps[m as usize][a].map(|p| (intensity, p.required))
+            })
+            .collect();
+        (0..self.motions.intensities)
+            .map(|i| {
+                let mine: Vec<f64> = required
+                    .iter()
+                    .filter(|(k, _)| *k == i)
+                    .map(|(_, g)| *g)
+                    .collect();
+                let points: Vec<(f64, u64, u64)> = gaps
+                    .iter()
+                    .map(|&g| {
+                        let pound = mine.iter().filter(|&&r| r > g).count() as u64;
+                        (g, mine.len() as u64, pound)
+                    })
+                    .collect();
+                // P(required <= g) rises with g like a fragility with g as the intensity.
+                let levels: Vec<Level> = points
+                    .iter()
+                    .filter(|(g, _, _)| *g > 0.0)
+                    .map(|&(g, n, pound)| Level {
+                        im: g,
+                        n,
+                        exceed: n - pound,
+                    })
+                    .collect();
+                PoundingCurve {
+                    pair: a,
+                    intensity: i,
+                    points,
+                    fit: fit(&levels),
+                }
+            })
+            .collect()
+    }
+
+    /// The intensity `i` as a label (`pga 0.35 g` or `x 1.5`).
+    pub fn intensity_label(&self, i: usize) -> String {
+        match self.scenes.base().spec.intensities[i] {
+            crate::plan::Intensity::PgaG(g) => format!("PGA {g} g"),
+            crate::plan::Intensity::Scale(s) => format!("scale {s}"),
+        }
+    }
+
+    /// Per pair: the required gap against the period ratio (one series per record), the rules'
+    /// ratios against it, and the probability of pounding against the gap.
+    pub fn panels(&self, curves: &[Vec<PoundingCurve>]) -> Vec<Panel> {
+        let records = &self.scenes.base().spec.records;
+        // (record, pair gaps) per run.
+        let runs: Vec<(usize, &Vec<Option<PairGap>>)> = (0..self.len())
+            .map(|m| {
+                (
+                    self.motions.record_and_intensity(m).0,
+                    &self.pair_gaps[m as usize],
+                )
+            })
+            .collect();
+        let mut panels = Vec::new();
+        for a in 0..self.pairs() {
+            let name = if self.pairs() == 1 {
+                String::new()
+            } else {
+                format!(", buildings {}", self.pair_name(a))
+            };
+            let ratio_label = format!("T{} / T{} (fundamental periods)", a + 2, a + 1);
+            let mut by_record = Vec::new();
+            for (r, rec) in records.iter().enumerate() {
+                let points: Vec<(f64, f64)> = runs
+                    .iter()
+                    .filter(|x| x.0 == r)
+                    .filter_map(|x| x.1[a].map(|p| (p.period_ratio, p.required * 1e3)))
+                    .collect();
+                if !points.is_empty() {
+                    by_record.push(Series {
+                        name: rec.name.clone(),
+                        points,
+                        scatter: true,
+                    });
+                }
+            }
+            panels.push(Panel {
+                title: format!("Required gap (time history){name}"),
+                x_label: ratio_label.clone(),
+                y_label: "required gap (mm)".into(),
+                series: by_record,
+                ..Panel::default()
+            });
+            let mut rules: Vec<Series> = Rule::ALL
+                .iter()
+                .enumerate()
+                .map(|(k, r)| Series {
+                    name: r.key().to_uppercase(),
+                    points: runs
+                        .iter()
+                        .filter_map(|x| {
+                            x.1[a].and_then(|p| p.ratio(k).map(|q| (p.period_ratio, q)))
+                        })
+                        .collect(),
+                    scatter: true,
+                })
+                .collect();
+            let xs = rules[0].points.iter().map(|p| p.0);
+            let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                (l.min(x), h.max(x))
+            });
+            if lo.is_finite() {
+                rules.push(Series {
+                    name: "time history (1)".into(),
+                    points: vec![(lo, 1.0), (hi, 1.0)],
+                    scatter: false,
+                });
+            }
+            panels.push(Panel {
+                title: format!("Code rule / time history{name}"),
+                x_label: ratio_label,
+                y_label: "rule gap / required gap".into(),
+                series: rules,
+                ..Panel::default()
+            });
+            let mut series = Vec::new();
+            for c in curves.get(a).into_iter().flatten() {
+                let label = self.intensity_label(c.intensity);
+                series.push(Series {
+                    name: format!("{label}: share of runs"),
+                    points: c
+                        .points
+                        .iter()
+                        .map(|&(g, n, k)| (g * 1e3, k as f64 / n.max(1) as f64))
+                        .collect(),
+                    scatter: true,
+                });
+                if let Ok(f) = &c.fit {
+                    let top = c.points.iter().map(|p| p.0).fold(0.0, f64::max);
+                    series.push(Series {
+                        name: format!(
+                            "{label}: lognormal, median {:.2} mm, beta {:.2}",
+                            f.median * 1e3,
+                            f.beta
+                        ),
+                        points: (1..=100)
+                            .map(|i| {
+                                let g = top * i as f64 / 100.0;
+                                (g * 1e3, 1.0 - f.probability(g))
+                            })
+                            .collect(),
+                        scatter: false,
+                    });
+                }
+            }
+            panels.push(Panel {
+                title: format!("Probability of pounding{name}"),
+                x_label: "gap (mm)".into(),
+                y_label: "P(required gap > gap)".into(),
+                series,
+                ..Panel::default()
+            });
+        }
+        panels
+    }
+}
+
+/// One rule's record against the time histories, for one pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RuleSummary {
+    pub pair: usize,
+    pub rule: Rule,
+    /// Runs where the pair shares a level.
+    pub runs: usize,
+    /// Of those, runs whose floors close at all (the ratio is defined).
+    pub closing: usize,
+    /// Quantiles of rule / exact over the closing runs (NaN where there are none).
+    pub median: f64,
+    pub p10: f64,
+    pub p90: f64,
+    /// Runs where the rule asks for less than the exact gap.
+    pub unconservative: usize,
+}
+
+/// The probability of pounding of one pair at one intensity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoundingCurve {
+    pub pair: usize,
+    pub intensity: usize,
+    /// `(gap, runs, runs that pound)`.
+    pub points: Vec<(f64, u64, u64)>,
+    /// The lognormal fit of `P(required gap <= gap)`: `P(pounding) = 1 - fit.probability`.
+    pub fit: Result<Fit, NoFit>,
+}
+
+impl PoundingCurve {
+    /// The gap at which the fitted probability of pounding is `p`.
+    pub fn gap_for(&self, p: f64) -> Option<f64> {
+        let f = self.fit.as_ref().ok()?;
+        Some(f.median * (f.beta * crate::plan::sample::phi_inv(1.0 - p)).exp())
+    }
+}
+
+/// Quantile `q` of sorted values, interpolated linearly between order statistics (NaN when
+/// there are none).
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    match sorted.len() {
+        0 => f64::NAN,
+        n => {
+            let x = q * (n - 1) as f64;
+            let (i, f) = (x.floor() as usize, x - x.floor());
+            let next = sorted[(i + 1).min(n - 1)];
+            sorted[i] + f * (next - sorted[i])
+        }
+    }
+}
+
+/// A round step (1, 2 or 5 times a power of ten) of at least `x`.
+fn round_step(x: f64) -> f64 {
+    if !(x > 0.0 && x.is_finite()) {
+        return 1e-3;
+    }
+    let p = 10f64.powf(x.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|k| k * p)
+        .find(|&s| s >= x * (1.0 - 1e-12))
+        .unwrap_or(10.0 * p)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_and_round_steps() {
+        let v = [1.0, 2.0, 3.0, 4.0, 5.0];
+        assert_eq!(quantile(&v, 0.5), 3.0);
+        assert_eq!(quantile(&v, 0.1), 1.4);
+        assert_eq!(quantile(&v, 1.0), 5.0);
+        assert!(quantile(&[], 0.5).is_nan());
+        assert_eq!(round_step(0.0031), 0.005);
+        assert_eq!(round_step(0.002), 0.002);
+        assert_eq!(round_step(0.011), 0.02);
+    }
+}
