@@ -622,6 +622,7 @@ impl<'a> GapStudy<'a> {
                 title: format!("Required gap (time history){name}"),
                 x_label: ratio_label.clone(),
                 y_label: "required gap (mm)".into(),
+                log_x: true,
                 series: by_record,
                 ..Panel::default()
             });
@@ -654,6 +655,7 @@ impl<'a> GapStudy<'a> {
                 title: format!("Code rule / time history{name}"),
                 x_label: ratio_label,
                 y_label: "rule gap / required gap".into(),
+                log_x: true,
                 series: rules,
                 ..Panel::default()
             });

@@ -7,7 +7,7 @@
 //! record's samples carry no truncation error. Between samples each quantity is a smooth
 //! function whose value, slope and curvature are known at both ends, and the quintic Hermite
 //! through them is within `h^6 max|f^(6)| / 46080` of it. That bound is computed per step
-//! ([`sixth_derivative_bound`]): only a step whose quintic comes within it of the running
+//! (`FreeMode::sixth_derivative_bound`): only a step whose quintic comes within it of the running
 //! extremum could raise that extremum, and such a step is stepped again exactly in
 //! [`REFINE_SUBSTEPS`] parts, whose quintics are `REFINE_SUBSTEPS^6` (1.7e7) times closer. So
 //! every extremum is exact to [`Separation::error_bound`], which is reported. The result is
@@ -280,6 +280,9 @@ impl Tracked {
     /// `t0`, which is within `e` of the quantity.
     #[inline]
     fn raise(&mut self, a: [f64; 3], b: [f64; 3], t0: f64, h: f64, e: f64) {
+        if self.zero {
+            return;
+        }
         let [(lo, _), (hi, s)] = quintic_range([a[0], b[0]], [a[1], b[1]], [a[2], b[2]], h);
         self.reach_lo = self.reach_lo.min(lo - e);
         self.reach_hi = self.reach_hi.max(hi + e);
