@@ -152,6 +152,9 @@ fn no_fit(e: &pounding::studies::fragility::NoFit) -> String {
         NoFit::AllExceed => {
             "no run pounds at any gap counted above 0 (--gaps can start lower)".into()
         }
+        NoFit::Separated => {
+            "the required gaps all lie between two neighbouring gaps counted (finer --gaps resolve them)".into()
+        }
         other => other.to_string(),
     }
 }
