@@ -161,23 +161,8 @@ fn no_fit(e: &pounding::studies::fragility::NoFit) -> String {
 
 /// `--gaps`: start:stop:step, a list a,b,c, or one value; each >= 0 m.
 fn parse_gaps(text: &str) -> Result<Vec<f64>> {
-    let gaps = if text.contains(',') {
-        text.split(',')
-            .map(|x| x.trim().parse::<f64>().ok())
-            .collect()
-    } else {
-        config::parse_colon_range(text)
-    }
-    .with_context(|| {
-        format!("--gaps `{text}`: expected start:stop:step, a list a,b,c or one value (m)")
-    })?;
-    if gaps.len() > pounding::plan::limits::MAX_CURVE_GAPS {
-        bail!(
-            "--gaps `{text}` gives {} values: expected at most {}",
-            gaps.len(),
-            pounding::plan::limits::MAX_CURVE_GAPS
-        );
-    }
+    let limit = pounding::plan::limits::MAX_CURVE_GAPS;
+    let gaps = super::values_arg("--gaps", text, " (m)", limit, "")?;
     if let Some(bad) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
         bail!("--gaps: {bad} is out of range: expected gaps >= 0 m");
     }

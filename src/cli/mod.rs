@@ -167,21 +167,37 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
-/// `--e`: start:stop:step, a list a,b,c, or one value; each in (0, 1].
-pub fn e_values(e: &str) -> Result<Vec<f64>> {
-    let es = if e.contains(',') {
-        e.split(',').map(|x| x.trim().parse::<f64>().ok()).collect()
+/// A flag's values from `text`: start:stop:step, a list a,b,c, or one value; at most `max`
+/// (`why` follows that bound in the message, `unit` the expected forms).
+pub fn values_arg(flag: &str, text: &str, unit: &str, max: usize, why: &str) -> Result<Vec<f64>> {
+    let values = if text.contains(',') {
+        text.split(',')
+            .map(|x| x.trim().parse::<f64>().ok())
+            .collect()
     } else {
-        pounding::plan::config::parse_colon_range(e)
+        pounding::plan::config::parse_colon_range(text)
     }
-    .with_context(|| format!("--e `{e}`: expected start:stop:step, a list a,b,c or one value"))?;
-    if es.len() > pounding::plan::limits::MAX_E_VALUES {
+    .with_context(|| {
+        format!("{flag} `{text}`: expected start:stop:step, a list a,b,c or one value{unit}")
+    })?;
+    if values.len() > max {
         bail!(
-            "--e `{e}` gives {} values: expected at most {} (each is a root-found collision)",
-            es.len(),
-            pounding::plan::limits::MAX_E_VALUES
+            "{flag} `{text}` gives {} values: expected at most {max}{why}",
+            values.len()
         );
     }
+    Ok(values)
+}
+
+/// `--e`: start:stop:step, a list a,b,c, or one value; each in (0, 1].
+pub fn e_values(e: &str) -> Result<Vec<f64>> {
+    let es = values_arg(
+        "--e",
+        e,
+        "",
+        pounding::plan::limits::MAX_E_VALUES,
+        " (each is a root-found collision)",
+    )?;
     let es: Vec<f64> = es.iter().map(|e| (e * 1e12).round() / 1e12).collect();
     if let Some(bad) = es.iter().find(|e| !(**e > 0.0 && **e <= 1.0)) {
         bail!("--e: e = {bad} is out of range: expected 0 < e <= 1");

@@ -30,6 +30,16 @@ pub enum PerStorey {
     Each(Vec<f64>),
 }
 
+/// The column prefix of a contact level: `level_b1f3_b2f3` for floor 3 of building 1 (`left`
+/// = 0, buildings from 0 here) against floor 3 of building 2 (floors from 1).
+pub fn level_name(left: usize, floor_left: usize, floor_right: usize) -> String {
+    format!(
+        "level_b{}f{floor_left}_b{}f{floor_right}",
+        left + 1,
+        left + 2
+    )
+}
+
 /// One `[[building]]` as written.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -358,15 +368,7 @@ impl RowPlan {
         self.row(&first)
             .levels
             .iter()
-            .map(|l| {
-                format!(
-                    "level_b{}f{}_b{}f{}",
-                    l.left + 1,
-                    l.floor_left,
-                    l.left + 2,
-                    l.floor_right
-                )
-            })
+            .map(|l| level_name(l.left, l.floor_left, l.floor_right))
             .collect()
     }
 

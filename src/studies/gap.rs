@@ -13,7 +13,7 @@ use crate::physics::separation::{cqc_rho, Rule};
 use crate::physics::shear::ShearBuilding;
 use crate::physics::solver::separation::{separation, LevelSeparation, Separation};
 use crate::plan::columns::{contact_and_motion, num};
-use crate::plan::row::RowPlan;
+use crate::plan::row::{level_name, RowPlan};
 use crate::plan::{Motions, Plan};
 use crate::studies::fragility::{fit, Fit, Level, NoFit};
 use crate::studies::plot::{Panel, Series};
@@ -134,16 +134,16 @@ impl Scenes<'_> {
         }
     }
 
-    /// Motion `m`'s fundamental periods as given (s), record and scale.
-    fn periods(&self, m: u64) -> (Vec<f64>, usize, f64) {
+    /// Motion `m`'s fundamental periods as given (s), and its record's scale.
+    fn periods(&self, m: u64) -> (Vec<f64>, f64) {
         match self {
             Scenes::Pairs(p) => {
                 let r = p.motion_run(m);
-                (vec![r.t1, r.t2], r.record, r.scale)
+                (vec![r.t1, r.t2], r.scale)
             }
             Scenes::Rows(plan) => {
                 let r = plan.motion_run(m);
-                (r.period, r.base.record, r.base.scale)
+                (r.period, r.base.scale)
             }
         }
     }
@@ -195,8 +195,6 @@ impl PairGap {
 #[derive(Debug, Clone, PartialEq)]
 pub struct GapRun {
     pub motion: u64,
-    pub record: usize,
-    pub intensity: usize,
     pub separation: Separation,
     /// Per adjacent pair (None where the two share no floor level).
     pub pairs: Vec<Option<PairGap>>,
@@ -229,7 +227,7 @@ impl<'a> GapStudy<'a> {
             .map(|u| {
                 // The response's first intensity, at unit scale.
                 let m = (u / inner) * per_record + u % inner;
-                let (_, record, _) = scenes.periods(m);
+                let record = (u / inner) as usize;
                 let spec = &scenes.base().spec;
                 separation(
                     &scenes.buildings(m),
@@ -243,7 +241,7 @@ impl<'a> GapStudy<'a> {
                     .map(|i| {
                         scenes
                             .periods((r * motions.intensities + i) as u64 * inner)
-                            .2
+                            .1
                     })
                     .collect()
             })
@@ -252,15 +250,7 @@ impl<'a> GapStudy<'a> {
         let level_names = first.map_or(Vec::new(), |s| {
             s.levels
                 .iter()
-                .map(|l| {
-                    format!(
-                        "level_b{}f{}_b{}f{}",
-                        l.pair + 1,
-                        l.floor_left,
-                        l.pair + 2,
-                        l.floor_right
-                    )
-                })
+                .map(|l| level_name(l.pair, l.floor_left, l.floor_right))
                 .collect()
         });
         let level_pairs = first.map_or(Vec::new(), |s| s.levels.iter().map(|l| l.pair).collect());
@@ -332,11 +322,8 @@ impl<'a> GapStudy<'a> {
 
     /// Run `m`.
     pub fn get(&self, m: u64) -> GapRun {
-        let (record, intensity) = self.motions.record_and_intensity(m);
         GapRun {
             motion: m,
-            record,
-            intensity,
             separation: self.separation(m),
             pairs: self.pair_gaps[m as usize].clone(),
         }
@@ -344,7 +331,7 @@ impl<'a> GapStudy<'a> {
 
     /// What each adjacent pair needs in run `m`, of separation `sep`.
     fn pairs_of(&self, m: u64, sep: &Separation) -> Vec<Option<PairGap>> {
-        let (periods, _, _) = self.scenes.periods(m);
+        let (periods, _) = self.scenes.periods(m);
         (0..self.pairs())
             .map(|a| {
                 let (wa, xa) = sep.fundamental[a];
@@ -443,9 +430,7 @@ impl<'a> GapStudy<'a> {
         }
         if self.per_level() {
             for l in &run.separation.levels {
-                let (wa, xa) = run.separation.fundamental[l.pair];
-                let (wb, xb) = run.separation.fundamental[l.pair + 1];
-                let rho = cqc_rho(wa, xa, wb, xb);
+                let rho = run.pairs[l.pair].expect("a level's pair shares it").rho;
                 c.extend([l.required, l.peak_left, l.peak_right].map(num));
                 c.extend(Rule::ALL.map(|r| num(r.gap(l.peak_left, l.peak_right, rho))));
             }
