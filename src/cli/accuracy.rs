@@ -5,7 +5,6 @@ use anyhow::{bail, Result};
 use pounding::plan::config;
 use pounding::plan::limits::{MAX_SUBSTEPS_PER_CONTACT, WHY_SUBSTEPS};
 use pounding::studies::accuracy;
-use std::io::Write as _;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -22,8 +21,9 @@ pub struct Args {
     /// one; `cpu` leaves them out.
     #[arg(long, value_enum, default_value = "auto")]
     backend: BackendArg,
-    #[arg(short, long, default_value = "accuracy.csv")]
-    output: PathBuf,
+    /// (default: accuracy.csv, numbered `-2`, `-3`, ... where that file exists)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
     /// Work-precision plot (SVG, or PNG for a .png name).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -48,6 +48,7 @@ pub fn run(a: Args) -> Result<()> {
         plot,
         target_error,
     } = a;
+    let output = super::default_output(output, "accuracy.csv");
     let text = config::read_text(&config)?;
     let is_row = pounding::plan::row::is_row_config(&text);
     let suite = if is_row {
@@ -72,12 +73,12 @@ pub fn run(a: Args) -> Result<()> {
     let most = MAX_SUBSTEPS_PER_CONTACT;
     if let Some(bad) = settings.iter().find(|s| !(**s >= 1.0 && **s <= most)) {
         bail!(
-            "--settings: {bad} is out of range: expected substeps per contact from 1 to {most} ({WHY_SUBSTEPS})"
+            "--settings: {} is out of range: expected substeps per contact from 1 to {most} ({WHY_SUBSTEPS})",
+            pounding::plan::limits::show(*bad)
         );
     }
-    if !(tol > 0.0 && tol < 1e-3) {
-        bail!("--tol: {tol} is out of range: expected 0 < tol < 1e-3");
-    }
+    // The config key's bound (run.tol).
+    let tol = pounding::plan::limits::check_tol(tol).map_err(|m| anyhow::anyhow!("--tol {m}"))?;
     let records = config::input_files(&text, &config);
     check_outputs(
         &config_inputs(&config, &records),
@@ -89,6 +90,13 @@ pub fn run(a: Args) -> Result<()> {
             bail!("--backend gpu is not available for the accuracy of rows of multi-storey buildings ([[building]] configs) yet: it compares the CPU paths");
         }
         let plan = config::load_row_text(&text, &config)?;
+        for w in plan.warnings() {
+            note!("warning: {}: {w}", config.display());
+        }
+        let finest = settings.iter().cloned().fold(0.0, f64::max);
+        if let Some(w) = plan.cost_warning(finest) {
+            note!("warning: {}: {w}", config.display());
+        }
         note!(
             "{}: {} runs of a row; reference at tol {tol:e}, then {} settings on the CPU",
             config.display(),
@@ -97,15 +105,22 @@ pub fn run(a: Args) -> Result<()> {
         );
         say!("{}", accuracy::ROW_MARKDOWN_HEADER);
         let points = accuracy::row_study(&plan, &settings, tol, |p| {
-            let _ = writeln!(std::io::stdout(), "{}", accuracy::row_markdown(p));
+            let _ = super::say_text(&format!("{}\n", accuracy::row_markdown(p)));
         });
         write_file(&output, accuracy::row_csv(&points).as_bytes())?;
         if let Some(p) = plot {
-            pounding::studies::plot::save(&p, &accuracy::row_panels(&points), 2)?;
+            super::save_plot(&p, &accuracy::row_panels(&points), 2)?;
         }
-        let measured: Vec<(&str, f64, f64)> = points
+        let measured: Vec<Measured> = points
             .iter()
-            .map(|p| (p.path.as_str(), p.substeps_per_contact, p.force[1]))
+            .map(|p| Measured {
+                path: &p.path,
+                setting: p.substeps_per_contact,
+                force_p99: p.force[1],
+                failed: p.failed,
+                compared: p.compared,
+                runs: plan.len(),
+            })
             .collect();
         return check_targets(&choices, &measured, &config);
     }
@@ -125,41 +140,91 @@ pub fn run(a: Args) -> Result<()> {
     );
     say!("{}", accuracy::MARKDOWN_HEADER);
     let points = accuracy::study(&plan, ctx.as_ref(), &settings, tol, |p| {
-        let _ = writeln!(std::io::stdout(), "{}", accuracy::markdown_row(p));
+        let _ = super::say_text(&format!("{}\n", accuracy::markdown_row(p)));
     })?;
     write_file(&output, accuracy::csv(&points).as_bytes())?;
     if let Some(p) = plot {
-        pounding::studies::plot::save(&p, &accuracy::panels(&points), 2)?;
+        super::save_plot(&p, &accuracy::panels(&points), 2)?;
     }
-    let measured: Vec<(&str, f64, f64)> = points
+    let measured: Vec<Measured> = points
         .iter()
-        .map(|p| (p.path.as_str(), p.substeps_per_contact, p.errors.force_p99))
+        .map(|p| Measured {
+            path: &p.path,
+            setting: p.substeps_per_contact,
+            force_p99: p.errors.force_p99,
+            failed: p.errors.failed,
+            compared: p.errors.compared,
+            runs: plan.len(),
+        })
         .collect();
     check_targets(&choices, &measured, &config)
 }
 
-/// `--target-error`: each chosen setting's p99 peak-force error on every path (`measured`:
-/// path, setting, error) against its target; an error naming the targets missed.
+/// One path at one setting, as `--target-error` judges it.
+struct Measured<'a> {
+    path: &'a str,
+    setting: f64,
+    /// p99 relative peak-force error over the compared runs (NaN over none).
+    force_p99: f64,
+    /// Runs that failed on this path or in the reference.
+    failed: u64,
+    /// Runs that pounded and were compared.
+    compared: u64,
+    runs: u64,
+}
+
+impl Measured<'_> {
+    /// Why this point cannot certify `target`, or None when it meets it. A failed run on either
+    /// side is evidence against the target, and no compared run is no evidence for it.
+    fn short_of(&self, target: f64) -> Option<String> {
+        if self.failed > 0 {
+            Some(format!(
+                "{} of {} runs failed (here or in the reference; pound sweep shows their status)",
+                self.failed, self.runs
+            ))
+        } else if self.compared == 0 {
+            Some(format!(
+                "no run was compared (of {}, none pounded with the reference's impact count)",
+                self.runs
+            ))
+        } else if self.force_p99.is_nan() || self.force_p99 > target {
+            Some(format!("p99 above {target:e}"))
+        } else {
+            None
+        }
+    }
+}
+
+/// `--target-error`: each chosen setting's p99 peak-force error on every path against its
+/// target; an error naming the targets missed. Met only with every run `ok` on both sides and
+/// at least one run compared.
 fn check_targets(
     choices: &[pounding::physics::solver::calibration::Choice],
-    measured: &[(&str, f64, f64)],
+    measured: &[Measured],
     config: &std::path::Path,
 ) -> Result<()> {
     let mut missed = Vec::new();
     for c in choices {
-        for &(path, _, force_p99) in measured
+        for m in measured
             .iter()
-            .filter(|(path, s, _)| *path != "reference" && *s == c.substeps_per_contact)
+            .filter(|m| m.path != "reference" && m.setting == c.substeps_per_contact)
         {
-            let met = force_p99 <= c.target;
+            let short = m.short_of(c.target);
             say!(
-                "--target-error {:e}: {} substeps per contact, {path}: p99 peak-force error {force_p99:.2e} ({})",
+                "--target-error {:e}: {} substeps per contact, {}: p99 peak-force error {:.2e} over {} runs compared, {} failed ({})",
                 c.target,
                 c.substeps_per_contact,
-                if met { "met" } else { "NOT met" }
+                m.path,
+                m.force_p99,
+                m.compared,
+                m.failed,
+                match &short {
+                    None => "met".to_string(),
+                    Some(why) => format!("NOT met: {why}"),
+                }
             );
-            if !met {
-                missed.push(format!("{:e} on {path}", c.target));
+            if short.is_some() {
+                missed.push(format!("{:e} on {}", c.target, m.path));
             }
         }
     }

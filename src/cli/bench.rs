@@ -1,13 +1,12 @@
 //! `pound bench`: the benchmark sweeps on every engine found, as a markdown table.
 
 use super::{check_outputs, write_file, PrecisionArg};
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use pounding::engine::gpu::GpuOptions;
 use pounding::engine::{Backend, Engine};
 use pounding::physics::solver::{FastOptions, Scheme};
 use pounding::plan::limits::MAX_BENCH_RUNS;
 use pounding::studies::bench;
-use std::io::Write as _;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -62,7 +61,7 @@ pub fn run(a: Args) -> Result<()> {
     }
     // Checked here, not only when an adapter is found, so a typo fails on every machine.
     let chunk = pounding::engine::check_chunk(Some(a.chunk), true)?;
-    check_outputs(&[], &[("-o", a.output.as_deref())])?;
+    check_outputs(&[], &[("-o (any)", a.output.as_deref())])?;
     let mut fast = FastOptions::default();
     if let Some(e) = a.target_error {
         fast.substeps_per_contact = super::target_error(e)?.substeps_per_contact;
@@ -117,7 +116,7 @@ pub fn run(a: Args) -> Result<()> {
         }
     }
     let table = bench::table(&rows);
-    write!(std::io::stdout(), "{table}").context("writing to standard output")?;
+    super::say_text(&table)?;
     if let Some(p) = &a.output {
         write_file(p, table.as_bytes())?;
     }
@@ -140,7 +139,7 @@ fn run_storeys(
             bail!("{flag}: {n} is out of range: expected 1 to {MAX_BENCH_RUNS}");
         }
     }
-    check_outputs(&[], &[("-o", output)])?;
+    check_outputs(&[], &[("-o (any)", output)])?;
     // A software adapter runs the row kernel far slower than the CPU path: hardware only.
     let ctx = Backend::Auto.acquire("rows on the CPU only", &mut |l| note!("{l}"))?;
     let opts = GpuOptions {
@@ -167,7 +166,7 @@ fn run_storeys(
         }
     }
     let table = bench::storey_table(&rows);
-    write!(std::io::stdout(), "{table}").context("writing to standard output")?;
+    super::say_text(&table)?;
     if let Some(p) = output {
         write_file(p, table.as_bytes())?;
     }

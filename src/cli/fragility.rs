@@ -23,17 +23,19 @@ pub struct Args {
     #[arg(long = "where", value_name = "FILTER")]
     filters: Vec<String>,
     /// Counts per threshold and level (CSV).
-    #[arg(short, long, default_value = "fragility.csv")]
-    output: PathBuf,
+    /// (default: fragility.csv, numbered `-2`, `-3`, ... where that file exists)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
     /// Observed fractions and fitted curves (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> Result<()> {
+    let output = super::default_output(a.output.clone(), "fragility.csv");
     check_study_outputs(
         &a.results,
-        &[("-o", Some(&a.output)), ("--plot", a.plot.as_deref())],
+        &[("-o", Some(&output)), ("--plot", a.plot.as_deref())],
     )?;
     let table = Table::read(&a.results)?;
     let spec = FragilitySpec {
@@ -55,8 +57,8 @@ pub fn run(a: Args) -> Result<()> {
         "{runs} runs at {} levels of {}{}",
         lv[0].len(),
         spec.im,
-        if skipped > 0 {
-            format!(" ({skipped} rows left out: status not ok, or no value)")
+        if skipped.total() > 0 {
+            format!(" ({} rows left out: {skipped})", skipped.total())
         } else {
             String::new()
         }
@@ -75,9 +77,9 @@ pub fn run(a: Args) -> Result<()> {
             Err(e) => say!("| {t} | no fit: {e} | | | | |"),
         }
     }
-    write_file(&a.output, csv(&spec, &lv).as_bytes())?;
+    write_file(&output, csv(&spec, &lv).as_bytes())?;
     if let Some(p) = &a.plot {
-        pounding::studies::plot::save(p, &[panel(&spec, &lv, &fits)], 1)?;
+        super::save_plot(p, &[panel(&spec, &lv, &fits)], 1)?;
     }
     Ok(())
 }

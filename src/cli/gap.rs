@@ -15,8 +15,9 @@ pub struct Args {
     config: PathBuf,
     /// One row per run: the required gap of each adjacent pair (and of each shared floor
     /// level of multi-storey buildings), the rules' gaps and their ratios to it.
-    #[arg(short, long, default_value = "gaps.csv")]
-    output: PathBuf,
+    /// (default: gaps.csv, numbered `-2`, `-3`, ... where that file exists)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
     /// Per pair: required gap and rule ratios against the period ratio, and the probability of
     /// pounding against the gap (.svg or .png).
     #[arg(long)]
@@ -35,12 +36,13 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<()> {
+    let output = super::default_output(a.output.clone(), "gaps.csv");
     let text = config::read_text(&a.config)?;
     let records = config::input_files(&text, &a.config);
     check_outputs(
         &config_inputs(&a.config, &records),
         &[
-            ("-o", Some(&a.output)),
+            ("-o", Some(&output)),
             ("--plot", a.plot.as_deref()),
             ("--curve", a.curve.as_deref()),
         ],
@@ -51,6 +53,18 @@ pub fn run(a: Args) -> Result<()> {
     let pair_plan;
     let scenes = if pounding::plan::row::is_row_config(&text) {
         row_plan = config::load_row_text(&text, &a.config)?;
+        // A pair that cannot touch floor to floor has no required gap to give.
+        let apart = row_plan.pairs_without_levels();
+        if !apart.is_empty() {
+            bail!(
+                "{}: {}: no required gap can be computed for such a pair",
+                a.config.display(),
+                apart.join("; ")
+            );
+        }
+        for w in row_plan.warnings() {
+            note!("warning: {}: {w}", a.config.display());
+        }
         Scenes::Rows(&row_plan)
     } else {
         pair_plan = config::load_text(&text, &a.config)?;
@@ -131,12 +145,12 @@ pub fn run(a: Args) -> Result<()> {
             ),
         }
     }
-    write_file(&a.output, &study.csv())?;
+    write_file(&output, &study.csv())?;
     if let Some(p) = &a.curve {
         write_file(p, curve_csv(&study, &curves).as_bytes())?;
     }
     if let Some(p) = &a.plot {
-        pounding::studies::plot::save(p, &study.panels(&curves), 3)?;
+        super::save_plot(p, &study.panels(&curves), 3)?;
     }
     Ok(())
 }
@@ -164,7 +178,10 @@ fn parse_gaps(text: &str) -> Result<Vec<f64>> {
     let limit = pounding::plan::limits::MAX_CURVE_GAPS;
     let gaps = super::values_arg("--gaps", text, " (m)", limit, "")?;
     if let Some(bad) = gaps.iter().find(|g| !(g.is_finite() && **g >= 0.0)) {
-        bail!("--gaps: {bad} is out of range: expected gaps >= 0 m");
+        bail!(
+            "--gaps: {} is out of range: expected gaps >= 0 m",
+            pounding::plan::limits::show(*bad)
+        );
     }
     Ok(gaps)
 }

@@ -5,7 +5,6 @@ use anyhow::{bail, Context, Result};
 use pounding::physics::contact::LawKind;
 use pounding::physics::restitution::Formula;
 use pounding::studies::fidelity;
-use std::io::Write as _;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -28,14 +27,16 @@ pub struct Args {
     #[arg(long, default_value_t = 5.0e4)]
     m_eff: f64,
     /// Loop points as CSV (e, delta_m, force_n).
-    #[arg(short, long, default_value = "hysteresis.csv")]
-    output: PathBuf,
+    /// (default: hysteresis.csv, numbered `-2`, `-3`, ... where that file exists)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
     /// The loops as SVG.
     #[arg(long)]
     plot: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> Result<()> {
+    let output = super::default_output(a.output.clone(), "hysteresis.csv");
     let law = LawKind::from_key(&a.law)
         .with_context(|| format!("law `{}`: expected one of {}", a.law, LawKind::keys()))?;
     let formula = Formula::from_key(&a.formula).with_context(|| {
@@ -60,16 +61,13 @@ pub fn run(a: Args) -> Result<()> {
             bail!("{name}: {x} is out of range: expected a positive number");
         }
     }
-    check_outputs(
-        &[],
-        &[("-o", Some(&a.output)), ("--plot", a.plot.as_deref())],
-    )?;
+    check_outputs(&[], &[("-o", Some(&output)), ("--plot", a.plot.as_deref())])?;
     let es = e_values(&a.e)?;
     let loops = fidelity::loops(law, formula, &es, a.v0, a.stiffness, a.m_eff)?;
-    write!(std::io::stdout(), "{}", loops.markdown()).context("writing to standard output")?;
-    write_file(&a.output, loops.csv().as_bytes())?;
+    super::say_text(&loops.markdown())?;
+    write_file(&output, loops.csv().as_bytes())?;
     if let Some(p) = &a.plot {
-        pounding::studies::plot::svg(p, &[loops.panel()], 1)?;
+        super::save_plot(p, &[loops.panel()], 1)?;
     }
     Ok(())
 }

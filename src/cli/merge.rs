@@ -8,16 +8,20 @@ pub struct Args {
     /// Shard outputs (CSV files written by `pound sweep --shard`), in any order.
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
-    #[arg(short, long, default_value = "results.csv")]
-    output: PathBuf,
+    /// (default: results.csv, numbered `-2`, `-3`, ... where that file exists)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> Result<()> {
-    let rows = pounding::io::merge::merge(&a.output, &a.inputs)?;
+    let output = super::default_output(a.output.clone(), "results.csv");
+    // Merge writes CSV (its own checks of inputs against the output follow).
+    super::check_extension("-o", &output, "csv")?;
+    let rows = pounding::io::merge::merge(&output, &a.inputs)?;
     note!(
         "{rows} runs from {} inputs -> {}",
         a.inputs.len(),
-        a.output.display()
+        output.display()
     );
     Ok(())
 }

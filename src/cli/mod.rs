@@ -14,15 +14,42 @@ macro_rules! note {
     ($($t:tt)*) => { pounding::note(format_args!($($t)*)) };
 }
 
-/// A line on standard output; a failed write is an error, not a panic.
+/// A line on standard output (standard error when an output of the command goes to standard
+/// output, [`tables_on_stderr`]); a failed write is an error, not a panic.
 macro_rules! say {
     ($($t:tt)*) => {{
         use std::io::Write as _;
-        anyhow::Context::context(
-            writeln!(std::io::stdout(), $($t)*),
-            "writing to standard output",
-        )?
+        if $crate::cli::tables_on_stderr() {
+            pounding::note(format_args!($($t)*));
+        } else {
+            anyhow::Context::context(
+                writeln!(std::io::stdout(), $($t)*),
+                "writing to standard output",
+            )?
+        }
     }};
+}
+
+/// Text (a table, with its own line ends) where [`say!`] writes.
+pub fn say_text(text: &str) -> Result<()> {
+    use std::io::Write as _;
+    if tables_on_stderr() {
+        let _ = std::io::stderr().write_all(text.as_bytes());
+        Ok(())
+    } else {
+        std::io::stdout()
+            .write_all(text.as_bytes())
+            .context("writing to standard output")
+    }
+}
+
+/// Set once an output of this command is standard output (`-o -`): its tables and summaries
+/// then go to standard error, so standard output holds that output alone.
+static STDOUT_TAKEN: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Does an output of this command go to standard output?
+pub fn tables_on_stderr() -> bool {
+    STDOUT_TAKEN.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 pub mod accuracy;
@@ -125,16 +152,130 @@ pub fn check_outputs(
     outputs: &[(&str, Option<&Path>)],
 ) -> Result<Vec<pounding::io::target::Target>> {
     use pounding::io::target::Target;
+    let on_stdout: Vec<&str> = outputs
+        .iter()
+        .filter(|(_, p)| p.is_some_and(|p| p.as_os_str() == "-"))
+        .map(|(w, _)| flag(w))
+        .collect();
+    if on_stdout.len() > 1 {
+        bail!(
+            "{} all name standard output (-): two outputs may not share one stream; give all but one a file name",
+            on_stdout.join(" and ")
+        );
+    }
     let mut targets = Vec::new();
     for (what, p) in outputs {
         let Some(p) = p else { continue };
+        let what = flag(what);
         let t = Target::resolve(what, p)?;
         t.probe(what)?;
-        targets.push((*what, t));
+        targets.push((what, t));
     }
     let named: Vec<(&str, &Target)> = targets.iter().map(|(w, t)| (*w, t)).collect();
     pounding::io::target::check_outputs(inputs, &named)?;
+    // After the checks that protect inputs, which say more about a wrong name.
+    for (what, p) in outputs {
+        if let (Some(p), Some(expected)) = (p, format_of(what)) {
+            check_extension(flag(what), p, expected)?;
+        }
+    }
+    if !on_stdout.is_empty() {
+        STDOUT_TAKEN.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
     Ok(targets.into_iter().map(|(_, t)| t).collect())
+}
+
+/// What an output flag writes, for the extension check: plots (`--plot`, and `-o` of
+/// `pound plot`, named `plot -o`) write SVG or PNG, the rest CSV unless the command says
+/// otherwise (`-o (parquet)` for `--format parquet`, `-o (any)` where the format is free).
+fn format_of(what: &str) -> Option<&'static str> {
+    match what {
+        "--plot" | "plot -o" => Some("plot"),
+        "-o (parquet)" => Some("parquet"),
+        "-o (any)" => None,
+        _ => Some("csv"),
+    }
+}
+
+/// The flag of an output as [`check_outputs`] is given it, without what [`format_of`] reads.
+fn flag(what: &str) -> &str {
+    let what = what.strip_prefix("plot ").unwrap_or(what);
+    what.split(" (").next().unwrap_or(what)
+}
+
+/// An output whose extension names another format than the one written is refused: a file
+/// called `x.pdf` that holds SVG, or `m.parquet` that holds CSV, misleads every reader.
+pub fn check_extension(what: &str, path: &Path, expected: &str) -> Result<()> {
+    if path.as_os_str() == "-" {
+        return Ok(());
+    }
+    let Some(ext) = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+    else {
+        return Ok(());
+    };
+    let plots = ["svg", "png"];
+    let named = [
+        "csv", "parquet", "svg", "png", "pdf", "jpg", "jpeg", "eps", "ps", "json", "xlsx", "tsv",
+    ];
+    let fits = match expected {
+        "plot" => plots.contains(&ext.as_str()),
+        "parquet" => ext == "parquet" || !named.contains(&ext.as_str()),
+        _ => ext == "csv" || ext == "txt" || !named.contains(&ext.as_str()),
+    };
+    if !fits {
+        let writes = match expected {
+            "plot" => "a plot as SVG, or PNG for a .png name",
+            "parquet" => "Parquet (--format parquet)",
+            _ => "CSV",
+        };
+        bail!(
+            "{what} {}: a .{ext} name for an output written as {writes}: give it a matching extension",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// The output file of a flag left at its default `name`: `name` unless a file of that name
+/// exists, else the first of `stem-2.ext`, `stem-3.ext`, ... that does not, so a default never
+/// replaces an earlier output (of another config or command); said on stderr.
+pub fn default_output(given: Option<std::path::PathBuf>, name: &str) -> std::path::PathBuf {
+    if let Some(p) = given {
+        return p;
+    }
+    let plain = Path::new(name);
+    if !plain.exists() {
+        return plain.to_path_buf();
+    }
+    let stem = plain.file_stem().unwrap_or_default().to_string_lossy();
+    let ext = plain.extension().map(|e| e.to_string_lossy().into_owned());
+    let free = (2u64..)
+        .map(|k| match &ext {
+            Some(e) => std::path::PathBuf::from(format!("{stem}-{k}.{e}")),
+            None => std::path::PathBuf::from(format!("{stem}-{k}")),
+        })
+        .find(|p| !p.exists() && !pounding::io::atomic::partial_path(p).exists())
+        .expect("a free name");
+    note!(
+        "notice: {name} exists and is kept: writing {} (name the output with -o)",
+        free.display()
+    );
+    free
+}
+
+/// Save a plot, saying where.
+pub fn save_plot(
+    path: &Path,
+    panels: &[pounding::studies::plot::Panel],
+    cols: usize,
+) -> Result<()> {
+    pounding::studies::plot::save(path, panels, cols)?;
+    if path.as_os_str() != "-" {
+        note!("wrote {}", path.display());
+    }
+    Ok(())
 }
 
 /// A config and the record files it names, as the inputs its outputs must not replace.
@@ -164,12 +305,28 @@ pub fn check_study_outputs(results: &Path, outputs: &[(&str, Option<&Path>)]) ->
 /// Write `bytes` to `path` whole (temporary file, fsync, rename), naming the file on error.
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     pounding::io::atomic::write_atomic(path, bytes)
-        .with_context(|| format!("writing {}", path.display()))
+        .with_context(|| format!("writing {}", path.display()))?;
+    if path.as_os_str() != "-" {
+        note!("wrote {}", path.display());
+    }
+    Ok(())
 }
 
 /// A flag's values from `text`: start:stop:step, a list a,b,c, or one value; at most `max`
 /// (`why` follows that bound in the message, `unit` the expected forms).
 pub fn values_arg(flag: &str, text: &str, unit: &str, max: usize, why: &str) -> Result<Vec<f64>> {
+    // A range's count is checked before its values are made: `0:1e9:1` is over the bound, not
+    // a syntax error.
+    let parts: Vec<f64> = text
+        .split(':')
+        .filter_map(|x| x.trim().parse::<f64>().ok())
+        .collect();
+    if let [a, b, step] = parts[..] {
+        let count = ((b - a) / step).floor() + 1.0;
+        if step > 0.0 && b >= a && count > max as f64 {
+            bail!("{flag} `{text}` gives {count:.0} values: expected at most {max}{why}");
+        }
+    }
     let values = if text.contains(',') {
         text.split(',')
             .map(|x| x.trim().parse::<f64>().ok())
@@ -200,7 +357,10 @@ pub fn e_values(e: &str) -> Result<Vec<f64>> {
     )?;
     let es: Vec<f64> = es.iter().map(|e| (e * 1e12).round() / 1e12).collect();
     if let Some(bad) = es.iter().find(|e| !(**e > 0.0 && **e <= 1.0)) {
-        bail!("--e: e = {bad} is out of range: expected 0 < e <= 1");
+        bail!(
+            "--e: e = {} is out of range: expected 0 < e <= 1",
+            pounding::plan::limits::show(*bad)
+        );
     }
     Ok(es)
 }

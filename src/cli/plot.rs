@@ -32,8 +32,9 @@ pub struct Args {
     #[arg(long)]
     log_y: bool,
     /// Output: .svg, or .png (text in a font built into the binary).
-    #[arg(short, long, default_value = "plot.svg")]
-    output: PathBuf,
+    /// (default: plot.svg, numbered `-2`, `-3`, ... where that file exists)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -46,7 +47,8 @@ enum AggArg {
 }
 
 pub fn run(a: Args) -> Result<()> {
-    check_study_outputs(&a.results, &[("-o", Some(&a.output))])?;
+    let output = super::default_output(a.output.clone(), "plot.svg");
+    check_study_outputs(&a.results, &[("plot -o", Some(&output))])?;
     let table = Table::read(&a.results)?;
     let spec = PlotSpec {
         x: a.x,
@@ -70,7 +72,20 @@ pub fn run(a: Args) -> Result<()> {
             a.results.display()
         );
     }
-    let points: usize = p.series.iter().map(|s| s.points.len()).sum();
+    // A log axis cannot show a value <= 0: such points are left out, with a count.
+    let off_log = p
+        .series
+        .iter()
+        .flat_map(|s| &s.points)
+        .filter(|(x, y)| (spec.log_x && *x <= 0.0) || (spec.log_y && *y <= 0.0))
+        .count();
+    if off_log > 0 {
+        note!(
+            "{}: {off_log} points left out: a value <= 0 on a log axis (--log-x / --log-y)",
+            a.results.display()
+        );
+    }
+    let points: usize = p.series.iter().map(|s| s.points.len()).sum::<usize>() - off_log;
     if points == 0 {
         bail!(
             "{}: no rows left to plot (check --where and that {} and {} have values)",
@@ -79,11 +94,11 @@ pub fn run(a: Args) -> Result<()> {
             spec.y
         );
     }
-    pounding::studies::plot::save(&a.output, std::slice::from_ref(&p), 1)?;
+    super::save_plot(&output, std::slice::from_ref(&p), 1)?;
     note!(
         "{} series, {points} points -> {}",
         p.series.len(),
-        a.output.display()
+        output.display()
     );
     Ok(())
 }

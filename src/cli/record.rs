@@ -67,5 +67,14 @@ pub fn run(cmd: Cmd) -> Result<()> {
         pga.index,
         rec.accel[pga.index] / G
     );
+    let limit = pounding::plan::limits::WARN_PGA_G;
+    if pga.value / G > limit {
+        note!(
+            "warning: {}: a PGA of {:.3} g is above {limit} g, where no recorded earthquake reaches: are the values in {} (--units)?",
+            file.display(),
+            pga.value / G,
+            if pga.value / G > 100.0 { "cm/s2" } else { "m/s2 or cm/s2" }
+        );
+    }
     Ok(())
 }

@@ -17,9 +17,10 @@ use std::path::PathBuf;
 #[derive(clap::Args)]
 pub struct Args {
     config: PathBuf,
-    /// Output CSV (written as OUT.partial, renamed when complete).
-    #[arg(short, long, default_value = "results.csv")]
-    output: PathBuf,
+    /// Output CSV (written as OUT.partial, renamed when complete; default results.csv,
+    /// numbered `-2`, `-3`, ... where that file exists, except with --resume).
+    #[arg(short, long)]
+    output: Option<PathBuf>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
@@ -55,10 +56,10 @@ pub struct Args {
     /// With --aggregate: count runs with COLUMN > THRESHOLD (e.g. peak_force_n=1e6); repeatable.
     #[arg(long, value_name = "COLUMN=THRESHOLD", requires = "aggregate")]
     exceed: Vec<String>,
-    /// Output format: csv (journaled, resumable) or parquet (typed columns, the plan
-    /// fingerprint in its metadata).
-    #[arg(long, value_enum, default_value = "csv")]
-    format: FormatArg,
+    /// Output format: csv (journaled, resumable; the default) or parquet (typed columns, the
+    /// plan fingerprint in its metadata; the default for a .parquet output name).
+    #[arg(long, value_enum)]
+    format: Option<FormatArg>,
     /// Write only these columns (comma-separated; `run` is always kept, first).
     #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
     columns: Option<Vec<String>>,
@@ -109,6 +110,17 @@ fn scheme_as_run(configured: Scheme, asked: Option<SchemeArg>, energy: bool) -> 
     }
 }
 
+/// Say that `--target-error` replaces a `run.substeps_per_contact` the config gives.
+fn overrides_configured(config_text: &str, chosen: f64) {
+    let given = config_text
+        .parse::<toml::Table>()
+        .ok()
+        .and_then(|t| t.get("run")?.get("substeps_per_contact").cloned());
+    if let Some(v) = given {
+        note!("notice: --target-error overrides the config's run.substeps_per_contact = {v} with {chosen}");
+    }
+}
+
 /// `--threads`, checked.
 pub fn check_threads(t: usize) -> Result<usize> {
     use pounding::plan::limits::{MAX_THREADS, WHY_THREADS};
@@ -139,6 +151,19 @@ pub fn run(a: Args) -> Result<()> {
         columns,
         target_error,
     } = a;
+    // A default name is never an earlier output; --resume continues the one it names.
+    let output = match (output, resume) {
+        (None, true) => PathBuf::from("results.csv"),
+        (given, _) => super::default_output(given, "results.csv"),
+    };
+    let parquet_name = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("parquet"));
+    let format = format.unwrap_or(if parquet_name && aggregate.is_none() {
+        FormatArg::Parquet
+    } else {
+        FormatArg::Csv
+    });
     if format == FormatArg::Parquet && resume {
         bail!("--resume continues CSV output only: a Parquet file is readable only once its footer is written at the end");
     }
@@ -153,26 +178,42 @@ pub fn run(a: Args) -> Result<()> {
     // writable.
     let config_text = config::read_text(&config)?;
     let records = config::input_files(&config_text, &config);
-    let target = check_outputs(&config_inputs(&config, &records), &[("-o", Some(&output))])?
+    let what = if format == FormatArg::Parquet {
+        "-o (parquet)"
+    } else {
+        "-o"
+    };
+    let target = check_outputs(&config_inputs(&config, &records), &[(what, Some(&output))])?
         .pop()
         .expect("one output");
     if pounding::plan::row::is_row_config(&config_text) {
         let mut plan = config::load_row_text(&config_text, &config)?;
+        for w in plan.warnings() {
+            note!("warning: {}: {w}", config.display());
+        }
         plan.base.spec.scheme = scheme_as_run(plan.base.spec.scheme, scheme, energy);
         let chosen = match (target_error, &mut plan.base.spec.scheme) {
             (None, _) => None,
             (Some(_), Scheme::Reference(_)) => bail!(
-                "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.rtol)"
+                "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.tol)"
             ),
             (Some(e), Scheme::Fast(o)) => {
                 let c = super::target_error_in(
                     pounding::physics::solver::calibration::Suite::Rows,
                     e,
                 )?;
+                overrides_configured(&config_text, c.substeps_per_contact);
                 o.substeps_per_contact = c.substeps_per_contact;
                 Some(c)
             }
         };
+        let spc = match plan.base.spec.scheme {
+            Scheme::Fast(o) => o.substeps_per_contact,
+            Scheme::Reference(_) => FastOptions::default().substeps_per_contact,
+        };
+        if let Some(w) = plan.cost_warning(spc) {
+            note!("warning: {}: {w}", config.display());
+        }
         // The row kernel runs the fast scheme without the energy balance; the rows' calibration
         // is of the CPU's f64 (the GPU in f64 agrees with it to 3.7e-6, BENCHMARKS.md; f32
         // adds up to 7.2e-5).
@@ -264,10 +305,11 @@ pub fn run(a: Args) -> Result<()> {
     let chosen = match (target_error, &mut scheme) {
         (None, _) => None,
         (Some(_), Scheme::Reference(_)) => bail!(
-            "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.rtol)"
+            "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.tol)"
         ),
         (Some(e), Scheme::Fast(o)) => {
             let c = super::target_error(e)?;
+            overrides_configured(&config_text, c.substeps_per_contact);
             o.substeps_per_contact = c.substeps_per_contact;
             Some(c)
         }
@@ -316,7 +358,7 @@ pub fn run(a: Args) -> Result<()> {
     };
     let todo = out.todo();
     let partial = out.partial_path();
-    let bar = progress_bar(todo.end - todo.start);
+    let mut bar = progress_bar(todo.end - todo.start);
     note!(
         "{}: {} runs, {} scheme, {}",
         config.display(),
@@ -487,6 +529,10 @@ fn run_row(
         content: None,
         target_error: target_error.map(pounding::io::provenance::TargetError::of),
     };
+    // Every refusal that the plan decides comes before any file is made.
+    if let Some((ctx, _)) = gpu {
+        pounding::engine::gpu::row::check_fits(ctx, plan)?;
+    }
     let Some(mut out) = open_output(target, meta, format, picked, resume)? else {
         return Ok(());
     };
@@ -510,11 +556,15 @@ fn run_row(
         plan.row(&plan.run(0)).levels.len(),
         plan.scheme().key(),
     );
-    let bar = progress_bar(todo.end - todo.start);
+    let mut bar = progress_bar(todo.end - todo.start);
+    let mut absurd = 0u64;
     let write = |rows: &[(
         pounding::plan::row::RowRunSpec,
         pounding::physics::row::RowOutput,
-    )]| { out.take(plan, rows).map_err(anyhow::Error::from) };
+    )]| {
+        absurd += plan.above_height(rows);
+        out.take(plan, rows).map_err(anyhow::Error::from)
+    };
     let progress = |done| bar.set_position(done);
     let summary = pool
         .install(|| match gpu {
@@ -549,6 +599,11 @@ fn run_row(
     // Records are read once, at the start, as for pairs.
     let changed = config::changed_records(config_text, config, &plan.base);
     let (path, what) = finish_unless_changed(*out, &changed)?;
+    if absurd > 0 {
+        note!(
+            "warning: {absurd} runs have a building whose peak roof displacement exceeds its height (the sum of its storey heights): check the record's units, the intensity and storey_height_m"
+        );
+    }
     finished(&summary, &path, &format!(" ({what})"));
     Ok(())
 }
@@ -624,8 +679,92 @@ fn finish_unless_changed(
     Ok(out.finish()?)
 }
 
-/// A progress bar on a terminal, hidden otherwise.
-fn progress_bar(runs: u64) -> indicatif::ProgressBar {
+/// Progress: a bar on a terminal; elsewhere (a log, a batch job) a line every
+/// `POUND_PROGRESS_S` seconds (default 10) from a watcher thread, so a long sweep is never
+/// silent, even while its first chunk runs.
+enum Progress {
+    Bar(indicatif::ProgressBar),
+    Lines {
+        /// Runs done, and whether the sweep is over.
+        state: std::sync::Arc<(std::sync::atomic::AtomicU64, std::sync::atomic::AtomicBool)>,
+        watcher: Option<std::thread::JoinHandle<()>>,
+    },
+}
+
+impl Progress {
+    fn set_position(&self, done: u64) {
+        match self {
+            Progress::Bar(b) => b.set_position(done),
+            Progress::Lines { state, .. } => {
+                state.0.store(done, std::sync::atomic::Ordering::Relaxed)
+            }
+        }
+    }
+
+    fn suspend(&self, f: impl FnOnce()) {
+        match self {
+            Progress::Bar(b) => b.suspend(f),
+            Progress::Lines { .. } => f(),
+        }
+    }
+
+    fn finish_and_clear(&mut self) {
+        match self {
+            Progress::Bar(b) => b.finish_and_clear(),
+            Progress::Lines { state, watcher } => {
+                state.1.store(true, std::sync::atomic::Ordering::Relaxed);
+                if let Some(w) = watcher.take() {
+                    w.thread().unpark();
+                    let _ = w.join();
+                }
+            }
+        }
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.finish_and_clear();
+    }
+}
+
+/// The watcher of [`Progress::Lines`]: a line every `every` until the sweep is over.
+fn watch(
+    runs: u64,
+    every: std::time::Duration,
+    state: std::sync::Arc<(std::sync::atomic::AtomicU64, std::sync::atomic::AtomicBool)>,
+) {
+    use std::sync::atomic::Ordering;
+    let start = std::time::Instant::now();
+    let mut next = every;
+    loop {
+        while start.elapsed() < next {
+            if state.1.load(Ordering::Relaxed) {
+                return;
+            }
+            std::thread::park_timeout((next - start.elapsed().min(next)).min(every));
+        }
+        if state.1.load(Ordering::Relaxed) {
+            return;
+        }
+        let now = start.elapsed().as_secs_f64();
+        let done = state.0.load(Ordering::Relaxed);
+        let rate = done as f64 / now.max(1e-9);
+        let eta = if done > 0 {
+            format!("{:.0} s", runs.saturating_sub(done) as f64 / rate)
+        } else {
+            "unknown until the first chunk ends".into()
+        };
+        note!(
+            "progress: {done}/{runs} runs ({:.1} %) in {now:.0} s, {rate:.1} runs/s, eta {eta}",
+            100.0 * done as f64 / runs.max(1) as f64
+        );
+        next += every;
+    }
+}
+
+/// A progress bar on a terminal, progress lines otherwise ([`Progress`]).
+fn progress_bar(runs: u64) -> Progress {
     if std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(runs);
         b.set_style(
@@ -634,8 +773,25 @@ fn progress_bar(runs: u64) -> indicatif::ProgressBar {
             )
             .expect("valid template"),
         );
-        b
+        Progress::Bar(b)
     } else {
-        indicatif::ProgressBar::hidden()
+        let seconds = std::env::var("POUND_PROGRESS_S")
+            .ok()
+            .and_then(|s| s.parse::<f64>().ok())
+            .filter(|s| s.is_finite() && *s >= 0.0)
+            .unwrap_or(10.0);
+        let every = std::time::Duration::from_secs_f64(seconds.max(0.05));
+        let state = std::sync::Arc::new((
+            std::sync::atomic::AtomicU64::new(0),
+            std::sync::atomic::AtomicBool::new(false),
+        ));
+        let watcher = {
+            let state = state.clone();
+            std::thread::Builder::new()
+                .name("progress".into())
+                .spawn(move || watch(runs, every, state))
+                .ok()
+        };
+        Progress::Lines { state, watcher }
     }
 }

@@ -221,6 +221,8 @@ pub enum AggregateError {
         columns: String,
         example: String,
     },
+    #[error("--exceed `{given}`: the threshold must be a finite number (COLUMN > THRESHOLD is never decided by NaN or infinity)")]
+    NonFiniteThreshold { given: String },
     #[error("--exceed: at most {MAX_EXCEED} thresholds, {0} given")]
     TooManyExceed(usize),
 }
@@ -425,6 +427,9 @@ impl Aggregator {
                     .position(|(o, _)| *o == c.trim())
                     .ok_or_else(bad)?;
                 let t: f64 = t.trim().parse().map_err(|_| bad())?;
+                if !t.is_finite() {
+                    return Err(AggregateError::NonFiniteThreshold { given: e.clone() });
+                }
                 Ok((c.trim().to_string(), i, t))
             })
             .collect::<Result<_, _>>()?;

@@ -70,6 +70,17 @@ pub enum Opened {
     Complete(PathBuf),
 }
 
+/// Does the journal `progress` say 0 runs are done, and `partial` hold at most a header line
+/// (no row)? An edited journal beside rows is not such a journal: the rows decide.
+fn holds_no_rows(partial: &Path, progress: &Path) -> bool {
+    let journal_empty = read_toml::<Progress>(progress).is_ok_and(|p| p.done == 0);
+    let rows = std::fs::read(partial).map(|b| {
+        let body = b.strip_suffix(b"\n").unwrap_or(&b);
+        body.contains(&b'\n')
+    });
+    journal_empty && rows.is_ok_and(|has_rows| !has_rows)
+}
+
 impl SweepOutput {
     /// Open `target` for the runs `meta.first_run..meta.end_run`: a fresh output, or with
     /// `resume` the verified prefix an interrupted sweep left. `columns` are indices into
@@ -139,6 +150,18 @@ impl SweepOutput {
         let names = header_for(meta.columns.as_deref());
         let header = header_line(&names);
         let progress_file = progress_path(path);
+        // A journal of 0 runs beside a `.partial` of no rows (a sweep stopped before its first
+        // chunk) holds nothing to continue or protect: it never blocks a new sweep.
+        if let Some(l) = lock {
+            if progress_file.exists() && holds_no_rows(l.path(), &progress_file) {
+                std::fs::remove_file(&progress_file)
+                    .map_err(|e| at(&progress_file, e.to_string()))?;
+                note(format!(
+                    "notice: {} recorded 0 finished runs: starting afresh",
+                    progress_file.display()
+                ));
+            }
+        }
         // An unfinished CSV sweep's rows are only ever continued (CSV, --resume), never
         // overwritten by a fresh sweep of any format.
         if let Some(l) = lock {

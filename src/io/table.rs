@@ -39,12 +39,24 @@ impl Table {
             path: path.into(),
             message,
         };
+        // A Parquet file (`pound sweep --format parquet`) starts with its magic bytes.
+        let mut magic = [0u8; 4];
+        if std::fs::File::open(path)
+            .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic))
+            .is_ok()
+            && &magic == b"PAR1"
+        {
+            return Err(fail(
+                "is a Parquet file: this command reads the CSV a sweep writes (run the sweep with --format csv, or convert the file)".into(),
+            ));
+        }
         let mut r = csv::Reader::from_path(path).map_err(|e| fail(e.to_string()))?;
-        let header = r
+        let header: Vec<String> = r
             .headers()
             .map_err(|e| fail(e.to_string()))?
             .iter()
-            .map(String::from)
+            // A UTF-8 byte-order mark is not part of the first column's name.
+            .map(|h| h.strip_prefix('\u{feff}').unwrap_or(h).to_string())
             .collect();
         let rows = r
             .records()
@@ -146,8 +158,8 @@ impl Filter {
         if column.is_empty() || value.is_empty() {
             return Err(fail("expected COLUMN=VALUE (or !=, <, <=, >, >=)"));
         }
-        if !matches!(op, Op::Eq | Op::Ne) && value.parse::<f64>().is_err() {
-            return Err(fail("<, <=, > and >= need a number"));
+        if !matches!(op, Op::Eq | Op::Ne) && !value.parse::<f64>().is_ok_and(f64::is_finite) {
+            return Err(fail("<, <=, > and >= need a finite number"));
         }
         Ok(Filter { column, op, value })
     }

@@ -213,6 +213,15 @@ pub fn check_distinct(
         .filter(|(_, p)| p.as_os_str() != "-" && !is_char_device(p))
         .map(|&(w, p)| (w, p, file_id(p)))
         .collect();
+    let spelled = |p: &Path| {
+        let dir = p
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        std::fs::canonicalize(dir)
+            .ok()
+            .map(|d| d.join(p.file_name().unwrap_or_default()))
+    };
     for &(what_in, input) in inputs {
         if input.as_os_str() == "-" || is_char_device(input) {
             continue;
@@ -231,17 +240,33 @@ pub fn check_distinct(
             }
         }
     }
+    // The `.partial` of an input is where a sweep resumes it: never an output, whether it
+    // exists yet or not.
+    for &(what_in, input) in inputs {
+        if input.as_os_str() == "-" || is_char_device(input) {
+            continue;
+        }
+        let partial = crate::io::atomic::partial_path(input);
+        let partial_id = file_id(&partial);
+        for (what_out, out, oid) in &outs {
+            let same = match (&partial_id, oid) {
+                (Some(x), Some(y)) => x == y,
+                _ => spelled(out).is_some() && spelled(out) == spelled(&partial),
+            };
+            if same {
+                return Err(refused(
+                    what_out,
+                    out,
+                    format!(
+                        "is the .partial of {what_in} {}, where an unfinished sweep keeps its rows: choose another output",
+                        input.display()
+                    ),
+                ));
+            }
+        }
+    }
     // Two outputs that name one file (an existing one by identity, a new one by its
     // absolute spelling).
-    let spelled = |p: &Path| {
-        let dir = p
-            .parent()
-            .filter(|d| !d.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        std::fs::canonicalize(dir)
-            .ok()
-            .map(|d| d.join(p.file_name().unwrap_or_default()))
-    };
     for (i, (wa, a, ia)) in outs.iter().enumerate() {
         for (wb, b, ib) in &outs[i + 1..] {
             let same = match (ia, ib) {

@@ -22,11 +22,49 @@ use std::sync::Arc;
 /// directory, i.e. the repository root beside `shared/`).
 pub const DEFAULT_RECORDS_DIR: &str = "../shared/records";
 
-/// Where `file = ...` records are looked up.
+/// Where `file = ...` records are looked up from the working directory: `POUND_RECORDS_DIR`,
+/// else [`DEFAULT_RECORDS_DIR`].
 pub fn records_dir() -> PathBuf {
     std::env::var_os("POUND_RECORDS_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(DEFAULT_RECORDS_DIR))
+}
+
+/// Where `file = ...` records of a config in folder `base` are looked up: `POUND_RECORDS_DIR`
+/// if set; else [`DEFAULT_RECORDS_DIR`] from the working directory where that folder exists;
+/// else the first `shared/records` beside the config's folder or a folder above it (so a
+/// command run from elsewhere finds the records of a config in a checkout beside `shared/`).
+pub fn records_dir_for(base: &Path) -> PathBuf {
+    let default = records_dir();
+    if std::env::var_os("POUND_RECORDS_DIR").is_some() || default.is_dir() {
+        return default;
+    }
+    let from = std::fs::canonicalize(if base.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        base
+    });
+    from.ok()
+        .and_then(|b| {
+            b.ancestors()
+                .map(|a| a.join("shared").join("records"))
+                .find(|d| d.is_dir())
+        })
+        .unwrap_or(default)
+}
+
+/// Why a `file = ` record is not found: where it was looked for and how to point elsewhere.
+fn missing_record(name: &str, looked: &Path) -> String {
+    let how = match std::env::var_os("POUND_RECORDS_DIR") {
+        Some(_) => "POUND_RECORDS_DIR is set to that folder".to_string(),
+        None => format!(
+            "POUND_RECORDS_DIR is unset, so {DEFAULT_RECORDS_DIR} from the working directory and shared/records beside the config's folders were tried"
+        ),
+    };
+    format!(
+        "file = \"{name}\": no such record in {} ({how}); set POUND_RECORDS_DIR to the folder that holds it, or give path = \"...\" (relative to the config) instead",
+        looked.display()
+    )
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -380,9 +418,14 @@ pub fn load_with_text(path: &Path) -> Result<(Plan, String), ConfigError> {
 
 /// The text of a config file, read once (it may be a pipe: `pound sweep <(make-config)`).
 pub fn read_text(path: &Path) -> Result<String, ConfigError> {
-    std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| ConfigError::Io {
         path: path.into(),
         error,
+    })?;
+    // A UTF-8 byte-order mark (Windows editors write one) is not TOML.
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
     })
 }
 
@@ -390,7 +433,7 @@ pub fn read_text(path: &Path) -> Result<String, ConfigError> {
 /// [`records_dir`]).
 pub fn load_text(text: &str, path: &Path) -> Result<Plan, ConfigError> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    parse(text, path, &base, &records_dir())
+    parse(text, path, &base, &records_dir_for(&base))
 }
 
 /// The record files config `text` (read from `path`) reads, `file =` and `path =` records
@@ -405,7 +448,7 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
         },
     };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let records = records_dir();
+    let records = records_dir_for(&base);
     raw_records
         .iter()
         .filter_map(|r| r.file_path(&base, &records))
@@ -418,9 +461,9 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
 pub fn changed_records(text: &str, path: &Path, plan: &Plan) -> Vec<String> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let now = if crate::plan::row::is_row_config(text) {
-        crate::plan::row::parse_row(text, path, &base, &records_dir()).map(|row| row.base)
+        crate::plan::row::parse_row(text, path, &base, &records_dir_for(&base)).map(|row| row.base)
     } else {
-        parse(text, path, &base, &records_dir())
+        parse(text, path, &base, &records_dir_for(&base))
     };
     match now {
         Err(e) => vec![format!("the records can no longer be read ({e})")],
@@ -438,7 +481,7 @@ pub fn changed_records(text: &str, path: &Path, plan: &Plan) -> Vec<String> {
 /// Validate the row config `text` read from `path` ([`crate::plan::row`]).
 pub fn load_row_text(text: &str, path: &Path) -> Result<crate::plan::row::RowPlan, ConfigError> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    crate::plan::row::parse_row(text, path, &base, &records_dir())
+    crate::plan::row::parse_row(text, path, &base, &records_dir_for(&base))
 }
 
 /// A plan from config text that names no record file (synthetic records only), `name` standing
@@ -499,12 +542,7 @@ pub(crate) fn parse_raw(
                 .run
                 .tol
                 .unwrap_or(crate::physics::solver::reference::DEFAULT_TOL);
-            if !(tol > 1e-13 && tol < 1e-2) {
-                return Err(invalid(
-                    "run.tol",
-                    format!("{tol}: expected 1e-13 < tol < 1e-2"),
-                ));
-            }
+            let tol = crate::plan::limits::check_tol(tol).map_err(|m| invalid("run.tol", m))?;
             Scheme::Reference(ReferenceOptions::with_tol(tol))
         }
         other => {
@@ -844,6 +882,11 @@ fn load_record(r: &RawRecord, base: &Path, records: &Path) -> Result<Record, Loa
         let file = r
             .file_path(base, records)
             .expect("one source checked above");
+        if let Some(name) = &r.file {
+            if !file.exists() {
+                return Err(LoadError::Invalid(missing_record(name, records)));
+            }
+        }
         let format = match &r.format {
             Some(f) => Format::parse(f).ok_or_else(|| {
                 LoadError::Invalid(format!("format `{f}`: expected {}", Format::KEYS))

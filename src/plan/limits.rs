@@ -32,6 +32,20 @@ pub const MAX_SUBSTEPS_PER_CONTACT: f64 = 4096.0;
 pub const WHY_SUBSTEPS: &str =
     "the peak-force error falls ~16x per doubling and reaches f64 round-off well before 4,096 (pound accuracy)";
 
+/// The reference scheme's stated relative accuracy (`run.tol`, `pound accuracy --tol`): an
+/// open interval. Below 1e-13 the local error test asks for less than f64 round-off.
+pub const TOL_RANGE: (f64, f64) = (1e-13, 1e-2);
+
+/// `tol` checked against [`TOL_RANGE`]: the message names what was expected.
+pub fn check_tol(tol: f64) -> Result<f64, String> {
+    let (lo, hi) = TOL_RANGE;
+    if tol > lo && tol < hi {
+        Ok(tol)
+    } else {
+        Err(format!("{}: expected {lo:e} < tol < {hi:e}", show(tol)))
+    }
+}
+
 /// Samples of `[sample]` (`sample.n`).
 pub const MAX_SAMPLES: usize = 10_000_000;
 pub const WHY_SAMPLES: &str = "every sample is held in memory and crossed with the whole grid";
@@ -68,3 +82,14 @@ pub fn above_height(rows: &[(crate::plan::RunSpec, crate::physics::model::RunOut
 
 /// The runs of a grid axis or range (`{ from, to, n }`).
 pub const MAX_AXIS_POINTS: usize = 10_000_000;
+
+/// A number as a message shows it: as typed for ordinary magnitudes, in exponent form beyond
+/// (`1e300`, not three hundred digits).
+pub fn show(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}

@@ -352,7 +352,10 @@ pub(crate) fn check_axis(
         if !ok(v) {
             return Err(err(
                 format!("{key}[{i}]"),
-                format!("{v} is out of range: expected {expected}"),
+                format!(
+                    "{} is out of range: expected {expected}",
+                    crate::plan::limits::show(v)
+                ),
             ));
         }
     }
@@ -409,13 +412,19 @@ impl Plan {
                 Intensity::PgaG(g) if !pos(g) => {
                     return Err(err(
                         format!("intensity.pga_g[{i}]"),
-                        format!("{g} is out of range: expected a PGA > 0 g"),
+                        format!(
+                            "{} is out of range: expected a PGA > 0 g",
+                            crate::plan::limits::show(g)
+                        ),
                     ))
                 }
                 Intensity::Scale(s) if !pos(s) => {
                     return Err(err(
                         format!("intensity.scale[{i}]"),
-                        format!("{s} is out of range: expected a factor > 0"),
+                        format!(
+                            "{} is out of range: expected a factor > 0",
+                            crate::plan::limits::show(s)
+                        ),
                     ))
                 }
                 _ => {}
@@ -427,7 +436,7 @@ impl Plan {
                 "run.tail_s",
                 format!(
                     "{} is out of range: expected 0 to {} s ({})",
-                    spec.tail,
+                    crate::plan::limits::show(spec.tail),
                     crate::plan::limits::MAX_TAIL_S,
                     crate::plan::limits::WHY_TAIL
                 ),

@@ -186,9 +186,15 @@ pub struct RowPlan {
     pub samples: Option<RowSamples>,
     /// Which gaps `contact.gap_m` gives (the others are given per building).
     shared_gap: Vec<bool>,
+    /// Per adjacent pair, the gap axis it reads: its own, or for every pair that
+    /// `contact.gap_m` gives, the first such pair's. `contact.gap_m` is one gap shared by those
+    /// pairs, in the grid as under `[sample]`; `gap_right_m` gives a pair an axis of its own.
+    gap_axis: Vec<usize>,
     /// Sizes of the axes below a base run: the samples, then mass, period, damping per
     /// building, then the gaps.
     dims: Vec<usize>,
+    /// Keys the config gives that no run uses, with why.
+    ignored: Vec<String>,
     per_base: u64,
 }
 
@@ -241,7 +247,7 @@ impl RowPlan {
                 .map(|b| self.buildings[b].damping[at[3 + 3 * b]])
                 .collect(),
             gaps: (0..nb - 1)
-                .map(|a| self.gaps[a][at[1 + 3 * nb + a]])
+                .map(|a| self.gaps[a][at[1 + 3 * nb + self.gap_axis[a]]])
                 .collect(),
             sample: None,
         };
@@ -325,6 +331,116 @@ impl RowPlan {
             cost += part as u128 * record_cost[self.base.run(whole).record] as u128;
         }
         cost
+    }
+
+    /// What a user should hear before any run: the base plan's warnings (PGA above 5 g), each
+    /// adjacent pair that shares no floor level, and keys the config gives that no run uses.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut w = self.base.warnings();
+        w.extend(self.pairs_without_levels());
+        w.extend(self.ignored.iter().cloned());
+        w
+    }
+
+    /// Each adjacent pair with no floor at a common elevation, and why: they never touch floor
+    /// to floor (mid-column pounding is not modelled), so no run checks them for contact.
+    /// Heights are not swept, so this holds for every run of the plan.
+    pub fn pairs_without_levels(&self) -> Vec<String> {
+        let elevations = |a: &ShearAxes| -> Vec<String> {
+            let mut z = 0.0;
+            a.heights
+                .iter()
+                .map(|h| {
+                    z += h;
+                    format!("{z}")
+                })
+                .collect()
+        };
+        let row = self.row(&self.run(0));
+        (0..self.buildings.len() - 1)
+            .filter(|&a| !row.levels.iter().any(|l| l.left == a))
+            .map(|a| {
+                format!(
+                    "buildings {} and {} share no floor level (floors at {} m against {} m; levels meet within {} m): floors at different heights are not modelled as touching (mid-column pounding), so this pair is never checked for contact and has no level columns",
+                    a + 1,
+                    a + 2,
+                    elevations(&self.buildings[a]).join(", "),
+                    elevations(&self.buildings[a + 1]).join(", "),
+                    crate::physics::row::LEVEL_TOLERANCE_M
+                )
+            })
+            .collect()
+    }
+
+    /// RK4 substeps per record step in contact above which a sweep says, before it starts,
+    /// that its runs are costly (typical scenes take tens to a few hundred).
+    pub const COSTLY_SUBSTEPS: f64 = 20_000.0;
+
+    /// A notice when a run of this plan may take extreme work: contact substeps resolve the
+    /// fastest mode of the buildings in contact (`h = 2 pi / (substeps_per_contact (w + 2 xi
+    /// w)_max)`), so a record step in contact costs `dt substeps_per_contact rate / 2 pi`
+    /// substeps, which grows as 1 / T. Estimated per building at its shortest swept period.
+    pub fn cost_warning(&self, substeps_per_contact: f64) -> Option<String> {
+        if self.is_empty() {
+            return None;
+        }
+        let dt = self
+            .base
+            .spec
+            .records
+            .iter()
+            .map(|r| r.dt)
+            .fold(0.0, f64::max);
+        let mut run = self.run(0);
+        let mut worst: Option<(usize, f64, f64)> = None;
+        for (b, axes) in self.buildings.iter().enumerate() {
+            let mut shortest = axes.period.iter().cloned().fold(f64::INFINITY, f64::min);
+            if let Some(smp) = &self.samples {
+                for (j, a) in smp.axes.iter().enumerate() {
+                    if *a == RowSampled::Period(b) {
+                        shortest = smp.points.iter().map(|p| p[j]).fold(shortest, f64::min);
+                    }
+                }
+            }
+            run.period[b] = shortest;
+            let modes = self.row(&run).buildings[b].modes();
+            let rate = modes
+                .omega
+                .iter()
+                .zip(&modes.xi)
+                .map(|(w, xi)| w * (1.0 + 2.0 * xi.abs()))
+                .fold(0.0, f64::max);
+            let per_step = dt * substeps_per_contact * rate / (2.0 * std::f64::consts::PI);
+            if worst.is_none_or(|(_, _, x)| per_step > x) {
+                worst = Some((b, shortest, per_step));
+            }
+        }
+        let (b, period, per_step) = worst?;
+        (per_step > Self::COSTLY_SUBSTEPS).then(|| {
+            format!(
+                "building {} at period_s = {period} s: its fastest mode makes every record step in contact take about {per_step:.0} RK4 substeps (dt {dt} s x substeps_per_contact {substeps_per_contact} x its rate / 2 pi; typical scenes take tens to hundreds): runs may take minutes each",
+                b + 1
+            )
+        })
+    }
+
+    /// Runs among `rows` in which a building's peak roof displacement exceeds its height (the
+    /// sum of its storey heights): physically absurd, as for pairs
+    /// ([`crate::plan::limits::above_height`]).
+    pub fn above_height(&self, rows: &[(RowRunSpec, RowOutput)]) -> u64 {
+        let heights: Vec<f64> = self
+            .buildings
+            .iter()
+            .map(|b| b.heights.iter().sum())
+            .collect();
+        rows.iter()
+            .filter(|(_, o)| {
+                o.buildings
+                    .iter()
+                    .zip(&heights)
+                    .any(|(b, h)| b.peak_roof > *h)
+            })
+            .count() as u64
     }
 
     /// The scene of `run`.
@@ -618,7 +734,10 @@ pub fn parse_row(
         match v.iter().position(|x| !positive(*x)) {
             Some(i) => Err(invalid(
                 &format!("{key}[{i}]"),
-                format!("{} is out of range: expected a value > 0", v[i]),
+                format!(
+                    "{} is out of range: expected a value > 0",
+                    crate::plan::limits::show(v[i])
+                ),
             )),
             None => Ok(v.to_vec()),
         }
@@ -713,6 +832,10 @@ pub fn parse_row(
         }
     }
     shared.truncate(nb - 1);
+    let mut ignored = Vec::new();
+    if raw.contact.gap_m.is_some() && !shared.contains(&true) {
+        ignored.push("contact.gap_m is ignored: every pair has its own gap_right_m".to_string());
+    }
     if sampled(RowSampled::SharedGap) && !shared.contains(&true) {
         return Err(invalid(
             "contact.gap_m",
@@ -726,7 +849,19 @@ pub fn parse_row(
             .iter()
             .flat_map(|a| [a.mass.len(), a.period.len(), a.damping.len()]),
     );
-    dims.extend(gaps.iter().map(Vec::len));
+    // `contact.gap_m` is one axis: the first pair it gives carries it, the others read it.
+    let first_shared = shared.iter().position(|&s| s);
+    let gap_axis: Vec<usize> = (0..nb - 1)
+        .map(|a| match first_shared {
+            Some(f) if shared[a] => f,
+            _ => a,
+        })
+        .collect();
+    dims.extend(
+        gaps.iter()
+            .enumerate()
+            .map(|(a, g)| if gap_axis[a] == a { g.len() } else { 1 }),
+    );
     let per_base = dims
         .iter()
         .try_fold(1u64, |p, &d| p.checked_mul(d as u64))
@@ -749,7 +884,9 @@ pub fn parse_row(
         gaps,
         samples,
         shared_gap: shared,
+        gap_axis,
         dims,
+        ignored,
         per_base,
     })
 }

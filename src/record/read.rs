@@ -33,6 +33,15 @@ impl Units {
     }
 
     pub const KEYS: &'static str = "g, m/s2 or cm/s2";
+
+    /// The key that names these units in a config (`units =`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Units::G => "g",
+            Units::MPerS2 => "m/s2",
+            Units::CmPerS2 => "cm/s2",
+        }
+    }
 }
 
 /// File layout.
@@ -126,6 +135,8 @@ pub fn parse_record(
     name: String,
     opts: &ReadOptions,
 ) -> Result<Record, RecordError> {
+    // A UTF-8 byte-order mark (Windows editors write one) is not part of the first line.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     // Split on LF and drop every trailing CR, so CR LF and CR CR LF both end up clean; numbering
     // follows the LF lines a text editor shows.
     let lines: Vec<(usize, &str)> = text
@@ -169,6 +180,17 @@ pub fn parse_record(
             values.len()
         )));
     }
+    // Units the header states are the file's own: a contradicting `units` is refused, as a
+    // contradicting `dt` is (a units slip scales every run by 9.81, 100 or 981).
+    if let (Some(given), Some(stated)) = (opts.units, header_units) {
+        if given != stated {
+            return Err(ctx.invalid(format!(
+                "the file's header says its values are in {} but units = {} was given (leave units out to use the header's)",
+                stated.key(),
+                given.key()
+            )));
+        }
+    }
     let units = opts.units.or(header_units).unwrap_or(Units::G);
     let f = units.to_si();
     Ok(Record {
@@ -203,7 +225,7 @@ fn detect(lines: &[(usize, &str)]) -> Format {
     if lines
         .iter()
         .take(12)
-        .any(|(_, l)| find_npts_dt(l).is_some())
+        .any(|(_, l)| npts_dt_numbers(l).is_some())
     {
         return Format::At2;
     }
@@ -273,6 +295,16 @@ fn is_comment(line: &str) -> bool {
 /// Find NPTS and DT on a header line: `NPTS=  5372, DT= .0100 SEC`, `NPTS = 7500 , DT = .020`,
 /// or `4000    0.0100    NPTS, DT` (numbers first).
 fn find_npts_dt(line: &str) -> Option<(usize, f64)> {
+    let (npts, dt) = npts_dt_numbers(line)?;
+    if npts >= 1.0 && npts.fract() == 0.0 && dt > 0.0 && dt.is_finite() {
+        Some((npts as usize, dt))
+    } else {
+        None
+    }
+}
+
+/// The NPTS and DT numbers of a header line as written, valid or not (`NPTS= 0`, `DT= .0000`).
+fn npts_dt_numbers(line: &str) -> Option<(f64, f64)> {
     let up = line.to_ascii_uppercase();
     if !up.contains("NPTS") || !up.contains("DT") {
         return None;
@@ -292,14 +324,36 @@ fn find_npts_dt(line: &str) -> Option<(usize, f64)> {
         let j = toks.iter().position(|t| *t == "DT")?;
         (first_num(i + 1)?, first_num(j + 1)?)
     };
-    if npts >= 1.0 && npts.fract() == 0.0 && dt > 0.0 && dt.is_finite() {
-        Some((npts as usize, dt))
-    } else {
-        None
-    }
+    Some((npts, dt))
 }
 
 type Parsed = (f64, f64, Vec<f64>, Option<Units>);
+
+/// The units a header states, if it states any: `CM/S`, `CM/SEC`, `CM/S2` or `GAL` words are
+/// cm/s2, `M/S...` words m/s2, a word `G` (`UNITS OF G`, `(g)`) g. None where it says nothing.
+fn stated_units<'a>(header: impl Iterator<Item = &'a str>) -> Option<Units> {
+    let mut found = None;
+    for line in header {
+        let up = line.to_ascii_uppercase();
+        for w in up
+            .split(|c: char| !(c.is_ascii_alphanumeric() || c == '/' || c == '^'))
+            .filter(|w| !w.is_empty())
+        {
+            let u = if w.starts_with("CM/S") || w == "GAL" || w == "GALS" {
+                Units::CmPerS2
+            } else if w.starts_with("M/S") {
+                Units::MPerS2
+            } else if w == "G" {
+                Units::G
+            } else {
+                continue;
+            };
+            // The first statement counts (a later `G` can be a station's name).
+            found.get_or_insert(u);
+        }
+    }
+    found
+}
 
 fn parse_at2(lines: &[(usize, &str)], ctx: &Ctx) -> Result<Parsed, RecordError> {
     let Some(hdr) = lines
@@ -307,24 +361,24 @@ fn parse_at2(lines: &[(usize, &str)], ctx: &Ctx) -> Result<Parsed, RecordError> 
         .take(12)
         .position(|(_, l)| find_npts_dt(l).is_some())
     else {
+        // A header with NPTS and DT whose values cannot be a record's.
+        if let Some((n, (npts, dt))) = lines
+            .iter()
+            .take(12)
+            .find_map(|(n, l)| npts_dt_numbers(l).map(|v| (*n, v)))
+        {
+            return Err(ctx.parse(
+                n,
+                format!("the header gives NPTS = {npts} and DT = {dt}: expected a whole number of points >= 1 and a sample interval > 0 s"),
+            ));
+        }
         let last = lines
             .get(lines.len().min(12).saturating_sub(1))
             .map_or(1, |(n, _)| *n);
         return Err(ctx.parse(last, "expected a PEER AT2 header line with NPTS and DT in the first 12 lines (e.g. `NPTS=  5372, DT= .0100 SEC`)".into()));
     };
     let (npts, dt) = find_npts_dt(lines[hdr].1).expect("checked above");
-    let header: String = lines[..hdr]
-        .iter()
-        .map(|(_, l)| l.to_ascii_uppercase())
-        .collect::<Vec<_>>()
-        .join(" ");
-    let units = if header.contains("CM/S") || header.contains("CM/SEC") || header.contains("GAL") {
-        Some(Units::CmPerS2)
-    } else if header.contains("M/S") {
-        Some(Units::MPerS2)
-    } else {
-        Some(Units::G)
-    };
+    let units = stated_units(lines[..hdr].iter().map(|(_, l)| *l));
     // The header is not trusted with the allocation: NPTS = 1e18 would abort the process.
     let mut values = Vec::with_capacity(npts.min(1 << 20));
     let mut last_line = lines[hdr].0;
@@ -388,6 +442,14 @@ fn parse_values(lines: &[(usize, &str)], ctx: &Ctx) -> Result<Vec<f64>, RecordEr
     Ok(values)
 }
 
+/// A line before the data of a two-column file shaped like a data row (two tokens, at least one
+/// a number): a row with a typo, not header text.
+fn looks_like_a_row(line: &str) -> bool {
+    let toks: Vec<&str> = tokens(line).collect();
+    let numeric = toks.iter().filter(|t| parse_fortran(t).is_some()).count();
+    toks.len() == 2 && numeric >= 1
+}
+
 fn parse_two_column(lines: &[(usize, &str)], ctx: &Ctx) -> Result<Parsed, RecordError> {
     let mut times = Vec::new();
     let mut values = Vec::new();
@@ -402,8 +464,18 @@ fn parse_two_column(lines: &[(usize, &str)], ctx: &Ctx) -> Result<Parsed, Record
                 values.push(r[1]);
                 rows.push(n);
             }
-            // Free text before the numeric rows is a header.
-            _ if times.is_empty() => continue,
+            // Free text before the numeric rows is a header; a line that holds numbers is not
+            // (a row with a typo would silently shorten the record and shift its PGA).
+            None if times.is_empty() && !looks_like_a_row(l) => continue,
+            _ if times.is_empty() => {
+                return Err(ctx.parse(
+                    n,
+                    format!(
+                        "expected a header line of text or a row of 2 numbers (time, acceleration), found `{}`: a header holds no numbers (skip header lines with skip_lines / --skip-lines)",
+                        l.trim()
+                    ),
+                ))
+            }
             Some(r) => {
                 return Err(ctx.parse(
                     n,
@@ -477,5 +549,16 @@ mod tests {
             Some((1991, 0.01))
         );
         assert_eq!(find_npts_dt("ACCELERATION TIME SERIES IN UNITS OF G"), None);
+    }
+
+    #[test]
+    fn header_units() {
+        let u = |l: &str| stated_units(std::iter::once(l));
+        assert_eq!(u("ACCELERATION TIME SERIES IN UNITS OF G"), Some(Units::G));
+        assert_eq!(u("The units are (g)"), Some(Units::G));
+        assert_eq!(u("ACCELERATION IN CM/SEC/SEC"), Some(Units::CmPerS2));
+        assert_eq!(u("units: gal"), Some(Units::CmPerS2));
+        assert_eq!(u("ACCELERATION IN M/S^2"), Some(Units::MPerS2));
+        assert_eq!(u("IMPERIAL VALLEY 5/19/40 0439, EL CENTRO ARRAY #9"), None);
     }
 }

@@ -22,7 +22,8 @@ pub struct Point {
 }
 
 /// Relative errors against the reference over the runs both end `ok` with equal impact counts
-/// (medians and 99th percentiles), and the fraction of runs whose impact count differs.
+/// (medians and 99th percentiles; NaN where no run was compared: a statistic over zero runs is
+/// no figure), and the fraction of runs whose impact count differs.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Errors {
     pub force_median: f64,
@@ -32,7 +33,12 @@ pub struct Errors {
     pub energy_median: f64,
     pub energy_p99: f64,
     pub impact_count_differs: f64,
+    /// Runs that failed (`status` not `ok`) on this path or in the reference: evidence against
+    /// any accuracy claim, never left out silently.
     pub failed: u64,
+    /// Runs that pounded and were compared (both `ok`, equal impact counts): the peak-force
+    /// statistics are over these.
+    pub compared: u64,
     /// `|energy residual|` over the runs that end `ok` (`model::EnergyBalance`).
     pub residual_median: f64,
     pub residual_p99: f64,
@@ -42,9 +48,10 @@ fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)
 }
 
+/// The `p` quantile of `v`; NaN for no values (statistics over zero runs are not zeros).
 fn quantile(v: &mut [f64], p: f64) -> f64 {
     if v.is_empty() {
-        return 0.0;
+        return f64::NAN;
     }
     v.sort_by(f64::total_cmp);
     v[((v.len() - 1) as f64 * p).round() as usize]
@@ -77,6 +84,7 @@ pub fn errors(truth: &[RunOutput], out: &[RunOutput]) -> Errors {
         }
     }
     Errors {
+        compared: f.len() as u64,
         force_median: quantile(&mut f, 0.5),
         force_p99: quantile(&mut f, 0.99),
         displacement_median: quantile(&mut u, 0.5),
@@ -182,7 +190,7 @@ impl Errors {
 pub fn csv(points: &[Point]) -> String {
     let mut s = String::from("path,substeps_per_contact,runs_per_second,force_median,force_p99,displacement_median,displacement_p99,energy_median,energy_p99,residual_median,residual_p99,impact_count_differs,failed\n");
     for p in points {
-        let q = p.errors.quantiles().map(|x| format!("{x:e}"));
+        let q = p.errors.quantiles().map(|x| cell(x, |x| format!("{x:e}")));
         s.push_str(&format!(
             "{},{},{:.1},{},{},{}\n",
             p.path,
@@ -236,13 +244,13 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
 }
 
 /// A markdown table header for [`markdown_row`].
-pub const MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | peak force median / p99 | peak u median / p99 | energy median / p99 | energy residual median / p99 | impact counts differ |\n|---|---:|---:|---|---|---|---|---:|";
+pub const MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | peak force median / p99 | peak u median / p99 | energy median / p99 | energy residual median / p99 | impact counts differ | failed |\n|---|---:|---:|---|---|---|---|---:|---:|";
 
 /// One point as a markdown table row.
 pub fn markdown_row(p: &Point) -> String {
-    let q = p.errors.quantiles().map(|x| format!("{x:.1e}"));
+    let q = p.errors.quantiles().map(figure);
     format!(
-        "| {} | {} | {:.0} | {} | {:.2} % |",
+        "| {} | {} | {:.0} | {} | {:.2} % | {} |",
         p.path,
         if p.substeps_per_contact.is_nan() {
             "-".to_string()
@@ -253,8 +261,27 @@ pub fn markdown_row(p: &Point) -> String {
         [&q[0..2], &q[2..4], &q[4..6], &q[6..8]]
             .map(|pair| pair.join(" / "))
             .join(" | "),
-        100.0 * p.errors.impact_count_differs
+        100.0 * p.errors.impact_count_differs,
+        p.errors.failed
     )
+}
+
+/// A statistic for a CSV cell: empty where it is over no runs (NaN).
+fn cell(x: f64, show: impl Fn(f64) -> String) -> String {
+    if x.is_nan() {
+        String::new()
+    } else {
+        show(x)
+    }
+}
+
+/// A statistic for a table: `-` where it is over no runs (NaN).
+fn figure(x: f64) -> String {
+    if x.is_nan() {
+        "-".into()
+    } else {
+        format!("{x:.1e}")
+    }
 }
 
 /// A row sweep's outputs at one setting (the multi-storey work-precision table).
@@ -272,7 +299,10 @@ pub struct RowPoint {
     pub drift: [f64; 2],
     pub accel: [f64; 2],
     pub impact_count_differs: f64,
+    /// Runs that failed on this path or in the reference.
     pub failed: u64,
+    /// Runs that pounded and were compared (the peak-force statistics are over these).
+    pub compared: u64,
     /// |energy residual|, median and p99, over the runs that end `ok`.
     pub residual: [f64; 2],
     /// Over the runs whose impact count differs from the reference's (left out of the errors
@@ -318,7 +348,7 @@ pub fn row_markdown(p: &RowPoint) -> String {
             0 | 11 | 14 => format!("{x}"),
             1 => format!("{x:.0}"),
             10 => format!("{:.2} %", 100.0 * x),
-            _ => format!("{x:.1e}"),
+            _ => figure(*x),
         })
         .collect();
     format!("| {} | {} |", p.path, cells.join(" | "))
@@ -357,18 +387,18 @@ pub fn row_study(
         let (mut differ, mut failed) = (0usize, 0u64);
         let (mut gap_max, mut differing_force) = (0u32, 0.0f64);
         for (t, o) in truth.iter().zip(out) {
-            if o.status != Status::Ok {
+            if o.status == Status::Ok {
+                r.extend(o.energy.map(|e| e.residual.abs()));
+            }
+            if o.status != Status::Ok || t.status != Status::Ok {
                 failed += 1;
                 continue;
             }
-            r.extend(o.energy.map(|e| e.residual.abs()));
-            if t.status != Status::Ok || t.impacts != o.impacts {
-                if t.status == Status::Ok {
-                    differ += 1;
-                    gap_max = gap_max.max(t.impacts.abs_diff(o.impacts));
-                    if t.impacts > 0 && o.impacts > 0 {
-                        differing_force = differing_force.max(rel(o.peak_force, t.peak_force));
-                    }
+            if t.impacts != o.impacts {
+                differ += 1;
+                gap_max = gap_max.max(t.impacts.abs_diff(o.impacts));
+                if t.impacts > 0 && o.impacts > 0 {
+                    differing_force = differing_force.max(rel(o.peak_force, t.peak_force));
                 }
                 continue;
             }
@@ -381,6 +411,7 @@ pub fn row_study(
                 a.push(rel(bo.peak_accel, bt.peak_accel));
             }
         }
+        let compared = f.len() as u64;
         RowPoint {
             path: path.into(),
             substeps_per_contact: setting,
@@ -391,6 +422,7 @@ pub fn row_study(
             accel: med_p99(a),
             impact_count_differs: differ as f64 / truth.len().max(1) as f64,
             failed,
+            compared,
             residual: med_p99(r),
             count_gap_max: gap_max,
             differing_force_max: differing_force,
@@ -449,7 +481,11 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
 pub fn row_csv(points: &[RowPoint]) -> String {
     let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99,count_gap_max,differing_force_max\n");
     for p in points {
-        let cells: Vec<String> = p.numbers().iter().map(f64::to_string).collect();
+        let cells: Vec<String> = p
+            .numbers()
+            .iter()
+            .map(|x| cell(*x, |x| x.to_string()))
+            .collect();
         s.push_str(&format!("{},{}\n", p.path, cells.join(",")));
     }
     s

@@ -22,26 +22,41 @@ const RECORD: &str = r#"[[record]]
 synthetic = { seed = 1, duration_s = 20.0, dt_s = 0.01, pga_g = 0.35 }
 "#;
 
-/// A sweep of about `n` runs (periods of both buildings x 10 gaps).
+/// An axis of `n` values from `from` to `to` as config text: a range needs two or more
+/// values, so one value is written as a number (`from`).
+fn axis(from: f64, to: f64, n: u64) -> String {
+    if n > 1 {
+        format!("{{ from = {from}, to = {to}, n = {n} }}")
+    } else {
+        format!("{from}")
+    }
+}
+
+/// A sweep of about `n` runs (periods of both buildings x up to 10 gaps). Every `n` from 1 to
+/// [`crate::plan::limits::MAX_BENCH_RUNS`] gives a valid config (test `every_bounded_size_plans`).
 pub fn config(n: u64) -> String {
-    let per = (n as f64 / 10.0).max(1.0);
+    let gaps = n.clamp(1, 10);
+    let per = (n as f64 / gaps as f64).max(1.0);
     let a = per.sqrt().ceil().max(1.0) as u64;
     let b = (per / a as f64).ceil().max(1.0) as u64;
     format!(
         r#"[building1]
 mass_kg = 1.0e5
-period_s = {{ from = 0.2, to = 2.0, n = {a} }}
+period_s = {}
 damping_ratio = 0.05
 
 [building2]
 mass_kg = 1.0e5
-period_s = {{ from = 0.15, to = 1.5, n = {b} }}
+period_s = {}
 damping_ratio = 0.05
 
 {CONTACT}
-gap_m = {{ from = 0.0, to = 0.05, n = 10 }}
+gap_m = {}
 
-{RECORD}"#
+{RECORD}"#,
+        axis(0.2, 2.0, a),
+        axis(0.15, 1.5, b),
+        axis(0.0, 0.05, gaps)
     )
 }
 
@@ -238,16 +253,23 @@ pub fn table(rows: &[Row]) -> String {
 
 /// The multi-storey suite's sweep: two `storeys`-storey shear buildings (3 m storeys, 3e5 kg
 /// floors, uniform stiffness, Rayleigh 5 %), the left one's period swept, 10 gaps from 0 to
-/// 45 mm, the bench's record and contact: about `n` runs.
+/// 45 mm, the bench's record and contact: about `n` runs. Past 10,000 periods (an axis holds
+/// at most [`crate::plan::limits::MAX_AXIS_POINTS`]) the right one's period is swept too.
 pub fn row_config(storeys: usize, n: u64) -> String {
-    let periods = (n as f64 / 10.0).ceil().max(1.0) as u64;
+    let gaps = n.clamp(1, 10);
+    let mut periods = (n as f64 / gaps as f64).ceil().max(1.0) as u64;
+    let mut right = 1;
+    if periods > 10_000 {
+        right = (periods as f64 / 10_000.0).ceil() as u64;
+        periods = (periods as f64 / right as f64).ceil() as u64;
+    }
     let t = 0.1 * storeys as f64;
     format!(
         r#"[[building]]
 storeys = {storeys}
 storey_height_m = 3.0
 mass_kg = 3.0e5
-period_s = {{ from = {a}, to = {b}, n = {periods} }}
+period_s = {l}
 damping_ratio = 0.05
 
 [[building]]
@@ -258,12 +280,12 @@ period_s = {c}
 damping_ratio = 0.05
 
 {CONTACT}
-gap_m = {{ from = 0.0, to = 0.045, n = 10 }}
+gap_m = {g}
 
 {RECORD}"#,
-        a = t + 0.05,
-        b = if periods > 1 { 2.0 * t + 0.1 } else { t + 0.05 },
-        c = 1.5 * t + 0.1,
+        l = axis(t + 0.05, 2.0 * t + 0.1, periods),
+        c = axis(1.5 * t + 0.1, 2.5 * t + 0.1, right),
+        g = axis(0.0, 0.045, gaps),
     )
 }
 
@@ -378,4 +400,40 @@ pub fn storey_table(rows: &[StoreyRow]) -> String {
         ));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::limits::MAX_BENCH_RUNS;
+
+    /// `pound bench --sizes N` and `--storey-runs N` are served for every N the flags accept:
+    /// each size plans (no panic) with at least N and at most 2 N + 20 runs.
+    #[test]
+    fn every_bounded_size_plans() {
+        let sizes: Vec<u64> = (1..=120)
+            .chain([
+                999,
+                1001,
+                12_345,
+                99_999,
+                1_000_001,
+                123_456_789,
+                MAX_BENCH_RUNS,
+            ])
+            .collect();
+        for &n in &sizes {
+            let runs = plan(n).len();
+            assert!(runs >= n && runs <= 2 * n + 20, "{n}: {runs}");
+        }
+        for storeys in [1, 3, crate::physics::shear::MAX_STOREYS] {
+            for &n in &sizes {
+                let runs = row_plan(storeys, n).len();
+                assert!(
+                    runs >= n && runs <= 2 * n + 20,
+                    "{storeys} storeys, {n}: {runs}"
+                );
+            }
+        }
+    }
 }

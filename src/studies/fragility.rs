@@ -157,23 +157,68 @@ pub struct FragilitySpec {
     pub filters: Vec<Filter>,
 }
 
-/// Counts per threshold and intensity level, and how many rows were left out (status not
-/// `ok`, or no IM or EDP value).
-pub fn levels(table: &Table, spec: &FragilitySpec) -> Result<(Vec<Vec<Level>>, usize), TableError> {
+/// Rows a fragility count left out, by reason.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LeftOut {
+    /// `status` not `ok`.
+    pub failed: usize,
+    /// An empty IM or EDP cell.
+    pub empty: usize,
+    /// A NaN or infinite IM or EDP: neither exceeding nor not.
+    pub non_finite: usize,
+}
+
+impl LeftOut {
+    pub fn total(&self) -> usize {
+        self.failed + self.empty + self.non_finite
+    }
+}
+
+impl std::fmt::Display for LeftOut {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let parts: Vec<String> = [
+            (self.failed, "status not ok"),
+            (self.empty, "no value"),
+            (self.non_finite, "a value not finite (NaN or infinite)"),
+        ]
+        .iter()
+        .filter(|(n, _)| *n > 0)
+        .map(|(n, why)| format!("{n} {why}"))
+        .collect();
+        write!(f, "{}", parts.join(", "))
+    }
+}
+
+/// Counts per threshold and intensity level, and the rows left out (status not `ok`, no IM or
+/// EDP value, or one that is not finite). Thresholds must be finite.
+pub fn levels(
+    table: &Table,
+    spec: &FragilitySpec,
+) -> Result<(Vec<Vec<Level>>, LeftOut), TableError> {
+    if let Some(t) = spec.thresholds.iter().find(|t| !t.is_finite()) {
+        return Err(TableError::Read {
+            path: table.path.clone(),
+            message: format!("--threshold {t}: expected a finite number (EDP > threshold is never decided by NaN or infinity)"),
+        });
+    }
     let (ci, ce) = (table.col(&spec.im)?, table.col(&spec.edp)?);
     let cs = table.col("status").ok();
     let rows = table.select(&spec.filters)?;
     let mut by_im: BTreeMap<u64, (f64, Vec<f64>)> = BTreeMap::new();
-    let mut skipped = 0;
+    let mut skipped = LeftOut::default();
     for i in rows {
         if cs.is_some_and(|c| table.rows[i][c] != "ok") {
-            skipped += 1;
+            skipped.failed += 1;
             continue;
         }
         let (Some(im), Some(edp)) = (table.num(i, ci)?, table.num(i, ce)?) else {
-            skipped += 1;
+            skipped.empty += 1;
             continue;
         };
+        if !(im.is_finite() && edp.is_finite()) {
+            skipped.non_finite += 1;
+            continue;
+        }
         // Levels keyed by the IM rounded to 12 significant digits (CSV text round-trips exactly,
         // but scaled PGAs computed per record may differ in the last bits).
         let key = format!("{im:.11e}").parse::<f64>().unwrap_or(im);

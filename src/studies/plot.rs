@@ -62,10 +62,13 @@ fn range(v: impl Iterator<Item = f64>) -> (f64, f64) {
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
+    // One value: half of it either side, or a unit either side of 0 (not +-5e-13).
     let pad = if hi > lo {
         0.04 * (hi - lo)
+    } else if lo == 0.0 {
+        1.0
     } else {
-        0.5 * lo.abs().max(1e-12)
+        0.5 * lo.abs()
     };
     (lo - pad, hi + pad)
 }

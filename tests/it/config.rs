@@ -228,7 +228,9 @@ fn bad_configs_name_the_key() {
     ))
     .unwrap_err();
     assert!(
-        e.to_string().contains("no_such_record.AT2: cannot read"),
+        e.to_string()
+            .contains("file = \"no_such_record.AT2\": no such record in")
+            && e.to_string().contains("POUND_RECORDS_DIR"),
         "{e}"
     );
     // TOML syntax errors give the line.

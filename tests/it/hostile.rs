@@ -282,7 +282,7 @@ fn outputs_never_replace_inputs() {
     refused(&sweep(&sc.cfg, sc.dir.path(), &[]), "is a directory", None);
 
     // An unfinished CSV sweep's rows are not taken over by another format or a study's output.
-    let u = sc.path("u.csv");
+    let u = sc.path("u"); // no extension: a name every format and a plot may take
     sc.interrupted(&u, 0.5);
     let held = std::fs::read(sibling(&u, ".partial")).unwrap();
     for extra in [&["--format", "parquet"][..], &["--aggregate", "gap_m"][..]] {
@@ -1094,3 +1094,5 @@ fn scene() -> &'static Scene {
         sc
     })
 }
+
+mod round2;

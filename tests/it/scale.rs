@@ -218,12 +218,19 @@ fn resume_refuses_a_different_sweep() {
     let d = tempdir();
     let cfg = setup(d.path());
     let out = d.path().join("r.csv");
-    // Leave an unfinished output: kill the sweep once its journal holds a chunk (waiting for
-    // it rather than a fixed time, which a loaded machine can outlast before the first chunk).
+    // Leave an unfinished output: kill the sweep once its journal holds a finished run
+    // (waiting for it rather than a fixed time, which a loaded machine can outlast before the
+    // first chunk; a journal of 0 runs blocks nothing).
     let mut child = spawn(&cfg, &out, &["--chunk", "1"]);
     let journal = d.path().join("r.csv.progress.toml");
     let start = std::time::Instant::now();
-    while !journal.exists() && start.elapsed() < Duration::from_secs(30) {
+    let holds_a_run = || {
+        std::fs::read_to_string(&journal).is_ok_and(|t| {
+            t.lines()
+                .any(|l| l.starts_with("done = ") && l != "done = 0")
+        })
+    };
+    while !holds_a_run() && start.elapsed() < Duration::from_secs(30) {
         std::thread::sleep(Duration::from_millis(2));
     }
     child.kill().unwrap();

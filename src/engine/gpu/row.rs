@@ -434,6 +434,32 @@ fn model_blocks(m: &RowModel, dt: f64) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// Units of work per dispatch on a software adapter (unbounded on hardware), or an error when
+/// a row of `shape` cannot run there at all.
+fn software_cap(ctx: &GpuContext, shape: &RowShape) -> Result<u64, GpuError> {
+    let cap = SOFTWARE_LOOP_TRIPS / shape.loop_trips_per_unit();
+    if ctx.is_software() && cap == 0 {
+        return Err(GpuError::Other {
+            message: format!(
+                "a row of {} storeys and {} contact levels is too large for the software adapter's loop limit (use --backend cpu)",
+                shape.modes(),
+                shape.levels.len()
+            ),
+        });
+    }
+    Ok(cap)
+}
+
+/// Can the row kernel run `plan` on `ctx`? Decided from the plan alone, so a sweep refuses
+/// before it makes any file.
+pub fn check_fits(ctx: &GpuContext, plan: &RowPlan) -> Result<(), GpuError> {
+    if plan.is_empty() {
+        return Ok(());
+    }
+    let shape = RowShape::of(&RowModel::new(&plan.row(&plan.run(0))));
+    software_cap(ctx, &shape).map(|_| ())
+}
+
 /// Integrate a chunk of packed rows over their whole records; results in input order, None
 /// for runs handed back to the host (more substeps per record step than `opts` allows the
 /// precision).
@@ -454,17 +480,7 @@ pub fn run_rows(
         });
     }
     let shape = &chunk.shape;
-    let trips = shape.loop_trips_per_unit();
-    let cap = SOFTWARE_LOOP_TRIPS / trips;
-    if ctx.is_software() && cap == 0 {
-        return Err(GpuError::Other {
-            message: format!(
-                "a row of {} storeys and {} contact levels is too large for the software adapter's loop limit",
-                shape.modes(),
-                shape.levels.len()
-            ),
-        });
-    }
+    let cap = software_cap(ctx, shape)?;
     let kernel = ctx.row_kernel(opts.precision, shape)?;
     let t = Instant::now();
     let p = opts.precision;
