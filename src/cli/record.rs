@@ -1,54 +1,210 @@
-//! `pound record info`: what a record file holds.
+//! `pound record info` and `pound record spectrum`: what a record file holds.
 
-use anyhow::{Context, Result};
-use pounding::record::{read_record, Format, ReadOptions, Units, G};
+use anyhow::{bail, Context, Result};
+use pounding::record::intensity;
+use pounding::record::{read_record, Format, ReadOptions, Record, Units, G};
 use std::path::PathBuf;
+
+/// A record file and how to read it.
+#[derive(clap::Args)]
+pub struct FileArgs {
+    file: PathBuf,
+    /// auto, at2, values or two_column.
+    #[arg(long, default_value = "auto")]
+    format: String,
+    /// Sample interval, s (needed for value files without a header).
+    #[arg(long)]
+    dt: Option<f64>,
+    /// g, m/s2 or cm/s2 (default: from the header, else g).
+    #[arg(long)]
+    units: Option<String>,
+    /// Lines to skip before parsing.
+    #[arg(long, default_value_t = 0)]
+    skip_lines: usize,
+}
+
+impl FileArgs {
+    fn read(&self) -> Result<Record> {
+        let format = Format::parse(&self.format)
+            .with_context(|| format!("--format `{}`: expected {}", self.format, Format::KEYS))?;
+        let units = match &self.units {
+            Some(u) => Some(
+                Units::parse(u)
+                    .with_context(|| format!("--units `{u}`: expected {}", Units::KEYS))?,
+            ),
+            None => None,
+        };
+        Ok(read_record(
+            &self.file,
+            &ReadOptions {
+                format,
+                units,
+                dt: self.dt,
+                skip_lines: self.skip_lines,
+            },
+        )?)
+    }
+}
 
 #[derive(clap::Subcommand)]
 pub enum Cmd {
-    /// Print npts, dt, duration and PGA of a record file.
+    /// Print npts, dt, duration, PGA, PGV, PGD and Sa at a few periods of a record file.
     Info {
-        file: PathBuf,
-        /// auto, at2, values or two_column.
-        #[arg(long, default_value = "auto")]
-        format: String,
-        /// Sample interval, s (needed for value files without a header).
+        #[command(flatten)]
+        record: FileArgs,
+    },
+    /// The 5 %-damped pseudo-acceleration response spectrum Sa(T) of a record file (CSV), with
+    /// PGA, PGV and PGD.
+    Spectrum {
+        #[command(flatten)]
+        record: FileArgs,
+        /// Periods, s: FROM:TO:N (N periods evenly spaced in log) or a list a,b,c.
+        #[arg(long, default_value = "0.05:4:100")]
+        periods: String,
+        /// Damping ratio of the oscillators.
+        #[arg(long, default_value_t = intensity::DEFAULT_DAMPING)]
+        damping: f64,
+        /// (default: spectrum.csv, numbered `-2`, `-3`, ... where that file exists)
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Sa against the period (.svg or .png).
         #[arg(long)]
-        dt: Option<f64>,
-        /// g, m/s2 or cm/s2 (default: from the header, else g).
-        #[arg(long)]
-        units: Option<String>,
-        /// Lines to skip before parsing.
-        #[arg(long, default_value_t = 0)]
-        skip_lines: usize,
+        plot: Option<PathBuf>,
     },
 }
 
-pub fn run(cmd: Cmd) -> Result<()> {
-    let Cmd::Info {
-        file,
-        format,
-        dt,
-        units,
-        skip_lines,
-    } = cmd;
-    let format = Format::parse(&format)
-        .with_context(|| format!("--format `{format}`: expected {}", Format::KEYS))?;
-    let units = match units {
-        Some(u) => Some(
-            Units::parse(&u).with_context(|| format!("--units `{u}`: expected {}", Units::KEYS))?,
-        ),
-        None => None,
+/// Periods of a spectrum at most (each is an exact response over the whole record).
+const MAX_PERIODS: usize = 10_000;
+
+/// `--periods`: FROM:TO:N, log-spaced, or a list; each from the shortest building period
+/// ([`pounding::plan::limits::MIN_PERIOD_S`]) to 100 s.
+fn parse_periods(text: &str) -> Result<Vec<f64>> {
+    let bad = || {
+        anyhow::anyhow!(
+            "--periods `{text}`: expected FROM:TO:N (N periods evenly spaced in log, e.g. 0.05:4:100) or a list a,b,c"
+        )
     };
-    let rec = read_record(
-        &file,
-        &ReadOptions {
-            format,
-            units,
-            dt,
-            skip_lines,
-        },
-    )?;
+    let periods = match text.split(':').collect::<Vec<_>>()[..] {
+        [a, b, n] => {
+            let (a, b) = (
+                a.trim().parse::<f64>().map_err(|_| bad())?,
+                b.trim().parse::<f64>().map_err(|_| bad())?,
+            );
+            let n: usize = n.trim().parse().map_err(|_| bad())?;
+            if n == 0 || n > MAX_PERIODS {
+                bail!("--periods `{text}`: {n} periods: expected 1 to {MAX_PERIODS}");
+            }
+            if !(a > 0.0 && b > a) {
+                bail!("--periods `{text}`: expected 0 < FROM < TO");
+            }
+            intensity::log_periods(a, b, n)
+        }
+        [_] => text
+            .split(',')
+            .map(|x| x.trim().parse::<f64>().map_err(|_| bad()))
+            .collect::<Result<Vec<_>>>()?,
+        _ => return Err(bad()),
+    };
+    if periods.len() > MAX_PERIODS {
+        bail!(
+            "--periods: {} periods: expected at most {MAX_PERIODS}",
+            periods.len()
+        );
+    }
+    let lo = pounding::plan::limits::MIN_PERIOD_S;
+    if let Some(t) = periods.iter().find(|t| !(**t >= lo && **t <= 100.0)) {
+        bail!(
+            "--periods: {} s is out of range: expected {lo} to 100 s",
+            pounding::plan::limits::show(*t)
+        );
+    }
+    Ok(periods)
+}
+
+pub fn run(cmd: Cmd) -> Result<()> {
+    match cmd {
+        Cmd::Info { record } => info(&record),
+        Cmd::Spectrum {
+            record,
+            periods,
+            damping,
+            output,
+            plot,
+        } => {
+            let output = super::default_output(output, "spectrum.csv");
+            let periods = parse_periods(&periods)?;
+            if !(0.0..1.0).contains(&damping) {
+                bail!("--damping {damping}: expected 0 <= damping < 1");
+            }
+            super::check_outputs(
+                &[("the record", record.file.as_path())],
+                &[("-o", Some(&output)), ("--plot", plot.as_deref())],
+            )?;
+            let rec = record.read()?;
+            spectrum(&rec, &periods, damping, &output, plot.as_deref())
+        }
+    }
+}
+
+/// `pound record spectrum`: the CSV, the peaks on stdout (stderr with `-o -`), the plot.
+fn spectrum(
+    rec: &Record,
+    periods: &[f64],
+    damping: f64,
+    output: &std::path::Path,
+    plot: Option<&std::path::Path>,
+) -> Result<()> {
+    use rayon::prelude::*;
+    let rows: Vec<(f64, f64)> = periods
+        .par_iter()
+        .map(|&t| (t, intensity::peak_displacement(rec, t, damping)))
+        .collect();
+    let mut csv = String::from("period_s,sa_g,sa_m_s2,sd_m\n");
+    let mut points = Vec::new();
+    for &(t, sd) in &rows {
+        let w = 2.0 * std::f64::consts::PI / t;
+        let sa = w * w * sd;
+        csv.push_str(&format!("{t},{},{sa},{sd}\n", sa / G));
+        points.push((t, sa / G));
+    }
+    let (pgv, pgd) = intensity::pgv_pgd(rec);
+    let peak = points
+        .iter()
+        .cloned()
+        .fold((0.0, 0.0), |b, p| if p.1 > b.1 { p } else { b });
+    say!(
+        "{}: PGA {:.4} g, PGV {:.4} m/s, PGD {:.4} m (from rest, no baseline correction); Sa peaks at {:.4} g at T = {:.3} s ({} periods, {} % damping)",
+        rec.name,
+        rec.pga().value / G,
+        pgv,
+        pgd,
+        peak.1,
+        peak.0,
+        periods.len(),
+        100.0 * damping
+    );
+    super::write_file(output, csv.as_bytes())?;
+    if let Some(p) = plot {
+        let panel = pounding::studies::plot::Panel {
+            title: format!("{}: {} % damped spectrum", rec.name, 100.0 * damping),
+            x_label: "period T (s)".into(),
+            y_label: "Sa (g)".into(),
+            log_x: true,
+            log_y: false,
+            series: vec![pounding::studies::plot::Series {
+                name: "Sa".into(),
+                points,
+                scatter: false,
+            }],
+        };
+        super::save_plot(p, &[panel], 1)?;
+    }
+    Ok(())
+}
+
+fn info(record: &FileArgs) -> Result<()> {
+    let file = &record.file;
+    let rec = record.read()?;
     let pga = rec.pga();
     say!("file      {}", file.display());
     say!("npts      {}", rec.npts());
@@ -67,6 +223,19 @@ pub fn run(cmd: Cmd) -> Result<()> {
         pga.index,
         rec.accel[pga.index] / G
     );
+    let (pgv, pgd) = intensity::pgv_pgd(&rec);
+    say!("pgv       {pgv:.4} m/s  (from rest, no baseline correction)");
+    say!("pgd       {pgd:.4} m");
+    let sa: Vec<String> = [0.2, 0.5, 1.0, 2.0]
+        .iter()
+        .map(|&t| {
+            format!(
+                "{t} s {:.4} g",
+                intensity::sa(&rec, t, intensity::DEFAULT_DAMPING) / G
+            )
+        })
+        .collect();
+    say!("sa (5 %)  {}", sa.join(", "));
     let limit = pounding::plan::limits::WARN_PGA_G;
     if pga.value / G > limit {
         note!(

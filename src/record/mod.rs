@@ -3,6 +3,7 @@
 //!
 //! May import the physics only (a record makes a `Forcing`); never plans, engines, io or studies.
 
+pub mod intensity;
 mod read;
 mod synthetic;
 

@@ -384,3 +384,57 @@ fn synthetic_is_deterministic_and_scaled() {
         "{bad}"
     );
 }
+
+/// `pound record spectrum`: Sa of a step record (a value file) against the closed form of the
+/// first overshoot, through the reader and its units; the default periods; bounds refused.
+#[test]
+fn spectrum_of_a_step_is_the_first_overshoot() {
+    let d = crate::support::tempdir();
+    // 2 m/s^2 held for 10 s, written in cm/s2.
+    let rec = d.path().join("step.txt");
+    std::fs::write(&rec, vec!["200.0"; 1000].join("\n")).unwrap();
+    let out = d.path().join("s.csv");
+    let run = |periods: &str| {
+        crate::support::pound(&[
+            "record",
+            "spectrum",
+            rec.to_str().unwrap(),
+            "--dt",
+            "0.01",
+            "--units",
+            "cm/s2",
+            "--periods",
+            periods,
+            "--damping",
+            "0.05",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    crate::support::ok(&run("0.1,0.5,1.3"));
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let xi: f64 = 0.05;
+    let want = 2.0 * (1.0 + (-xi * std::f64::consts::PI / (1.0 - xi * xi).sqrt()).exp());
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    for row in rows {
+        let sa: f64 = row.split(',').nth(2).unwrap().parse().unwrap();
+        assert!(((sa - want) / want).abs() < 1e-10, "{row}: {sa} vs {want}");
+    }
+    std::fs::remove_file(&out).unwrap();
+    crate::support::ok(&run("0.05:4:100"));
+    let csv = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(csv.lines().count(), 101);
+    assert!(csv.lines().nth(1).unwrap().starts_with("0.05,"));
+    assert!(csv.lines().last().unwrap().starts_with("4,"));
+    for (bad, why) in [
+        ("0.05:4:0", "expected 1 to 10000"),
+        ("1e-9,1", "out of range"),
+        ("4:0.05:10", "0 < FROM < TO"),
+    ] {
+        let o = run(bad);
+        assert!(!o.status.success());
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(e.contains(why), "{bad}: {e}");
+    }
+}
