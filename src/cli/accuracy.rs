@@ -1,6 +1,6 @@
 //! `pound accuracy`: speed against error of every path against the reference.
 
-use super::{check_outputs, config_inputs, write_file, BackendArg};
+use super::{check_outputs, config_inputs, write_file, BackendArg, Holds};
 use anyhow::{bail, Result};
 use pounding::plan::config;
 use pounding::plan::limits::{MAX_SUBSTEPS_PER_CONTACT, WHY_SUBSTEPS};
@@ -82,7 +82,10 @@ pub fn run(a: Args) -> Result<()> {
     let records = config::input_files(&text, &config);
     check_outputs(
         &config_inputs(&config, &records),
-        &[("-o", Some(&output)), ("--plot", plot.as_deref())],
+        &[
+            ("-o", Some(&output), Holds::Csv),
+            ("--plot", plot.as_deref(), Holds::Plot),
+        ],
     )?;
     if is_row {
         // Rows: the CPU paths only, as a table, CSV and plot.

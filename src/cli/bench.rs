@@ -1,6 +1,6 @@
 //! `pound bench`: the benchmark sweeps on every engine found, as a markdown table.
 
-use super::{check_outputs, write_file, PrecisionArg};
+use super::{check_outputs, write_file, Holds, PrecisionArg};
 use anyhow::{bail, Result};
 use pounding::engine::gpu::GpuOptions;
 use pounding::engine::{Backend, Engine};
@@ -61,7 +61,7 @@ pub fn run(a: Args) -> Result<()> {
     }
     // Checked here, not only when an adapter is found, so a typo fails on every machine.
     let chunk = pounding::engine::check_chunk(Some(a.chunk), true)?;
-    check_outputs(&[], &[("-o (any)", a.output.as_deref())])?;
+    check_outputs(&[], &[("-o", a.output.as_deref(), Holds::Text)])?;
     let mut fast = FastOptions::default();
     if let Some(e) = a.target_error {
         fast.substeps_per_contact = super::target_error(e)?.substeps_per_contact;
@@ -139,7 +139,7 @@ fn run_storeys(
             bail!("{flag}: {n} is out of range: expected 1 to {MAX_BENCH_RUNS}");
         }
     }
-    check_outputs(&[], &[("-o (any)", output)])?;
+    check_outputs(&[], &[("-o", output, Holds::Text)])?;
     // A software adapter runs the row kernel far slower than the CPU path: hardware only.
     let ctx = Backend::Auto.acquire("rows on the CPU only", &mut |l| note!("{l}"))?;
     let opts = GpuOptions {

@@ -1,6 +1,6 @@
 //! `pound formulas`: zeta(e) of every formula as CSV on standard output, and Fig. 2.
 
-use super::{check_outputs, e_values};
+use super::{check_outputs, e_values, Holds};
 use anyhow::Result;
 use pounding::physics::restitution::Formula;
 use pounding::studies::formulas;
@@ -18,7 +18,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<()> {
     let es = e_values(&a.e)?;
-    check_outputs(&[], &[("--plot", a.plot.as_deref())])?;
+    check_outputs(&[], &[("--plot", a.plot.as_deref(), Holds::Plot)])?;
     if let Some(path) = &a.plot {
         super::save_plot(path, &formulas::zeta_panels(&es)?, 2)?;
         note!(

@@ -1,6 +1,6 @@
 //! `pound fragility`: exceedance counts and fitted lognormal curves from a results CSV.
 
-use super::{check_study_outputs, write_file};
+use super::{check_study_outputs, write_file, Holds};
 use anyhow::{bail, Result};
 use pounding::io::table::{Filter, Table};
 use pounding::studies::fragility::{csv, fit, levels, panel, FragilitySpec};
@@ -35,7 +35,10 @@ pub fn run(a: Args) -> Result<()> {
     let output = super::default_output(a.output.clone(), "fragility.csv");
     check_study_outputs(
         &a.results,
-        &[("-o", Some(&output)), ("--plot", a.plot.as_deref())],
+        &[
+            ("-o", Some(&output), Holds::Csv),
+            ("--plot", a.plot.as_deref(), Holds::Plot),
+        ],
     )?;
     let table = Table::read(&a.results)?;
     let spec = FragilitySpec {

@@ -1,7 +1,7 @@
 //! `pound gap`: the separation each adjacent pair of a sweep's buildings needs, exactly and by
 //! the code rules, with the probability of pounding against the gap.
 
-use super::{check_outputs, config_inputs, write_file};
+use super::{check_outputs, config_inputs, write_file, Holds};
 use anyhow::{bail, Context, Result};
 use pounding::plan::config;
 use pounding::studies::gap::{GapStudy, PoundingCurve, Scenes};
@@ -42,9 +42,9 @@ pub fn run(a: Args) -> Result<()> {
     check_outputs(
         &config_inputs(&a.config, &records),
         &[
-            ("-o", Some(&output)),
-            ("--plot", a.plot.as_deref()),
-            ("--curve", a.curve.as_deref()),
+            ("-o", Some(&output), Holds::Csv),
+            ("--plot", a.plot.as_deref(), Holds::Plot),
+            ("--curve", a.curve.as_deref(), Holds::Csv),
         ],
     )?;
     let gaps = a.gaps.as_deref().map(parse_gaps).transpose()?;

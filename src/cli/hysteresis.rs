@@ -1,6 +1,6 @@
 //! `pound hysteresis`: force against penetration through one isolated impact, per e.
 
-use super::{check_outputs, e_values, write_file};
+use super::{check_outputs, e_values, write_file, Holds};
 use anyhow::{bail, Context, Result};
 use pounding::physics::contact::LawKind;
 use pounding::physics::restitution::Formula;
@@ -61,7 +61,13 @@ pub fn run(a: Args) -> Result<()> {
             bail!("{name}: {x} is out of range: expected a positive number");
         }
     }
-    check_outputs(&[], &[("-o", Some(&output)), ("--plot", a.plot.as_deref())])?;
+    check_outputs(
+        &[],
+        &[
+            ("-o", Some(&output), Holds::Csv),
+            ("--plot", a.plot.as_deref(), Holds::Plot),
+        ],
+    )?;
     let es = e_values(&a.e)?;
     let loops = fidelity::loops(law, formula, &es, a.v0, a.stiffness, a.m_eff)?;
     super::say_text(&loops.markdown())?;

@@ -16,7 +16,7 @@ pub struct Args {
 pub fn run(a: Args) -> Result<()> {
     let output = super::default_output(a.output.clone(), "results.csv");
     // Merge writes CSV (its own checks of inputs against the output follow).
-    super::check_extension("-o", &output, "csv")?;
+    super::check_extension("-o", &output, super::Holds::Csv)?;
     let rows = pounding::io::merge::merge(&output, &a.inputs)?;
     note!(
         "{rows} runs from {} inputs -> {}",

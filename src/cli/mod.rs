@@ -149,13 +149,13 @@ impl PrecisionArg {
 /// pound output writes beside it count). Returns the targets given.
 pub fn check_outputs(
     inputs: &[(&str, &Path)],
-    outputs: &[(&str, Option<&Path>)],
+    outputs: &[(&str, Option<&Path>, Holds)],
 ) -> Result<Vec<pounding::io::target::Target>> {
     use pounding::io::target::Target;
     let on_stdout: Vec<&str> = outputs
         .iter()
-        .filter(|(_, p)| p.is_some_and(|p| p.as_os_str() == "-"))
-        .map(|(w, _)| flag(w))
+        .filter(|(_, p, _)| p.is_some_and(|p| p.as_os_str() == "-"))
+        .map(|(w, _, _)| *w)
         .collect();
     if on_stdout.len() > 1 {
         bail!(
@@ -164,19 +164,18 @@ pub fn check_outputs(
         );
     }
     let mut targets = Vec::new();
-    for (what, p) in outputs {
+    for (what, p, _) in outputs {
         let Some(p) = p else { continue };
-        let what = flag(what);
         let t = Target::resolve(what, p)?;
         t.probe(what)?;
-        targets.push((what, t));
+        targets.push((*what, t));
     }
     let named: Vec<(&str, &Target)> = targets.iter().map(|(w, t)| (*w, t)).collect();
     pounding::io::target::check_outputs(inputs, &named)?;
     // After the checks that protect inputs, which say more about a wrong name.
-    for (what, p) in outputs {
-        if let (Some(p), Some(expected)) = (p, format_of(what)) {
-            check_extension(flag(what), p, expected)?;
+    for (what, p, holds) in outputs {
+        if let Some(p) = p {
+            check_extension(what, p, *holds)?;
         }
     }
     if !on_stdout.is_empty() {
@@ -185,28 +184,21 @@ pub fn check_outputs(
     Ok(targets.into_iter().map(|(_, t)| t).collect())
 }
 
-/// What an output flag writes, for the extension check: plots (`--plot`, and `-o` of
-/// `pound plot`, named `plot -o`) write SVG or PNG, the rest CSV unless the command says
-/// otherwise (`-o (parquet)` for `--format parquet`, `-o (any)` where the format is free).
-fn format_of(what: &str) -> Option<&'static str> {
-    match what {
-        "--plot" | "plot -o" => Some("plot"),
-        "-o (parquet)" => Some("parquet"),
-        "-o (any)" => None,
-        _ => Some("csv"),
-    }
-}
-
-/// The flag of an output as [`check_outputs`] is given it, without what [`format_of`] reads.
-fn flag(what: &str) -> &str {
-    let what = what.strip_prefix("plot ").unwrap_or(what);
-    what.split(" (").next().unwrap_or(what)
+/// What an output holds, for the check that its name's extension does not say otherwise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Holds {
+    Csv,
+    Parquet,
+    /// SVG, or PNG for a `.png` name.
+    Plot,
+    /// A table as text (`pound bench -o`): any name.
+    Text,
 }
 
 /// An output whose extension names another format than the one written is refused: a file
 /// called `x.pdf` that holds SVG, or `m.parquet` that holds CSV, misleads every reader.
-pub fn check_extension(what: &str, path: &Path, expected: &str) -> Result<()> {
-    if path.as_os_str() == "-" {
+pub fn check_extension(what: &str, path: &Path, holds: Holds) -> Result<()> {
+    if path.as_os_str() == "-" || holds == Holds::Text {
         return Ok(());
     }
     let Some(ext) = path
@@ -219,16 +211,16 @@ pub fn check_extension(what: &str, path: &Path, expected: &str) -> Result<()> {
     let named = [
         "csv", "parquet", "svg", "png", "pdf", "jpg", "jpeg", "eps", "ps", "json", "xlsx", "tsv",
     ];
-    let fits = match expected {
-        "plot" => plots.contains(&ext.as_str()),
-        "parquet" => ext == "parquet" || !named.contains(&ext.as_str()),
-        _ => ext == "csv" || ext == "txt" || !named.contains(&ext.as_str()),
+    let fits = match holds {
+        Holds::Plot => plots.contains(&ext.as_str()),
+        Holds::Parquet => ext == "parquet" || !named.contains(&ext.as_str()),
+        Holds::Csv | Holds::Text => ext == "csv" || ext == "txt" || !named.contains(&ext.as_str()),
     };
     if !fits {
-        let writes = match expected {
-            "plot" => "a plot as SVG, or PNG for a .png name",
-            "parquet" => "Parquet (--format parquet)",
-            _ => "CSV",
+        let writes = match holds {
+            Holds::Plot => "a plot as SVG, or PNG for a .png name",
+            Holds::Parquet => "Parquet (--format parquet)",
+            Holds::Csv | Holds::Text => "CSV",
         };
         bail!(
             "{what} {}: a .{ext} name for an output written as {writes}: give it a matching extension",
@@ -290,7 +282,7 @@ pub fn config_inputs<'a>(
 
 /// Check the outputs of a study of a results file (`plot`, `fragility`) against the file and
 /// its sidecar, then warn when the results are not vouched for by that sidecar.
-pub fn check_study_outputs(results: &Path, outputs: &[(&str, Option<&Path>)]) -> Result<()> {
+pub fn check_study_outputs(results: &Path, outputs: &[(&str, Option<&Path>, Holds)]) -> Result<()> {
     let sidecar = pounding::io::provenance::meta_path(results);
     check_outputs(
         &[("the results", results), ("the results' sidecar", &sidecar)],

@@ -1,6 +1,6 @@
 //! `pound plot`: an output of a results CSV against a swept parameter.
 
-use super::check_study_outputs;
+use super::{check_study_outputs, Holds};
 use anyhow::{bail, Result};
 use clap::ValueEnum;
 use pounding::io::table::{Filter, Table};
@@ -48,7 +48,7 @@ enum AggArg {
 
 pub fn run(a: Args) -> Result<()> {
     let output = super::default_output(a.output.clone(), "plot.svg");
-    check_study_outputs(&a.results, &[("plot -o", Some(&output))])?;
+    check_study_outputs(&a.results, &[("-o", Some(&output), Holds::Plot)])?;
     let table = Table::read(&a.results)?;
     let spec = PlotSpec {
         x: a.x,

@@ -138,7 +138,10 @@ pub fn run(cmd: Cmd) -> Result<()> {
             }
             super::check_outputs(
                 &[("the record", record.file.as_path())],
-                &[("-o", Some(&output)), ("--plot", plot.as_deref())],
+                &[
+                    ("-o", Some(&output), super::Holds::Csv),
+                    ("--plot", plot.as_deref(), super::Holds::Plot),
+                ],
             )?;
             let rec = record.read()?;
             spectrum(&rec, &periods, damping, &output, plot.as_deref())

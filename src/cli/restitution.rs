@@ -1,6 +1,6 @@
 //! `pound restitution`: one isolated collision per damped law, formula and e.
 
-use super::{check_outputs, e_values, write_file};
+use super::{check_outputs, e_values, write_file, Holds};
 use anyhow::Result;
 use pounding::studies::fidelity;
 use std::path::PathBuf;
@@ -21,7 +21,13 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<()> {
     let output = super::default_output(a.output.clone(), "restitution.csv");
-    check_outputs(&[], &[("-o", Some(&output)), ("--plot", a.plot.as_deref())])?;
+    check_outputs(
+        &[],
+        &[
+            ("-o", Some(&output), Holds::Csv),
+            ("--plot", a.plot.as_deref(), Holds::Plot),
+        ],
+    )?;
     let rows = fidelity::table(&e_values(&a.e)?)?;
     write_file(&output, fidelity::csv(&rows).as_bytes())?;
     say!("max |achieved e - asked e| per law and formula (`own`: the law's own chi(e)):\n");

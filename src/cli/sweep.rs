@@ -1,7 +1,7 @@
 //! `pound sweep`: settings from flags, the output opened (fresh or resumed), the engine run,
 //! the output put in place.
 
-use super::{check_outputs, config_inputs, BackendArg, PrecisionArg};
+use super::{check_outputs, config_inputs, BackendArg, Holds, PrecisionArg};
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 use pounding::engine::{Backend, Engine, EngineError};
@@ -178,14 +178,17 @@ pub fn run(a: Args) -> Result<()> {
     // writable.
     let config_text = config::read_text(&config)?;
     let records = config::input_files(&config_text, &config);
-    let what = if format == FormatArg::Parquet {
-        "-o (parquet)"
+    let holds = if format == FormatArg::Parquet {
+        Holds::Parquet
     } else {
-        "-o"
+        Holds::Csv
     };
-    let target = check_outputs(&config_inputs(&config, &records), &[(what, Some(&output))])?
-        .pop()
-        .expect("one output");
+    let target = check_outputs(
+        &config_inputs(&config, &records),
+        &[("-o", Some(&output), holds)],
+    )?
+    .pop()
+    .expect("one output");
     if pounding::plan::row::is_row_config(&config_text) {
         let mut plan = config::load_row_text(&config_text, &config)?;
         for w in plan.warnings() {
