@@ -66,19 +66,34 @@ pub fn run(a: Args) -> Result<()> {
             String::new()
         }
     );
-    say!("\n| {} > | median {} | beta | se(ln median) | se(beta) | log-likelihood |\n|---:|---:|---:|---:|---:|---:|", spec.edp, spec.im);
+    say!("\n| {} > | median {} | beta | se(ln median) | se(beta) | log-likelihood | deviance (dof) | p (fit) |\n|---:|---:|---:|---:|---:|---:|---:|---:|", spec.edp, spec.im);
+    let mut poor = Vec::new();
     for (t, f) in spec.thresholds.iter().zip(&fits) {
         match f {
-            Ok(f) => say!(
-                "| {t} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} |",
-                f.median,
-                f.beta,
-                f.se_ln_median,
-                f.se_beta,
-                f.log_likelihood
-            ),
-            Err(e) => say!("| {t} | no fit: {e} | | | | |"),
+            Ok(f) => {
+                say!(
+                    "| {t} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} | {:.2} ({}) | {} |",
+                    f.median,
+                    f.beta,
+                    f.se_ln_median,
+                    f.se_beta,
+                    f.log_likelihood,
+                    f.deviance,
+                    f.dof,
+                    f.p_fit.map_or("-".into(), |p| format!("{p:.3}"))
+                );
+                if f.p_fit.is_some_and(|p| p < 0.05) {
+                    poor.push(t.to_string());
+                }
+            }
+            Err(e) => say!("| {t} | no fit: {e} | | | | | | |"),
         }
+    }
+    if !poor.is_empty() {
+        note!(
+            "notice: the shares above {} do not follow a lognormal curve (goodness of fit p < 0.05): the deviance against each level's own share is larger than chance allows; read the fitted median and beta with care",
+            poor.join(", ")
+        );
     }
     write_file(&output, csv(&spec, &lv).as_bytes())?;
     if let Some(p) = &a.plot {
