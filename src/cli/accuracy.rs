@@ -93,13 +93,9 @@ pub fn run(a: Args) -> Result<()> {
             bail!("--backend gpu is not available for the accuracy of rows of multi-storey buildings ([[building]] configs) yet: it compares the CPU paths");
         }
         let plan = config::load_row_text(&text, &config)?;
-        for w in plan.warnings() {
-            note!("warning: {}: {w}", config.display());
-        }
+        super::warn_all(&config, plan.warnings());
         let finest = settings.iter().cloned().fold(0.0, f64::max);
-        if let Some(w) = plan.cost_warning(finest) {
-            note!("warning: {}: {w}", config.display());
-        }
+        super::warn_all(&config, plan.cost_warning(finest));
         note!(
             "{}: {} runs of a row; reference at tol {tol:e}, then {} settings on the CPU",
             config.display(),
@@ -128,9 +124,7 @@ pub fn run(a: Args) -> Result<()> {
         return check_targets(&choices, &measured, &config);
     }
     let plan = config::load_text(&text, &config)?;
-    for w in plan.warnings() {
-        note!("warning: {}: {w}", config.display());
-    }
+    super::warn_all(&config, plan.warnings());
     let ctx = backend
         .get()
         .acquire("CPU path only", &mut |l| note!("{l}"))?;

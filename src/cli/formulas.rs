@@ -20,7 +20,8 @@ pub fn run(a: Args) -> Result<()> {
     let es = e_values(&a.e)?;
     check_outputs(&[], &[("--plot", a.plot.as_deref(), Holds::Plot)])?;
     if let Some(path) = &a.plot {
-        super::save_plot(path, &formulas::zeta_panels(&es)?, 2)?;
+        // The line below says what was written.
+        pounding::studies::plot::save(path, &formulas::zeta_panels(&es)?, 2)?;
         note!(
             "zeta(e) of {} formulas -> {}",
             Formula::ALL.len(),

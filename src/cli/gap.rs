@@ -62,15 +62,11 @@ pub fn run(a: Args) -> Result<()> {
                 apart.join("; ")
             );
         }
-        for w in row_plan.warnings() {
-            note!("warning: {}: {w}", a.config.display());
-        }
+        super::warn_all(&a.config, row_plan.warnings());
         Scenes::Rows(&row_plan)
     } else {
         pair_plan = config::load_text(&text, &a.config)?;
-        for w in pair_plan.warnings() {
-            note!("warning: {}: {w}", a.config.display());
-        }
+        super::warn_all(&a.config, pair_plan.warnings());
         Scenes::Pairs(&pair_plan)
     };
     let mut pool = rayon::ThreadPoolBuilder::new();

@@ -17,20 +17,13 @@ macro_rules! note {
 /// A line on standard output (standard error when an output of the command goes to standard
 /// output, [`tables_on_stderr`]); a failed write is an error, not a panic.
 macro_rules! say {
-    ($($t:tt)*) => {{
-        use std::io::Write as _;
-        if $crate::cli::tables_on_stderr() {
-            pounding::note(format_args!($($t)*));
-        } else {
-            anyhow::Context::context(
-                writeln!(std::io::stdout(), $($t)*),
-                "writing to standard output",
-            )?
-        }
-    }};
+    ($($t:tt)*) => {
+        $crate::cli::say_text(&format!("{}\n", format_args!($($t)*)))?
+    };
 }
 
-/// Text (a table, with its own line ends) where [`say!`] writes.
+/// Text (a table, with its own line ends) on standard output, or on standard error when an
+/// output of the command goes to standard output ([`tables_on_stderr`]).
 pub fn say_text(text: &str) -> Result<()> {
     use std::io::Write as _;
     if tables_on_stderr() {
@@ -264,10 +257,15 @@ pub fn save_plot(
     cols: usize,
 ) -> Result<()> {
     pounding::studies::plot::save(path, panels, cols)?;
-    if path.as_os_str() != "-" {
-        note!("wrote {}", path.display());
-    }
+    wrote(path);
     Ok(())
+}
+
+/// Each warning a config's plan gives, one line each on stderr, named by the config.
+pub fn warn_all(config: &Path, warnings: impl IntoIterator<Item = String>) {
+    for w in warnings {
+        note!("warning: {}: {w}", config.display());
+    }
 }
 
 /// A config and the record files it names, as the inputs its outputs must not replace.
@@ -298,10 +296,15 @@ pub fn check_study_outputs(results: &Path, outputs: &[(&str, Option<&Path>, Hold
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     pounding::io::atomic::write_atomic(path, bytes)
         .with_context(|| format!("writing {}", path.display()))?;
+    wrote(path);
+    Ok(())
+}
+
+/// Say that `path` was written (standard output needs no saying).
+fn wrote(path: &Path) {
     if path.as_os_str() != "-" {
         note!("wrote {}", path.display());
     }
-    Ok(())
 }
 
 /// A flag's values from `text`: start:stop:step, a list a,b,c, or one value; at most `max`

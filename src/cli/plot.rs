@@ -94,7 +94,8 @@ pub fn run(a: Args) -> Result<()> {
             spec.y
         );
     }
-    super::save_plot(&output, std::slice::from_ref(&p), 1)?;
+    // The line below says what was written.
+    pounding::studies::plot::save(&output, std::slice::from_ref(&p), 1)?;
     note!(
         "{} series, {points} points -> {}",
         p.series.len(),

@@ -191,9 +191,7 @@ pub fn run(a: Args) -> Result<()> {
     .expect("one output");
     if pounding::plan::row::is_row_config(&config_text) {
         let mut plan = config::load_row_text(&config_text, &config)?;
-        for w in plan.warnings() {
-            note!("warning: {}: {w}", config.display());
-        }
+        super::warn_all(&config, plan.warnings());
         plan.base.spec.scheme = scheme_as_run(plan.base.spec.scheme, scheme, energy);
         let chosen = match (target_error, &mut plan.base.spec.scheme) {
             (None, _) => None,
@@ -214,9 +212,7 @@ pub fn run(a: Args) -> Result<()> {
             Scheme::Fast(o) => o.substeps_per_contact,
             Scheme::Reference(_) => FastOptions::default().substeps_per_contact,
         };
-        if let Some(w) = plan.cost_warning(spc) {
-            note!("warning: {}: {w}", config.display());
-        }
+        super::warn_all(&config, plan.cost_warning(spc));
         // The row kernel runs the fast scheme without the energy balance; the rows' calibration
         // is of the CPU's f64 (the GPU in f64 agrees with it to 3.7e-6, BENCHMARKS.md; f32
         // adds up to 7.2e-5).
@@ -301,9 +297,7 @@ pub fn run(a: Args) -> Result<()> {
     });
     let precision = precision.get();
     let mut plan = config::load_text(&config_text, &config)?;
-    for w in plan.warnings() {
-        note!("warning: {}: {w}", config.display());
-    }
+    super::warn_all(&config, plan.warnings());
     let mut scheme = scheme_as_run(plan.spec.scheme, scheme, energy);
     let chosen = match (target_error, &mut scheme) {
         (None, _) => None,
@@ -688,8 +682,10 @@ fn finish_unless_changed(
 enum Progress {
     Bar(indicatif::ProgressBar),
     Lines {
-        /// Runs done, and whether the sweep is over.
-        state: std::sync::Arc<(std::sync::atomic::AtomicU64, std::sync::atomic::AtomicBool)>,
+        /// Runs done.
+        done: std::sync::Arc<std::sync::atomic::AtomicU64>,
+        /// Dropped when the sweep is over, which ends the watcher's wait at once.
+        stop: Option<std::sync::mpsc::Sender<()>>,
         watcher: Option<std::thread::JoinHandle<()>>,
     },
 }
@@ -698,9 +694,7 @@ impl Progress {
     fn set_position(&self, done: u64) {
         match self {
             Progress::Bar(b) => b.set_position(done),
-            Progress::Lines { state, .. } => {
-                state.0.store(done, std::sync::atomic::Ordering::Relaxed)
-            }
+            Progress::Lines { done: d, .. } => d.store(done, std::sync::atomic::Ordering::Relaxed),
         }
     }
 
@@ -714,10 +708,9 @@ impl Progress {
     fn finish_and_clear(&mut self) {
         match self {
             Progress::Bar(b) => b.finish_and_clear(),
-            Progress::Lines { state, watcher } => {
-                state.1.store(true, std::sync::atomic::Ordering::Relaxed);
+            Progress::Lines { stop, watcher, .. } => {
+                stop.take();
                 if let Some(w) = watcher.take() {
-                    w.thread().unpark();
                     let _ = w.join();
                 }
             }
@@ -731,27 +724,20 @@ impl Drop for Progress {
     }
 }
 
-/// The watcher of [`Progress::Lines`]: a line every `every` until the sweep is over.
+/// The watcher of [`Progress::Lines`]: a line every `every` until `stop` is dropped.
 fn watch(
     runs: u64,
     every: std::time::Duration,
-    state: std::sync::Arc<(std::sync::atomic::AtomicU64, std::sync::atomic::AtomicBool)>,
+    done: std::sync::Arc<std::sync::atomic::AtomicU64>,
+    stop: std::sync::mpsc::Receiver<()>,
 ) {
-    use std::sync::atomic::Ordering;
     let start = std::time::Instant::now();
-    let mut next = every;
-    loop {
-        while start.elapsed() < next {
-            if state.1.load(Ordering::Relaxed) {
-                return;
-            }
-            std::thread::park_timeout((next - start.elapsed().min(next)).min(every));
-        }
-        if state.1.load(Ordering::Relaxed) {
-            return;
-        }
+    let mut next = start + every;
+    while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) =
+        stop.recv_timeout(next.saturating_duration_since(std::time::Instant::now()))
+    {
         let now = start.elapsed().as_secs_f64();
-        let done = state.0.load(Ordering::Relaxed);
+        let done = done.load(std::sync::atomic::Ordering::Relaxed);
         let rate = done as f64 / now.max(1e-9);
         let eta = if done > 0 {
             format!("{:.0} s", runs.saturating_sub(done) as f64 / rate)
@@ -784,17 +770,19 @@ fn progress_bar(runs: u64) -> Progress {
             .filter(|s| s.is_finite() && *s >= 0.0)
             .unwrap_or(10.0);
         let every = std::time::Duration::from_secs_f64(seconds.max(0.05));
-        let state = std::sync::Arc::new((
-            std::sync::atomic::AtomicU64::new(0),
-            std::sync::atomic::AtomicBool::new(false),
-        ));
+        let done = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+        let (stop, stopped) = std::sync::mpsc::channel();
         let watcher = {
-            let state = state.clone();
+            let done = done.clone();
             std::thread::Builder::new()
                 .name("progress".into())
-                .spawn(move || watch(runs, every, state))
+                .spawn(move || watch(runs, every, done, stopped))
                 .ok()
         };
-        Progress::Lines { state, watcher }
+        Progress::Lines {
+            done,
+            stop: Some(stop),
+            watcher,
+        }
     }
 }

@@ -73,12 +73,18 @@ pub enum Opened {
 /// Does the journal `progress` say 0 runs are done, and `partial` hold at most a header line
 /// (no row)? An edited journal beside rows is not such a journal: the rows decide.
 fn holds_no_rows(partial: &Path, progress: &Path) -> bool {
-    let journal_empty = read_toml::<Progress>(progress).is_ok_and(|p| p.done == 0);
-    let rows = std::fs::read(partial).map(|b| {
-        let body = b.strip_suffix(b"\n").unwrap_or(&b);
-        body.contains(&b'\n')
-    });
-    journal_empty && rows.is_ok_and(|has_rows| !has_rows)
+    use std::io::{BufRead, Read};
+    if !read_toml::<Progress>(progress).is_ok_and(|p| p.done == 0) {
+        return false;
+    }
+    // The header line, then nothing: read no further than one byte past it.
+    let Ok(f) = std::fs::File::open(partial) else {
+        return false;
+    };
+    let mut r = std::io::BufReader::new(f);
+    let mut header = Vec::new();
+    let mut next = [0u8; 1];
+    r.read_until(b'\n', &mut header).is_ok() && r.read(&mut next).is_ok_and(|n| n == 0)
 }
 
 impl SweepOutput {

@@ -346,17 +346,10 @@ impl RowPlan {
     /// to floor (mid-column pounding is not modelled), so no run checks them for contact.
     /// Heights are not swept, so this holds for every run of the plan.
     pub fn pairs_without_levels(&self) -> Vec<String> {
-        let elevations = |a: &ShearAxes| -> Vec<String> {
-            let mut z = 0.0;
-            a.heights
-                .iter()
-                .map(|h| {
-                    z += h;
-                    format!("{z}")
-                })
-                .collect()
-        };
         let row = self.row(&self.run(0));
+        let elevations = |b: &ShearBuilding| -> Vec<String> {
+            b.elevations().iter().map(|z| format!("{z}")).collect()
+        };
         (0..self.buildings.len() - 1)
             .filter(|&a| !row.levels.iter().any(|l| l.left == a))
             .map(|a| {
@@ -364,8 +357,8 @@ impl RowPlan {
                     "buildings {} and {} share no floor level (floors at {} m against {} m; levels meet within {} m): floors at different heights are not modelled as touching (mid-column pounding), so this pair is never checked for contact and has no level columns",
                     a + 1,
                     a + 2,
-                    elevations(&self.buildings[a]).join(", "),
-                    elevations(&self.buildings[a + 1]).join(", "),
+                    elevations(&row.buildings[a]).join(", "),
+                    elevations(&row.buildings[a + 1]).join(", "),
                     crate::physics::row::LEVEL_TOLERANCE_M
                 )
             })
@@ -377,9 +370,10 @@ impl RowPlan {
     pub const COSTLY_SUBSTEPS: f64 = 20_000.0;
 
     /// A notice when a run of this plan may take extreme work: contact substeps resolve the
-    /// fastest mode of the buildings in contact (`h = 2 pi / (substeps_per_contact (w + 2 xi
-    /// w)_max)`), so a record step in contact costs `dt substeps_per_contact rate / 2 pi`
-    /// substeps, which grows as 1 / T. Estimated per building at its shortest swept period.
+    /// fastest mode of the buildings in contact (`h = 2 pi / (substeps_per_contact rate)`, the
+    /// rate the solver takes, `RowModel::building_rates`), so a record step in contact costs
+    /// `dt substeps_per_contact rate / 2 pi` substeps, which grows as 1 / T. Estimated with
+    /// every building at its shortest swept (or sampled) period.
     pub fn cost_warning(&self, substeps_per_contact: f64) -> Option<String> {
         if self.is_empty() {
             return None;
@@ -392,7 +386,6 @@ impl RowPlan {
             .map(|r| r.dt)
             .fold(0.0, f64::max);
         let mut run = self.run(0);
-        let mut worst: Option<(usize, f64, f64)> = None;
         for (b, axes) in self.buildings.iter().enumerate() {
             let mut shortest = axes.period.iter().cloned().fold(f64::INFINITY, f64::min);
             if let Some(smp) = &self.samples {
@@ -403,19 +396,14 @@ impl RowPlan {
                 }
             }
             run.period[b] = shortest;
-            let modes = self.row(&run).buildings[b].modes();
-            let rate = modes
-                .omega
-                .iter()
-                .zip(&modes.xi)
-                .map(|(w, xi)| w * (1.0 + 2.0 * xi.abs()))
-                .fold(0.0, f64::max);
-            let per_step = dt * substeps_per_contact * rate / (2.0 * std::f64::consts::PI);
-            if worst.is_none_or(|(_, _, x)| per_step > x) {
-                worst = Some((b, shortest, per_step));
-            }
         }
-        let (b, period, per_step) = worst?;
+        let rates = crate::physics::solver::row::RowModel::new(&self.row(&run)).building_rates();
+        let (b, rate) = rates
+            .into_iter()
+            .enumerate()
+            .max_by(|x, y| x.1.total_cmp(&y.1))?;
+        let period = run.period[b];
+        let per_step = dt * substeps_per_contact * rate / (2.0 * std::f64::consts::PI);
         (per_step > Self::COSTLY_SUBSTEPS).then(|| {
             format!(
                 "building {} at period_s = {period} s: its fastest mode makes every record step in contact take about {per_step:.0} RK4 substeps (dt {dt} s x substeps_per_contact {substeps_per_contact} x its rate / 2 pi; typical scenes take tens to hundreds): runs may take minutes each",

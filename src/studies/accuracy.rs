@@ -190,15 +190,14 @@ impl Errors {
 pub fn csv(points: &[Point]) -> String {
     let mut s = String::from("path,substeps_per_contact,runs_per_second,force_median,force_p99,displacement_median,displacement_p99,energy_median,energy_p99,residual_median,residual_p99,impact_count_differs,failed\n");
     for p in points {
-        let q = p.errors.quantiles().map(|x| cell(x, |x| format!("{x:e}")));
+        let q = p
+            .errors
+            .quantiles()
+            .map(|x| shown(x, "", |x| format!("{x:e}")));
         s.push_str(&format!(
             "{},{},{:.1},{},{},{}\n",
             p.path,
-            if p.substeps_per_contact.is_nan() {
-                String::new()
-            } else {
-                p.substeps_per_contact.to_string()
-            },
+            shown(p.substeps_per_contact, "", |x| x.to_string()),
             p.runs_per_second,
             q.join(","),
             p.errors.impact_count_differs,
@@ -252,11 +251,7 @@ pub fn markdown_row(p: &Point) -> String {
     format!(
         "| {} | {} | {:.0} | {} | {:.2} % | {} |",
         p.path,
-        if p.substeps_per_contact.is_nan() {
-            "-".to_string()
-        } else {
-            p.substeps_per_contact.to_string()
-        },
+        shown(p.substeps_per_contact, "-", |x| x.to_string()),
         p.runs_per_second,
         [&q[0..2], &q[2..4], &q[4..6], &q[6..8]]
             .map(|pair| pair.join(" / "))
@@ -266,22 +261,19 @@ pub fn markdown_row(p: &Point) -> String {
     )
 }
 
-/// A statistic for a CSV cell: empty where it is over no runs (NaN).
-fn cell(x: f64, show: impl Fn(f64) -> String) -> String {
+/// A number for a table or CSV cell, `none` where there is none (NaN: a statistic over zero
+/// runs, or the reference's setting).
+fn shown(x: f64, none: &str, show: impl Fn(f64) -> String) -> String {
     if x.is_nan() {
-        String::new()
+        none.into()
     } else {
         show(x)
     }
 }
 
-/// A statistic for a table: `-` where it is over no runs (NaN).
+/// A statistic in a table: `-` where it is over no runs.
 fn figure(x: f64) -> String {
-    if x.is_nan() {
-        "-".into()
-    } else {
-        format!("{x:.1e}")
-    }
+    shown(x, "-", |x| format!("{x:.1e}"))
 }
 
 /// A row sweep's outputs at one setting (the multi-storey work-precision table).
@@ -484,7 +476,7 @@ pub fn row_csv(points: &[RowPoint]) -> String {
         let cells: Vec<String> = p
             .numbers()
             .iter()
-            .map(|x| cell(*x, |x| x.to_string()))
+            .map(|x| shown(*x, "", |x| x.to_string()))
             .collect();
         s.push_str(&format!("{},{}\n", p.path, cells.join(",")));
     }

@@ -2,28 +2,19 @@
 //! silent physics, nothing left behind, outputs that say what they are, and every bounded input
 //! served or refused with its reason.
 
+use super::{s, stderr as err};
 use crate::support::{ok, pound, tempdir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn err(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn out(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
-/// Fails with `needle` in its message, without a panic.
+/// Fails with `needle` in its message, without a panic ([`super::refused`] with no output to
+/// check).
 fn refused(o: &Output, needle: &str) {
-    let e = err(o);
-    assert!(!o.status.success(), "rc 0 where an error was due: {e}");
-    assert!(e.contains(needle), "expected `{needle}` in: {e}");
-    assert!(!e.contains("panicked"), "{e}");
+    super::refused(o, needle, None);
 }
 
 /// Succeeds, and says `needle` on stderr.
@@ -151,17 +142,14 @@ fn no_silent_physics() {
     let bad = write(d.path(), "units.toml", &pair("units = \"cm/s2\""));
     let o = d.path().join("o.csv");
     refused(
-        &pound(&["sweep", s(&bad), "-o", s(&o), "--backend", "cpu"]),
+        &super::sweep(&bad, &o, &[]),
         "header says its values are in g but units = cm/s2 was given",
     );
-    ok(&pound(&[
-        "sweep",
-        s(&write(d.path(), "g.toml", &pair("units = \"g\""))),
-        "-o",
-        s(&o),
-        "--backend",
-        "cpu",
-    ]));
+    ok(&super::sweep(
+        &write(d.path(), "g.toml", &pair("units = \"g\"")),
+        &o,
+        &[],
+    ));
     // Rows: PGA above 5 g, and displacements above the building's real height.
     let hot = write(
         d.path(),
@@ -169,14 +157,7 @@ fn no_silent_physics() {
         &row(STOREYS3, STOREYS3, "").replace("pga_g = 0.35", "pga_g = 6.0"),
     );
     warns(
-        &pound(&[
-            "sweep",
-            s(&hot),
-            "-o",
-            s(&d.path().join("hot.csv")),
-            "--backend",
-            "cpu",
-        ]),
+        &super::sweep(&hot, &d.path().join("hot.csv"), &[]),
         "above 5 g",
     );
     let flat = write(
@@ -189,14 +170,7 @@ fn no_silent_physics() {
         ),
     );
     warns(
-        &pound(&[
-            "sweep",
-            s(&flat),
-            "-o",
-            s(&d.path().join("flat.csv")),
-            "--backend",
-            "cpu",
-        ]),
+        &super::sweep(&flat, &d.path().join("flat.csv"), &[]),
         "exceeds its height",
     );
     // Neighbours that share no floor level: said before any run, refused by the gap study.
@@ -210,14 +184,7 @@ fn no_silent_physics() {
         ),
     );
     warns(
-        &pound(&[
-            "sweep",
-            s(&apart),
-            "-o",
-            s(&d.path().join("apart.csv")),
-            "--backend",
-            "cpu",
-        ]),
+        &super::sweep(&apart, &d.path().join("apart.csv"), &[]),
         "buildings 1 and 2 share no floor level (floors at 3, 6, 9 m against 3.2, 6.4 m",
     );
     let gaps = d.path().join("apart-gaps.csv");
@@ -293,18 +260,11 @@ fn no_silent_physics() {
     );
     let cfg = write(d.path(), "row.toml", &row(STOREYS3, STOREYS2, ""));
     refused(
-        &pound(&[
-            "sweep",
-            s(&cfg),
-            "-o",
-            s(&d.path().join("agg.csv")),
-            "--backend",
-            "cpu",
-            "--aggregate",
-            "gap_1_2_m",
-            "--exceed",
-            "b1_peak_roof_m=nan",
-        ]),
+        &super::sweep(
+            &cfg,
+            &d.path().join("agg.csv"),
+            &["--aggregate", "gap_1_2_m", "--exceed", "b1_peak_roof_m=nan"],
+        ),
         "must be a finite number",
     );
     // Two-column records: a BOM is not part of the first line, a typo is an error.
@@ -392,14 +352,7 @@ fn refusals_leave_nothing_behind() {
         ),
     );
     let whole = d.path().join("whole.csv");
-    ok(&pound(&[
-        "sweep",
-        s(&cfg),
-        "-o",
-        s(&whole),
-        "--backend",
-        "cpu",
-    ]));
+    ok(&super::sweep(&cfg, &whole, &[]));
     let whole = std::fs::read_to_string(&whole).unwrap();
     let header = format!("{}\n", whole.lines().next().unwrap());
     let journal = pounding::io::atomic::sibling(&x, ".progress.toml");
@@ -451,14 +404,7 @@ fn outputs_say_what_they_are() {
     );
     // The `.partial` of an input, existing or not.
     let results = d.path().join("r.csv");
-    ok(&pound(&[
-        "sweep",
-        s(&cfg),
-        "-o",
-        s(&results),
-        "--backend",
-        "cpu",
-    ]));
+    ok(&super::sweep(&cfg, &results, &[]));
     refused(
         &pound(&[
             "fragility",
@@ -508,16 +454,7 @@ fn outputs_say_what_they_are() {
     assert!(d.path().join("fragility.csv").exists() && d.path().join("fragility-2.csv").exists());
     // Extensions that contradict the format.
     refused(
-        &pound(&[
-            "sweep",
-            s(&cfg),
-            "--format",
-            "parquet",
-            "-o",
-            s(&d.path().join("p.csv")),
-            "--backend",
-            "cpu",
-        ]),
+        &super::sweep(&cfg, &d.path().join("p.csv"), &["--format", "parquet"]),
         "a .csv name for an output written as Parquet",
     );
     refused(
@@ -539,14 +476,7 @@ fn outputs_say_what_they_are() {
     );
     // A .parquet name chooses Parquet.
     let pq = d.path().join("p.parquet");
-    ok(&pound(&[
-        "sweep",
-        s(&cfg),
-        "-o",
-        s(&pq),
-        "--backend",
-        "cpu",
-    ]));
+    ok(&super::sweep(&cfg, &pq, &[]));
     assert_eq!(&std::fs::read(&pq).unwrap()[..4], b"PAR1");
     // ... which plot and fragility name as such.
     refused(
@@ -756,16 +686,7 @@ fn messages_name_the_bound_and_the_fact() {
             .replace("tail_s = 0.5", "tail_s = 0.5\nsubsteps_per_contact = 32"),
     );
     warns(
-        &pound(&[
-            "sweep",
-            s(&spc),
-            "--target-error",
-            "1e-2",
-            "-o",
-            s(&d.path().join("s.csv")),
-            "--backend",
-            "cpu",
-        ]),
+        &super::sweep(&spc, &d.path().join("s.csv"), &["--target-error", "1e-2"]),
         "overrides the config's run.substeps_per_contact = 32",
     );
     let results = d.path().join("s.csv");
