@@ -11,7 +11,8 @@
 
 use crate::physics::model::{RunOutput, Status};
 use crate::plan::columns::{header, row};
-use crate::plan::{Intensity, Plan, RunSpec};
+use crate::plan::intensity::target_values;
+use crate::plan::{Plan, RunSpec};
 use std::collections::{BTreeMap, HashMap};
 
 /// Outputs summarised per group: named by the schema, in [`outputs`] order.
@@ -238,7 +239,8 @@ enum Param {
     K,
     Beta,
     Record,
-    TargetPga,
+    /// One of [`crate::plan::intensity::TARGET_COLUMNS`].
+    Target(usize),
     Scale,
     Pga,
     M1,
@@ -263,7 +265,12 @@ impl Param {
             "k_n_per_m" => K,
             "beta_n_per_m1_5" => Beta,
             "record" => Record,
-            "target_pga_g" => TargetPga,
+            "target_pga_g" => Target(0),
+            "target_sa_g" => Target(1),
+            "sa_period_s" => Target(2),
+            "target_sa_avg_g" => Target(3),
+            "sa_avg_from_s" => Target(4),
+            "sa_avg_to_s" => Target(5),
             "scale_factor" => Scale,
             "pga_g" => Pga,
             "m1_kg" => M1,
@@ -291,10 +298,7 @@ impl Param {
             Param::K => bits((!hertz).then_some(s.stiffness)),
             Param::Beta => bits(hertz.then_some(s.stiffness)),
             Param::Record => s.record as u64,
-            Param::TargetPga => bits(match s.intensity {
-                Intensity::PgaG(g) => Some(g),
-                Intensity::Scale(_) => None,
-            }),
+            Param::Target(i) => bits(target_values(&s.intensity, s.im_periods)[i]),
             Param::Scale => s.scale.to_bits(),
             Param::Pga => s.pga_g.to_bits(),
             Param::M1 => s.m1.to_bits(),

@@ -3,12 +3,13 @@
 //! device fold all name columns from here.
 
 use crate::physics::model::RunOutput;
-use crate::plan::{Intensity, Plan, RunSpec};
+use crate::plan::intensity::target_values;
+use crate::plan::{Plan, RunSpec};
 
 /// Every column, in file order: the swept parameters, then the status and the outputs. Units are
 /// in the names. The last three, the energy balance, are empty unless it was asked for
 /// (`run.energy`, `--energy`).
-pub const HEADER: [&str; 33] = [
+pub const HEADER: [&str; 38] = [
     "run",
     "law",
     "formula",
@@ -18,6 +19,11 @@ pub const HEADER: [&str; 33] = [
     "beta_n_per_m1_5",
     "record",
     "target_pga_g",
+    "target_sa_g",
+    "sa_period_s",
+    "target_sa_avg_g",
+    "sa_avg_from_s",
+    "sa_avg_to_s",
     "scale_factor",
     "pga_g",
     "m1_kg",
@@ -45,7 +51,7 @@ pub const HEADER: [&str; 33] = [
 ];
 
 /// Where [`SUMMARISED`] lies in [`HEADER`].
-const SUMMARISED_AT: [usize; 8] = [20, 21, 22, 23, 24, 25, 27, 28];
+const SUMMARISED_AT: [usize; 8] = [25, 26, 27, 28, 29, 30, 32, 33];
 
 /// The outputs an `--aggregate` summary folds per group (as magnitudes): every numeric output
 /// but the first impact's time (absent where nothing touches), the step count and the energy
@@ -72,7 +78,7 @@ pub(crate) fn num(x: f64) -> String {
 
 /// The columns of the contact and the ground motion: the first [`CONTACT_AND_MOTION`] of
 /// [`HEADER`], which rows of multi-storey buildings share ([`crate::plan::row`]).
-pub const CONTACT_AND_MOTION: usize = 11;
+pub const CONTACT_AND_MOTION: usize = 16;
 
 /// The fields of one row, in [`HEADER`] order.
 pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
@@ -109,7 +115,7 @@ pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
 pub fn contact_and_motion(plan: &Plan, spec: &RunSpec) -> Vec<String> {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
     let hertz = spec.law.is_hertzian();
-    vec![
+    let mut cells = vec![
         spec.index.to_string(),
         spec.law.key().to_string(),
         spec.formula
@@ -132,13 +138,14 @@ pub fn contact_and_motion(plan: &Plan, spec: &RunSpec) -> Vec<String> {
             String::new()
         },
         plan.spec.records[spec.record].name.clone(),
-        match spec.intensity {
-            Intensity::PgaG(g) => num(g),
-            Intensity::Scale(_) => String::new(),
-        },
-        num(spec.scale),
-        num(spec.pga_g),
-    ]
+    ];
+    cells.extend(
+        target_values(&spec.intensity, spec.im_periods)
+            .into_iter()
+            .map(opt),
+    );
+    cells.extend([num(spec.scale), num(spec.pga_g)]);
+    cells
 }
 
 /// Indices into [`header`] of `names` (`run` first, added if missing), or the first name that is
@@ -170,6 +177,7 @@ pub fn header() -> Vec<&'static str> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::plan::intensity::TARGET_COLUMNS;
 
     #[test]
     fn select_keeps_run_first_once_and_names_the_first_unknown() {
@@ -189,6 +197,13 @@ mod tests {
             select(&names(&["gap_m", "gap", "nope"])),
             Err("gap".to_string())
         );
+    }
+
+    #[test]
+    fn target_columns_follow_the_record_in_the_header() {
+        let at = HEADER.iter().position(|c| *c == "record").unwrap() + 1;
+        assert_eq!(HEADER[at..at + TARGET_COLUMNS.len()], TARGET_COLUMNS);
+        assert_eq!(HEADER[at + TARGET_COLUMNS.len()], "scale_factor");
     }
 
     #[test]

@@ -7,6 +7,7 @@
 use crate::physics::contact::LawKind;
 use crate::physics::restitution::Formula;
 use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
+use crate::plan::intensity::{PeriodRef, SpectralIm};
 use crate::plan::sample::{draw, Dist, Method};
 use crate::plan::{BuildingAxes, Intensity, Plan, PlanError, PlanSpec, SampledAxis, Samples};
 use crate::record::{
@@ -386,6 +387,184 @@ impl RawRecord {
 pub struct RawIntensity {
     pub pga_g: Option<Axis>,
     pub scale: Option<Axis>,
+    /// Targets of `Sa(T)` (g) at `sa_period_s`.
+    pub sa_g: Option<Axis>,
+    pub sa_period_s: Option<RawPeriod>,
+    /// Targets of `Sa_avg` (g) over `sa_avg_periods_s` (from, to), `sa_avg_n` periods.
+    pub sa_avg_g: Option<Axis>,
+    pub sa_avg_periods_s: Option<Vec<RawPeriod>>,
+    pub sa_avg_n: Option<usize>,
+    /// Damping ratio of the spectral targets' oscillator (default 5 %).
+    pub sa_damping: Option<f64>,
+}
+
+/// A period as written: seconds, or `"building1"`, `"0.2*building1"`, `"building[0]"`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum RawPeriod {
+    Seconds(f64),
+    Named(String),
+}
+
+/// The periods `sa_avg_n` may ask for: Eads et al. (2015) use 10.
+const MAX_SA_AVG_N: usize = 100;
+
+impl RawIntensity {
+    /// The intensity axis, for a scene of `buildings` buildings.
+    fn axis(
+        &self,
+        buildings: usize,
+        invalid: &dyn Fn(&str, String) -> ConfigError,
+    ) -> Result<Vec<Intensity>, ConfigError> {
+        let given: Vec<(&str, &Axis)> = [
+            ("pga_g", &self.pga_g),
+            ("scale", &self.scale),
+            ("sa_g", &self.sa_g),
+            ("sa_avg_g", &self.sa_avg_g),
+        ]
+        .into_iter()
+        .filter_map(|(k, a)| a.as_ref().map(|a| (k, a)))
+        .collect();
+        let spectral = |key: &str| -> Result<(), ConfigError> {
+            let owned: [(&str, bool); 4] = [
+                ("sa_period_s", self.sa_period_s.is_some()),
+                ("sa_avg_periods_s", self.sa_avg_periods_s.is_some()),
+                ("sa_avg_n", self.sa_avg_n.is_some()),
+                ("sa_damping", self.sa_damping.is_some()),
+            ];
+            let allowed: &[&str] = match key {
+                "sa_g" => &["sa_period_s", "sa_damping"],
+                "sa_avg_g" => &["sa_avg_periods_s", "sa_avg_n", "sa_damping"],
+                _ => &[],
+            };
+            match owned.iter().find(|(k, set)| *set && !allowed.contains(k)) {
+                Some((k, _)) => Err(invalid(
+                    &format!("intensity.{k}"),
+                    match key {
+                        "sa_g" | "sa_avg_g" => format!("does not apply to {key}"),
+                        _ => format!("applies to sa_g or sa_avg_g, not {key}"),
+                    },
+                )),
+                None => Ok(()),
+            }
+        };
+        let (key, a) = match given[..] {
+            [] => {
+                spectral("scale")?;
+                return Ok(vec![Intensity::Scale(1.0)]);
+            }
+            [one] => one,
+            _ => {
+                return Err(invalid(
+                    "intensity",
+                    format!(
+                        "gives {}: give one of pga_g, scale, sa_g, sa_avg_g",
+                        given.iter().map(|g| g.0).collect::<Vec<_>>().join(" and ")
+                    ),
+                ))
+            }
+        };
+        spectral(key)?;
+        let full = format!("intensity.{key}");
+        let values = a.values().map_err(|m| invalid(&full, m))?;
+        let period = |k: &str, p: &RawPeriod| -> Result<PeriodRef, ConfigError> {
+            let r = match p {
+                RawPeriod::Seconds(t) => PeriodRef::Seconds(*t),
+                RawPeriod::Named(n) => PeriodRef::parse(n).map_err(|m| invalid(k, m))?,
+            };
+            if let Some(b) = r.building() {
+                if b >= buildings {
+                    return Err(invalid(
+                        k,
+                        format!(
+                            "follows building{} (building[{b}]), but the scene has {buildings} buildings",
+                            b + 1
+                        ),
+                    ));
+                }
+            }
+            if let PeriodRef::Seconds(t) = r {
+                SpectralIm::check_range([t, t]).map_err(|m| invalid(k, m))?;
+            }
+            Ok(r)
+        };
+        let damping = self
+            .sa_damping
+            .unwrap_or(crate::record::intensity::DEFAULT_DAMPING);
+        if !(0.0..1.0).contains(&damping) {
+            return Err(invalid(
+                "intensity.sa_damping",
+                format!(
+                    "{} is out of range: expected 0 <= damping ratio < 1",
+                    crate::plan::limits::show(damping)
+                ),
+            ));
+        }
+        let im = match key {
+            "pga_g" => return Ok(values.into_iter().map(Intensity::PgaG).collect()),
+            "scale" => return Ok(values.into_iter().map(Intensity::Scale).collect()),
+            "sa_g" => {
+                let k = "intensity.sa_period_s";
+                let p = self.sa_period_s.as_ref().ok_or_else(|| {
+                    invalid(
+                        k,
+                        "is missing: sa_g needs the period of Sa, in s or \"building1\"".into(),
+                    )
+                })?;
+                let t = period(k, p)?;
+                SpectralIm {
+                    average: false,
+                    from: t,
+                    to: t,
+                    n: 1,
+                    damping,
+                }
+            }
+            _ => {
+                let k = "intensity.sa_avg_periods_s";
+                let p = match self.sa_avg_periods_s.as_deref() {
+                    Some([a, b]) => [period(&format!("{k}[0]"), a)?, period(&format!("{k}[1]"), b)?],
+                    Some(v) => {
+                        return Err(invalid(
+                            k,
+                            format!("{} values: expected two, [from, to]", v.len()),
+                        ))
+                    }
+                    None => {
+                        return Err(invalid(
+                            k,
+                            "is missing: sa_avg_g needs the periods [from, to], e.g. [\"0.2*building1\", \"3*building1\"]".into(),
+                        ))
+                    }
+                };
+                let n = self.sa_avg_n.unwrap_or(10);
+                if !(2..=MAX_SA_AVG_N).contains(&n) {
+                    return Err(invalid(
+                        "intensity.sa_avg_n",
+                        format!("{n}: expected 2 to {MAX_SA_AVG_N} periods"),
+                    ));
+                }
+                if p[0] == p[1] {
+                    return Err(invalid(
+                        k,
+                        "from and to are the same period: give a range (or sa_g for one period)"
+                            .into(),
+                    ));
+                }
+                SpectralIm {
+                    average: true,
+                    from: p[0],
+                    to: p[1],
+                    n,
+                    damping,
+                }
+            }
+        };
+        Ok(values
+            .into_iter()
+            .map(|g| Intensity::Spectral { g, im })
+            .collect())
+    }
 }
 
 /// A config file as written.
@@ -497,7 +676,7 @@ pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Pla
         path: path.into(),
         message: e.to_string(),
     })?;
-    parse_raw(&raw, path, base, records)
+    parse_raw(&raw, path, base, records, None)
 }
 
 /// [`parse`] of a config already read into its raw form.
@@ -506,6 +685,7 @@ pub(crate) fn parse_raw(
     path: &Path,
     base: &Path,
     records: &Path,
+    row_buildings: Option<usize>,
 ) -> Result<Plan, ConfigError> {
     let invalid = |key: &str, message: String| ConfigError::Invalid {
         path: path.into(),
@@ -605,20 +785,7 @@ pub(crate) fn parse_raw(
         })
     };
 
-    let intensities = match (&raw.intensity.pga_g, &raw.intensity.scale) {
-        (Some(a), None) => axis("intensity.pga_g", a)?
-            .into_iter()
-            .map(Intensity::PgaG)
-            .collect(),
-        (None, Some(a)) => axis("intensity.scale", a)?
-            .into_iter()
-            .map(Intensity::Scale)
-            .collect(),
-        (None, None) => vec![Intensity::Scale(1.0)],
-        (Some(_), Some(_)) => {
-            return Err(invalid("intensity", "give pga_g or scale, not both".into()))
-        }
-    };
+    let intensities = raw.intensity.axis(row_buildings.unwrap_or(2), &invalid)?;
 
     let mut recs = Vec::new();
     for (i, r) in raw.records.iter().enumerate() {
@@ -649,7 +816,11 @@ pub(crate) fn parse_raw(
         tail: raw.run.tail_s.unwrap_or(0.0),
         samples,
     };
-    Plan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
+    let plan = match row_buildings {
+        None => Plan::new(spec),
+        Some(_) => Plan::row_base(spec),
+    };
+    plan.map_err(|PlanError { key, message }| invalid(&key, message))
 }
 
 /// Refuse a sweep of more than [`crate::plan::limits::MAX_RUNS`] runs from the axes' sizes alone,
@@ -677,7 +848,9 @@ fn check_size(
         beta: count("contact.beta_n_per_m1_5", &raw.contact.beta_n_per_m1_5)?,
         records: raw.records.len(),
         intensities: count("intensity.pga_g", &raw.intensity.pga_g)?
-            * count("intensity.scale", &raw.intensity.scale)?,
+            * count("intensity.scale", &raw.intensity.scale)?
+            * count("intensity.sa_g", &raw.intensity.sa_g)?
+            * count("intensity.sa_avg_g", &raw.intensity.sa_avg_g)?,
         samples: raw.sample.as_ref().map_or(1, |s| s.n.max(1)),
         building1: b("building1", &raw.building1)?,
         building2: b("building2", &raw.building2)?,

@@ -18,6 +18,7 @@
 
 pub mod columns;
 pub mod config;
+pub mod intensity;
 pub mod limits;
 pub mod row;
 pub mod sample;
@@ -31,14 +32,7 @@ use crate::record::{Record, G};
 use std::collections::HashMap;
 use std::sync::Arc;
 
-/// A value of the intensity axis.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Intensity {
-    /// Scale each record to this PGA, g.
-    PgaG(f64),
-    /// Multiply each record by this factor.
-    Scale(f64),
-}
+pub use intensity::Intensity;
 
 /// Sweep axes of one building.
 #[derive(Debug, Clone, PartialEq)]
@@ -270,8 +264,10 @@ pub struct Plan {
     total: u64,
     /// Dimensionless damping per (law, formula, e index).
     damping: HashMap<(LawKind, Formula, usize), f64>,
-    /// Scale factor per (record, intensity).
-    scales: Vec<Vec<f64>>,
+    /// PGA of each record as read, m/s^2.
+    pgas: Vec<f64>,
+    /// Spectral measures of the records, as runs ask for them.
+    ims: intensity::ImCache,
 }
 
 /// One run, decoded.
@@ -290,6 +286,8 @@ pub struct RunSpec {
     pub record: usize,
     pub intensity: Intensity,
     pub scale: f64,
+    /// For a spectral target, the periods it was read at (s, from and to).
+    pub im_periods: Option<[f64; 2]>,
     /// PGA of the scaled record, g.
     pub pga_g: f64,
     pub m1: f64,
@@ -364,6 +362,15 @@ pub(crate) fn check_axis(
 
 impl Plan {
     pub fn new(spec: PlanSpec) -> Result<Plan, PlanError> {
+        Plan::build(spec, false)
+    }
+
+    /// The plan of a row's contact, record and intensity axes, its buildings placeholders.
+    pub(crate) fn row_base(spec: PlanSpec) -> Result<Plan, PlanError> {
+        Plan::build(spec, true)
+    }
+
+    fn build(spec: PlanSpec, row_base: bool) -> Result<Plan, PlanError> {
         let pos = POSITIVE.0;
         for (name, b) in [
             ("building1", &spec.building1),
@@ -408,27 +415,37 @@ impl Plan {
             return Err(err("intensity", "is empty"));
         }
         for (i, v) in spec.intensities.iter().enumerate() {
-            match *v {
-                Intensity::PgaG(g) if !pos(g) => {
-                    return Err(err(
-                        format!("intensity.pga_g[{i}]"),
-                        format!(
-                            "{} is out of range: expected a PGA > 0 g",
-                            crate::plan::limits::show(g)
-                        ),
-                    ))
-                }
-                Intensity::Scale(s) if !pos(s) => {
-                    return Err(err(
-                        format!("intensity.scale[{i}]"),
-                        format!(
-                            "{} is out of range: expected a factor > 0",
-                            crate::plan::limits::show(s)
-                        ),
-                    ))
-                }
-                _ => {}
+            let (value, expected) = match v {
+                Intensity::PgaG(_) => (v.value(), "a PGA > 0 g"),
+                Intensity::Scale(_) => (v.value(), "a factor > 0"),
+                Intensity::Spectral { im, .. } if im.average => (v.value(), "an Sa_avg > 0 g"),
+                Intensity::Spectral { .. } => (v.value(), "an Sa > 0 g"),
+            };
+            if !pos(value) {
+                return Err(err(
+                    format!("{}[{i}]", v.key()),
+                    format!(
+                        "{} is out of range: expected {expected}",
+                        crate::plan::limits::show(value)
+                    ),
+                ));
             }
+        }
+        let extremes = |b: &BuildingAxes, axis: SampledAxis| {
+            let sampled = spec.samples.iter().flat_map(|s| {
+                let j = s.axes.iter().position(|a| *a == axis);
+                j.into_iter()
+                    .flat_map(move |j| s.points.iter().map(move |p| p[j]))
+            });
+            intensity::span(b.period.iter().copied().chain(sampled))
+        };
+        let (lo1, hi1) = extremes(&spec.building1, SampledAxis::Period1);
+        let (lo2, hi2) = extremes(&spec.building2, SampledAxis::Period2);
+        // A row's base plan holds placeholder buildings: the row checks its targets' periods
+        // against its own buildings ([`row::RowPlan`]).
+        if !row_base {
+            intensity::check_periods(&spec.intensities, &[lo1, lo2], &[hi1, hi2])
+                .map_err(|(k, m)| err(k, m))?;
         }
         if !(spec.tail.is_finite() && (0.0..=crate::plan::limits::MAX_TAIL_S).contains(&spec.tail))
         {
@@ -492,18 +509,18 @@ impl Plan {
                 "a stiffness > 0 N/m^1.5",
             )?;
         }
-        let mut scales = Vec::with_capacity(spec.records.len());
+        let mut pgas = Vec::with_capacity(spec.records.len());
         for (r, rec) in spec.records.iter().enumerate() {
-            let mut row = Vec::with_capacity(spec.intensities.len());
-            for v in &spec.intensities {
-                row.push(match *v {
-                    Intensity::PgaG(g) => rec
-                        .scale_to_pga(g * G)
-                        .map_err(|e| err(format!("record[{r}]"), e.to_string()))?,
-                    Intensity::Scale(s) => s,
-                });
+            let scaled = spec
+                .intensities
+                .iter()
+                .any(|i| !matches!(i, Intensity::Scale(_)));
+            if scaled {
+                // A record of zeros has no PGA or Sa to scale to.
+                rec.scale_to_pga(1.0)
+                    .map_err(|e| err(format!("record[{r}]"), e.to_string()))?;
             }
-            scales.push(row);
+            pgas.push(rec.pga().value);
         }
         // Damping per (law, formula, e): printed formulas are cheap, `exact` root-finds once here.
         let mut damping = HashMap::new();
@@ -563,17 +580,24 @@ impl Plan {
             blocks,
             total,
             damping,
-            scales,
+            pgas,
+            ims: intensity::ImCache::default(),
         })
     }
 
     /// Inputs that are valid but physically absurd (a units mix-up?), one line each.
     pub fn warnings(&self) -> Vec<String> {
         let mut w = Vec::new();
+        let first = self.run(0);
         for (r, rec) in self.spec.records.iter().enumerate() {
-            let pga = self.scales[r]
+            let pga = self
+                .spec
+                .intensities
                 .iter()
-                .map(|s| rec.pga().value * s / G)
+                .map(|i| {
+                    let s = i.scaling(r, rec, self.pgas[r], &[first.t1, first.t2], &self.ims);
+                    self.pgas[r] * s.scale / G
+                })
                 .fold(0.0, f64::max);
             if pga > crate::plan::limits::WARN_PGA_G {
                 w.push(format!(
@@ -597,6 +621,27 @@ impl Plan {
 
     /// Decode run `index` (< `len()`).
     pub fn run(&self, index: u64) -> RunSpec {
+        let mut run = self.decode(index);
+        let periods = [run.t1, run.t2];
+        self.scale(&mut run, &periods);
+        run
+    }
+
+    /// Set `run`'s scale factor, the periods its intensity read and its PGA, for buildings of
+    /// these fundamental periods (left to right).
+    pub(crate) fn scale(&self, run: &mut RunSpec, periods: &[f64]) {
+        let r = run.record;
+        let s = run
+            .intensity
+            .scaling(r, &self.spec.records[r], self.pgas[r], periods, &self.ims);
+        run.scale = s.scale;
+        run.im_periods = s.periods;
+        run.pga_g = self.pgas[r] * s.scale / G;
+    }
+
+    /// Run `index`, its scale left unset (NaN) until its buildings' periods are known
+    /// ([`Plan::scale`]).
+    pub(crate) fn decode(&self, index: u64) -> RunSpec {
         assert!(
             index < self.total,
             "run {index} out of range (plan has {})",
@@ -629,7 +674,6 @@ impl Plan {
             s.k_linear[ix[2]]
         };
         let (record, inten) = (ix[3], ix[4]);
-        let scale = self.scales[record][inten];
         let mut run = RunSpec {
             index,
             law,
@@ -639,8 +683,9 @@ impl Plan {
             stiffness,
             record,
             intensity: s.intensities[inten],
-            scale,
-            pga_g: s.records[record].pga().value * scale / G,
+            scale: f64::NAN,
+            im_periods: None,
+            pga_g: f64::NAN,
             m1: s.building1.mass[ix[6]],
             t1: s.building1.period[ix[7]],
             xi1: s.building1.damping[ix[8]],
@@ -695,6 +740,15 @@ impl Plan {
     /// Motion `m` of [`Plan::motions`], as the run of the plan that has it (its sample `None`
     /// where the samples move nothing).
     pub fn motion_run(&self, m: u64) -> RunSpec {
+        let mut run = self.run(self.motion_index(m));
+        if self.motion_samples() == 1 {
+            run.sample = None;
+        }
+        run
+    }
+
+    /// The index of the run that has motion `m` ([`Plan::motion_run`]).
+    pub(crate) fn motion_index(&self, m: u64) -> u64 {
         let b = &self.blocks[0];
         let mut dims = b.dims;
         dims[5] = self.motion_samples();
@@ -706,11 +760,7 @@ impl Plan {
             rem /= dims[a] as u64;
         }
         let index = (0..NAXES).fold(0u64, |acc, a| acc * b.dims[a] as u64 + ix[a] as u64);
-        let mut run = self.run(b.start + index);
-        if dims[5] == 1 {
-            run.sample = None;
-        }
-        run
+        b.start + index
     }
 
     /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`:

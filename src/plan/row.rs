@@ -223,7 +223,7 @@ impl RowPlan {
     }
 
     pub fn run(&self, index: u64) -> RowRunSpec {
-        let base = self.base.run(index / self.per_base);
+        let base = self.base.decode(index / self.per_base);
         let mut rest = index % self.per_base;
         let mut at = vec![0usize; self.dims.len()];
         for (k, &d) in self.dims.iter().enumerate().rev() {
@@ -273,6 +273,7 @@ impl RowPlan {
                 }
             }
         }
+        self.base.scale(&mut run.base, &run.period);
         run
     }
 
@@ -306,7 +307,7 @@ impl RowPlan {
         let mut dims = self.dims.clone();
         dims[0] = self.motion_samples();
         let inner: u64 = dims[..1 + 3 * nb].iter().map(|&d| d as u64).product();
-        let base = self.base.motion_run(m / inner);
+        let base_index = self.base.motion_index(m / inner);
         let mut rem = m % inner;
         let mut at = vec![0usize; self.dims.len()];
         for k in (0..1 + 3 * nb).rev() {
@@ -315,7 +316,7 @@ impl RowPlan {
         }
         let within =
             (0..self.dims.len()).fold(0u64, |acc, k| acc * self.dims[k] as u64 + at[k] as u64);
-        let mut run = self.run(base.index * self.per_base + within);
+        let mut run = self.run(base_index * self.per_base + within);
         if dims[0] == 1 {
             run.sample = None;
         }
@@ -705,7 +706,7 @@ pub fn parse_row(
         intensity: raw.intensity.clone(),
         sample: None,
     };
-    let base_plan = parse_raw(&base_raw, path, base, records)?;
+    let base_plan = parse_raw(&base_raw, path, base, records, Some(nb))?;
     let axis = |key: &str, a: &Axis, (ok, expected): Check| {
         let v = a.values().map_err(|m| invalid(key, m))?;
         check_axis(key, &v, ok, expected).map_err(|e| invalid(&e.key, e.message))?;
@@ -831,6 +832,20 @@ pub fn parse_row(
                 .into(),
         ));
     }
+    // Each building's shortest and longest period, over its axis and its samples.
+    let (mut lo, mut hi) = (Vec::new(), Vec::new());
+    for (b, a) in buildings.iter().enumerate() {
+        let sampled = samples.iter().flat_map(|s| {
+            let j = s.axes.iter().position(|x| *x == RowSampled::Period(b));
+            j.into_iter()
+                .flat_map(move |j| s.points.iter().map(move |p| p[j]))
+        });
+        let (l, h) = crate::plan::intensity::span(a.period.iter().copied().chain(sampled));
+        lo.push(l);
+        hi.push(h);
+    }
+    crate::plan::intensity::check_periods(&base_plan.spec.intensities, &lo, &hi)
+        .map_err(|(k, m)| invalid(&k, m))?;
     let mut dims = vec![samples.as_ref().map_or(1, |s| s.points.len())];
     dims.extend(
         buildings

@@ -12,7 +12,8 @@ use crate::physics::model::Oscillator;
 use crate::physics::separation::{cqc_rho, Rule};
 use crate::physics::shear::ShearBuilding;
 use crate::physics::solver::separation::{separation, LevelSeparation, Separation};
-use crate::plan::columns::{contact_and_motion, num};
+use crate::plan::columns::{contact_and_motion, num, CONTACT_AND_MOTION};
+use crate::plan::intensity::TARGET_COLUMNS;
 use crate::plan::row::{level_name, RowPlan};
 use crate::plan::{Motions, Plan};
 use crate::studies::fragility::{fit, Fit, Level, NoFit};
@@ -83,9 +84,9 @@ impl Scenes<'_> {
 
     /// The parameter columns: the run, the ground motion, the buildings, the sample.
     fn parameter_header(&self) -> Vec<String> {
-        let mut h: Vec<String> = ["run", "record", "target_pga_g", "scale_factor", "pga_g"]
-            .map(String::from)
-            .to_vec();
+        let mut h: Vec<String> = vec!["run".into(), "record".into()];
+        h.extend(TARGET_COLUMNS.map(String::from));
+        h.extend(["scale_factor", "pga_g"].map(String::from));
         match self {
             Scenes::Pairs(_) => {
                 h.extend(["m1_kg", "t1_s", "xi1", "m2_kg", "t2_s", "xi2"].map(String::from))
@@ -106,8 +107,8 @@ impl Scenes<'_> {
     fn cells(&self, m: u64) -> Vec<String> {
         let motion_cells = |plan: &Plan, spec: &crate::plan::RunSpec| {
             let mut c = vec![m.to_string()];
-            // record, target_pga_g, scale_factor, pga_g
-            c.extend(contact_and_motion(plan, spec).drain(7..11));
+            // record, the targets, scale_factor, pga_g
+            c.extend(contact_and_motion(plan, spec).drain(7..CONTACT_AND_MOTION));
             c
         };
         let sample = |s: Option<usize>| s.map(|s| s.to_string()).unwrap_or_default();
@@ -206,8 +207,6 @@ pub struct GapStudy<'a> {
     motions: Motions,
     /// One per record and inner motion, at unit scale.
     responses: Vec<Separation>,
-    /// Per record and intensity.
-    scales: Vec<Vec<f64>>,
     /// Per run, what each adjacent pair needs.
     pair_gaps: Vec<Vec<Option<PairGap>>>,
     /// The contact levels' column prefixes (the same in every run).
@@ -235,17 +234,6 @@ impl<'a> GapStudy<'a> {
                 )
             })
             .collect();
-        let scales = (0..motions.records)
-            .map(|r| {
-                (0..motions.intensities)
-                    .map(|i| {
-                        scenes
-                            .periods((r * motions.intensities + i) as u64 * inner)
-                            .1
-                    })
-                    .collect()
-            })
-            .collect();
         let first = responses.first();
         let level_names = first.map_or(Vec::new(), |s| {
             s.levels
@@ -258,7 +246,6 @@ impl<'a> GapStudy<'a> {
             scenes,
             motions,
             responses,
-            scales,
             level_names,
             level_pairs,
             pair_gaps: Vec::new(),
@@ -270,10 +257,10 @@ impl<'a> GapStudy<'a> {
         study
     }
 
-    /// Run `m`'s separation: its response, scaled to its intensity.
+    /// Run `m`'s separation: its response, scaled to its intensity (per run: a spectral target
+    /// at a building's period scales each building's record by its own factor).
     fn separation(&self, m: u64) -> Separation {
-        let (record, intensity) = self.motions.record_and_intensity(m);
-        self.responses[self.motions.response(m) as usize].scaled(self.scales[record][intensity])
+        self.responses[self.motions.response(m) as usize].scaled(self.scenes.periods(m).1)
     }
 
     /// Runs in the study.
@@ -564,6 +551,8 @@ impl<'a> GapStudy<'a> {
         match self.scenes.base().spec.intensities[i] {
             crate::plan::Intensity::PgaG(g) => format!("PGA {g} g"),
             crate::plan::Intensity::Scale(s) => format!("scale {s}"),
+            crate::plan::Intensity::Spectral { g, im } if im.average => format!("Sa_avg {g} g"),
+            crate::plan::Intensity::Spectral { g, .. } => format!("Sa {g} g"),
         }
     }
 

@@ -175,7 +175,7 @@ fn bad_configs_name_the_key() {
         (
             "pga_g = [0.2, 0.4]",
             "pga_g = 0.2\nscale = 2",
-            "intensity: give pga_g or scale, not both",
+            "intensity: gives pga_g and scale: give one of pga_g, scale, sa_g, sa_avg_g",
         ),
         (
             "synthetic = { seed = 2, duration_s = 5.0 }",

@@ -10,6 +10,7 @@ mod gpu;
 mod gpu_rows;
 mod hard;
 mod hostile;
+mod intensity;
 mod layers;
 pub mod multistorey;
 mod oracles;

@@ -1,0 +1,320 @@
+//! The intensity axis: what each record is scaled to (`[intensity]`, `shared/docs/physics.md`
+//! section 9). A target PGA or a plain factor scales a record the same way in every run; a
+//! spectral target (`sa_g`, `sa_avg_g`) at a period that follows a building's fundamental
+//! period scales it per run, so its factor is resolved where the run's periods are known
+//! ([`crate::plan::Plan::run`], [`crate::plan::row::RowPlan::run`]).
+
+use crate::record::intensity::{log_periods, sa_avg};
+use crate::record::{Record, G};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+/// The longest period a spectral target reads (s); the shortest is a building's
+/// ([`crate::plan::limits::MIN_PERIOD_S`]).
+pub const MAX_SPECTRAL_PERIOD_S: f64 = 100.0;
+
+/// A value of the intensity axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Intensity {
+    /// Scale each record to this PGA, g.
+    PgaG(f64),
+    /// Multiply each record by this factor.
+    Scale(f64),
+    /// Scale each record so that its spectral measure `im` equals `g` (g).
+    Spectral { g: f64, im: SpectralIm },
+}
+
+/// Which spectral measure, at which periods.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpectralIm {
+    /// `Sa(T)` (`from` is `to`, one period) or `Sa_avg` over `n` log-spaced periods.
+    pub average: bool,
+    pub from: PeriodRef,
+    pub to: PeriodRef,
+    pub n: usize,
+    /// Damping ratio of the oscillator.
+    pub damping: f64,
+}
+
+/// A period: in seconds, or a multiple of a building's fundamental period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PeriodRef {
+    Seconds(f64),
+    /// `factor` times the fundamental period of building `building` (0-based, left to right).
+    Building {
+        building: usize,
+        factor: f64,
+    },
+}
+
+impl PeriodRef {
+    /// Parse `"building1"` (1-based, as the columns `b1_...`), `"building[0]"` (0-based, as the
+    /// `[[building]]` entries) or either with a factor, `"0.2*building1"`.
+    pub fn parse(text: &str) -> Result<PeriodRef, String> {
+        let bad = || {
+            format!("`{text}`: expected a period in s, or \"building1\", \"building[0]\", \"0.2*building1\" (a multiple of a building's fundamental period)")
+        };
+        let t = text.trim();
+        let (factor, name) = match t.split_once('*') {
+            Some((f, n)) => (f.trim().parse::<f64>().map_err(|_| bad())?, n.trim()),
+            None => (1.0, t),
+        };
+        let rest = name.strip_prefix("building").ok_or_else(bad)?;
+        let building = match rest.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
+            Some(i) => i.trim().parse::<usize>().map_err(|_| bad())?,
+            None => match rest.parse::<usize>() {
+                Ok(n) if n >= 1 => n - 1,
+                _ => return Err(bad()),
+            },
+        };
+        if !(factor.is_finite() && factor > 0.0) {
+            return Err(format!("`{text}`: the factor must be > 0"));
+        }
+        Ok(PeriodRef::Building { building, factor })
+    }
+
+    /// The period in s, given the buildings' fundamental periods.
+    pub fn resolve(&self, periods: &[f64]) -> f64 {
+        match *self {
+            PeriodRef::Seconds(t) => t,
+            // NaN where the scene has no such building (the config refuses it): a failed run.
+            PeriodRef::Building { building, factor } => {
+                factor * periods.get(building).copied().unwrap_or(f64::NAN)
+            }
+        }
+    }
+
+    /// The building it follows, if any.
+    pub fn building(&self) -> Option<usize> {
+        match *self {
+            PeriodRef::Seconds(_) => None,
+            PeriodRef::Building { building, .. } => Some(building),
+        }
+    }
+}
+
+impl SpectralIm {
+    /// The periods it reads from and to (s), in order, for these fundamental periods.
+    pub fn range(&self, periods: &[f64]) -> [f64; 2] {
+        let (a, b) = (self.from.resolve(periods), self.to.resolve(periods));
+        [a.min(b), a.max(b)]
+    }
+
+    /// The config key of its periods.
+    pub fn periods_key(&self) -> &'static str {
+        if self.average {
+            "intensity.sa_avg_periods_s"
+        } else {
+            "intensity.sa_period_s"
+        }
+    }
+
+    /// The buildings whose periods it follows.
+    pub fn buildings(&self) -> impl Iterator<Item = usize> {
+        self.from.building().into_iter().chain(self.to.building())
+    }
+
+    /// Its value (m/s^2) for the unscaled record `rec` over `range`.
+    pub fn of(&self, rec: &Record, range: [f64; 2]) -> f64 {
+        let n = if self.average { self.n } else { 1 };
+        sa_avg(rec, &log_periods(range[0], range[1], n), self.damping)
+    }
+
+    /// Why the periods `range` cannot be read, if they cannot.
+    pub fn check_range(range: [f64; 2]) -> Result<(), String> {
+        let lo = crate::plan::limits::MIN_PERIOD_S;
+        match range
+            .iter()
+            .find(|t| !(**t >= lo && **t <= MAX_SPECTRAL_PERIOD_S))
+        {
+            Some(t) => Err(format!(
+                "reads Sa at {} s: expected periods from {lo} to {MAX_SPECTRAL_PERIOD_S} s",
+                crate::plan::limits::show(*t)
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What the intensity gave a run: its factor and, for a spectral target, the periods read.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scaling {
+    pub scale: f64,
+    /// s, from and to (equal for `Sa(T)`).
+    pub periods: Option<[f64; 2]>,
+}
+
+/// The columns that say what a run's record was scaled to, in file order (units in the names).
+pub const TARGET_COLUMNS: [&str; 6] = [
+    "target_pga_g",
+    "target_sa_g",
+    "sa_period_s",
+    "target_sa_avg_g",
+    "sa_avg_from_s",
+    "sa_avg_to_s",
+];
+
+/// The values of [`TARGET_COLUMNS`] for a run of `intensity` whose spectral target read
+/// `periods` (None where a column does not apply).
+pub fn target_values(intensity: &Intensity, periods: Option<[f64; 2]>) -> [Option<f64>; 6] {
+    let mut v = [None; 6];
+    match *intensity {
+        Intensity::PgaG(g) => v[0] = Some(g),
+        Intensity::Scale(_) => {}
+        Intensity::Spectral { g, im } => {
+            let p = periods.unwrap_or([f64::NAN; 2]);
+            if im.average {
+                v[3..6].copy_from_slice(&[Some(g), Some(p[0]), Some(p[1])]);
+            } else {
+                v[1..3].copy_from_slice(&[Some(g), Some(p[0])]);
+            }
+        }
+    }
+    v
+}
+
+/// Spectral measures of the unscaled records, computed once per record and periods: runs that
+/// share them share one computation whichever thread asks first.
+#[derive(Debug, Clone, Default)]
+pub struct ImCache {
+    values: Arc<Mutex<HashMap<ImKey, f64>>>,
+}
+
+/// A record's index and the bits of the periods read from and to.
+type ImKey = (usize, u64, u64);
+
+impl ImCache {
+    /// `im` of record `r` (`rec`) over `range`, m/s^2.
+    pub fn get(&self, r: usize, rec: &Record, im: &SpectralIm, range: [f64; 2]) -> f64 {
+        let key = (r, range[0].to_bits(), range[1].to_bits());
+        if let Some(v) = self.values.lock().expect("cache lock").get(&key) {
+            return *v;
+        }
+        // Computed outside the lock: other records and periods go on meanwhile.
+        let v = im.of(rec, range);
+        self.values.lock().expect("cache lock").insert(key, v);
+        v
+    }
+}
+
+impl Intensity {
+    /// The factor for record `r` (`rec`, whose PGA is `pga` m/s^2) in a run whose buildings
+    /// have these fundamental periods.
+    pub fn scaling(
+        &self,
+        r: usize,
+        rec: &Record,
+        pga: f64,
+        periods: &[f64],
+        cache: &ImCache,
+    ) -> Scaling {
+        match *self {
+            Intensity::PgaG(g) => Scaling {
+                scale: g * G / pga,
+                periods: None,
+            },
+            Intensity::Scale(s) => Scaling {
+                scale: s,
+                periods: None,
+            },
+            Intensity::Spectral { g, im } => {
+                let range = im.range(periods);
+                Scaling {
+                    scale: g * G / cache.get(r, rec, &im, range),
+                    periods: Some(range),
+                }
+            }
+        }
+    }
+
+    /// The spectral measure it targets, if any.
+    pub fn spectral(&self) -> Option<&SpectralIm> {
+        match self {
+            Intensity::Spectral { im, .. } => Some(im),
+            _ => None,
+        }
+    }
+
+    /// Its config key (`intensity.pga_g`, ...).
+    pub fn key(&self) -> &'static str {
+        match self {
+            Intensity::PgaG(_) => "intensity.pga_g",
+            Intensity::Scale(_) => "intensity.scale",
+            Intensity::Spectral { im, .. } if im.average => "intensity.sa_avg_g",
+            Intensity::Spectral { .. } => "intensity.sa_g",
+        }
+    }
+
+    /// Its target value (g or a factor).
+    pub fn value(&self) -> f64 {
+        match *self {
+            Intensity::PgaG(g) | Intensity::Scale(g) | Intensity::Spectral { g, .. } => g,
+        }
+    }
+}
+
+/// The shortest and longest of `periods` (what [`check_periods`] needs of each building).
+pub fn span(periods: impl Iterator<Item = f64>) -> (f64, f64) {
+    periods.fold((f64::INFINITY, 0.0), |(lo, hi), t| (lo.min(t), hi.max(t)))
+}
+
+/// Check a spectral target's periods against every value the buildings' periods take: `lo` and
+/// `hi` hold, per building, its shortest and longest fundamental period in the sweep (each
+/// period read grows with the building's, so the extremes bound them all).
+pub fn check_periods(
+    intensities: &[Intensity],
+    lo: &[f64],
+    hi: &[f64],
+) -> Result<(), (String, String)> {
+    let Some(im) = intensities.iter().find_map(|i| i.spectral()) else {
+        return Ok(());
+    };
+    for b in im.buildings() {
+        if b >= lo.len() {
+            return Err((
+                im.periods_key().into(),
+                format!(
+                    "follows building{} (building[{b}]), but the scene has {} buildings",
+                    b + 1,
+                    lo.len()
+                ),
+            ));
+        }
+    }
+    for periods in [lo, hi] {
+        SpectralIm::check_range(im.range(periods))
+            .map_err(|m| (im.periods_key().to_string(), m))?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn period_references_parse_and_resolve() {
+        let b = |building, factor| PeriodRef::Building { building, factor };
+        assert_eq!(PeriodRef::parse("building1"), Ok(b(0, 1.0)));
+        assert_eq!(PeriodRef::parse("building[2]"), Ok(b(2, 1.0)));
+        assert_eq!(PeriodRef::parse(" 0.2 * building2"), Ok(b(1, 0.2)));
+        for bad in [
+            "building0",
+            "buildin1",
+            "building",
+            "x*building1",
+            "-1*building1",
+        ] {
+            assert!(PeriodRef::parse(bad).is_err(), "{bad}");
+        }
+        assert_eq!(b(1, 3.0).resolve(&[0.5, 0.4]), 3.0 * 0.4);
+        let im = SpectralIm {
+            average: true,
+            from: b(0, 3.0),
+            to: b(1, 0.2),
+            n: 10,
+            damping: 0.05,
+        };
+        assert_eq!(im.range(&[1.0, 2.0]), [0.4, 3.0]);
+    }
+}
