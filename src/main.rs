@@ -55,6 +55,7 @@ fn run(cmd: cli::Cmd) -> anyhow::Result<()> {
         Cmd::Formulas(a) => cli::formulas::run(a),
         Cmd::Plot(a) => cli::plot::run(a),
         Cmd::Fragility(a) => cli::fragility::run(a),
+        Cmd::Ida(a) => cli::ida::run(a),
         Cmd::Gap(a) => cli::gap::run(a),
         Cmd::Merge(a) => cli::merge::run(a),
         Cmd::Paper => cli::paper::run(),

@@ -1,24 +1,50 @@
-//! `pound fragility`: exceedance counts and fitted lognormal curves from a results CSV.
+//! `pound fragility`: exceedance counts and fitted lognormal curves from a results CSV, per
+//! threshold or per named damage state, with bootstrap bands over records.
 
 use super::{check_study_outputs, write_file, Holds};
-use anyhow::{bail, Result};
+use anyhow::{anyhow, bail, Result};
 use pounding::io::table::{Filter, Table};
-use pounding::studies::fragility::{csv, fit, levels, panel, FragilitySpec};
+use pounding::studies::damage_states::DamageStates;
+use pounding::studies::fragility::{
+    bootstrap, crossings, csv, default_im, fit, panel, Band, FragilitySpec, Grouped,
+};
+use pounding::studies::plot::Series;
 use std::path::PathBuf;
 
+/// Bootstrap replicates at most (each refits every threshold).
+const MAX_BOOTSTRAP: usize = 100_000;
+
 #[derive(clap::Args)]
+#[command(group(clap::ArgGroup::new("limits").required(true).args(["threshold", "damage_states"])))]
 pub struct Args {
     /// A CSV written by `pound sweep`.
     results: PathBuf,
-    /// Intensity measure column (e.g. pga_g, scale_factor).
-    #[arg(long, default_value = "pga_g")]
-    im: String,
-    /// Demand column (e.g. peak_force_n; `impacts` with threshold 0 for "pounds at all").
+    /// Intensity measure: any numeric column (e.g. pga_g, target_sa_g, target_sa_avg_g,
+    /// scale_factor). Default: the spectral target the CSV was scaled to, else pga_g.
+    #[arg(long)]
+    im: Option<String>,
+    /// Demand column (e.g. peak_force_n, b1_peak_drift_ratio; `impacts` with threshold 0 for
+    /// "pounds at all").
     #[arg(long, default_value = "peak_force_n")]
     edp: String,
     /// Exceedance thresholds (EDP > threshold), comma-separated.
-    #[arg(long, value_delimiter = ',', required = true)]
+    #[arg(long, value_delimiter = ',')]
     threshold: Vec<f64>,
+    /// Named damage states instead of thresholds: a built-in set (hazus-c1l-high,
+    /// hazus-c1l-moderate, hazus-c1l-low, hazus-c1l-pre: HAZUS-MH drift ratios of low-rise
+    /// concrete moment frames) or a TOML file of `[[state]]` entries with `name` and `limit`.
+    #[arg(long, value_name = "SET")]
+    damage_states: Option<String>,
+    /// Bootstrap replicates over the groups of `--by` (records), for 90 % bands of each
+    /// fitted median, beta and curve (0: none).
+    #[arg(long, default_value_t = 0)]
+    bootstrap: usize,
+    /// Seed of the bootstrap draws.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// The column whose groups the bootstrap draws with replacement.
+    #[arg(long, default_value = "record")]
+    by: String,
     /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
     #[arg(long = "where", value_name = "FILTER")]
     filters: Vec<String>,
@@ -40,14 +66,35 @@ pub fn run(a: Args) -> Result<()> {
             ("--plot", a.plot.as_deref(), Holds::Plot),
         ],
     )?;
+    if a.bootstrap > MAX_BOOTSTRAP {
+        bail!(
+            "--bootstrap {}: expected at most {MAX_BOOTSTRAP} replicates",
+            a.bootstrap
+        );
+    }
+    let states = a
+        .damage_states
+        .as_deref()
+        .map(DamageStates::get)
+        .transpose()
+        .map_err(|e| anyhow!(e))?;
+    let (thresholds, names): (Vec<f64>, Vec<String>) = match &states {
+        Some(d) => (d.limits(), d.states.iter().map(|s| s.0.clone()).collect()),
+        None => (
+            a.threshold.clone(),
+            a.threshold.iter().map(|t| t.to_string()).collect(),
+        ),
+    };
     let table = Table::read(&a.results)?;
     let spec = FragilitySpec {
-        im: a.im,
+        im: a.im.unwrap_or_else(|| default_im(&table)),
         edp: a.edp,
-        thresholds: a.threshold,
+        thresholds,
         filters: Filter::parse_all(&a.filters)?,
     };
-    let (lv, skipped) = levels(&table, &spec)?;
+    let group = (a.bootstrap > 0).then_some(a.by.as_str());
+    let (grouped, skipped) = Grouped::read(&table, &spec, group)?;
+    let lv = grouped.pooled(&[1]);
     let runs: u64 = lv.first().map_or(0, |l| l.iter().map(|x| x.n).sum());
     if runs == 0 {
         bail!(
@@ -66,13 +113,79 @@ pub fn run(a: Args) -> Result<()> {
             String::new()
         }
     );
-    say!("\n| {} > | median {} | beta | se(ln median) | se(beta) | log-likelihood | deviance (dof) | p (fit) |\n|---:|---:|---:|---:|---:|---:|---:|---:|", spec.edp, spec.im);
+    if lv[0].len() as u64 * 2 > runs && runs >= 10 {
+        note!(
+            "notice: {} takes {} values over {runs} runs: an intensity measure that differs from run to run (levels of one or two runs each) gives shares of little meaning; the level a sweep scales to is a target column (target_pga_g, target_sa_g, target_sa_avg_g)",
+            spec.im,
+            lv[0].len()
+        );
+    }
+    if let Some(d) = &states {
+        say!("damage states {} ({}) on {}", d.name, d.source, spec.edp);
+    }
+    let (lo, hi) = (grouped.ims[0], grouped.ims[grouped.ims.len() - 1]);
+    let plot_ims: Vec<f64> = (0..=100)
+        .map(|i| lo + (hi - lo) * i as f64 / 100.0)
+        .collect();
+    let bands = if a.bootstrap > 0 {
+        if grouped.groups.len() < 2 {
+            bail!(
+                "--bootstrap: the runs fall in {} group of {}: resampling needs at least two",
+                grouped.groups.len(),
+                a.by
+            );
+        }
+        say!(
+            "bootstrap: {} replicates over {} groups of {} (seed {}), 90 % bands",
+            a.bootstrap,
+            grouped.groups.len(),
+            a.by,
+            a.seed
+        );
+        bootstrap(&grouped, a.bootstrap, a.seed, &plot_ims)
+    } else {
+        vec![None; spec.thresholds.len()]
+    };
+    let first = if states.is_some() {
+        format!("state ({} >)", spec.edp)
+    } else {
+        format!("{} >", spec.edp)
+    };
+    let band_head = if a.bootstrap > 0 {
+        " median 90 % | beta 90 % |"
+    } else {
+        ""
+    };
+    let band_rule = if a.bootstrap > 0 { "---:|---:|" } else { "" };
+    say!("\n| {first} | median {} | beta | se(ln median) | se(beta) | log-likelihood | deviance (dof) | p (fit) |{band_head}\n|---:|---:|---:|---:|---:|---:|---:|---:|{band_rule}", spec.im);
     let mut poor = Vec::new();
-    for (t, f) in spec.thresholds.iter().zip(&fits) {
+    let mut unfitted = Vec::new();
+    for (i, f) in fits.iter().enumerate() {
+        let label = match &states {
+            Some(_) => format!("{} ({})", names[i], spec.thresholds[i]),
+            None => names[i].clone(),
+        };
+        let band = match (&bands[i], a.bootstrap > 0) {
+            (Some(b), _) => {
+                if b.unfitted > 0 {
+                    unfitted.push(format!(
+                        "{label}: {} of {}",
+                        b.unfitted,
+                        b.unfitted + b.fitted
+                    ));
+                }
+                format!(
+                    " {:.4}-{:.4} | {:.4}-{:.4} |",
+                    b.median[0], b.median[1], b.beta[0], b.beta[1],
+                )
+            }
+            (None, true) => " no replicate fitted | |".into(),
+            (None, false) => String::new(),
+        };
         match f {
             Ok(f) => {
                 say!(
-                    "| {t} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} | {:.2} ({}) | {} |",
+                    "| {label} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} | {:.2} ({}) | {} |{band}",
                     f.median,
                     f.beta,
                     f.se_ln_median,
@@ -83,11 +196,17 @@ pub fn run(a: Args) -> Result<()> {
                     f.p_fit.map_or("-".into(), |p| format!("{p:.3}"))
                 );
                 if f.p_fit.is_some_and(|p| p < 0.05) {
-                    poor.push(t.to_string());
+                    poor.push(label);
                 }
             }
-            Err(e) => say!("| {t} | no fit: {e} | | | | | | |"),
+            Err(e) => say!("| {label} | no fit: {e} | | | | | | |{band}"),
         }
+    }
+    if !unfitted.is_empty() {
+        note!(
+            "notice: bootstrap replicates with no fit (left out of the bands): {}",
+            unfitted.join("; ")
+        );
     }
     if !poor.is_empty() {
         note!(
@@ -95,9 +214,46 @@ pub fn run(a: Args) -> Result<()> {
             poor.join(", ")
         );
     }
+    for (i, j, im) in crossings(&fits, lo, hi) {
+        note!(
+            "notice: the fitted curves of {} and {} cross: from {} = {im:.4} the more severe ({}) is the more probable, which no run can be (every run above {} is above {}); the curves are kept as fitted, read them only below that intensity or fit with more runs",
+            names[i], names[j], spec.im, names[j], spec.thresholds[j], spec.thresholds[i]
+        );
+    }
     write_file(&output, csv(&spec, &lv).as_bytes())?;
     if let Some(p) = &a.plot {
-        super::save_plot(p, &[panel(&spec, &lv, &fits)], 1)?;
+        let mut pl = panel(&spec, &lv, &fits);
+        if states.is_some() {
+            for s in &mut pl.series {
+                for (n, t) in names.iter().zip(&spec.thresholds) {
+                    let prefix = format!("{} > {t}:", spec.edp);
+                    if let Some(rest) = s.name.strip_prefix(&prefix) {
+                        s.name = format!("{n} ({} > {t}):{rest}", spec.edp);
+                    }
+                }
+            }
+        }
+        for b in bands.iter().flatten() {
+            pl.series.extend(band_series(b));
+        }
+        if bands.iter().any(|b| b.is_some()) {
+            pl.title.push_str(" (grey: 90 % bands)");
+        }
+        super::save_plot(p, &[pl], 1)?;
     }
     Ok(())
+}
+
+/// A bootstrap band as two grey lines (unnamed: no legend entry).
+fn band_series(b: &Band) -> [Series; 2] {
+    [0, 1].map(|k| Series {
+        name: String::new(),
+        points: b
+            .ims
+            .iter()
+            .zip(&b.curve)
+            .map(|(&im, c)| (im, c[k]))
+            .collect(),
+        scatter: false,
+    })
 }

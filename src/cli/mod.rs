@@ -52,6 +52,7 @@ pub mod fragility;
 pub mod gap;
 pub mod gpu;
 pub mod hysteresis;
+pub mod ida;
 pub mod merge;
 pub mod paper;
 pub mod plot;
@@ -81,6 +82,9 @@ pub enum Cmd {
     /// Fragility curves from a results CSV: the share of runs whose EDP exceeds each threshold
     /// at each intensity level, and a lognormal curve fitted by maximum likelihood.
     Fragility(fragility::Args),
+    /// Incremental dynamic analysis from a results CSV: per record the demand against the
+    /// intensity, and the 16, 50 and 84 % fractiles across records at each intensity level.
+    Ida(ida::Args),
     /// The separation each adjacent pair of a sweep's buildings needs: exactly from the time
     /// histories (the largest closing of the uncoupled responses), and by the ABS, SRSS and DDC
     /// rules from the same peaks; their ratios, and the probability of pounding against the gap.

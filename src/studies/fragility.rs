@@ -293,18 +293,39 @@ pub fn levels(
     table: &Table,
     spec: &FragilitySpec,
 ) -> Result<(Vec<Vec<Level>>, LeftOut), TableError> {
-    if let Some(t) = spec.thresholds.iter().find(|t| !t.is_finite()) {
-        return Err(TableError::Read {
-            path: table.path.clone(),
-            message: format!("--threshold {t}: expected a finite number (EDP > threshold is never decided by NaN or infinity)"),
-        });
-    }
-    let (ci, ce) = (table.col(&spec.im)?, table.col(&spec.edp)?);
+    let (grouped, skipped) = Grouped::read(table, spec, None)?;
+    Ok((grouped.pooled(&[1]), skipped))
+}
+
+/// The intensity measure a results CSV was scaled to: its spectral target column where it has
+/// one filled (`target_sa_g`, `target_sa_avg_g`), else `pga_g` (the PGA of each scaled record,
+/// which is the target PGA where one was given).
+pub fn default_im(table: &Table) -> String {
+    ["target_sa_g", "target_sa_avg_g"]
+        .into_iter()
+        .find(|c| {
+            table
+                .col(c)
+                .is_ok_and(|i| table.rows.iter().any(|r| !r[i].is_empty()))
+        })
+        .unwrap_or("pga_g")
+        .to_string()
+}
+
+/// The rows of `table` that `filters` keep, whose status is `ok` (where there is a status column)
+/// and whose IM (column `ci`) and EDP (`ce`) are finite numbers: (row, intensity level, EDP).
+/// The level is the IM rounded to 12 significant digits (CSV text round-trips exactly, but
+/// scaled PGAs computed per record may differ in the last bits). `skipped` counts the rest.
+pub fn demand_rows(
+    table: &Table,
+    filters: &[Filter],
+    ci: usize,
+    ce: usize,
+    skipped: &mut LeftOut,
+) -> Result<Vec<(usize, f64, f64)>, TableError> {
     let cs = table.col("status").ok();
-    let rows = table.select(&spec.filters)?;
-    let mut by_im: BTreeMap<u64, (f64, Vec<f64>)> = BTreeMap::new();
-    let mut skipped = LeftOut::default();
-    for i in rows {
+    let mut out = Vec::new();
+    for i in table.select(filters)? {
         if cs.is_some_and(|c| table.rows[i][c] != "ok") {
             skipped.failed += 1;
             continue;
@@ -317,30 +338,195 @@ pub fn levels(
             skipped.non_finite += 1;
             continue;
         }
-        // Levels keyed by the IM rounded to 12 significant digits (CSV text round-trips exactly,
-        // but scaled PGAs computed per record may differ in the last bits).
-        let key = format!("{im:.11e}").parse::<f64>().unwrap_or(im);
-        by_im
-            .entry(order_key(key))
-            .or_insert((key, Vec::new()))
-            .1
-            .push(edp);
+        let level = format!("{im:.11e}").parse::<f64>().unwrap_or(im);
+        out.push((i, level, edp));
     }
-    let out = spec
-        .thresholds
-        .iter()
-        .map(|&t| {
-            by_im
-                .values()
-                .map(|(im, edps)| Level {
-                    im: *im,
-                    n: edps.len() as u64,
-                    exceed: edps.iter().filter(|&&e| e > t).count() as u64,
-                })
-                .collect()
+    Ok(out)
+}
+
+/// Counts per group of runs (e.g. per record), threshold and intensity level: what a bootstrap
+/// over the groups resamples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grouped {
+    /// The intensity levels, ascending (every group's counts use them all, with n = 0 where a
+    /// group has no run at a level).
+    pub ims: Vec<f64>,
+    /// The groups' names (the group column's text), in order of first appearance.
+    pub groups: Vec<String>,
+    /// `counts[group][threshold][level]`: runs and exceedances.
+    pub counts: Vec<Vec<Vec<(u64, u64)>>>,
+}
+
+impl Grouped {
+    /// The counts of `table` under `spec`, grouped by the column `group` (one group if None).
+    pub fn read(
+        table: &Table,
+        spec: &FragilitySpec,
+        group: Option<&str>,
+    ) -> Result<(Grouped, LeftOut), TableError> {
+        if let Some(t) = spec.thresholds.iter().find(|t| !t.is_finite()) {
+            return Err(TableError::Read {
+                path: table.path.clone(),
+                message: format!("--threshold {t}: expected a finite number (EDP > threshold is never decided by NaN or infinity)"),
+            });
+        }
+        let (ci, ce) = (table.col(&spec.im)?, table.col(&spec.edp)?);
+        let cg = group.map(|g| table.col(g)).transpose()?;
+        let mut skipped = LeftOut::default();
+        let mut ims: BTreeMap<u64, f64> = BTreeMap::new();
+        let mut groups: Vec<String> = Vec::new();
+        let mut group_of: std::collections::HashMap<String, usize> = Default::default();
+        let mut runs: Vec<(usize, u64, f64)> = Vec::new();
+        for (i, level, edp) in demand_rows(table, &spec.filters, ci, ce, &mut skipped)? {
+            ims.insert(order_key(level), level);
+            let name = cg.map_or(String::new(), |c| table.rows[i][c].clone());
+            let g = *group_of.entry(name.clone()).or_insert_with(|| {
+                groups.push(name);
+                groups.len() - 1
+            });
+            runs.push((g, order_key(level), edp));
+        }
+        let at: BTreeMap<u64, usize> = ims.keys().enumerate().map(|(i, k)| (*k, i)).collect();
+        let mut counts =
+            vec![vec![vec![(0u64, 0u64); ims.len()]; spec.thresholds.len()]; groups.len()];
+        for (g, key, edp) in runs {
+            for (t, &limit) in spec.thresholds.iter().enumerate() {
+                let c = &mut counts[g][t][at[&key]];
+                c.0 += 1;
+                c.1 += u64::from(edp > limit);
+            }
+        }
+        let grouped = Grouped {
+            ims: ims.into_values().collect(),
+            groups,
+            counts,
+        };
+        Ok((grouped, skipped))
+    }
+
+    /// The levels per threshold when group `g` counts `weights[g]` times (a weight of 1 for
+    /// every group, or `[1]` for all: the counts as read).
+    pub fn pooled(&self, weights: &[u32]) -> Vec<Vec<Level>> {
+        let thresholds = self.counts.first().map_or(0, |c| c.len());
+        (0..thresholds)
+            .map(|t| {
+                self.ims
+                    .iter()
+                    .enumerate()
+                    .map(|(l, &im)| {
+                        let (mut n, mut exceed) = (0, 0);
+                        for (g, c) in self.counts.iter().enumerate() {
+                            let w = u64::from(*weights.get(g).unwrap_or(&weights[0]));
+                            n += w * c[t][l].0;
+                            exceed += w * c[t][l].1;
+                        }
+                        Level { im, n, exceed }
+                    })
+                    .filter(|l| l.n > 0)
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// A bootstrap over groups of runs (records): the fitted median's and beta's 5 and 95 %
+/// percentiles and the curve's, pointwise, at `ims`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Band {
+    pub median: [f64; 2],
+    pub beta: [f64; 2],
+    /// At each of `ims`: the 5 and 95 % percentiles of the fitted probability.
+    pub ims: Vec<f64>,
+    pub curve: Vec<[f64; 2]>,
+    /// Replicates fitted, and those where no curve could be (left out of the band).
+    pub fitted: usize,
+    pub unfitted: usize,
+}
+
+/// Per threshold, `replicates` bootstrap fits of `grouped` (groups drawn with replacement,
+/// seeded), the band read at `ims`; None for a threshold where no replicate could be fitted.
+pub fn bootstrap(
+    grouped: &Grouped,
+    replicates: usize,
+    seed: u64,
+    ims: &[f64],
+) -> Vec<Option<Band>> {
+    let ng = grouped.groups.len();
+    let thresholds = grouped.counts.first().map_or(0, |c| c.len());
+    let mut rng = crate::plan::sample::Rng::new(seed);
+    let mut fits: Vec<Vec<Fit>> = vec![Vec::new(); thresholds];
+    let mut unfitted = vec![0usize; thresholds];
+    for _ in 0..replicates {
+        let mut weights = vec![0u32; ng];
+        for _ in 0..ng {
+            weights[((rng.uniform() * ng as f64) as usize).min(ng - 1)] += 1;
+        }
+        for (t, lv) in grouped.pooled(&weights).iter().enumerate() {
+            match fit(lv) {
+                Ok(f) => fits[t].push(f),
+                Err(_) => unfitted[t] += 1,
+            }
+        }
+    }
+    let band = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        [quantile(&v, 0.05), quantile(&v, 0.95)]
+    };
+    fits.into_iter()
+        .zip(unfitted)
+        .map(|(f, unfitted)| {
+            (!f.is_empty()).then(|| Band {
+                median: band(f.iter().map(|x| x.median).collect()),
+                beta: band(f.iter().map(|x| x.beta).collect()),
+                ims: ims.to_vec(),
+                curve: ims
+                    .iter()
+                    .map(|&im| band(f.iter().map(|x| x.probability(im)).collect()))
+                    .collect(),
+                fitted: f.len(),
+                unfitted,
+            })
         })
+        .collect()
+}
+
+/// Where fitted curves of ascending thresholds disagree with their order, within the
+/// intensities `lo..=hi`: for each pair `(i, j)`, `i < j`, the lowest intensity (of 200 spaced
+/// evenly) at which the curve of the higher threshold `j` lies above the curve of `i`. Counts
+/// cannot do that (a run above `j` is above `i`); fitted curves of different betas can.
+pub fn crossings(fits: &[Result<Fit, NoFit>], lo: f64, hi: f64) -> Vec<(usize, usize, f64)> {
+    let n = 200;
+    let ims: Vec<f64> = (0..=n)
+        .map(|k| lo + (hi - lo) * k as f64 / n as f64)
+        .filter(|&im| im > 0.0)
         .collect();
-    Ok((out, skipped))
+    let mut out = Vec::new();
+    for (i, a) in fits.iter().enumerate() {
+        for (j, b) in fits.iter().enumerate().skip(i + 1) {
+            let (Ok(a), Ok(b)) = (a, b) else { continue };
+            if let Some(&im) = ims
+                .iter()
+                .find(|&&im| b.probability(im) > a.probability(im) + 1e-12)
+            {
+                out.push((i, j, im));
+            }
+        }
+    }
+    out
+}
+
+/// Quantile `q` of sorted values, interpolated linearly between order statistics (NaN when
+/// there are none).
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    match sorted.len() {
+        0 => f64::NAN,
+        n => {
+            let x = q * (n - 1) as f64;
+            let (i, f) = (x.floor() as usize, x - x.floor());
+            let next = sorted[(i + 1).min(n - 1)];
+            sorted[i] + f * (next - sorted[i])
+        }
+    }
 }
 
 /// The counts as CSV: threshold, im, n, exceed, fraction.
@@ -406,6 +592,78 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Groups of `(n, exceed)` per level at `ims`, one threshold.
+    fn grouped(ims: &[f64], groups: &[Vec<(u64, u64)>]) -> Grouped {
+        Grouped {
+            ims: ims.to_vec(),
+            groups: (0..groups.len()).map(|g| format!("r{g}")).collect(),
+            counts: groups.iter().map(|c| vec![c.clone()]).collect(),
+        }
+    }
+
+    /// Identical groups: every replicate is the pooled counts scaled, so the band is the point
+    /// fit itself; different groups give a band around it that the seed reproduces exactly.
+    #[test]
+    fn bootstrap_bands_collapse_for_identical_groups_and_follow_the_seed() {
+        let ims = [0.1, 0.2, 0.4, 0.8];
+        let one = vec![(10, 1), (10, 3), (10, 6), (10, 9)];
+        let same = grouped(&ims, &vec![one.clone(); 5]);
+        let f = fit(&same.pooled(&[1])[0]).unwrap();
+        let b = bootstrap(&same, 50, 7, &[0.3])[0].clone().unwrap();
+        for x in b.median {
+            assert!((x / f.median - 1.0).abs() < 1e-9);
+        }
+        assert!((b.curve[0][1] - f.probability(0.3)).abs() < 1e-9);
+        let mixed = grouped(
+            &ims,
+            &[
+                one.clone(),
+                vec![(10, 0), (10, 1), (10, 4), (10, 7)],
+                vec![(10, 3), (10, 6), (10, 8), (10, 10)],
+                vec![(10, 1), (10, 2), (10, 7), (10, 9)],
+            ],
+        );
+        let f = fit(&mixed.pooled(&[1])[0]).unwrap();
+        let b = bootstrap(&mixed, 400, 7, &[0.3])[0].clone().unwrap();
+        assert!(
+            b.median[0] < f.median && f.median < b.median[1],
+            "{b:?} {f:?}"
+        );
+        assert!(b.median[1] / b.median[0] > 1.05);
+        assert_eq!(b.fitted + b.unfitted, 400);
+        assert_eq!(bootstrap(&mixed, 400, 7, &[0.3])[0], Some(b.clone()));
+        assert_ne!(bootstrap(&mixed, 400, 8, &[0.3])[0], Some(b));
+    }
+
+    /// Curves of ascending thresholds whose betas differ cross where the flatter one rises
+    /// above the steeper; ordered curves of one beta never do.
+    #[test]
+    fn crossing_curves_are_found() {
+        let curve = |median: f64, beta: f64| -> Result<Fit, NoFit> {
+            Ok(Fit {
+                median,
+                beta,
+                se_ln_median: 0.0,
+                se_beta: 0.0,
+                log_likelihood: 0.0,
+                deviance: 0.0,
+                dof: 0,
+                p_fit: None,
+            })
+        };
+        assert!(crossings(&[curve(0.5, 0.4), curve(0.8, 0.4)], 0.05, 3.0).is_empty());
+        // ln(im) where they meet: (b2 ln m1 - b1 ln m2) / (b2 - b1), below which the flatter
+        // (higher threshold) curve lies above the steeper one.
+        let c = crossings(&[curve(0.5, 0.2), curve(0.6, 0.8)], 0.05, 3.0);
+        assert_eq!(c.len(), 1);
+        let (i, j, im) = c[0];
+        assert_eq!((i, j), (0, 1));
+        assert!(im < 0.5, "{im}");
+        assert!(
+            curve(0.6, 0.8).unwrap().probability(im) > curve(0.5, 0.2).unwrap().probability(im)
+        );
+    }
 
     /// A curve through exact probabilities is recovered to the solver's precision.
     #[test]

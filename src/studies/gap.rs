@@ -711,19 +711,7 @@ impl PoundingCurve {
     }
 }
 
-/// Quantile `q` of sorted values, interpolated linearly between order statistics (NaN when
-/// there are none).
-pub fn quantile(sorted: &[f64], q: f64) -> f64 {
-    match sorted.len() {
-        0 => f64::NAN,
-        n => {
-            let x = q * (n - 1) as f64;
-            let (i, f) = (x.floor() as usize, x - x.floor());
-            let next = sorted[(i + 1).min(n - 1)];
-            sorted[i] + f * (next - sorted[i])
-        }
-    }
-}
+pub use crate::studies::fragility::quantile;
 
 /// A round step (1, 2 or 5 times a power of ten) of at least `x`.
 fn round_step(x: f64) -> f64 {

@@ -1,16 +1,19 @@
 //! What users do with sweeps and single collisions: speed against error ([`accuracy`]),
 //! throughput ([`bench`](mod@bench)), restitution fidelity and hysteresis loops ([`fidelity`]), the
-//! formulas' zeta(e) ([`formulas`]), fragility curves ([`fragility`]), sensitivity plots
+//! formulas' zeta(e) ([`formulas`]), fragility curves ([`fragility`]) with
+//! named damage states ([`damage_states`]), incremental dynamic analysis summaries ([`ida`]), sensitivity plots
 //! ([`sensitivity`]), the seed paper's checks ([`paper`]), and drawing them ([`plot`]).
 //!
 //! The top layer of the library: may import every layer below; nothing below imports it.
 
 pub mod accuracy;
 pub mod bench;
+pub mod damage_states;
 pub mod fidelity;
 pub mod formulas;
 pub mod fragility;
 pub mod gap;
+pub mod ida;
 pub mod paper;
 pub mod plot;
 pub mod sensitivity;

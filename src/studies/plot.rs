@@ -20,6 +20,7 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Markers only (no line).
     pub scatter: bool,
+    // An empty name draws a thin grey line with no legend entry (one of many, as IDA curves).
 }
 
 /// One chart.
@@ -205,7 +206,15 @@ fn draw<DB: DrawingBackend>(
     for (i, s) in p.series.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
         let data = pts(s);
-        if s.scatter {
+        if s.name.is_empty() {
+            // Unnamed: a background line (one of many), thin and grey, with no legend entry.
+            chart
+                .draw_series(LineSeries::new(
+                    data,
+                    RGBColor(175, 175, 175).stroke_width(1),
+                ))
+                .map_err(|x| e(&x))?;
+        } else if s.scatter {
             chart
                 .draw_series(data.into_iter().map(|q| Circle::new(q, 3, color.filled())))
                 .map_err(|x| e(&x))?

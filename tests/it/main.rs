@@ -3,6 +3,7 @@
 mod accuracy;
 mod cli;
 mod config;
+mod damage;
 mod fast_vs_reference;
 mod fidelity;
 mod gap;

@@ -1,0 +1,116 @@
+//! `pound ida`: IDA curves and their fractiles from a results CSV.
+
+use super::{check_study_outputs, write_file, Holds};
+use anyhow::Result;
+use pounding::io::table::{Filter, Table};
+use pounding::studies::fragility::default_im;
+use pounding::studies::ida::{read, IdaSpec, FRACTILES};
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// A CSV written by `pound sweep`.
+    results: PathBuf,
+    /// Intensity measure column (e.g. target_sa_g, target_sa_avg_g, pga_g). Default: the
+    /// spectral target the CSV was scaled to, else pga_g.
+    #[arg(long)]
+    im: Option<String>,
+    /// Demand column (e.g. b1_peak_drift_ratio, peak_force_n).
+    #[arg(long)]
+    edp: String,
+    /// The columns that name a curve, comma-separated (default: record, and sample where the
+    /// CSV has samples).
+    #[arg(long, value_delimiter = ',')]
+    by: Vec<String>,
+    /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
+    #[arg(long = "where", value_name = "FILTER")]
+    filters: Vec<String>,
+    /// Per level: the intensity, the curves there, the fractiles and each curve's demand (CSV).
+    /// (default: ida.csv, numbered `-2`, `-3`, ... where that file exists)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// The curves and the fractiles (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let output = super::default_output(a.output.clone(), "ida.csv");
+    check_study_outputs(
+        &a.results,
+        &[
+            ("-o", Some(&output), Holds::Csv),
+            ("--plot", a.plot.as_deref(), Holds::Plot),
+        ],
+    )?;
+    let table = Table::read(&a.results)?;
+    let by = if a.by.is_empty() {
+        let sampled = table
+            .col("sample")
+            .is_ok_and(|c| table.rows.iter().any(|r| !r[c].is_empty()));
+        let mut by = vec!["record".to_string()];
+        if sampled {
+            by.push("sample".into());
+        }
+        by
+    } else {
+        a.by
+    };
+    let spec = IdaSpec {
+        im: a.im.unwrap_or_else(|| default_im(&table)),
+        edp: a.edp,
+        by,
+        filters: Filter::parse_all(&a.filters)?,
+    };
+    let (ida, skipped) = read(&table, &spec)?;
+    say!(
+        "{} curves (by {}) at {} levels of {}{}",
+        ida.curves.len(),
+        spec.by.join(", "),
+        ida.ims.len(),
+        spec.im,
+        if skipped.total() > 0 {
+            format!(" ({} rows left out: {skipped})", skipped.total())
+        } else {
+            String::new()
+        }
+    );
+    let head: Vec<String> = FRACTILES
+        .iter()
+        .map(|f| format!("{} {f} %", spec.edp))
+        .collect();
+    say!(
+        "\n| {} | curves | {} |\n|---:|---:|---:|---:|---:|",
+        spec.im,
+        head.join(" | ")
+    );
+    for (l, im) in ida.ims.iter().enumerate() {
+        let f = ida.fractiles[l];
+        say!(
+            "| {im} | {} | {:.4e} | {:.4e} | {:.4e} |",
+            ida.counts[l],
+            f[0],
+            f[1],
+            f[2]
+        );
+    }
+    let short: Vec<String> = ida
+        .ims
+        .iter()
+        .zip(&ida.counts)
+        .filter(|(_, &n)| n < ida.curves.len())
+        .map(|(im, n)| format!("{im} ({n} of {})", ida.curves.len()))
+        .collect();
+    if !short.is_empty() {
+        note!(
+            "notice: some curves have no run at {} = {}: the fractiles there are over the curves that do",
+            spec.im,
+            short.join(", ")
+        );
+    }
+    write_file(&output, ida.csv(&spec).as_bytes())?;
+    if let Some(p) = &a.plot {
+        super::save_plot(p, &[ida.panel(&spec)], 1)?;
+    }
+    Ok(())
+}
