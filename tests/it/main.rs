@@ -18,6 +18,7 @@ mod oracles;
 mod records;
 mod row_sweeps;
 mod scale;
+mod scenes;
 mod shared;
 mod studies;
 pub mod support;
