@@ -8,11 +8,13 @@
 //! ```
 //!
 //! - [`physics`]: one run in f64: buildings, contact laws, restitution, free stepping, solvers;
-//! - [`record`]: ground motions, read from files or synthesised;
-//! - [`plan`]: a validated sweep, its columns, samples, shards and input bounds;
+//! - [`record`]: ground motions, read from files or synthesised, and their intensity measures;
+//! - [`plan`]: a validated sweep, its intensity axis, its columns and their meanings, samples,
+//!   shards and input bounds;
 //! - [`engine`]: the one enum that runs a range of a plan on the CPU or the GPU (`shaders/`);
 //! - [`io`]: outputs that are never destroyed nor called complete when they are not;
-//! - [`studies`]: accuracy, benchmarks, fidelity, fragility, sensitivity, the seed paper, plots.
+//! - [`studies`]: accuracy, benchmarks, fidelity, fragility (damage states, bootstrap bands), IDA,
+//!   the gap study, sensitivity, the seed paper, plots.
 //!
 //! Each layer imports only those above it in this list (the command line, `src/cli/`, sits on
 //! top of them all, in the binary).

@@ -58,11 +58,14 @@ pub mod paper;
 pub mod plot;
 pub mod record;
 pub mod restitution;
+pub mod start;
 pub mod sweep;
 
 #[derive(Subcommand)]
 pub enum Cmd {
-    /// Run every run of a sweep config and write one CSV row per run.
+    /// Run every run of a sweep config and write one CSV row per run. A starting config:
+    /// `pound init pair|row|fragility|gap`; the config keys: README.md, "A config"; the
+    /// columns with units and meanings: `pound columns CONFIG`.
     Sweep(sweep::Args),
     /// GPU adapters.
     Gpu {
@@ -100,6 +103,10 @@ pub enum Cmd {
     Restitution(restitution::Args),
     /// Force against penetration through one isolated impact (the seed's Fig. 5), per e.
     Hysteresis(hysteresis::Args),
+    /// Print a commented starting config that runs as is: `pound init pair > my.toml`.
+    Init(start::InitArgs),
+    /// The output columns of a sweep (of CONFIG, or of a pair), with units and meanings.
+    Columns(start::ColumnsArgs),
     /// Ground-motion records.
     Record {
         #[command(subcommand)]

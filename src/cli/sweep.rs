@@ -16,6 +16,7 @@ use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct Args {
+    /// The sweep config (TOML; keys in README.md, "A config"; a start: `pound init pair`).
     config: PathBuf,
     /// Output CSV (written as OUT.partial, renamed when complete; default results.csv,
     /// numbered `-2`, `-3`, ... where that file exists, except with --resume).

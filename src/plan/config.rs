@@ -663,6 +663,19 @@ pub fn load_row_text(text: &str, path: &Path) -> Result<crate::plan::row::RowPla
     crate::plan::row::parse_row(text, path, &base, &records_dir_for(&base))
 }
 
+/// The columns a sweep of this config writes, in file order (a pair's or a row's).
+pub fn columns_of(text: &str, path: &Path) -> Result<Vec<String>, ConfigError> {
+    if crate::plan::row::is_row_config(text) {
+        Ok(load_row_text(text, path)?.header())
+    } else {
+        load_text(text, path)?;
+        Ok(crate::plan::columns::header()
+            .into_iter()
+            .map(String::from)
+            .collect())
+    }
+}
+
 /// A plan from config text that names no record file (synthetic records only), `name` standing
 /// for its file in messages: built-in sweeps (`pound bench`) and tests.
 pub fn parse_builtin(text: &str, name: &str) -> Result<Plan, ConfigError> {

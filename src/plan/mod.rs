@@ -3,6 +3,7 @@
 //! - [`config`]: a TOML config (stage 1, raw serde structs) turned into a [`Plan`] (stage 2);
 //! - [`sample`]: Latin hypercube and Monte Carlo samples of uncertain parameters;
 //! - [`columns`]: the schema, every run's parameters and outputs as named columns;
+//! - [`meaning`]: what each column holds, and its unit;
 //! - [`shard`]: cost-balanced run ranges for job arrays;
 //! - [`limits`]: the bound on every size a user types, with its reason.
 //!
@@ -20,6 +21,7 @@ pub mod columns;
 pub mod config;
 pub mod intensity;
 pub mod limits;
+pub mod meaning;
 pub mod row;
 pub mod sample;
 pub mod shard;

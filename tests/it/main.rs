@@ -20,5 +20,6 @@ mod row_sweeps;
 mod scale;
 mod scenes;
 mod shared;
+mod start;
 mod studies;
 pub mod support;

@@ -1,0 +1,79 @@
+//! A way in: `pound init KIND` prints a commented starting config that runs as is (synthetic
+//! records, no files needed); `pound columns [CONFIG]` lists the output columns with their units
+//! and meanings.
+
+use anyhow::Result;
+use clap::ValueEnum;
+use pounding::plan::{config, meaning};
+use std::io::Write;
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Kind {
+    /// Two single-storey buildings: restitution formulas, e, periods and gaps (2,700 runs).
+    Pair,
+    /// A 3-storey building beside a 6-storey one, pounding floor against floor (180 runs).
+    Row,
+    /// Uncertain periods, damping and gap over an intensity ladder, for `pound fragility`.
+    Fragility,
+    /// A period grid for `pound gap`: the separation two buildings need.
+    Gap,
+}
+
+impl Kind {
+    /// The template (a shipped config) and the command that runs it.
+    fn template(self) -> (&'static str, &'static str) {
+        match self {
+            Kind::Pair => (
+                include_str!("../../configs/quickstart.toml"),
+                "pound sweep my.toml -o results.csv",
+            ),
+            Kind::Row => (
+                include_str!("../../configs/row-3-6.toml"),
+                "pound sweep my.toml -o results.csv",
+            ),
+            Kind::Fragility => (
+                include_str!("../../configs/fragility-example.toml"),
+                "pound sweep my.toml -o runs.csv && pound fragility runs.csv --edp peak_force_n --threshold 0,1e6",
+            ),
+            Kind::Gap => (
+                include_str!("../../configs/gap-example.toml"),
+                "pound gap my.toml -o gaps.csv --plot gaps.svg",
+            ),
+        }
+    }
+}
+
+#[derive(clap::Args)]
+pub struct InitArgs {
+    /// What the config studies.
+    #[arg(value_enum)]
+    kind: Kind,
+}
+
+#[derive(clap::Args)]
+pub struct ColumnsArgs {
+    /// A sweep config: its own columns (a row's name each building and contact level);
+    /// without one, a pair's.
+    config: Option<PathBuf>,
+}
+
+pub fn init(a: InitArgs) -> Result<()> {
+    let (text, command) = a.kind.template();
+    // The template goes to stdout whole (to be redirected into a file); the hint to stderr.
+    std::io::stdout().write_all(text.as_bytes())?;
+    note!("# then: {command}  (keys: README.md \"A config\"; columns: pound columns my.toml)");
+    Ok(())
+}
+
+pub fn columns(a: ColumnsArgs) -> Result<()> {
+    let names = match &a.config {
+        Some(path) => config::columns_of(&config::read_text(path)?, path)?,
+        None => pounding::plan::columns::header()
+            .into_iter()
+            .map(String::from)
+            .collect(),
+    };
+    std::io::stdout().write_all(meaning::table(&names).as_bytes())?;
+    Ok(())
+}

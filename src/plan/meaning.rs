@@ -1,0 +1,288 @@
+//! What every output column holds, and in which unit: one table for `pound columns`, the docs
+//! and plot labels. A pair's columns are named outright; a row's per-building (`b2_...`),
+//! per-gap (`gap_1_2_m`) and per-level (`level_b1f3_b2f3_...`) columns by pattern.
+
+/// A column's meaning and unit (`-` for counts, ratios and text).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Meaning {
+    pub unit: &'static str,
+    pub text: String,
+}
+
+/// The columns of one run that do not depend on the scene, with unit and meaning.
+const FIXED: [(&str, &str, &str); 36] = [
+    ("run", "-", "run number"),
+    ("law", "-", "contact law"),
+    (
+        "formula",
+        "-",
+        "restitution formula (empty where the law takes none)",
+    ),
+    (
+        "e",
+        "-",
+        "coefficient of restitution (empty for elastic laws)",
+    ),
+    (
+        "impact_damping",
+        "-",
+        "the damping used: zeta, or a in chi = a / v0 (Hunt-Crossley laws)",
+    ),
+    ("k_n_per_m", "N/m", "contact stiffness of a linear law"),
+    (
+        "beta_n_per_m1_5",
+        "N/m^1.5",
+        "contact stiffness of a Hertz-type law",
+    ),
+    ("record", "-", "record label"),
+    (
+        "target_pga_g",
+        "g",
+        "target PGA the record was scaled to (empty for other targets)",
+    ),
+    (
+        "target_sa_g",
+        "g",
+        "target Sa(T) the record was scaled to (empty for other targets)",
+    ),
+    (
+        "sa_period_s",
+        "s",
+        "the period T of target_sa_g (the run's own where it follows a building)",
+    ),
+    (
+        "target_sa_avg_g",
+        "g",
+        "target Sa_avg the record was scaled to (empty for other targets)",
+    ),
+    (
+        "sa_avg_from_s",
+        "s",
+        "the shortest period of target_sa_avg_g",
+    ),
+    ("sa_avg_to_s", "s", "the longest period of target_sa_avg_g"),
+    ("scale_factor", "-", "factor applied to the record"),
+    ("pga_g", "g", "PGA of the scaled record"),
+    ("m1_kg", "kg", "mass of building 1"),
+    ("t1_s", "s", "period of building 1"),
+    ("xi1", "-", "damping ratio of building 1"),
+    ("m2_kg", "kg", "mass of building 2"),
+    ("t2_s", "s", "period of building 2"),
+    ("xi2", "-", "damping ratio of building 2"),
+    ("gap_m", "m", "gap between the buildings"),
+    (
+        "sample",
+        "-",
+        "the sample that set the sampled parameters (empty without [sample])",
+    ),
+    ("status", "-", "ok, non_finite or step_limit"),
+    (
+        "impacts",
+        "-",
+        "number of impacts (summed over the contact levels)",
+    ),
+    ("peak_force_n", "N", "largest pounding force"),
+    ("peak_penetration_m", "m", "largest penetration"),
+    (
+        "peak_u1_m",
+        "m",
+        "largest displacement of building 1 relative to the ground",
+    ),
+    (
+        "peak_u2_m",
+        "m",
+        "largest displacement of building 2 relative to the ground",
+    ),
+    (
+        "impact_velocity_m_s",
+        "m/s",
+        "approach speed v0 of the impact with the largest force",
+    ),
+    (
+        "first_impact_s",
+        "s",
+        "onset of the first impact (empty if none)",
+    ),
+    ("contact_time_s", "s", "total time in contact"),
+    (
+        "dissipated_energy_j",
+        "J",
+        "net work of the contact force on the relative motion",
+    ),
+    (
+        "substeps",
+        "-",
+        "integration work beyond the exact free steps (RK4 substeps or trial steps)",
+    ),
+    (
+        "input_energy_j",
+        "J",
+        "input work of the ground motion (with --energy or the reference scheme)",
+    ),
+];
+
+/// The energy balance's last two columns.
+const ENERGY: [(&str, &str, &str); 2] = [
+    (
+        "damping_energy_j",
+        "J",
+        "structural damping work (with --energy or the reference scheme)",
+    ),
+    (
+        "energy_residual",
+        "-",
+        "(input - kinetic - strain - damping - contact work) / largest input",
+    ),
+];
+
+/// Per building `k`: suffix, unit, meaning.
+const PER_BUILDING: [(&str, &str, &str); 9] = [
+    ("storeys", "-", "storeys of building {k}"),
+    (
+        "mass_kg",
+        "kg",
+        "floor mass of building {k} (empty where floor masses are given)",
+    ),
+    ("t1_s", "s", "fundamental period of building {k}"),
+    ("xi", "-", "damping ratio of building {k}"),
+    (
+        "peak_roof_m",
+        "m",
+        "largest roof displacement of building {k} relative to the ground",
+    ),
+    (
+        "peak_drift_ratio",
+        "-",
+        "largest interstorey drift ratio of building {k}",
+    ),
+    ("drift_storey", "-", "the storey of that drift (from 1)"),
+    (
+        "peak_accel_m_s2",
+        "m/s^2",
+        "largest absolute floor acceleration of building {k}",
+    ),
+    (
+        "accel_floor",
+        "-",
+        "the floor of that acceleration (from 1)",
+    ),
+];
+
+/// Per contact level: suffix, unit, meaning.
+const PER_LEVEL: [(&str, &str, &str); 4] = [
+    ("impacts", "-", "impacts at {level}"),
+    ("peak_force_n", "N", "largest force at {level}"),
+    ("peak_penetration_m", "m", "largest penetration at {level}"),
+    (
+        "impact_velocity_m_s",
+        "m/s",
+        "approach speed of the largest impact at {level}",
+    ),
+];
+
+fn number(s: &str) -> Option<usize> {
+    (!s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()))
+        .then(|| s.parse().ok())
+        .flatten()
+}
+
+/// What `column` holds, or None for a name no sweep writes.
+pub fn meaning(column: &str) -> Option<Meaning> {
+    let of = |(_, unit, text): &(&str, &'static str, &str)| Meaning {
+        unit,
+        text: text.to_string(),
+    };
+    if let Some(m) = FIXED.iter().chain(&ENERGY).find(|m| m.0 == column) {
+        return Some(of(m));
+    }
+    // gap_A_B_m
+    if let Some(rest) = column
+        .strip_prefix("gap_")
+        .and_then(|r| r.strip_suffix("_m"))
+    {
+        if let Some((a, b)) = rest.split_once('_') {
+            if let (Some(a), Some(b)) = (number(a), number(b)) {
+                return Some(Meaning {
+                    unit: "m",
+                    text: format!("gap between buildings {a} and {b}"),
+                });
+            }
+        }
+    }
+    // level_bIfJ_bKfL_<output>
+    if let Some(rest) = column.strip_prefix("level_") {
+        let parts: Vec<&str> = rest.splitn(3, '_').collect();
+        if let [left, right, output] = parts[..] {
+            let floor = |p: &str| -> Option<(usize, usize)> {
+                let (b, f) = p.strip_prefix('b')?.split_once('f')?;
+                Some((number(b)?, number(f)?))
+            };
+            if let (Some(l), Some(r), Some(m)) = (
+                floor(left),
+                floor(right),
+                PER_LEVEL.iter().find(|m| m.0 == output),
+            ) {
+                let level = format!(
+                    "the level where floor {} of building {} meets floor {} of building {}",
+                    l.1, l.0, r.1, r.0
+                );
+                return Some(Meaning {
+                    unit: m.1,
+                    text: m.2.replace("{level}", &level),
+                });
+            }
+        }
+    }
+    // bK_<output>
+    if let Some((k, suffix)) = column.strip_prefix('b').and_then(|r| r.split_once('_')) {
+        if let (Some(k), Some(m)) = (number(k), PER_BUILDING.iter().find(|m| m.0 == suffix)) {
+            return Some(Meaning {
+                unit: m.1,
+                text: m.2.replace("{k}", &k.to_string()),
+            });
+        }
+    }
+    None
+}
+
+/// A markdown table of `columns`: name, unit, meaning.
+pub fn table<S: AsRef<str>>(columns: &[S]) -> String {
+    let mut s = String::from("| column | unit | meaning |\n|---|---|---|\n");
+    for c in columns {
+        let c = c.as_ref();
+        let m = meaning(c).expect("every written column has a meaning");
+        s.push_str(&format!("| `{c}` | {} | {} |\n", m.unit, m.text));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_pair_column_and_row_pattern_has_a_meaning() {
+        for c in crate::plan::columns::HEADER {
+            assert!(meaning(c).is_some(), "{c}");
+        }
+        let m = meaning("level_b1f3_b2f2_peak_force_n").unwrap();
+        assert_eq!(m.unit, "N");
+        assert!(m
+            .text
+            .contains("floor 3 of building 1 meets floor 2 of building 2"));
+        assert_eq!(meaning("b12_peak_drift_ratio").unwrap().unit, "-");
+        assert_eq!(
+            meaning("gap_2_3_m").unwrap().text,
+            "gap between buildings 2 and 3"
+        );
+        for bad in [
+            "b_peak_roof_m",
+            "gap_a_2_m",
+            "level_b1f3_peak_force_n",
+            "nope",
+            "b1_nope",
+        ] {
+            assert!(meaning(bad).is_none(), "{bad}");
+        }
+    }
+}
