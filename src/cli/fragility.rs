@@ -226,9 +226,8 @@ pub fn run(a: Args) -> Result<()> {
         if states.is_some() {
             for s in &mut pl.series {
                 for (n, t) in names.iter().zip(&spec.thresholds) {
-                    let prefix = format!("{} > {t}:", spec.edp);
-                    if let Some(rest) = s.name.strip_prefix(&prefix) {
-                        s.name = format!("{n} ({} > {t}):{rest}", spec.edp);
+                    if let Some(rest) = s.name.strip_prefix(&format!("> {t}:")) {
+                        s.name = format!("{n} (> {t}):{rest}");
                     }
                 }
             }
@@ -255,5 +254,6 @@ fn band_series(b: &Band) -> [Series; 2] {
             .map(|(&im, c)| (im, c[k]))
             .collect(),
         scatter: false,
+        style: None,
     })
 }

@@ -198,6 +198,7 @@ fn spectrum(
                 name: "Sa".into(),
                 points,
                 scatter: false,
+                style: None,
             }],
         };
         super::save_plot(p, &[panel], 1)?;

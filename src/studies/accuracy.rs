@@ -233,6 +233,7 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
                     .map(|p| (err(&p.errors), p.runs_per_second))
                     .collect(),
                 scatter: false,
+                style: None,
             })
             .collect(),
     };
@@ -463,6 +464,7 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
                     .filter(|&(e, _)| e > 0.0)
                     .collect(),
                 scatter: false,
+                style: None,
             })
             .collect(),
     };

@@ -146,6 +146,7 @@ pub fn panels(rows: &[Fidelity]) -> Vec<Panel> {
             name: "achieved = asked".into(),
             points: es.iter().map(|&e| (e, e)).collect(),
             scatter: false,
+            style: None,
         }];
         let mut formulas: Vec<Option<Formula>> = mine.iter().map(|r| r.formula).collect();
         formulas.dedup();
@@ -158,6 +159,7 @@ pub fn panels(rows: &[Fidelity]) -> Vec<Panel> {
                     .map(|r| (r.e, r.achieved_e))
                     .collect(),
                 scatter: true,
+                style: None,
             });
         }
         out.push(Panel {
@@ -257,6 +259,7 @@ impl Loops {
                     name: format!("e = {e}"),
                     points: l.points.iter().map(|&(x, f)| (x * 1e3, f / 1e3)).collect(),
                     scatter: false,
+                    style: None,
                 })
                 .collect(),
             ..Default::default()

@@ -64,6 +64,7 @@ pub fn zeta_panels(es: &[f64]) -> Result<Vec<Panel>, RestitutionError> {
             name,
             points,
             scatter: false,
+            style: None,
         });
     }
     let panel = |log_y: bool| Panel {

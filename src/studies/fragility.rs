@@ -555,20 +555,26 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
         .fold((f64::INFINITY, 0.0f64), |(a, b), l| {
             (a.min(l.im), b.max(l.im))
         });
-    for ((t, lv), f) in spec.thresholds.iter().zip(levels).zip(fits) {
-        let name = format!("{} > {t}", spec.edp);
+    for (k, ((t, lv), f)) in spec.thresholds.iter().zip(levels).zip(fits).enumerate() {
+        // The EDP is in the title; a threshold's points and its curve share one style; a failed
+        // fit says why.
+        let name = format!("> {t}");
         series.push(Series {
-            name: format!("{name}: observed"),
+            name: match f {
+                Ok(_) => format!("{name}: observed"),
+                Err(e) => format!("{name}: observed (no fit: {e})"),
+            },
             points: lv
                 .iter()
                 .map(|l| (l.im, l.exceed as f64 / l.n as f64))
                 .collect(),
             scatter: true,
+            style: Some(k),
         });
         if let Ok(f) = f {
             let n = 100;
             series.push(Series {
-                name: format!("{name}: median {:.3}, beta {:.3}", f.median, f.beta),
+                name: format!("{name}: fit, median {:.3}, beta {:.3}", f.median, f.beta),
                 points: (0..=n)
                     .map(|i| {
                         let im = lo + (hi - lo) * i as f64 / n as f64;
@@ -576,6 +582,7 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
                     })
                     .collect(),
                 scatter: false,
+                style: Some(k),
             });
         }
     }

@@ -589,6 +589,7 @@ impl<'a> GapStudy<'a> {
                         name: rec.name.clone(),
                         points,
                         scatter: true,
+                        style: None,
                     });
                 }
             }
@@ -612,6 +613,7 @@ impl<'a> GapStudy<'a> {
                         })
                         .collect(),
                     scatter: true,
+                    style: None,
                 })
                 .collect();
             let xs = rules[0].points.iter().map(|p| p.0);
@@ -623,6 +625,7 @@ impl<'a> GapStudy<'a> {
                     name: "time history (1)".into(),
                     points: vec![(lo, 1.0), (hi, 1.0)],
                     scatter: false,
+                    style: None,
                 });
             }
             panels.push(Panel {
@@ -644,6 +647,7 @@ impl<'a> GapStudy<'a> {
                         .map(|&(g, n, k)| (g * 1e3, k as f64 / n.max(1) as f64))
                         .collect(),
                     scatter: true,
+                    style: None,
                 });
                 if let Ok(f) = &c.fit {
                     let top = c.points.iter().map(|p| p.0).fold(0.0, f64::max);
@@ -660,6 +664,7 @@ impl<'a> GapStudy<'a> {
                             })
                             .collect(),
                         scatter: false,
+                        style: None,
                     });
                 }
             }

@@ -176,6 +176,7 @@ impl Ida {
                     .filter_map(|(x, &im)| x.map(|x| (x, im)))
                     .collect(),
                 scatter: false,
+                style: None,
             })
             .collect();
         for (k, f) in FRACTILES.iter().enumerate() {
@@ -188,6 +189,7 @@ impl Ida {
                     .map(|(q, &im)| (q[k], im))
                     .collect(),
                 scatter: false,
+                style: None,
             });
         }
         Panel {

@@ -20,7 +20,89 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Markers only (no line).
     pub scatter: bool,
-    // An empty name draws a thin grey line with no legend entry (one of many, as IDA curves).
+    /// Series with the same style share colour and marker (a fitted curve and the points it
+    /// fits); None: a style of its own. An empty name draws a thin grey line with no legend
+    /// entry (one of many, as IDA curves).
+    pub style: Option<usize>,
+}
+
+/// Okabe & Ito's colour-blind-safe palette, without its yellow (unreadable on white).
+const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+];
+
+/// Marker shapes, cycled with a period prime to the palette's: colour and marker together tell
+/// 28 styles apart.
+const MARKERS: usize = 4;
+
+/// Scatter series of more points than this are drawn translucent (thousands of points hide
+/// each other, and a series drawn last would hide those before it).
+const DENSE: usize = 400;
+
+/// Lines of more points than this are smooth curves: no markers on their points.
+const SMOOTH: usize = 40;
+
+/// A marker of kind `k` at `at`: a filled circle, a triangle, a cross or a ring.
+fn marker<DB: DrawingBackend, C: Clone + 'static>(
+    k: usize,
+    at: C,
+    color: RGBAColor,
+) -> DynElement<'static, DB, C> {
+    match k % MARKERS {
+        0 => Circle::new(at, 3, color.filled()).into_dyn(),
+        1 => TriangleMarker::new(at, 4, color.filled()).into_dyn(),
+        2 => Cross::new(at, 4, color.stroke_width(2)).into_dyn(),
+        _ => Circle::new(at, 4, color.stroke_width(2)).into_dyn(),
+    }
+}
+
+/// The legend's corners, in the order they are tried.
+const CORNERS: [SeriesLabelPosition; 4] = [
+    SeriesLabelPosition::UpperLeft,
+    SeriesLabelPosition::UpperRight,
+    SeriesLabelPosition::LowerRight,
+    SeriesLabelPosition::LowerLeft,
+];
+
+/// Where the legend goes, and how far the y range must grow upwards for it: the first corner
+/// whose box (estimated from the entries' text, as fractions `w`, `h` of the plot area) covers
+/// no point; else the top left, with the y range raised by the box's height so that it covers
+/// none there either.
+fn legend_place(
+    points: &[(f64, f64)],
+    x: (f64, f64),
+    y: (f64, f64),
+    w: f64,
+    h: f64,
+) -> (SeriesLabelPosition, f64) {
+    let inside = |(fx0, fx1): (f64, f64), (fy0, fy1): (f64, f64)| {
+        points.iter().any(|&(px, py)| {
+            let (u, v) = ((px - x.0) / (x.1 - x.0), (py - y.0) / (y.1 - y.0));
+            (fx0..=fx1).contains(&u) && (fy0..=fy1).contains(&v)
+        })
+    };
+    for (i, c) in CORNERS.into_iter().enumerate() {
+        let fx = if i == 0 || i == 3 {
+            (0.0, w)
+        } else {
+            (1.0 - w, 1.0)
+        };
+        let fy = if i < 2 { (1.0 - h, 1.0) } else { (0.0, h) };
+        if !inside(fx, fy) {
+            return (c, y.1);
+        }
+    }
+    let h = h.min(0.9);
+    (
+        SeriesLabelPosition::UpperLeft,
+        y.1 + (y.1 - y.0) * h / (1.0 - h),
+    )
 }
 
 /// One chart.
@@ -181,6 +263,23 @@ fn draw<DB: DrawingBackend>(
     let all: Vec<(f64, f64)> = p.series.iter().flat_map(pts).collect();
     let (x0, x1) = range(all.iter().map(|q| q.0));
     let (y0, y1) = range(all.iter().map(|q| q.1));
+    let named: Vec<&Series> = p.series.iter().filter(|s| !s.name.is_empty()).collect();
+    // The legend box as a share of the plot area (about 535 x 380 px in a 640 x 480 panel):
+    // 7 px a character at the legend's 12 px font, 40 px of marker and margins; 20 px a line.
+    let longest = named
+        .iter()
+        .map(|s| s.name.chars().count())
+        .max()
+        .unwrap_or(0);
+    let (w, h) = (
+        (longest as f64 * 7.0 + 40.0) / 535.0,
+        (named.len() as f64 * 20.0 + 20.0) / 380.0,
+    );
+    let (corner, y1) = if named.len() > 1 {
+        legend_place(&all, (x0, x1), (y0, y1), w, h)
+    } else {
+        (SeriesLabelPosition::UpperLeft, y1)
+    };
     let label = |l: &str, log: bool| {
         if log {
             format!("log10 {l}")
@@ -203,8 +302,20 @@ fn draw<DB: DrawingBackend>(
         .y_label_formatter(&|v| tick(*v))
         .draw()
         .map_err(|x| e(&x))?;
+    // Style slots in order of first appearance: a curve and its points share one.
+    let mut slots: Vec<usize> = Vec::new();
     for (i, s) in p.series.iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+        let slot = {
+            let key = s.style.unwrap_or(usize::MAX - i);
+            match slots.iter().position(|k| *k == key) {
+                Some(n) => n,
+                None => {
+                    slots.push(key);
+                    slots.len() - 1
+                }
+            }
+        };
+        let color = PALETTE[slot % PALETTE.len()].to_rgba();
         let data = pts(s);
         if s.name.is_empty() {
             // Unnamed: a background line (one of many), thin and grey, with no legend entry.
@@ -215,23 +326,38 @@ fn draw<DB: DrawingBackend>(
                 ))
                 .map_err(|x| e(&x))?;
         } else if s.scatter {
+            let fill = if data.len() > DENSE {
+                color.mix(0.35)
+            } else {
+                color
+            };
             chart
-                .draw_series(data.into_iter().map(|q| Circle::new(q, 3, color.filled())))
+                .draw_series(data.into_iter().map(|q| marker(slot, q, fill)))
                 .map_err(|x| e(&x))?
                 .label(&s.name)
-                .legend(move |(x, y)| Circle::new((x + 8, y), 3, color.filled()));
+                .legend(move |(x, y)| marker(slot, (x + 8, y), color));
         } else {
+            // Markers on the points of a line of data, so that it reads without its colour
+            // too; a smooth curve (a fit) takes none, which would pass for observations.
+            let marks: Vec<(f64, f64)> = if data.len() <= SMOOTH {
+                data.clone()
+            } else {
+                Vec::new()
+            };
             chart
                 .draw_series(LineSeries::new(data, color.stroke_width(2)))
                 .map_err(|x| e(&x))?
                 .label(&s.name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
+                .legend(move |(x, y)| marker(slot, (x + 8, y), color));
+            chart
+                .draw_series(marks.into_iter().map(|q| marker(slot, q, color)))
+                .map_err(|x| e(&x))?;
         }
     }
-    if p.series.len() > 1 {
+    if named.len() > 1 {
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
+            .position(corner)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()

@@ -124,6 +124,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableErro
                 name,
                 points,
                 scatter: spec.aggregate == Aggregate::None,
+                style: None,
             }
         })
         .collect();

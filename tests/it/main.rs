@@ -6,6 +6,7 @@ mod config;
 mod damage;
 mod fast_vs_reference;
 mod fidelity;
+mod figures;
 mod gap;
 mod gpu;
 mod gpu_rows;

@@ -1,0 +1,171 @@
+//! Figures read back: the legend box covers no plotted point, every legend entry has its own
+//! colour-and-marker (a fitted curve shares its points'), and no series is drawn in yellow.
+
+use crate::support::{ok, pound, tempdir};
+use std::path::Path;
+
+/// The numbers in `attr="..."` of an SVG element.
+fn attr(element: &str, name: &str) -> Option<String> {
+    let at = element.find(&format!(" {name}=\""))? + name.len() + 3;
+    let rest = &element[at..];
+    Some(rest[..rest.find('"')?].to_string())
+}
+
+/// The elements of an SVG, as text, in document order.
+fn elements(svg: &str) -> Vec<&str> {
+    svg.split('<').filter(|e| !e.starts_with('/')).collect()
+}
+
+/// Where a drawn mark sits: a circle's centre or every vertex of a polygon or a coloured
+/// polyline (the mesh and the axes are grey or black polylines of width 1).
+fn vertices(e: &str) -> Vec<(f64, f64)> {
+    let num = |s: String| s.parse::<f64>().unwrap();
+    if e.starts_with("circle") {
+        return vec![(num(attr(e, "cx").unwrap()), num(attr(e, "cy").unwrap()))];
+    }
+    let data_line = e.starts_with("polyline") && attr(e, "stroke-width").is_some_and(|w| w != "1");
+    if e.starts_with("polygon") || data_line {
+        return attr(e, "points")
+            .unwrap()
+            .split_whitespace()
+            .map(|p| {
+                let (x, y) = p.split_once(',').unwrap();
+                (num(x.into()), num(y.into()))
+            })
+            .collect();
+    }
+    Vec::new()
+}
+
+/// What a figure shows: the legend's box (x0, y0, x1, y1), the marks drawn before it and the
+/// legend's glyphs (kind and colour).
+struct Figure {
+    legend: (f64, f64, f64, f64),
+    marks: Vec<(f64, f64)>,
+    glyphs: Vec<(String, String)>,
+}
+
+fn read(svg: &str) -> Figure {
+    let els = elements(svg);
+    let at = els
+        .iter()
+        .position(|e| e.starts_with("rect") && attr(e, "fill").as_deref() == Some("none"))
+        .expect("a legend");
+    let n = |k: &str| attr(els[at], k).unwrap().parse::<f64>().unwrap();
+    let (x, y, w, h) = (n("x"), n("y"), n("width"), n("height"));
+    let marks = els[..at].iter().flat_map(|e| vertices(e)).collect();
+    let mut glyphs = Vec::new();
+    let mut lines = 0;
+    for e in &els[at + 1..] {
+        if !["circle", "polygon", "line"]
+            .iter()
+            .any(|k| e.starts_with(k))
+        {
+            continue;
+        }
+        let kind = e.split_whitespace().next().unwrap();
+        // A cross is drawn as two lines: one glyph.
+        if kind == "line" {
+            lines += 1;
+            if lines % 2 == 0 {
+                continue;
+            }
+        }
+        let color = attr(e, "fill")
+            .filter(|f| f != "none")
+            .or_else(|| attr(e, "stroke"))
+            .unwrap();
+        let ring = kind == "circle" && attr(e, "fill").as_deref() == Some("none");
+        glyphs.push((format!("{kind}{}", if ring { " ring" } else { "" }), color));
+    }
+    Figure {
+        legend: (x, y, x + w, y + h),
+        marks,
+        glyphs,
+    }
+}
+
+fn check(path: &Path, entries: usize, shared: usize) {
+    let svg = std::fs::read_to_string(path).unwrap();
+    let Figure {
+        legend: (x0, y0, x1, y1),
+        marks,
+        glyphs,
+    } = read(&svg);
+    assert!(!marks.is_empty());
+    for (x, y) in &marks {
+        assert!(
+            !(x0..=x1).contains(x) || !(y0..=y1).contains(y),
+            "{}: a mark at ({x}, {y}) under the legend ({x0}, {y0})-({x1}, {y1})",
+            path.display()
+        );
+    }
+    let mut distinct = glyphs.clone();
+    distinct.sort();
+    distinct.dedup();
+    assert!(glyphs.len() >= entries, "{}: {glyphs:?}", path.display());
+    assert_eq!(
+        distinct.len(),
+        glyphs.len() - shared,
+        "{}: {glyphs:?}",
+        path.display()
+    );
+    assert!(
+        !svg.contains("#F0E442") && !svg.contains("#FFFF00"),
+        "no yellow"
+    );
+}
+
+#[test]
+fn legends_cover_no_point_and_styles_are_distinct() {
+    let dir = tempdir();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    // Peak force against the gap, one line per period of building 2 (five series).
+    let results = dir.path().join("q.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/quickstart.toml",
+        "-o",
+        &s(&results),
+    ]));
+    let plot = dir.path().join("q.svg");
+    ok(&pound(&[
+        "plot",
+        &s(&results),
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--by",
+        "t2_s",
+        "-o",
+        &s(&plot),
+    ]));
+    check(&plot, 5, 0);
+    // Fragility curves fill the corners (0 at the low left, near 1 at the top right): three
+    // thresholds, each its points and its curve in one style.
+    let runs = dir.path().join("fr.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/fragility-example.toml",
+        "-o",
+        &s(&runs),
+    ]));
+    let f = dir.path().join("f.svg");
+    ok(&pound(&[
+        "fragility",
+        &s(&runs),
+        "--edp",
+        "peak_force_n",
+        "--threshold",
+        "0,1e6,3e6",
+        "-o",
+        &s(&dir.path().join("f.csv")),
+        "--plot",
+        &s(&f),
+    ]));
+    let svg = std::fs::read_to_string(&f).unwrap();
+    let glyphs = read(&svg).glyphs;
+    assert_eq!(glyphs.len(), 6, "{glyphs:?}");
+    check(&f, 6, 3);
+}
