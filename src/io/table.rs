@@ -196,30 +196,78 @@ pub fn order_key(x: f64) -> u64 {
     }
 }
 
-/// An axis label from a column name: the unit suffix becomes a unit in parentheses
-/// (`gap_m` -> `gap (m)`, `peak_force_n` -> `peak force (N)`, `impact_velocity_m_s` ->
-/// `impact velocity (m/s)`).
-pub fn label(column: &str) -> String {
-    const UNITS: [(&str, &str); 10] = [
-        ("_n_per_m1_5", "N/m^1.5"),
-        ("_n_per_m", "N/m"),
-        ("_m_s", "m/s"),
-        ("_kg", "kg"),
-        ("_g", "g"),
-        ("_j", "J"),
-        ("_n", "N"),
-        ("_m", "m"),
-        ("_s", "s"),
-        ("_pct", "%"),
-    ];
+/// The unit suffixes of column names, longest first, and the units they stand for.
+const UNITS: [(&str, &str); 11] = [
+    ("_n_per_m1_5", "N/m^1.5"),
+    ("_n_per_m", "N/m"),
+    ("_m_s2", "m/s^2"),
+    ("_m_s", "m/s"),
+    ("_kg", "kg"),
+    ("_g", "g"),
+    ("_j", "J"),
+    ("_n", "N"),
+    ("_m", "m"),
+    ("_s", "s"),
+    ("_pct", "%"),
+];
+
+/// A column's name without its unit suffix, and the unit (None where it has none).
+fn split_unit(column: &str) -> (&str, Option<&'static str>) {
     for (suffix, unit) in UNITS {
         if let Some(stem) = column.strip_suffix(suffix) {
             if !stem.is_empty() {
-                return format!("{} ({unit})", stem.replace('_', " "));
+                return (stem, Some(unit));
             }
         }
     }
-    column.replace('_', " ")
+    (column, None)
+}
+
+/// A column's name in words: a row's `b2_peak_drift_ratio` is "peak drift ratio, building 2",
+/// `gap_1_2` "gap 1-2", `level_b1f3_b2f3_peak_force` "peak force, level b1f3-b2f3".
+fn words(stem: &str) -> String {
+    let numbered = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    if let Some((k, rest)) = stem.strip_prefix('b').and_then(|r| r.split_once('_')) {
+        if numbered(k) {
+            return format!("{}, building {k}", rest.replace('_', " "));
+        }
+    }
+    if let Some((a, b)) = stem.strip_prefix("gap_").and_then(|r| r.split_once('_')) {
+        if numbered(a) && numbered(b) {
+            return format!("gap {a}-{b}");
+        }
+    }
+    if let Some(rest) = stem.strip_prefix("level_") {
+        let parts: Vec<&str> = rest.splitn(3, '_').collect();
+        if let [l, r, what] = parts[..] {
+            return format!("{}, level {l}-{r}", what.replace('_', " "));
+        }
+    }
+    stem.replace('_', " ")
+}
+
+/// An axis label from a column name: words, and the unit suffix as a unit in parentheses
+/// (`gap_m` -> `gap (m)`, `peak_force_n` -> `peak force (N)`, `b2_peak_drift_ratio` ->
+/// `peak drift ratio, building 2`).
+pub fn label(column: &str) -> String {
+    match split_unit(column) {
+        (stem, Some(unit)) => format!("{} ({unit})", words(stem)),
+        (stem, None) => words(stem),
+    }
+}
+
+/// A column's name in words, without its unit (for titles: the axes carry the units).
+pub fn name(column: &str) -> String {
+    words(split_unit(column).0)
+}
+
+/// A legend entry for `column = value`, in words with the unit after the value
+/// (`b1_t1_s`, `0.25` -> `t1, building 1 = 0.25 s`).
+pub fn value_label(column: &str, value: &str) -> String {
+    match split_unit(column) {
+        (stem, Some(unit)) => format!("{} = {value} {unit}", words(stem)),
+        (stem, None) => format!("{} = {value}", words(stem)),
+    }
 }
 
 #[cfg(test)]
@@ -244,5 +292,17 @@ mod tests {
         assert_eq!(label("impact_velocity_m_s"), "impact velocity (m/s)");
         assert_eq!(label("beta_n_per_m1_5"), "beta (N/m^1.5)");
         assert_eq!(label("impacts"), "impacts");
+        assert_eq!(label("gap_1_2_m"), "gap 1-2 (m)");
+        assert_eq!(label("b2_peak_drift_ratio"), "peak drift ratio, building 2");
+        assert_eq!(
+            label("b1_peak_accel_m_s2"),
+            "peak accel, building 1 (m/s^2)"
+        );
+        assert_eq!(
+            label("level_b1f3_b2f3_peak_force_n"),
+            "peak force, level b1f3-b2f3 (N)"
+        );
+        assert_eq!(value_label("b1_t1_s", "0.25"), "t1, building 1 = 0.25 s");
+        assert_eq!(value_label("law", "hertz"), "law = hertz");
     }
 }

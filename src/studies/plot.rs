@@ -62,6 +62,33 @@ fn marker<DB: DrawingBackend, C: Clone + 'static>(
     }
 }
 
+/// An axis label in engineering units for values up to `biggest`, and the factor that takes
+/// the values there: `(N)` to kN or MN, `(J)` to kJ or MJ, `(N/m)` to kN/m or MN/m, `(m)` below
+/// a metre to mm. Log axes keep their unit (their ticks are powers of ten).
+fn engineering(label: &str, biggest: f64, log: bool) -> (String, f64) {
+    const LARGE: [(&str, [(&str, f64); 2]); 3] = [
+        ("(N)", [("(MN)", 1e6), ("(kN)", 1e3)]),
+        ("(J)", [("(MJ)", 1e6), ("(kJ)", 1e3)]),
+        ("(N/m)", [("(MN/m)", 1e6), ("(kN/m)", 1e3)]),
+    ];
+    if log || biggest == 0.0 {
+        return (label.to_string(), 1.0);
+    }
+    for (unit, scaled) in LARGE {
+        if let Some(stem) = label.strip_suffix(unit) {
+            for (to, f) in scaled {
+                if biggest >= f {
+                    return (format!("{stem}{to}"), 1.0 / f);
+                }
+            }
+        }
+    }
+    match label.strip_suffix("(m)") {
+        Some(stem) if biggest < 1.0 => (format!("{stem}(mm)"), 1e3),
+        _ => (label.to_string(), 1.0),
+    }
+}
+
 /// The legend's corners, in the order they are tried.
 const CORNERS: [SeriesLabelPosition; 4] = [
     SeriesLabelPosition::UpperLeft,
@@ -251,8 +278,18 @@ fn draw<DB: DrawingBackend>(
     p: &Panel,
 ) -> Result<(), String> {
     let e = |e: &dyn std::fmt::Display| e.to_string();
-    let tx = |x: f64| if p.log_x { x.log10() } else { x };
-    let ty = |y: f64| if p.log_y { y.log10() } else { y };
+    // Linear axes in engineering units: forces in kN or MN, small lengths in mm.
+    let biggest = |f: fn(&(f64, f64)) -> f64| {
+        p.series
+            .iter()
+            .flat_map(|s| s.points.iter().map(f))
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    let (x_label, fx) = engineering(&p.x_label, biggest(|q| q.0), p.log_x);
+    let (y_label, fy) = engineering(&p.y_label, biggest(|q| q.1), p.log_y);
+    let tx = |x: f64| if p.log_x { x.log10() } else { x * fx };
+    let ty = |y: f64| if p.log_y { y.log10() } else { y * fy };
     let pts = |s: &Series| -> Vec<(f64, f64)> {
         s.points
             .iter()
@@ -296,8 +333,8 @@ fn draw<DB: DrawingBackend>(
         .map_err(|x| e(&x))?;
     chart
         .configure_mesh()
-        .x_desc(label(&p.x_label, p.log_x))
-        .y_desc(label(&p.y_label, p.log_y))
+        .x_desc(label(&x_label, p.log_x))
+        .y_desc(label(&y_label, p.log_y))
         .x_label_formatter(&|v| tick(*v))
         .y_label_formatter(&|v| tick(*v))
         .draw()
@@ -364,4 +401,36 @@ fn draw<DB: DrawingBackend>(
             .map_err(|x| e(&x))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn axes_take_engineering_units() {
+        let e = |l: &str, m: f64, log: bool| engineering(l, m, log);
+        assert_eq!(
+            e("peak force (N)", 5.4e6, false),
+            ("peak force (MN)".into(), 1e-6)
+        );
+        assert_eq!(
+            e("peak force (N)", 5.4e4, false),
+            ("peak force (kN)".into(), 1e-3)
+        );
+        assert_eq!(
+            e("peak force (N)", 540.0, false),
+            ("peak force (N)".into(), 1.0)
+        );
+        assert_eq!(e("gap (m)", 0.055, false), ("gap (mm)".into(), 1e3));
+        assert_eq!(e("roof (m)", 1.5, false), ("roof (m)".into(), 1.0));
+        assert_eq!(
+            e("peak force (N)", 5.4e6, true),
+            ("peak force (N)".into(), 1.0)
+        );
+        assert_eq!(
+            e("beta (N/m^1.5)", 3e9, false),
+            ("beta (N/m^1.5)".into(), 1.0)
+        );
+    }
 }

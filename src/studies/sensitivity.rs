@@ -3,7 +3,7 @@
 //! plotted nor grouped are aggregated over (max, mean, median or min of the output at each x),
 //! or every row is drawn as a point.
 
-use crate::io::table::{label, order_key, Filter, Table, TableError};
+use crate::io::table::{label, name, order_key, value_label, Filter, Table, TableError};
 use crate::studies::plot::{Panel, Series};
 use std::collections::BTreeMap;
 
@@ -117,7 +117,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableErro
                     .collect()
             };
             let name = match &spec.by {
-                Some(b) => format!("{b} = {g}"),
+                Some(b) => value_label(b, &g),
                 None => label(&spec.y),
             };
             Series {
@@ -128,7 +128,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableErro
             }
         })
         .collect();
-    let mut title = format!("{} against {}", label(&spec.y), label(&spec.x));
+    let mut title = format!("{} against {}", name(&spec.y), name(&spec.x));
     if spec.aggregate != Aggregate::None {
         title.push_str(&format!(
             " ({} over the other parameters)",

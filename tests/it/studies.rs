@@ -134,10 +134,17 @@ fn plots_from_a_small_sweep() {
         "law = hertz",
         "law = nonlinear_viscoelastic",
         "pga (g)",
-        "peak force (N)",
+        "peak force against pga",
     ] {
         assert!(text.contains(name), "{name} not in the SVG");
     }
+    // Forces on the axis in engineering units.
+    assert!(
+        ["peak force (N)", "peak force (kN)", "peak force (MN)"]
+            .iter()
+            .any(|l| text.contains(l)),
+        "a force axis"
+    );
     let png = d.path().join("gap.png");
     ok(&pound(&[
         "plot",
