@@ -1,6 +1,7 @@
 //! Line and scatter plots (`plotters`): panels of named series, as SVG or PNG by the file's
 //! extension. Text is measured (and in PNG drawn) with a font built into the binary, so no font
-//! files are needed. Log axes plot `log10` of the values and say so in the axis label.
+//! files are needed. Log axes are drawn in `log10` of the values and labelled with the values,
+//! a label at each power of ten.
 
 use image::ImageEncoder;
 use plotters::prelude::*;
@@ -141,6 +142,15 @@ pub struct Panel {
     pub log_x: bool,
     pub log_y: bool,
     pub series: Vec<Series>,
+}
+
+/// The label of the power of ten `10^k`: `0.01` to `1000` plainly, else `1e-5`, `1e6`.
+fn decade(k: i32) -> String {
+    if (-2..=3).contains(&k) {
+        tick(10f64.powi(k))
+    } else {
+        format!("1e{k}")
+    }
 }
 
 /// A short tick label: plain for moderate magnitudes, else `1.2e6`.
@@ -319,11 +329,33 @@ fn draw<DB: DrawingBackend>(
     };
     let label = |l: &str, log: bool| {
         if log {
-            format!("log10 {l}")
+            format!("{l}, log scale")
         } else {
             l.to_string()
         }
     };
+    // A log axis is drawn in log10 of the values, labelled with the values themselves: with
+    // one label per decade where it spans two or more, each at a power of ten.
+    let ticks = |lo: f64, hi: f64, log: bool| {
+        if log {
+            ((hi - lo).floor() as usize + 1).clamp(3, 12)
+        } else {
+            10
+        }
+    };
+    let log_tick = |v: f64| {
+        let k = v.round();
+        if (v - k).abs() < 1e-9 {
+            decade(k as i32)
+        } else {
+            // Between decades: the value to two significant digits.
+            let x = 10f64.powf(v);
+            let unit = 10f64.powf(x.log10().floor() - 1.0);
+            tick((x / unit).round() * unit)
+        }
+    };
+    let fmt_x = |v: &f64| if p.log_x { log_tick(*v) } else { tick(*v) };
+    let fmt_y = |v: &f64| if p.log_y { log_tick(*v) } else { tick(*v) };
     let mut chart = ChartBuilder::on(area)
         .caption(&p.title, ("sans-serif", 18))
         .margin(10)
@@ -335,8 +367,10 @@ fn draw<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(label(&x_label, p.log_x))
         .y_desc(label(&y_label, p.log_y))
-        .x_label_formatter(&|v| tick(*v))
-        .y_label_formatter(&|v| tick(*v))
+        .x_labels(ticks(x0, x1, p.log_x))
+        .y_labels(ticks(y0, y1, p.log_y))
+        .x_label_formatter(&fmt_x)
+        .y_label_formatter(&fmt_y)
         .draw()
         .map_err(|x| e(&x))?;
     // Style slots in order of first appearance: a curve and its points share one.
@@ -406,6 +440,18 @@ fn draw<DB: DrawingBackend>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn decades_read_as_values() {
+        let labels: Vec<String> = (-5..=6).map(decade).collect();
+        assert_eq!(
+            labels,
+            [
+                "1e-5", "1e-4", "1e-3", "0.01", "0.1", "1", "10", "100", "1000", "1e4", "1e5",
+                "1e6"
+            ]
+        );
+    }
 
     #[test]
     fn axes_take_engineering_units() {

@@ -168,4 +168,45 @@ fn legends_cover_no_point_and_styles_are_distinct() {
     let glyphs = read(&svg).glyphs;
     assert_eq!(glyphs.len(), 6, "{glyphs:?}");
     check(&f, 6, 3);
+    // A log axis is labelled with values, one at each power of ten it spans.
+    let lg = dir.path().join("log.svg");
+    ok(&pound(&[
+        "plot",
+        &s(&runs),
+        "--x",
+        "pga_g",
+        "--y",
+        "peak_force_n",
+        "--log-y",
+        "--agg",
+        "max",
+        "-o",
+        &s(&lg),
+    ]));
+    let svg = std::fs::read_to_string(&lg).unwrap();
+    let y_ticks: Vec<f64> = svg
+        .split("<text")
+        .filter(|t| t.contains("text-anchor=\"end\""))
+        .map(|t| {
+            t.split('>')
+                .nth(1)
+                .unwrap()
+                .trim()
+                .split('<')
+                .next()
+                .unwrap()
+                .trim()
+        })
+        .map(|t| t.parse::<f64>().unwrap_or_else(|_| panic!("tick `{t}`")))
+        .collect();
+    assert!(
+        y_ticks.iter().all(|&v| v > 0.0),
+        "values, not their logs: {y_ticks:?}"
+    );
+    let decades = y_ticks
+        .iter()
+        .filter(|v| (v.log10() - v.log10().round()).abs() < 1e-12)
+        .count();
+    assert!(decades >= 2, "{y_ticks:?}");
+    assert!(svg.contains("log scale") && !svg.contains("log10"));
 }
