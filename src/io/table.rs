@@ -125,6 +125,29 @@ pub enum Op {
     Ge,
 }
 
+impl std::fmt::Display for Filter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let op = match self.op {
+            Op::Eq => "=",
+            Op::Ne => "!=",
+            Op::Lt => "<",
+            Op::Le => "<=",
+            Op::Gt => ">",
+            Op::Ge => ">=",
+        };
+        write!(f, "{}{op}{}", self.column, self.value)
+    }
+}
+
+/// The filters as a caption: `where a=1, b<2`; empty for none.
+pub fn caption(filters: &[Filter]) -> String {
+    if filters.is_empty() {
+        return String::new();
+    }
+    let all: Vec<String> = filters.iter().map(|f| f.to_string()).collect();
+    format!("where {}", all.join(", "))
+}
+
 /// `column OP value` with OP one of `=`, `!=`, `<`, `<=`, `>`, `>=`. `=` and `!=` compare numbers
 /// as numbers when both sides parse (so `gap_m=0.010` matches `0.01`), else as text.
 #[derive(Debug, Clone, PartialEq)]
@@ -292,6 +315,9 @@ mod tests {
         assert_eq!(label("impact_velocity_m_s"), "impact velocity (m/s)");
         assert_eq!(label("beta_n_per_m1_5"), "beta (N/m^1.5)");
         assert_eq!(label("impacts"), "impacts");
+        let f = Filter::parse_all(&["t2_s=0.9".into(), "law!=hertz".into()]).unwrap();
+        assert_eq!(caption(&f), "where t2_s=0.9, law!=hertz");
+        assert_eq!(caption(&[]), "");
         assert_eq!(label("gap_1_2_m"), "gap 1-2 (m)");
         assert_eq!(label("b2_peak_drift_ratio"), "peak drift ratio, building 2");
         assert_eq!(

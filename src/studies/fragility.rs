@@ -4,7 +4,7 @@
 //! likelihood (binomial at each level; Baker 2015), solved as a probit regression on `ln IM` by
 //! Fisher scoring.
 
-use crate::io::table::{label, order_key, Filter, Table, TableError};
+use crate::io::table::{caption, label, order_key, Filter, Table, TableError};
 use crate::plan::sample::phi;
 use crate::studies::plot::{Panel, Series};
 use std::collections::BTreeMap;
@@ -587,7 +587,10 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
         }
     }
     Panel {
-        title: format!("P({} > threshold) against {}", spec.edp, spec.im),
+        title: match caption(&spec.filters) {
+            c if c.is_empty() => format!("P({} > threshold) against {}", spec.edp, spec.im),
+            c => format!("P({} > threshold) against {}; {c}", spec.edp, spec.im),
+        },
         x_label: label(&spec.im),
         y_label: "probability of exceedance".into(),
         log_x: false,

@@ -211,20 +211,40 @@ fn register_font() -> Result<(), String> {
 /// Draw `panels` in a grid of `cols` columns into `path`: SVG, or PNG for a `.png` name
 /// (written whole, then renamed into place).
 pub fn save(path: &Path, panels: &[Panel], cols: usize) -> Result<(), PlotError> {
+    save_sized(path, panels, cols, PANEL)
+}
+
+/// A panel's size in pixels unless given.
+pub const PANEL: (u32, u32) = (640, 480);
+
+/// The sizes a panel may take, px.
+pub const PANEL_SIZES: std::ops::RangeInclusive<u32> = 320..=4000;
+
+/// [`save`] with each panel `size` pixels wide and high.
+pub fn save_sized(
+    path: &Path,
+    panels: &[Panel],
+    cols: usize,
+    size: (u32, u32),
+) -> Result<(), PlotError> {
     let png = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let size = (
+        size.0.clamp(*PANEL_SIZES.start(), *PANEL_SIZES.end()),
+        size.1.clamp(*PANEL_SIZES.start(), *PANEL_SIZES.end()),
+    );
     if png {
-        self::png(path, panels, cols)
+        self::png(path, panels, cols, size)
     } else {
-        svg(path, panels, cols)
+        svg(path, panels, cols, size)
     }
 }
 
-fn grid(panels: &[Panel], cols: usize) -> (usize, usize, (u32, u32)) {
+fn grid(panels: &[Panel], cols: usize, size: (u32, u32)) -> (usize, usize, (u32, u32)) {
     let cols = cols.clamp(1, panels.len().max(1));
     let rows = panels.len().div_ceil(cols).max(1);
-    (rows, cols, (640 * cols as u32, 480 * rows as u32))
+    (rows, cols, (size.0 * cols as u32, size.1 * rows as u32))
 }
 
 fn draw_all<DB: DrawingBackend>(
@@ -241,14 +261,14 @@ fn draw_all<DB: DrawingBackend>(
     root.present().map_err(|x| e(&x))
 }
 
-/// [`save`] as SVG whatever the name.
-pub fn svg(path: &Path, panels: &[Panel], cols: usize) -> Result<(), PlotError> {
+/// [`save_sized`] as SVG whatever the name.
+pub fn svg(path: &Path, panels: &[Panel], cols: usize, size: (u32, u32)) -> Result<(), PlotError> {
     let fail = |message: String| PlotError {
         path: path.into(),
         message,
     };
     register_font().map_err(fail)?;
-    let (rows, cols, size) = grid(panels, cols);
+    let (rows, cols, size) = grid(panels, cols, size);
     let mut text = String::new();
     draw_all(
         SVGBackend::with_string(&mut text, size).into_drawing_area(),
@@ -260,14 +280,14 @@ pub fn svg(path: &Path, panels: &[Panel], cols: usize) -> Result<(), PlotError> 
     crate::io::atomic::write_atomic(path, text.as_bytes()).map_err(|e| fail(e.to_string()))
 }
 
-/// [`save`] as PNG whatever the name.
-pub fn png(path: &Path, panels: &[Panel], cols: usize) -> Result<(), PlotError> {
+/// [`save_sized`] as PNG whatever the name.
+pub fn png(path: &Path, panels: &[Panel], cols: usize, size: (u32, u32)) -> Result<(), PlotError> {
     let fail = |message: String| PlotError {
         path: path.into(),
         message,
     };
     register_font().map_err(fail)?;
-    let (rows, cols, size) = grid(panels, cols);
+    let (rows, cols, size) = grid(panels, cols, size);
     let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
     draw_all(
         BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area(),

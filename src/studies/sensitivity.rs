@@ -3,7 +3,7 @@
 //! plotted nor grouped are aggregated over (max, mean, median or min of the output at each x),
 //! or every row is drawn as a point.
 
-use crate::io::table::{label, name, order_key, value_label, Filter, Table, TableError};
+use crate::io::table::{caption, label, name, order_key, value_label, Filter, Table, TableError};
 use crate::studies::plot::{Panel, Series};
 use std::collections::BTreeMap;
 
@@ -134,6 +134,9 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableErro
             " ({} over the other parameters)",
             spec.aggregate.key()
         ));
+    }
+    if !spec.filters.is_empty() {
+        title.push_str(&format!("; {}", caption(&spec.filters)));
     }
     Ok((
         Panel {

@@ -51,7 +51,7 @@ fn errors_fall_with_more_substeps_on_every_path() {
     }
     let d = tempdir();
     let svg = d.path().join("a.svg");
-    pounding::studies::plot::svg(&svg, &panels(points), 2).unwrap();
+    pounding::studies::plot::svg(&svg, &panels(points), 2, pounding::studies::plot::PANEL).unwrap();
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("\ncpu-fast-f64\n") && text.contains("\n99th percentile error\n"));
     assert_eq!(csv(points).lines().count(), 1 + points.len());

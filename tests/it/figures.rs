@@ -142,6 +142,53 @@ fn legends_cover_no_point_and_styles_are_distinct() {
         &s(&plot),
     ]));
     check(&plot, 5, 0);
+    // The filter in the caption; a title and a size of one's own.
+    let w = dir.path().join("w.svg");
+    ok(&pound(&[
+        "plot",
+        &s(&results),
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--by",
+        "formula",
+        "--where",
+        "t2_s=0.4",
+        "--size",
+        "1000x600",
+        "-o",
+        &s(&w),
+    ]));
+    let svg = std::fs::read_to_string(&w).unwrap();
+    assert!(svg.contains("where t2_s=0.4"), "the filter in the caption");
+    assert!(svg.contains("width=\"1000\" height=\"600\""));
+    check(&w, 3, 0);
+    ok(&pound(&[
+        "plot",
+        &s(&results),
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--title",
+        "Fig. 3",
+        "-o",
+        &s(&w),
+    ]));
+    assert!(std::fs::read_to_string(&w).unwrap().contains("Fig. 3"));
+    let bad = pound(&[
+        "plot",
+        &s(&results),
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--size",
+        "10x10",
+    ]);
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("WIDTHxHEIGHT"));
     // Fragility curves fill the corners (0 at the low left, near 1 at the top right): three
     // thresholds, each its points and its curve in one style.
     let runs = dir.path().join("fr.csv");
