@@ -589,15 +589,21 @@ impl Plan {
 
     /// Inputs that are valid but physically absurd (a units mix-up?), one line each.
     pub fn warnings(&self) -> Vec<String> {
-        let mut w = Vec::new();
         let first = self.run(0);
+        self.pga_warnings(&[first.t1, first.t2])
+    }
+
+    /// The records scaled past a PGA no earthquake reaches, for buildings of these fundamental
+    /// periods (a spectral target at a building's period scales by the first run's).
+    pub(crate) fn pga_warnings(&self, periods: &[f64]) -> Vec<String> {
+        let mut w = Vec::new();
         for (r, rec) in self.spec.records.iter().enumerate() {
             let pga = self
                 .spec
                 .intensities
                 .iter()
                 .map(|i| {
-                    let s = i.scaling(r, rec, self.pgas[r], &[first.t1, first.t2], &self.ims);
+                    let s = i.scaling(r, rec, self.pgas[r], periods, &self.ims);
                     self.pgas[r] * s.scale / G
                 })
                 .fold(0.0, f64::max);

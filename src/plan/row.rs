@@ -337,7 +337,9 @@ impl RowPlan {
     /// What a user should hear before any run: the base plan's warnings (PGA above 5 g), each
     /// adjacent pair that shares no floor level, and keys the config gives that no run uses.
     pub fn warnings(&self) -> Vec<String> {
-        let mut w = self.base.warnings();
+        // The base plan's buildings are placeholders: a target at a building's period reads
+        // the row's own.
+        let mut w = self.base.pga_warnings(&self.run(0).period);
         w.extend(self.pairs_without_levels());
         w.extend(self.ignored.iter().cloned());
         w

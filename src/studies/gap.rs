@@ -252,7 +252,11 @@ impl<'a> GapStudy<'a> {
         };
         study.pair_gaps = (0..study.len())
             .into_par_iter()
-            .map(|m| study.pairs_of(m, &study.separation(m)))
+            .map(|m| {
+                // One decode of the motion serves its scale and its periods.
+                let (periods, scale) = study.scenes.periods(m);
+                study.pairs_of(&study.scaled(m, scale), &periods)
+            })
             .collect();
         study
     }
@@ -260,7 +264,12 @@ impl<'a> GapStudy<'a> {
     /// Run `m`'s separation: its response, scaled to its intensity (per run: a spectral target
     /// at a building's period scales each building's record by its own factor).
     fn separation(&self, m: u64) -> Separation {
-        self.responses[self.motions.response(m) as usize].scaled(self.scenes.periods(m).1)
+        self.scaled(m, self.scenes.periods(m).1)
+    }
+
+    /// Run `m`'s response, scaled by `scale`.
+    fn scaled(&self, m: u64, scale: f64) -> Separation {
+        self.responses[self.motions.response(m) as usize].scaled(scale)
     }
 
     /// Runs in the study.
@@ -316,9 +325,9 @@ impl<'a> GapStudy<'a> {
         }
     }
 
-    /// What each adjacent pair needs in run `m`, of separation `sep`.
-    fn pairs_of(&self, m: u64, sep: &Separation) -> Vec<Option<PairGap>> {
-        let (periods, _) = self.scenes.periods(m);
+    /// What each adjacent pair needs in a run of separation `sep` whose buildings have these
+    /// fundamental periods.
+    fn pairs_of(&self, sep: &Separation, periods: &[f64]) -> Vec<Option<PairGap>> {
         (0..self.pairs())
             .map(|a| {
                 let (wa, xa) = sep.fundamental[a];

@@ -159,6 +159,13 @@ sa_period_s = "building[2]"
         let rec = scaled(&plan.base.spec.records[0], r.base.scale);
         assert!(rel(sa(&rec, t, 0.05) / G, r.base.intensity.value()) < 1e-12);
     }
+    // A warning of an absurd PGA reads the row's own period, not a placeholder's.
+    let loud =
+        config::load_row_text(&text.replace("sa_g = [0.3, 0.6]", "sa_g = 40.0"), &cfg).unwrap();
+    let pga = loud.run(0).base.pga_g;
+    assert!(pga > 5.0);
+    let w = loud.warnings().join("\n");
+    assert!(w.contains(&format!("a PGA of {pga:.3} g")), "{pga}: {w}");
     // The CSV carries the target, the period and the factor.
     let csv = dir.path().join("row.csv");
     ok(&pound(&[
