@@ -3,15 +3,20 @@
 //! The data path, in the order of the folders:
 //!
 //! ```text
-//! TOML config --plan::config--> Plan --engine::Engine (cpu | gpu)--> (RunSpec, RunOutput) rows
-//!     --io--> CSV / Parquet / summary with sidecar --studies--> tables and plots
+//! TOML config --plan::config--> Plan (a pair or a row) --engine::Engine (cpu | gpu), with the
+//!     kernels the scene takes (engine::Kernel)--> chunks of runs --io--> CSV / Parquet /
+//!     summary with sidecar --studies--> tables and plots
 //! ```
+//!
+//! One path for every scene: the config reader is the one place a config's kind is told, and
+//! [`engine::Kernel::of`] the one place the kernels are chosen (the pair kernels for two
+//! one-storey buildings, the row kernels otherwise); commands hold a [`plan::Plan`].
 //!
 //! - [`physics`]: one run in f64: buildings, contact laws, restitution, free stepping, solvers;
 //! - [`record`]: ground motions, read from files or synthesised, and their intensity measures;
-//! - [`plan`]: a validated sweep, its intensity axis, its columns and their meanings, samples,
+//! - [`plan`]: a validated sweep of a pair or a row ([`plan::Plan`]), its intensity axis, its columns and their meanings, samples,
 //!   shards and input bounds;
-//! - [`engine`]: the one enum that runs a range of a plan on the CPU or the GPU (`shaders/`);
+//! - [`engine`]: the one enum that runs a range of any plan on the CPU or the GPU (`shaders/`);
 //! - [`io`]: outputs that are never destroyed nor called complete when they are not;
 //! - [`studies`]: accuracy, benchmarks, fidelity, fragility (damage states, bootstrap bands), IDA,
 //!   the gap study, sensitivity, the seed paper, plots.

@@ -2,8 +2,8 @@
 
 use super::{check_outputs, config_inputs, write_file, BackendArg, Holds};
 use anyhow::{bail, Result};
-use pounding::plan::config;
 use pounding::plan::limits::{MAX_SUBSTEPS_PER_CONTACT, WHY_SUBSTEPS};
+use pounding::plan::{config, Plan};
 use pounding::studies::accuracy;
 use std::path::PathBuf;
 
@@ -50,12 +50,8 @@ pub fn run(a: Args) -> Result<()> {
     } = a;
     let output = super::default_output(output, "accuracy.csv");
     let text = config::read_text(&config)?;
-    let is_row = pounding::plan::row::is_row_config(&text);
-    let suite = if is_row {
-        pounding::physics::solver::calibration::Suite::Rows
-    } else {
-        pounding::physics::solver::calibration::Suite::Pairs
-    };
+    let plan = config::load_text(&text, &config)?;
+    let suite = plan.suite();
     let choices = target_error
         .unwrap_or_default()
         .into_iter()
@@ -87,44 +83,43 @@ pub fn run(a: Args) -> Result<()> {
             ("--plot", plot.as_deref(), Holds::Plot),
         ],
     )?;
-    if is_row {
-        // Rows: the CPU paths only, as a table, CSV and plot.
-        if backend.get() == pounding::engine::Backend::Gpu {
-            bail!("--backend gpu is not available for the accuracy of rows of multi-storey buildings ([[building]] configs) yet: it compares the CPU paths");
+    let finest = settings.iter().cloned().fold(0.0, f64::max);
+    super::warn_all(&config, plan.warnings(finest));
+    // The rows' study compares the CPU paths; the pairs' every path (studies::accuracy).
+    let plan = match plan {
+        Plan::Pair(pair) => pair,
+        Plan::Row(plan) => {
+            if backend.get() == pounding::engine::Backend::Gpu {
+                bail!("--backend gpu is not available for the accuracy of rows of multi-storey buildings ([[building]] configs) yet: it compares the CPU paths");
+            }
+            note!(
+                "{}: {} runs of a row; reference at tol {tol:e}, then {} settings on the CPU",
+                config.display(),
+                plan.len(),
+                settings.len()
+            );
+            say!("{}", accuracy::ROW_MARKDOWN_HEADER);
+            let points = accuracy::row_study(&plan, &settings, tol, |p| {
+                let _ = super::say_text(&format!("{}\n", accuracy::row_markdown(p)));
+            });
+            write_file(&output, accuracy::row_csv(&points).as_bytes())?;
+            if let Some(p) = plot {
+                super::save_plot(&p, &accuracy::row_panels(&points), 2)?;
+            }
+            let measured: Vec<Measured> = points
+                .iter()
+                .map(|p| Measured {
+                    path: &p.path,
+                    setting: p.substeps_per_contact,
+                    force_p99: p.force[1],
+                    failed: p.failed,
+                    compared: p.compared,
+                    runs: plan.len(),
+                })
+                .collect();
+            return check_targets(&choices, &measured, &config);
         }
-        let plan = config::load_row_text(&text, &config)?;
-        super::warn_all(&config, plan.warnings());
-        let finest = settings.iter().cloned().fold(0.0, f64::max);
-        super::warn_all(&config, plan.cost_warning(finest));
-        note!(
-            "{}: {} runs of a row; reference at tol {tol:e}, then {} settings on the CPU",
-            config.display(),
-            plan.len(),
-            settings.len()
-        );
-        say!("{}", accuracy::ROW_MARKDOWN_HEADER);
-        let points = accuracy::row_study(&plan, &settings, tol, |p| {
-            let _ = super::say_text(&format!("{}\n", accuracy::row_markdown(p)));
-        });
-        write_file(&output, accuracy::row_csv(&points).as_bytes())?;
-        if let Some(p) = plot {
-            super::save_plot(&p, &accuracy::row_panels(&points), 2)?;
-        }
-        let measured: Vec<Measured> = points
-            .iter()
-            .map(|p| Measured {
-                path: &p.path,
-                setting: p.substeps_per_contact,
-                force_p99: p.force[1],
-                failed: p.failed,
-                compared: p.compared,
-                runs: plan.len(),
-            })
-            .collect();
-        return check_targets(&choices, &measured, &config);
-    }
-    let plan = config::load_text(&text, &config)?;
-    super::warn_all(&config, plan.warnings());
+    };
     let ctx = backend
         .get()
         .acquire("CPU path only", &mut |l| note!("{l}"))?;

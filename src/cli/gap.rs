@@ -49,26 +49,18 @@ pub fn run(a: Args) -> Result<()> {
     )?;
     let gaps = a.gaps.as_deref().map(parse_gaps).transpose()?;
     let threads = a.threads.map(super::sweep::check_threads).transpose()?;
-    let row_plan;
-    let pair_plan;
-    let scenes = if pounding::plan::row::is_row_config(&text) {
-        row_plan = config::load_row_text(&text, &a.config)?;
-        // A pair that cannot touch floor to floor has no required gap to give.
-        let apart = row_plan.pairs_without_levels();
-        if !apart.is_empty() {
-            bail!(
-                "{}: {}: no required gap can be computed for such a pair",
-                a.config.display(),
-                apart.join("; ")
-            );
-        }
-        super::warn_all(&a.config, row_plan.warnings());
-        Scenes::Rows(&row_plan)
-    } else {
-        pair_plan = config::load_text(&text, &a.config)?;
-        super::warn_all(&a.config, pair_plan.warnings());
-        Scenes::Pairs(&pair_plan)
-    };
+    let plan = config::load_text(&text, &a.config)?;
+    // A pair that cannot touch floor to floor has no required gap to give.
+    let apart = plan.pairs_without_levels();
+    if !apart.is_empty() {
+        bail!(
+            "{}: {}: no required gap can be computed for such a pair",
+            a.config.display(),
+            apart.join("; ")
+        );
+    }
+    super::warn_all(&a.config, plan.input_warnings());
+    let scenes = Scenes::from(&plan);
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = threads {
         pool = pool.num_threads(t);

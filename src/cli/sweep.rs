@@ -4,13 +4,13 @@
 use super::{check_outputs, config_inputs, BackendArg, Holds, PrecisionArg};
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
-use pounding::engine::{Backend, Engine, EngineError};
+use pounding::engine::aggregate::Aggregator;
+use pounding::engine::{Backend, Chunk, Engine, Kernel};
 use pounding::io::provenance::{Fingerprint, Meta};
 use pounding::io::sweep_output::{Format, Opened, SweepOutput};
-use pounding::physics::model::RunOutput;
 use pounding::physics::solver::{FastOptions, ReferenceOptions, Scheme};
 use pounding::plan::shard::Shard;
-use pounding::plan::{config, RunSpec};
+use pounding::plan::{config, Plan};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -135,300 +135,296 @@ pub fn check_threads(t: usize) -> Result<usize> {
 }
 
 pub fn run(a: Args) -> Result<()> {
-    let Args {
-        config,
-        output,
-        threads,
-        scheme,
-        backend,
-        precision,
-        chunk,
-        energy,
-        shard,
-        resume,
-        aggregate,
-        exceed,
-        format,
-        columns,
-        target_error,
-    } = a;
-    // A default name is never an earlier output; --resume continues the one it names.
-    let output = match (output, resume) {
-        (None, true) => PathBuf::from("results.csv"),
-        (given, _) => super::default_output(given, "results.csv"),
-    };
-    let parquet_name = output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("parquet"));
-    let format = format.unwrap_or(if parquet_name && aggregate.is_none() {
-        FormatArg::Parquet
-    } else {
-        FormatArg::Csv
-    });
-    if format == FormatArg::Parquet && resume {
-        bail!("--resume continues CSV output only: a Parquet file is readable only once its footer is written at the end");
-    }
-    if aggregate.is_some() && (format == FormatArg::Parquet || columns.is_some()) {
-        bail!("--aggregate writes its own summary columns: --format and --columns do not apply");
-    }
-    if aggregate.is_some() && (resume || shard.is_some()) {
-        bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
-    }
-    let threads = threads.map(check_threads).transpose()?;
+    let flags = Flags::check(a)?;
     // The output is checked before anything runs: not a directory, not one of the inputs, and
     // writable.
-    let config_text = config::read_text(&config)?;
-    let records = config::input_files(&config_text, &config);
-    let holds = if format == FormatArg::Parquet {
-        Holds::Parquet
-    } else {
-        Holds::Csv
+    let config_text = config::read_text(&flags.config)?;
+    let target = flags.target(&config_text)?;
+    let mut plan = config::load_text(&config_text, &flags.config)?;
+    let chosen = flags.settle_scheme(&mut plan, &config_text)?;
+    let gpu = pounding::engine::gpu_for(
+        &plan,
+        flags.backend,
+        flags.precision,
+        chosen.is_some(),
+        &mut |l| note!("{l}"),
+    )?;
+    let engine = Engine::new(plan.scheme(), gpu.as_ref(), flags.precision, flags.chunk)?;
+    let Columns {
+        format,
+        picked,
+        names,
+    } = flags.output_columns(&plan)?;
+    let range = match flags.shard {
+        Some(s) => pounding::plan::shard::shard_range(&plan, s),
+        None => 0..plan.len(),
     };
-    let target = check_outputs(
-        &config_inputs(&config, &records),
-        &[("-o", Some(&output), holds)],
-    )?
-    .pop()
-    .expect("one output");
-    if pounding::plan::row::is_row_config(&config_text) {
-        let mut plan = config::load_row_text(&config_text, &config)?;
-        super::warn_all(&config, plan.warnings());
-        plan.base.spec.scheme = scheme_as_run(plan.base.spec.scheme, scheme, energy);
-        let chosen = match (target_error, &mut plan.base.spec.scheme) {
+    let meta = Meta {
+        fingerprint: Fingerprint::of_plan(&plan),
+        plan_runs: plan.len(),
+        first_run: range.start,
+        end_run: range.end,
+        shard: flags.shard,
+        backend: engine.key(),
+        kernel: Some(Kernel::of(&plan).key().into()),
+        columns: names,
+        content: None,
+        target_error: chosen.map(pounding::io::provenance::TargetError::of),
+    };
+    // Every refusal that the plan decides comes before any file is made.
+    engine.check(&plan)?;
+    let Some(mut out) = open_output(target, meta, format, picked, flags.resume)? else {
+        return Ok(());
+    };
+    let pool = flags.pool()?;
+    let todo = out.todo();
+    note!(
+        "{}: {} runs of {}, {} scheme, {} kernel on the {}",
+        flags.config.display(),
+        todo.end - todo.start,
+        plan.scene(),
+        plan.scheme().key(),
+        Kernel::of(&plan).key(),
+        pool.install(|| engine.describe()),
+    );
+    let (summary, absurd) = pool.install(|| integrate(&engine, &plan, &mut out, todo))?;
+    // Records are read once, at the start: a file changed since then no longer matches the rows
+    // (or the fingerprint), so the output is not put in place.
+    let changed = config::changed_records(&config_text, &flags.config, &plan);
+    let (path, what) = finish_unless_changed(*out, &changed)?;
+    if absurd > 0 {
+        note!("warning: {absurd} runs have a building whose peak displacement exceeds its height ({}): check the record's units and the intensity", plan.height_basis());
+    }
+    finished(&summary, &path, &format!(" ({what})"));
+    Ok(())
+}
+
+/// How a sweep's runs are written: a summary, Parquet or CSV; `--columns` as indices into the
+/// plan's header; the column names the sidecar records (None where they are the pair's fixed
+/// schema, which a reader knows).
+struct Columns {
+    format: Format,
+    picked: Option<Vec<usize>>,
+    names: Option<Vec<String>>,
+}
+
+/// The flags of `pound sweep`, checked against each other: the settings stage before any file
+/// is read.
+struct Flags {
+    config: PathBuf,
+    output: PathBuf,
+    format: FormatArg,
+    threads: Option<usize>,
+    scheme: Option<SchemeArg>,
+    backend: Backend,
+    precision: pounding::engine::gpu::Precision,
+    chunk: Option<usize>,
+    energy: bool,
+    shard: Option<Shard>,
+    resume: bool,
+    aggregate: Option<Vec<String>>,
+    exceed: Vec<String>,
+    columns: Option<Vec<String>>,
+    target_error: Option<f64>,
+}
+
+impl Flags {
+    fn check(a: Args) -> Result<Flags> {
+        // A default name is never an earlier output; --resume continues the one it names.
+        let output = match (a.output, a.resume) {
+            (None, true) => PathBuf::from("results.csv"),
+            (given, _) => super::default_output(given, "results.csv"),
+        };
+        let parquet_name = output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("parquet"));
+        let format = a
+            .format
+            .unwrap_or(if parquet_name && a.aggregate.is_none() {
+                FormatArg::Parquet
+            } else {
+                FormatArg::Csv
+            });
+        if format == FormatArg::Parquet && a.resume {
+            bail!("--resume continues CSV output only: a Parquet file is readable only once its footer is written at the end");
+        }
+        if a.aggregate.is_some() && (format == FormatArg::Parquet || a.columns.is_some()) {
+            bail!(
+                "--aggregate writes its own summary columns: --format and --columns do not apply"
+            );
+        }
+        if a.aggregate.is_some() && (a.resume || a.shard.is_some()) {
+            bail!("--aggregate keeps its summary in memory until the sweep ends: it cannot be combined with --resume or --shard");
+        }
+        Ok(Flags {
+            threads: a.threads.map(check_threads).transpose()?,
+            config: a.config,
+            output,
+            format,
+            scheme: a.scheme,
+            backend: a.backend.get(),
+            precision: a.precision.get(),
+            chunk: a.chunk,
+            energy: a.energy,
+            shard: a.shard,
+            resume: a.resume,
+            aggregate: a.aggregate,
+            exceed: a.exceed,
+            columns: a.columns,
+            target_error: a.target_error,
+        })
+    }
+
+    /// The output, checked: not a directory, not one of the config's inputs, writable.
+    fn target(&self, config_text: &str) -> Result<pounding::io::target::Target> {
+        let records = config::input_files(config_text, &self.config);
+        let holds = if self.format == FormatArg::Parquet {
+            Holds::Parquet
+        } else {
+            Holds::Csv
+        };
+        Ok(check_outputs(
+            &config_inputs(&self.config, &records),
+            &[("-o", Some(&self.output), holds)],
+        )?
+        .pop()
+        .expect("one output"))
+    }
+
+    /// Set the scheme as run on `plan` (the fingerprint covers it: the config's, `--scheme`,
+    /// `--energy`, and the setting `--target-error` chooses from the scene's calibration), and
+    /// say what a user should hear before any run. Returns the `--target-error` choice.
+    fn settle_scheme(
+        &self,
+        plan: &mut Plan,
+        config_text: &str,
+    ) -> Result<Option<pounding::physics::solver::calibration::Choice>> {
+        let mut scheme = scheme_as_run(plan.scheme(), self.scheme, self.energy);
+        let chosen = match (self.target_error, &mut scheme) {
             (None, _) => None,
             (Some(_), Scheme::Reference(_)) => bail!(
                 "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.tol)"
             ),
             (Some(e), Scheme::Fast(o)) => {
-                let c = super::target_error_in(
-                    pounding::physics::solver::calibration::Suite::Rows,
-                    e,
-                )?;
-                overrides_configured(&config_text, c.substeps_per_contact);
+                let c = super::target_error_in(plan.suite(), e)?;
+                overrides_configured(config_text, c.substeps_per_contact);
                 o.substeps_per_contact = c.substeps_per_contact;
                 Some(c)
             }
         };
-        let spc = match plan.base.spec.scheme {
+        plan.set_scheme(scheme);
+        let spc = match scheme {
             Scheme::Fast(o) => o.substeps_per_contact,
             Scheme::Reference(_) => FastOptions::default().substeps_per_contact,
         };
-        super::warn_all(&config, plan.cost_warning(spc));
-        // The row kernel runs the fast scheme without the energy balance; the rows' calibration
-        // is of the CPU's f64 (the GPU in f64 agrees with it to 3.7e-6, BENCHMARKS.md; f32
-        // adds up to 7.2e-5).
-        let gpu_fit = match plan.base.spec.scheme {
-            Scheme::Fast(o) if o.energy => {
-                Some("the energy balance of rows is integrated on the CPU only")
-            }
-            Scheme::Fast(_)
-                if chosen.is_some() && precision.get() == pounding::engine::gpu::Precision::F32 =>
-            {
-                Some("--target-error on rows is calibrated in f64 (add --precision f64)")
-            }
-            Scheme::Fast(_) => None,
-            Scheme::Reference(_) => Some("the reference scheme runs on the CPU only"),
-        };
-        let backend = backend.get();
-        let gpu = match (backend, gpu_fit) {
-            (Backend::Gpu, Some(why)) => bail!("--backend gpu: {why}; use --backend cpu"),
-            (_, Some(_)) => None,
-            // Measured on an H100: the row kernel beats 16 CPU threads only for rows of
-            // one-storey buildings (2.4x); 0.59x at 3 storeys, 0.17x at 6 (BENCHMARKS.md).
-            (Backend::Auto, None) if plan.buildings.iter().any(|b| b.storeys() > 1) => {
-                note!("notice: running on the CPU: the row kernel is slower than the CPU path for buildings of more than one storey (BENCHMARKS.md, \"Rows on the GPU\"); --backend gpu uses it");
-                None
-            }
-            _ => backend.acquire("running on the CPU", &mut |l| note!("{l}"))?,
-        };
+        super::warn_all(&self.config, plan.warnings(spc));
+        Ok(chosen)
+    }
+
+    /// How runs are written ([`Columns`]).
+    fn output_columns(&self, plan: &Plan) -> Result<Columns> {
         let header = plan.header();
-        let picked = columns
+        let picked = self
+            .columns
             .as_ref()
             .map(|c| pounding::plan::columns::select_in(&header, c))
             .transpose()
             .map_err(|bad| {
                 anyhow::anyhow!(
-                    "--columns: `{bad}` is not a column of this row sweep; its columns are: {}",
+                    "--columns: `{bad}` is not a column of this sweep ({}); its columns are: {}",
+                    plan.scene(),
                     header.join(", ")
                 )
             })?;
-        let summary = aggregate
+        let summary = self
+            .aggregate
             .as_ref()
-            .map(|by| {
-                pounding::engine::aggregate::Aggregator::of_cells(
-                    &header,
-                    plan.parameter_columns(),
-                    &plan.summarised(),
-                    by,
-                    &exceed,
-                )
-            })
+            .map(|by| Aggregator::for_plan(plan, by, &self.exceed))
             .transpose()?;
-        return run_row(
-            &config,
-            &config_text,
-            &plan,
-            RowSettings {
-                target,
-                threads,
-                chunk,
-                gpu: gpu.as_ref().map(|c| (c, precision.get())),
-                header,
-                picked,
-                shard,
-                resume,
-                format: output_format(summary, format),
-                target_error: chosen,
-            },
-        );
+        let format = output_format(summary, self.format);
+        let names: Vec<String> = match &picked {
+            Some(ix) => ix.iter().map(|&i| header[i].clone()).collect(),
+            None => header,
+        };
+        let fixed = names
+            .iter()
+            .map(String::as_str)
+            .eq(pounding::plan::columns::header());
+        let named = !matches!(format, Format::Summary(_)) && !fixed;
+        Ok(Columns {
+            format,
+            picked,
+            names: named.then_some(names),
+        })
     }
-    let picked = columns
-        .as_ref()
-        .map(|c| pounding::plan::columns::select(c))
-        .transpose()
-        .map_err(|bad| {
-            anyhow::anyhow!(
-                "--columns: `{bad}` is not a column; the columns are: {}",
-                pounding::plan::columns::header().join(", ")
-            )
-        })?;
-    let picked_names: Option<Vec<String>> = picked.as_ref().map(|ix| {
-        let h = pounding::plan::columns::header();
-        ix.iter().map(|&i| h[i].to_string()).collect()
-    });
-    let precision = precision.get();
-    let mut plan = config::load_text(&config_text, &config)?;
-    super::warn_all(&config, plan.warnings());
-    let mut scheme = scheme_as_run(plan.spec.scheme, scheme, energy);
-    let chosen = match (target_error, &mut scheme) {
-        (None, _) => None,
-        (Some(_), Scheme::Reference(_)) => bail!(
-            "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.tol)"
-        ),
-        (Some(e), Scheme::Fast(o)) => {
-            let c = super::target_error(e)?;
-            overrides_configured(&config_text, c.substeps_per_contact);
-            o.substeps_per_contact = c.substeps_per_contact;
-            Some(c)
+
+    /// The worker threads (`--threads`, default all cores).
+    fn pool(&self) -> Result<rayon::ThreadPool> {
+        let mut pool = rayon::ThreadPoolBuilder::new();
+        if let Some(t) = self.threads {
+            pool = pool.num_threads(t);
         }
-    };
-    // The fingerprint covers the scheme as run, not as configured.
-    plan.spec.scheme = scheme;
-    let fast = matches!(scheme, Scheme::Fast(_));
-    let backend = backend.get();
-    if backend == Backend::Gpu && !fast {
-        bail!(EngineError::GpuNeedsFast)
+        pool.build().context("starting worker threads")
     }
-    // The reference scheme runs on the CPU only: no adapter is looked for.
-    let gpu = if fast {
-        backend.acquire("running on the CPU", &mut |l| note!("{l}"))?
-    } else {
-        None
-    };
-    let engine = Engine::new(scheme, gpu.as_ref(), precision, chunk)?;
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = threads {
-        pool = pool.num_threads(t);
-    }
-    let pool = pool.build().context("starting worker threads")?;
-    let range = match shard {
-        Some(s) => pounding::plan::shard::shard_range(&plan, s),
-        None => 0..plan.len(),
-    };
-    let meta = Meta {
-        fingerprint: Fingerprint::of(&plan),
-        plan_runs: plan.len(),
-        first_run: range.start,
-        end_run: range.end,
-        shard,
-        backend: engine.key(),
-        columns: picked_names.clone(),
-        content: None,
-        target_error: chosen.map(pounding::io::provenance::TargetError::of),
-    };
-    let summary = aggregate
-        .as_ref()
-        .map(|by| pounding::engine::aggregate::Aggregator::new(by, &exceed))
-        .transpose()?;
-    let fmt = output_format(summary, format);
-    let Some(mut out) = open_output(target, meta, fmt, picked, resume)? else {
-        return Ok(());
-    };
-    let todo = out.todo();
+}
+
+/// Run the runs `out` still needs through `engine`, into `out` (rows, or folded into its
+/// summary): the report's totals, and the runs whose peak displacement passed a building's
+/// height.
+fn integrate(
+    engine: &Engine,
+    plan: &Plan,
+    out: &mut SweepOutput,
+    todo: std::ops::Range<u64>,
+) -> Result<(pounding::engine::Summary, u64)> {
     let partial = out.partial_path();
     let mut bar = progress_bar(todo.end - todo.start);
-    note!(
-        "{}: {} runs, {} scheme, {}",
-        config.display(),
-        todo.end - todo.start,
-        scheme.key(),
-        pool.install(|| engine.describe()),
-    );
+    let progress = |done| bar.set_position(done);
     let mut absurd = 0u64;
-    let report = pool
-        .install(|| -> Result<_> {
-            let progress = |done| bar.set_position(done);
-            let report = match out.aggregator() {
-                Some(agg) => {
-                    let r = engine.fold(&plan, todo.clone(), agg, progress)?;
-                    if let Engine::Gpu { .. } = engine {
-                        let t = r.gpu;
-                        bar.suspend(|| {
-                            note!(
-                                "aggregated on the device: {:.2} s folding; {} chunks with more than {} groups folded on the host; histograms flushed {} times",
-                                t.aggregate,
-                                t.host_folded_chunks,
-                                pounding::engine::gpu::reduce::DEFAULT_SLOTS,
-                                t.slot_flushes
-                            )
-                        });
-                    }
-                    r
-                }
-                None => engine.run(
-                    &plan,
-                    todo.clone(),
-                    |c: &[(RunSpec, RunOutput)]| {
-                        absurd += pounding::plan::limits::above_height(c);
-                        out.take(&plan, c).map_err(anyhow::Error::from)
-                    },
-                    progress,
-                )?,
-            };
-            if let Engine::Gpu { opts, .. } = engine {
-                if report.gpu.handed_off > 0 {
-                    bar.suspend(|| {
-                        note!(
-                            "{} runs needed more than {} RK4 substeps per record step, past what {} resolves: finished on the CPU in f64",
-                            report.gpu.handed_off,
-                            opts.handoff(),
-                            precision.key()
-                        )
-                    });
-                }
-            }
-            Ok(report)
-        })
-        .with_context(|| {
-            format!(
-                "writing {} (finished rows are kept there)",
-                partial.display()
-            )
-        })?;
-    let summary = report.summary;
-    bar.finish_and_clear();
-    // Records are read once, at the start: a file changed since then no longer matches the rows
-    // (or the fingerprint), so the output is not put in place.
-    let changed = config::changed_records(&config_text, &config, &plan);
-    let (path, what) = finish_unless_changed(*out, &changed)?;
-    if absurd > 0 {
-        note!(
-            "warning: {absurd} runs have a peak displacement above the building's height estimated from its period ({} m per s: T ~ 0.1 s per 3 m storey): check the record's units and the intensity",
-            pounding::plan::limits::HEIGHT_PER_PERIOD_M
-        );
+    let report = match out.aggregator() {
+        Some(agg) => engine
+            .summarise(plan, todo, agg, progress)
+            .map_err(anyhow::Error::from),
+        None => engine.sweep(
+            plan,
+            todo,
+            |c: Chunk<'_>| {
+                absurd += c.above_height();
+                out.take_chunk(c).map_err(anyhow::Error::from)
+            },
+            progress,
+        ),
     }
-    finished(&summary, &path, &format!(" ({what})"));
-    Ok(())
+    .with_context(|| {
+        format!(
+            "writing {} (finished rows are kept there)",
+            partial.display()
+        )
+    })?;
+    if let Engine::Gpu { opts, .. } = engine {
+        let t = report.gpu;
+        bar.suspend(|| {
+            if out.aggregator().is_some() && t.aggregate > 0.0 {
+                note!(
+                    "aggregated on the device: {:.2} s folding; {} chunks with more than {} groups folded on the host; histograms flushed {} times",
+                    t.aggregate,
+                    t.host_folded_chunks,
+                    pounding::engine::gpu::reduce::DEFAULT_SLOTS,
+                    t.slot_flushes
+                );
+            }
+            if t.handed_off > 0 {
+                note!(
+                    "{} runs needed more than {} RK4 substeps per record step, past what {} resolves: finished on the CPU in f64",
+                    t.handed_off,
+                    opts.handoff(),
+                    opts.precision.key()
+                );
+            }
+        });
+    }
+    bar.finish_and_clear();
+    Ok((report.summary, absurd))
 }
 
 /// The one line a finished sweep ends with.
@@ -443,167 +439,6 @@ fn finished(summary: &pounding::engine::Summary, path: &std::path::Path, what: &
         summary.failures,
         path.display()
     );
-}
-
-/// How a row sweep runs and where it goes.
-struct RowSettings<'a> {
-    target: pounding::io::target::Target,
-    threads: Option<usize>,
-    chunk: Option<usize>,
-    gpu: Option<(
-        &'a pounding::engine::gpu::GpuContext,
-        pounding::engine::gpu::Precision,
-    )>,
-    /// The row's columns ([`pounding::plan::row::RowPlan::header`]), and `--columns` as
-    /// indices into them.
-    header: Vec<String>,
-    picked: Option<Vec<usize>>,
-    shard: Option<Shard>,
-    resume: bool,
-    format: Format,
-    /// `--target-error`, and the setting it chose.
-    target_error: Option<pounding::physics::solver::calibration::Choice>,
-}
-
-/// `pound sweep` of a row config, on the CPU or the GPU, through the same output protocol as
-/// the pair's: CSV (journaled, resumable), Parquet or a summary, written to `OUT.partial` and
-/// renamed when complete with its sidecar.
-fn run_row(
-    config: &std::path::Path,
-    config_text: &str,
-    plan: &pounding::plan::row::RowPlan,
-    settings: RowSettings,
-) -> Result<()> {
-    let RowSettings {
-        target,
-        threads,
-        chunk,
-        gpu,
-        header,
-        picked,
-        shard,
-        resume,
-        format,
-        target_error,
-    } = settings;
-    let (default_chunk, max_chunk, on) = match gpu {
-        Some(_) => (
-            pounding::engine::GPU_CHUNK,
-            pounding::plan::limits::MAX_GPU_CHUNK,
-            "GPU",
-        ),
-        None => (
-            pounding::engine::CPU_CHUNK,
-            pounding::plan::limits::MAX_CPU_CHUNK,
-            "CPU",
-        ),
-    };
-    let chunk = chunk.unwrap_or(default_chunk);
-    if chunk == 0 || chunk > max_chunk {
-        bail!(EngineError::Chunk {
-            chunk,
-            max: max_chunk,
-            on
-        });
-    }
-    let names: Vec<String> = match &picked {
-        Some(ix) => ix.iter().map(|&i| header[i].clone()).collect(),
-        None => header,
-    };
-    let range = match shard {
-        Some(s) => pounding::plan::shard::row_shard_range(plan, s),
-        None => 0..plan.len(),
-    };
-    let summary_only = matches!(format, Format::Summary(_));
-    let meta = Meta {
-        fingerprint: Fingerprint::of_row(plan),
-        plan_runs: plan.len(),
-        first_run: range.start,
-        end_run: range.end,
-        shard,
-        backend: gpu.map_or("cpu".into(), |(_, p)| format!("gpu-{}", p.key())),
-        // A row's columns depend on its buildings, so they are always named.
-        columns: (!summary_only).then_some(names),
-        content: None,
-        target_error: target_error.map(pounding::io::provenance::TargetError::of),
-    };
-    // Every refusal that the plan decides comes before any file is made.
-    if let Some((ctx, _)) = gpu {
-        pounding::engine::gpu::row::check_fits(ctx, plan)?;
-    }
-    let Some(mut out) = open_output(target, meta, format, picked, resume)? else {
-        return Ok(());
-    };
-    let todo = out.todo();
-    let partial = out.partial_path();
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = threads {
-        pool = pool.num_threads(t);
-    }
-    let pool = pool.build().context("starting worker threads")?;
-    let on = match gpu {
-        Some((ctx, p)) => format!("GPU {} in {}", ctx.describe(), p.key()),
-        None => format!("CPU, {} threads", pool.current_num_threads()),
-    };
-    note!(
-        "{}: {} runs of a row of {} buildings ({} storeys, {} contact levels), {} scheme, on the {on}",
-        config.display(),
-        todo.end - todo.start,
-        plan.buildings.len(),
-        plan.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
-        plan.row(&plan.run(0)).levels.len(),
-        plan.scheme().key(),
-    );
-    let mut bar = progress_bar(todo.end - todo.start);
-    let mut absurd = 0u64;
-    let write = |rows: &[(
-        pounding::plan::row::RowRunSpec,
-        pounding::physics::row::RowOutput,
-    )]| {
-        absurd += plan.above_height(rows);
-        out.take(plan, rows).map_err(anyhow::Error::from)
-    };
-    let progress = |done| bar.set_position(done);
-    let summary = pool
-        .install(|| match gpu {
-            Some((ctx, precision)) => {
-                let Scheme::Fast(fast) = plan.base.spec.scheme else {
-                    unreachable!("the GPU runs the fast scheme")
-                };
-                let opts = pounding::engine::gpu::GpuOptions {
-                    precision,
-                    fast,
-                    ..Default::default()
-                };
-                pounding::engine::gpu::row::sweep_rows(
-                    ctx,
-                    plan,
-                    todo.clone(),
-                    chunk,
-                    &opts,
-                    write,
-                    progress,
-                )
-            }
-            None => pounding::engine::cpu::run_rows(plan, todo.clone(), chunk, write, progress),
-        })
-        .with_context(|| {
-            format!(
-                "writing {} (finished rows are kept there)",
-                partial.display()
-            )
-        })?;
-    bar.finish_and_clear();
-    // Records are read once, at the start, as for pairs.
-    let changed = config::changed_records(config_text, config, &plan.base);
-    let (path, what) = finish_unless_changed(*out, &changed)?;
-    if absurd > 0 {
-        note!(
-            "warning: {absurd} runs have a building whose peak roof displacement exceeds its height (the sum of its storey heights): check the record's units, the intensity and storey_height_m"
-        );
-    }
-    finished(&summary, &path, &format!(" ({what})"));
-    Ok(())
 }
 
 /// How rows are written: a summary (`--aggregate`), Parquet or CSV.

@@ -12,7 +12,7 @@
 use crate::physics::model::{RunOutput, Status};
 use crate::plan::columns::{header, row};
 use crate::plan::intensity::target_values;
-use crate::plan::{Plan, RunSpec};
+use crate::plan::{PairPlan, RunSpec};
 use std::collections::{BTreeMap, HashMap};
 
 /// Outputs summarised per group: named by the schema, in [`outputs`] order.
@@ -333,6 +333,25 @@ pub struct Aggregator {
 }
 
 impl Aggregator {
+    /// The summary of a sweep of `plan`: a pair's runs keyed by their typed parameters (which
+    /// the device fold can key too), a row's by its cells.
+    pub fn for_plan(
+        plan: &crate::plan::Plan,
+        by: &[String],
+        exceed: &[String],
+    ) -> Result<Aggregator, AggregateError> {
+        match plan {
+            crate::plan::Plan::Pair(_) => Aggregator::new(by, exceed),
+            crate::plan::Plan::Row(r) => Aggregator::of_cells(
+                &r.header(),
+                r.parameter_columns(),
+                &r.summarised(),
+                by,
+                exceed,
+            ),
+        }
+    }
+
     /// Group the pair's runs by the columns `by`; count runs whose `column > threshold` for
     /// each `exceed`.
     pub fn new(by: &[String], exceed: &[String]) -> Result<Aggregator, AggregateError> {
@@ -481,7 +500,7 @@ impl Aggregator {
     }
 
     /// The group of a run (numbered in the order of first appearance).
-    pub fn group_of(&mut self, plan: &Plan, spec: &RunSpec) -> u32 {
+    pub fn group_of(&mut self, plan: &PairPlan, spec: &RunSpec) -> u32 {
         let key: Vec<u64> = self
             .by
             .iter()
@@ -508,7 +527,7 @@ impl Aggregator {
     }
 
     /// Fold in finished runs of `plan`, each into its group.
-    pub fn add_rows(&mut self, plan: &Plan, rows: &[(RunSpec, RunOutput)]) {
+    pub fn add_rows(&mut self, plan: &PairPlan, rows: &[(RunSpec, RunOutput)]) {
         for (s, o) in rows {
             let g = self.group_of(plan, s);
             self.add(g, o);

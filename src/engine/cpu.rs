@@ -8,12 +8,12 @@ use crate::physics::row::RowOutput;
 use crate::physics::solver::row::{simulate_row, RowModel};
 use crate::physics::solver::{simulate, simulate_shared, FreeResponse, Scheme};
 use crate::plan::row::{RowPlan, RowRunSpec};
-use crate::plan::{Plan, RunSpec};
+use crate::plan::{PairPlan, RunSpec};
 use rayon::prelude::*;
 use std::time::Instant;
 
 /// Run one plan entry.
-pub fn run_one(plan: &Plan, spec: &RunSpec, scheme: &Scheme) -> RunOutput {
+pub fn run_one(plan: &PairPlan, spec: &RunSpec, scheme: &Scheme) -> RunOutput {
     simulate(
         &spec.pair(),
         &plan.forcing(spec),
@@ -52,7 +52,7 @@ pub(crate) fn free_motion_stretches<S: std::borrow::Borrow<RunSpec>>(
 
 /// Run `specs` in order; the fast scheme shares one free response ([`FreeResponse`]) among each
 /// stretch of at least [`MIN_SHARED_RUNS`] consecutive runs with the same free motion.
-pub fn run_many(plan: &Plan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunOutput> {
+pub fn run_many(plan: &PairPlan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunOutput> {
     let mut out = Vec::with_capacity(specs.len());
     for ks in free_motion_stretches(specs) {
         let group = &specs[ks];
@@ -74,7 +74,7 @@ pub fn run_many(plan: &Plan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunOutpu
 /// Run the runs `runs` of `plan` with `scheme`, `chunk` runs per task, on the current rayon pool;
 /// `sink` gets each chunk's results in run order, `progress` the number of runs done so far.
 pub fn run_range<E>(
-    plan: &Plan,
+    plan: &PairPlan,
     runs: std::ops::Range<u64>,
     scheme: &Scheme,
     chunk: usize,

@@ -1,8 +1,10 @@
-//! The engine: runs a range of a plan's runs and hands their outputs on, a chunk at a time in run
-//! order ([`Engine::run`]), folded into groups ([`Engine::fold`], `--aggregate`), or all at once
-//! ([`Engine::collect`]). One enum, [`Engine`], is every path: the CPU (the physics' solvers on a
-//! rayon pool, [`cpu`]) or the GPU (the WGSL kernel, [`gpu`]; with `--aggregate`, the fold runs
-//! on the device too). [`Backend`] and [`Engine::new`] are the one place a backend is chosen.
+//! The engine: runs a range of any plan's runs and hands their outputs on, a chunk at a time in
+//! run order ([`Engine::sweep`]), or folded into groups ([`Engine::summarise`], `--aggregate`);
+//! for a pair's plan also [`Engine::run`], [`Engine::fold`] and [`Engine::collect`], which the
+//! studies built on pairs use. One enum, [`Engine`], is every path: the CPU (the physics' solvers
+//! on a rayon pool, [`cpu`]) or the GPU (the WGSL kernels, [`gpu`]; with `--aggregate`, a pair's
+//! fold runs on the device too). [`Backend`], [`gpu_for`] and [`Engine::new`] are the one place
+//! a backend is chosen; [`Kernel::of`] the one place a scene's kernels are.
 //!
 //! May import the physics, records and the plan; never io, studies or the command line.
 
@@ -11,9 +13,11 @@ pub mod cpu;
 pub mod gpu;
 
 use crate::physics::model::{RunOutput, Status};
+use crate::physics::row::RowOutput;
 use crate::physics::solver::Scheme;
 use crate::plan::limits::{MAX_CPU_CHUNK, MAX_GPU_CHUNK, WHY_CHUNK};
-use crate::plan::{Plan, RunSpec};
+use crate::plan::row::{RowPlan, RowRunSpec};
+use crate::plan::{PairPlan, Plan, RunSpec};
 use aggregate::Aggregator;
 use gpu::{GpuContext, GpuError, GpuOptions, GpuTimes, Precision};
 use std::ops::Range;
@@ -86,6 +90,9 @@ pub enum EngineError {
     },
     #[error("--backend gpu runs the fast scheme only; use --scheme fast or --backend cpu")]
     GpuNeedsFast,
+    /// A scene the GPU kernels do not take as asked.
+    #[error("--backend gpu: {0}; use --backend cpu")]
+    GpuUnfit(&'static str),
     #[error(transparent)]
     Gpu(#[from] GpuError),
 }
@@ -131,6 +138,121 @@ impl Backend {
                 }
             },
         })
+    }
+}
+
+/// The kernels a plan's runs take, chosen from its scene alone ([`Kernel::of`]): the one place
+/// that choice is made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kernel {
+    /// Two elastic one-storey buildings: the specialised pair kernels (CPU `solver::fast` with
+    /// the shared free response, `shaders/fast.wgsl`).
+    Pair,
+    /// A row of shear buildings: the row kernels (CPU `solver::row`, `shaders/row.wgsl`).
+    Row,
+}
+
+impl Kernel {
+    pub fn of(plan: &Plan) -> Kernel {
+        match plan {
+            Plan::Pair(_) => Kernel::Pair,
+            Plan::Row(_) => Kernel::Row,
+        }
+    }
+
+    /// `pair` or `row` (the sidecar's `kernel`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Kernel::Pair => "pair",
+            Kernel::Row => "row",
+        }
+    }
+
+    /// Why `plan` cannot run on the GPU kernel at `precision`, if it cannot; `calibrated`:
+    /// `--target-error` chose its setting.
+    fn gpu_refusal(plan: &Plan, precision: Precision, calibrated: bool) -> Option<EngineError> {
+        let fast = match plan.scheme() {
+            Scheme::Fast(o) => o,
+            Scheme::Reference(_) => {
+                return Some(match Kernel::of(plan) {
+                    Kernel::Pair => EngineError::GpuNeedsFast,
+                    Kernel::Row => {
+                        EngineError::GpuUnfit("the reference scheme runs on the CPU only")
+                    }
+                })
+            }
+        };
+        match Kernel::of(plan) {
+            Kernel::Pair => None,
+            // The row kernel runs the fast scheme without the energy balance; the rows'
+            // calibration is of the CPU's f64 (the GPU in f64 agrees with it to 3.7e-6,
+            // BENCHMARKS.md; f32 adds up to 7.2e-5).
+            Kernel::Row if fast.energy => Some(EngineError::GpuUnfit(
+                "the energy balance of rows is integrated on the CPU only",
+            )),
+            Kernel::Row if calibrated && precision == Precision::F32 => {
+                Some(EngineError::GpuUnfit(
+                    "--target-error on rows is calibrated in f64 (add --precision f64)",
+                ))
+            }
+            Kernel::Row => None,
+        }
+    }
+}
+
+/// The GPU that `backend` asks for to run `plan` at `precision` (`calibrated`: the setting
+/// came from `--target-error`): None where the plan's runs go to the CPU, with a notice
+/// (`note`) where the user may not expect it; an error where `--backend gpu` asked for what
+/// the GPU kernels cannot do.
+pub fn gpu_for(
+    plan: &Plan,
+    backend: Backend,
+    precision: Precision,
+    calibrated: bool,
+    note: &mut dyn FnMut(String),
+) -> Result<Option<GpuContext>, EngineError> {
+    if let Some(why) = Kernel::gpu_refusal(plan, precision, calibrated) {
+        return match backend {
+            Backend::Gpu => Err(why),
+            _ => Ok(None),
+        };
+    }
+    // Measured on an H100: the row kernel beats 16 CPU threads only for rows of one-storey
+    // buildings (2.4x); 0.59x at 3 storeys, 0.17x at 6 (BENCHMARKS.md).
+    if backend == Backend::Auto && Kernel::of(plan) == Kernel::Row && plan.max_storeys() > 1 {
+        note("notice: running on the CPU: the row kernel is slower than the CPU path for buildings of more than one storey (BENCHMARKS.md, \"Rows on the GPU\"); --backend gpu uses it".into());
+        return Ok(None);
+    }
+    Ok(backend.acquire("running on the CPU", note)?)
+}
+
+/// A chunk of finished runs, in run order, with the plan they belong to: a pair's or a row's.
+#[derive(Clone, Copy)]
+pub enum Chunk<'a> {
+    Pairs(&'a PairPlan, &'a [(RunSpec, RunOutput)]),
+    Rows(&'a RowPlan, &'a [(RowRunSpec, RowOutput)]),
+}
+
+impl Chunk<'_> {
+    pub fn len(&self) -> usize {
+        match self {
+            Chunk::Pairs(_, rows) => rows.len(),
+            Chunk::Rows(_, rows) => rows.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Runs in which a building's peak displacement exceeds its height: physically absurd (a
+    /// units mix-up?). A pair's height is estimated from its period, a row's is the sum of its
+    /// storey heights.
+    pub fn above_height(&self) -> u64 {
+        match self {
+            Chunk::Pairs(_, rows) => crate::plan::limits::above_height(rows),
+            Chunk::Rows(plan, rows) => plan.above_height(rows),
+        }
     }
 }
 
@@ -246,11 +368,84 @@ impl<'c> Engine<'c> {
         }
     }
 
-    /// Run the runs `runs` of `plan`; `sink` gets each chunk's results in run order (rows already
+    /// Refuse, before any file is made, a plan this engine cannot run (a row too large for a
+    /// software adapter's loop limit).
+    pub fn check(&self, plan: &Plan) -> Result<(), GpuError> {
+        match (self, plan) {
+            (Engine::Gpu { ctx, .. }, Plan::Row(r)) => gpu::row::check_fits(ctx, r),
+            _ => Ok(()),
+        }
+    }
+
+    /// Run the runs `runs` of any plan, through the kernels its scene takes ([`Kernel::of`]):
+    /// `sink` gets each chunk's results in run order (rows already handed to it stay there if
+    /// a later chunk fails), `progress` the runs done so far.
+    pub fn sweep<E: From<GpuError>>(
+        &self,
+        plan: &Plan,
+        runs: Range<u64>,
+        mut sink: impl FnMut(Chunk<'_>) -> Result<(), E>,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, E> {
+        let row = match plan {
+            Plan::Pair(p) => {
+                return self.run(p, runs, |rows: &[_]| sink(Chunk::Pairs(p, rows)), progress)
+            }
+            Plan::Row(r) => r,
+        };
+        let sink = |rows: &[_]| sink(Chunk::Rows(row, rows));
+        let summary = match self {
+            Engine::Cpu { scheme, chunk } => {
+                debug_assert_eq!(*scheme, plan.scheme(), "the engine runs the plan's scheme");
+                cpu::run_rows(row, runs, *chunk, sink, progress)?
+            }
+            Engine::Gpu { ctx, opts, chunk } => {
+                gpu::row::sweep_rows(ctx, row, runs, *chunk, opts, sink, progress)?
+            }
+        };
+        Ok(Report {
+            summary,
+            gpu: GpuTimes::default(),
+        })
+    }
+
+    /// Run the runs `runs` of any plan and fold each into its group of `agg` (built for this
+    /// plan: [`Aggregator::for_plan`]): a pair's on the device on the GPU (only the groups'
+    /// partials come back), otherwise on the host.
+    pub fn summarise(
+        &self,
+        plan: &Plan,
+        runs: Range<u64>,
+        agg: &mut Aggregator,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, GpuError> {
+        match plan {
+            Plan::Pair(p) => self.fold(p, runs, agg, progress),
+            Plan::Row(r) => {
+                let status = r.parameter_columns();
+                self.sweep(
+                    plan,
+                    runs,
+                    |c: Chunk<'_>| -> Result<(), GpuError> {
+                        if let Chunk::Rows(_, rows) = c {
+                            for (s, o) in rows {
+                                agg.add_cells(&r.cells(s, o), status);
+                            }
+                        }
+                        Ok(())
+                    },
+                    progress,
+                )
+            }
+        }
+    }
+
+    /// Run the runs `runs` of a pair's plan (the pair kernels; every scene: [`Engine::sweep`]);
+    /// `sink` gets each chunk's results in run order (rows already
     /// handed to it stay there if a later chunk fails), `progress` the runs done so far.
     pub fn run<E: From<GpuError>>(
         &self,
-        plan: &Plan,
+        plan: &PairPlan,
         runs: Range<u64>,
         sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
         progress: impl FnMut(u64),
@@ -272,7 +467,7 @@ impl<'c> Engine<'c> {
     /// CPU, on the device for the GPU (only the groups' partials come back).
     pub fn fold(
         &self,
-        plan: &Plan,
+        plan: &PairPlan,
         runs: Range<u64>,
         agg: &mut Aggregator,
         progress: impl FnMut(u64),
@@ -304,7 +499,7 @@ impl<'c> Engine<'c> {
     }
 
     /// Every run of `plan`, its output in run order.
-    pub fn collect(&self, plan: &Plan) -> Result<(Vec<RunOutput>, Report), GpuError> {
+    pub fn collect(&self, plan: &PairPlan) -> Result<(Vec<RunOutput>, Report), GpuError> {
         let mut outs = Vec::with_capacity(plan.len() as usize);
         let report = self.run(
             plan,

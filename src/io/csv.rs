@@ -10,7 +10,7 @@ use crate::physics::model::RunOutput;
 use crate::physics::row::RowOutput;
 use crate::plan::columns::{header, row};
 use crate::plan::row::{RowPlan, RowRunSpec};
-use crate::plan::{Plan, RunSpec};
+use crate::plan::{PairPlan, RunSpec};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -212,7 +212,7 @@ pub trait RunRows: Sync {
     fn fold(&self, agg: &mut Aggregator, rows: &[(Self::Spec, Self::Output)]);
 }
 
-impl RunRows for Plan {
+impl RunRows for PairPlan {
     type Spec = RunSpec;
     type Output = RunOutput;
     fn run_index(spec: &RunSpec) -> u64 {

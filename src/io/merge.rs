@@ -149,6 +149,7 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, SidecarError> {
             end_run: first.plan_runs,
             shard: None,
             backend: backends.join("+"),
+            kernel: first.kernel.clone(),
             columns: first.columns.clone(),
             content: Some(content.clone()),
             // Shards share the fingerprint, so the setting; the first one's target is kept.

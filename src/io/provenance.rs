@@ -3,7 +3,7 @@
 //! an unfinished one. `pound merge`, `--resume` and the studies check them.
 
 use crate::plan::shard::Shard;
-use crate::plan::Plan;
+use crate::plan::PairPlan;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -27,7 +27,7 @@ fn hex(d: impl AsRef<[u8]>) -> String {
 }
 
 impl Fingerprint {
-    pub fn of(plan: &Plan) -> Fingerprint {
+    pub fn of(plan: &PairPlan) -> Fingerprint {
         let s = &plan.spec;
         // Debug prints every f64 exactly (shortest round-trip), so equal plans hash equally.
         let text = format!(
@@ -60,6 +60,15 @@ impl Fingerprint {
             plan: hex(Sha256::digest(text.as_bytes())),
             records: hex(rec.finalize()),
             engine: env!("CARGO_PKG_VERSION").to_string(),
+        }
+    }
+
+    /// The fingerprint of any plan: a pair's ([`Fingerprint::of`]) or a row's
+    /// ([`Fingerprint::of_row`]).
+    pub fn of_plan(plan: &crate::plan::Plan) -> Fingerprint {
+        match plan {
+            crate::plan::Plan::Pair(p) => Fingerprint::of(p),
+            crate::plan::Plan::Row(r) => Fingerprint::of_row(r),
         }
     }
 
@@ -103,6 +112,10 @@ pub struct Meta {
     /// Where the runs were integrated: `cpu`, `gpu-f32` or `gpu-f64` (a resumed sweep must keep
     /// it; merged shards may mix them).
     pub backend: String,
+    /// The kernels the runs took, chosen from the scene: `pair` or `row` (absent in sidecars
+    /// written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kernel: Option<String>,
     /// The columns written, when `--columns` chose them (all otherwise).
     #[serde(default)]
     pub columns: Option<Vec<String>>,

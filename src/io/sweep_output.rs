@@ -335,6 +335,15 @@ impl SweepOutput {
         }
     }
 
+    /// Write a chunk of finished runs of any plan ([`crate::engine::Engine::sweep`]), which must
+    /// be the next runs in order ([`SweepOutput::take`]).
+    pub fn take_chunk(&mut self, chunk: crate::engine::Chunk<'_>) -> Result<(), OutputError> {
+        match chunk {
+            crate::engine::Chunk::Pairs(plan, rows) => self.take(plan, rows),
+            crate::engine::Chunk::Rows(plan, rows) => self.take(plan, rows),
+        }
+    }
+
     /// Write a chunk of finished runs, which must be the next runs in order. CSV rows are
     /// fsynced before the journal counts them, so a crash leaves a consistent prefix.
     pub fn take<T: RunRows>(
@@ -515,7 +524,7 @@ mod tests {
     use super::*;
     use crate::io::provenance::Fingerprint;
     use crate::physics::model::RunOutput;
-    use crate::plan::{Plan, RunSpec};
+    use crate::plan::{PairPlan, RunSpec};
 
     const CFG: &str = r#"
 [building1]
@@ -534,7 +543,7 @@ gap_m = [0.0, 0.01, 0.02]
 synthetic = { seed = 2, duration_s = 2.0 }
 "#;
 
-    fn rows(plan: &Plan) -> Vec<(RunSpec, RunOutput)> {
+    fn rows(plan: &PairPlan) -> Vec<(RunSpec, RunOutput)> {
         let mut all = Vec::new();
         crate::engine::Engine::cpu(plan.spec.scheme, Some(2))
             .unwrap()
@@ -551,7 +560,7 @@ synthetic = { seed = 2, duration_s = 2.0 }
         all
     }
 
-    fn meta(plan: &Plan) -> Meta {
+    fn meta(plan: &PairPlan) -> Meta {
         Meta {
             fingerprint: Fingerprint::of(plan),
             plan_runs: plan.len(),
@@ -559,13 +568,14 @@ synthetic = { seed = 2, duration_s = 2.0 }
             end_run: plan.len(),
             shard: None,
             backend: "cpu".into(),
+            kernel: None,
             columns: None,
             content: None,
             target_error: None,
         }
     }
 
-    fn open(out: &Path, plan: &Plan, resume: bool) -> Result<Opened, OutputError> {
+    fn open(out: &Path, plan: &PairPlan, resume: bool) -> Result<Opened, OutputError> {
         SweepOutput::open(
             Target::File(out.into()),
             meta(plan),

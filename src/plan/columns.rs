@@ -4,7 +4,7 @@
 
 use crate::physics::model::RunOutput;
 use crate::plan::intensity::target_values;
-use crate::plan::{Plan, RunSpec};
+use crate::plan::{PairPlan, RunSpec};
 
 /// Every column, in file order: the swept parameters, then the status and the outputs. Units are
 /// in the names. The last three, the energy balance, are empty unless it was asked for
@@ -81,7 +81,7 @@ pub(crate) fn num(x: f64) -> String {
 pub const CONTACT_AND_MOTION: usize = 16;
 
 /// The fields of one row, in [`HEADER`] order.
-pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
+pub fn row(plan: &PairPlan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
     let mut cells = contact_and_motion(plan, spec);
     cells.extend([
@@ -112,7 +112,7 @@ pub fn row(plan: &Plan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
 }
 
 /// The first [`CONTACT_AND_MOTION`] fields of a row.
-pub fn contact_and_motion(plan: &Plan, spec: &RunSpec) -> Vec<String> {
+pub fn contact_and_motion(plan: &PairPlan, spec: &RunSpec) -> Vec<String> {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
     let hertz = spec.law.is_hertzian();
     let mut cells = vec![

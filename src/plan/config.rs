@@ -1,4 +1,4 @@
-//! TOML sweep configs: raw serde structs (stage 1), turned into a validated [`Plan`] (stage 2).
+//! TOML sweep configs: raw serde structs (stage 1), turned into a validated [`PairPlan`] (stage 2).
 //! Every error names the file and the key; unknown keys are errors.
 //!
 //! An axis is a number, a list of numbers, or a range table
@@ -9,7 +9,9 @@ use crate::physics::restitution::Formula;
 use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
 use crate::plan::intensity::{PeriodRef, SpectralIm};
 use crate::plan::sample::{draw, Dist, Method};
-use crate::plan::{BuildingAxes, Intensity, Plan, PlanError, PlanSpec, SampledAxis, Samples};
+use crate::plan::{
+    BuildingAxes, Intensity, PairPlan, Plan, PlanError, PlanSpec, SampledAxis, Samples,
+};
 use crate::record::{
     read_record, synthetic, Format, ReadOptions, Record, RecordError, SyntheticSpec, Units,
 };
@@ -583,7 +585,7 @@ pub struct RawConfig {
     pub sample: Option<RawSample>,
 }
 
-/// Read and validate a config file.
+/// Read and validate a config file, of any scene.
 pub fn load(path: &Path) -> Result<Plan, ConfigError> {
     load_with_text(path).map(|(plan, _)| plan)
 }
@@ -593,6 +595,20 @@ pub fn load_with_text(path: &Path) -> Result<(Plan, String), ConfigError> {
     let text = read_text(path)?;
     let plan = load_text(&text, path)?;
     Ok((plan, text))
+}
+
+/// Read and validate the config of a pair (`[building1]` and `[building2]`): for the studies
+/// built on the pair's runs alone. A row config is refused, naming its key.
+pub fn load_pair(path: &Path) -> Result<PairPlan, ConfigError> {
+    match load(path)? {
+        Plan::Pair(p) => Ok(p),
+        Plan::Row(_) => Err(ConfigError::Invalid {
+            path: path.into(),
+            key: "building".into(),
+            message: "a row of [[building]] entries: expected a pair ([building1] and [building2])"
+                .into(),
+        }),
+    }
 }
 
 /// The text of a config file, read once (it may be a pipe: `pound sweep <(make-config)`).
@@ -608,11 +624,23 @@ pub fn read_text(path: &Path) -> Result<String, ConfigError> {
     })
 }
 
+/// Does config `text` describe a row (`[[building]]` entries)? Text that is not TOML is not.
+/// The one place a config's kind is told: every other layer asks the [`Plan`].
+fn is_row_config(text: &str) -> bool {
+    text.parse::<toml::Table>()
+        .is_ok_and(|t| t.contains_key("building"))
+}
+
 /// Validate config `text` read from `path` (records resolved beside it and in
-/// [`records_dir`]).
+/// [`records_dir`]): a pair's or a row's plan, as the config describes.
 pub fn load_text(text: &str, path: &Path) -> Result<Plan, ConfigError> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    parse(text, path, &base, &records_dir_for(&base))
+    let records = records_dir_for(&base);
+    Ok(if is_row_config(text) {
+        Plan::Row(crate::plan::row::parse_row(text, path, &base, &records)?)
+    } else {
+        Plan::Pair(parse(text, path, &base, &records)?)
+    })
 }
 
 /// The record files config `text` (read from `path`) reads, `file =` and `path =` records
@@ -634,23 +662,18 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-/// The records of `plan` (from the config `text` at `path`; a row's base plan for a row config)
-/// whose files no longer hold what was read, by name; or why they cannot be read again. A sweep reads its records once, so this
+/// The records of `plan` (from the config `text` at `path`) whose files no longer hold what was
+/// read, by name; or why they cannot be read again. A sweep reads its records once, so this
 /// finds files changed while it ran.
 pub fn changed_records(text: &str, path: &Path, plan: &Plan) -> Vec<String> {
-    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    let now = if crate::plan::row::is_row_config(text) {
-        crate::plan::row::parse_row(text, path, &base, &records_dir_for(&base)).map(|row| row.base)
-    } else {
-        parse(text, path, &base, &records_dir_for(&base))
-    };
-    match now {
+    match load_text(text, path) {
         Err(e) => vec![format!("the records can no longer be read ({e})")],
         Ok(now) => plan
+            .contact()
             .spec
             .records
             .iter()
-            .zip(&now.spec.records)
+            .zip(&now.contact().spec.records)
             .filter(|(a, b)| a != b)
             .map(|(a, _)| format!("record `{}`", a.name))
             .collect(),
@@ -665,26 +688,23 @@ pub fn load_row_text(text: &str, path: &Path) -> Result<crate::plan::row::RowPla
 
 /// The columns a sweep of this config writes, in file order (a pair's or a row's).
 pub fn columns_of(text: &str, path: &Path) -> Result<Vec<String>, ConfigError> {
-    if crate::plan::row::is_row_config(text) {
-        Ok(load_row_text(text, path)?.header())
-    } else {
-        load_text(text, path)?;
-        Ok(crate::plan::columns::header()
-            .into_iter()
-            .map(String::from)
-            .collect())
-    }
+    Ok(load_text(text, path)?.header())
 }
 
 /// A plan from config text that names no record file (synthetic records only), `name` standing
 /// for its file in messages: built-in sweeps (`pound bench`) and tests.
-pub fn parse_builtin(text: &str, name: &str) -> Result<Plan, ConfigError> {
+pub fn parse_builtin(text: &str, name: &str) -> Result<PairPlan, ConfigError> {
     parse(text, Path::new(name), Path::new("."), Path::new("."))
 }
 
 /// Parse and validate config text. `path` names the file in errors; `base` resolves `path =`
 /// records; `records` resolves `file =` records.
-pub fn parse(text: &str, path: &Path, base: &Path, records: &Path) -> Result<Plan, ConfigError> {
+pub fn parse(
+    text: &str,
+    path: &Path,
+    base: &Path,
+    records: &Path,
+) -> Result<PairPlan, ConfigError> {
     let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Toml {
         path: path.into(),
         message: e.to_string(),
@@ -699,7 +719,7 @@ pub(crate) fn parse_raw(
     base: &Path,
     records: &Path,
     row_buildings: Option<usize>,
-) -> Result<Plan, ConfigError> {
+) -> Result<PairPlan, ConfigError> {
     let invalid = |key: &str, message: String| ConfigError::Invalid {
         path: path.into(),
         key: key.into(),
@@ -830,8 +850,8 @@ pub(crate) fn parse_raw(
         samples,
     };
     let plan = match row_buildings {
-        None => Plan::new(spec),
-        Some(_) => Plan::row_base(spec),
+        None => PairPlan::new(spec),
+        Some(_) => PairPlan::row_base(spec),
     };
     plan.map_err(|PlanError { key, message }| invalid(&key, message))
 }

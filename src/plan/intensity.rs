@@ -2,7 +2,7 @@
 //! section 9). A target PGA or a plain factor scales a record the same way in every run; a
 //! spectral target (`sa_g`, `sa_avg_g`) at a period that follows a building's fundamental
 //! period scales it per run, so its factor is resolved where the run's periods are known
-//! ([`crate::plan::Plan::run`], [`crate::plan::row::RowPlan::run`]).
+//! ([`crate::plan::PairPlan::run`], [`crate::plan::row::RowPlan::run`]).
 
 use crate::record::intensity::{log_periods, sa_avg};
 use crate::record::{Record, G};

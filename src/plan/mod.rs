@@ -1,6 +1,9 @@
-//! A validated sweep: every axis checked, every run numbered. The engine consumes only this.
+//! A validated sweep: every axis checked, every run numbered. The engine consumes only this:
+//! one [`Plan`], of a pair ([`PairPlan`]) or of a row of shear buildings ([`row::RowPlan`]).
 //!
 //! - [`config`]: a TOML config (stage 1, raw serde structs) turned into a [`Plan`] (stage 2);
+//!   the one place a config's kind is told;
+//! - [`row`]: the axes of a row's buildings and gaps;
 //! - [`sample`]: Latin hypercube and Monte Carlo samples of uncertain parameters;
 //! - [`columns`]: the schema, every run's parameters and outputs as named columns;
 //! - [`meaning`]: what each column holds, and its unit;
@@ -9,7 +12,7 @@
 //!
 //! May import the physics and the records; never the engine, io or studies.
 //!
-//! Runs are grouped by contact law. Within a law's block, only the axes that law uses vary
+//! A pair's runs (below; a row's in [`row`], in the same order) are grouped by contact law. Within a law's block, only the axes that law uses vary
 //! (elastic laws ignore `e` and the formula; linear laws take `k`, Hertz-type laws `beta`), so no
 //! run is a duplicate of another. Axis order, outermost first: law, formula, e, stiffness, record,
 //! intensity, sample, m1, T1, xi1, m2, T2, xi2, gap. A sample (of uncertain parameters, see
@@ -35,6 +38,150 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 pub use intensity::Intensity;
+
+/// A validated sweep of one scene, the one plan every command holds: the config reader
+/// ([`config::load_text`]) decides the scene's kind once, and the layers below ask the plan,
+/// never the config. A `[building1]`/`[building2]` config is a pair of one-storey buildings,
+/// planned by [`PairPlan`] (whose runs the engine's pair kernels take); a `[[building]]` config
+/// is a row of 2..n shear buildings of 1..N storeys, planned by [`row::RowPlan`] (the row
+/// kernels). Both number their runs in the same axis order (contact, record, intensity,
+/// sample, each building's values, the gaps), so a pair written as a row of two one-storey
+/// buildings has the same runs in the same order (`tests/it/scenes.rs`).
+#[derive(Debug, Clone)]
+pub enum Plan {
+    Pair(PairPlan),
+    Row(row::RowPlan),
+}
+
+impl Plan {
+    /// Number of runs.
+    pub fn len(&self) -> u64 {
+        match self {
+            Plan::Pair(p) => p.len(),
+            Plan::Row(r) => r.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The plan of the contact, record and intensity axes: the pair's own, a row's base.
+    pub fn contact(&self) -> &PairPlan {
+        match self {
+            Plan::Pair(p) => p,
+            Plan::Row(r) => &r.base,
+        }
+    }
+
+    /// The integration scheme the runs take.
+    pub fn scheme(&self) -> Scheme {
+        self.contact().spec.scheme
+    }
+
+    /// Set the scheme as run (the fingerprint covers it).
+    pub fn set_scheme(&mut self, scheme: Scheme) {
+        match self {
+            Plan::Pair(p) => p.spec.scheme = scheme,
+            Plan::Row(r) => r.base.spec.scheme = scheme,
+        }
+    }
+
+    /// The accuracy suite that calibrates `--target-error` for this scene.
+    pub fn suite(&self) -> crate::physics::solver::calibration::Suite {
+        use crate::physics::solver::calibration::Suite;
+        match self {
+            Plan::Pair(_) => Suite::Pairs,
+            Plan::Row(_) => Suite::Rows,
+        }
+    }
+
+    /// The most storeys of any building (1 for a pair).
+    pub fn max_storeys(&self) -> usize {
+        match self {
+            Plan::Pair(_) => 1,
+            Plan::Row(r) => r.buildings.iter().map(|b| b.storeys()).max().unwrap_or(1),
+        }
+    }
+
+    /// The scene in words: `a pair of one-storey buildings`, `a row of 3 buildings (9
+    /// storeys, 7 contact levels)`.
+    pub fn scene(&self) -> String {
+        match self {
+            Plan::Pair(_) => "a pair of one-storey buildings".into(),
+            Plan::Row(r) => format!(
+                "a row of {} buildings ({} storeys, {} contact levels)",
+                r.buildings.len(),
+                r.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
+                r.row(&r.run(0)).levels.len(),
+            ),
+        }
+    }
+
+    /// What a user should hear before any run, for contact substeps of `substeps_per_contact`
+    /// (a row's cost grows with its stiffest building): absurd intensities, a row's pairs that
+    /// never touch, keys no run uses, extreme costs.
+    pub fn warnings(&self, substeps_per_contact: f64) -> Vec<String> {
+        let mut w = self.input_warnings();
+        if let Plan::Row(r) = self {
+            w.extend(r.cost_warning(substeps_per_contact));
+        }
+        w
+    }
+
+    /// [`Plan::warnings`] without the cost of contact (for studies that integrate none).
+    pub fn input_warnings(&self) -> Vec<String> {
+        match self {
+            Plan::Pair(p) => p.warnings(),
+            Plan::Row(r) => r.warnings(),
+        }
+    }
+
+    /// Each adjacent pair of buildings with no floor at a common elevation, and why (none for
+    /// a pair of one-storey buildings, which touch at their roofs).
+    pub fn pairs_without_levels(&self) -> Vec<String> {
+        match self {
+            Plan::Pair(_) => Vec::new(),
+            Plan::Row(r) => r.pairs_without_levels(),
+        }
+    }
+
+    /// How a building's height is known, for the warning on runs whose displacement passes it.
+    pub fn height_basis(&self) -> String {
+        match self {
+            Plan::Pair(_) => format!(
+                "estimated from its period, {} m per s: T ~ 0.1 s per 3 m storey",
+                limits::HEIGHT_PER_PERIOD_M
+            ),
+            Plan::Row(_) => "the sum of its storey heights, storey_height_m".into(),
+        }
+    }
+
+    /// Every column, in file order: the pair's fixed schema ([`columns::header`]) or the
+    /// row's, which follows its buildings and levels ([`row::RowPlan::header`]).
+    pub fn header(&self) -> Vec<String> {
+        match self {
+            Plan::Pair(_) => columns::header().into_iter().map(String::from).collect(),
+            Plan::Row(r) => r.header(),
+        }
+    }
+
+    /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`.
+    pub fn cost_before(&self, end: u64, record_cost: &[u64]) -> u128 {
+        match self {
+            Plan::Pair(p) => p.cost_before(end, record_cost),
+            Plan::Row(r) => r.cost_before(end, record_cost),
+        }
+    }
+
+    /// The runs that differ in their motion before any contact ([`PairPlan::motions`]).
+    pub fn motions(&self) -> Motions {
+        match self {
+            Plan::Pair(p) => p.motions(),
+            Plan::Row(r) => r.motions(),
+        }
+    }
+}
 
 /// Sweep axes of one building.
 #[derive(Debug, Clone, PartialEq)]
@@ -128,7 +275,7 @@ impl SampledAxis {
     }
 }
 
-/// The motions of a sweep ([`Plan::motions`]): `records x intensities x inner`, the record
+/// The motions of a sweep ([`PairPlan::motions`]): `records x intensities x inner`, the record
 /// outermost, then the intensity; `inner` counts the samples and building values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Motions {
@@ -260,7 +407,7 @@ struct Block {
 
 /// A validated, numbered sweep.
 #[derive(Debug, Clone)]
-pub struct Plan {
+pub struct PairPlan {
     pub spec: PlanSpec,
     blocks: Vec<Block>,
     total: u64,
@@ -362,17 +509,17 @@ pub(crate) fn check_axis(
     Ok(())
 }
 
-impl Plan {
-    pub fn new(spec: PlanSpec) -> Result<Plan, PlanError> {
-        Plan::build(spec, false)
+impl PairPlan {
+    pub fn new(spec: PlanSpec) -> Result<PairPlan, PlanError> {
+        PairPlan::build(spec, false)
     }
 
     /// The plan of a row's contact, record and intensity axes, its buildings placeholders.
-    pub(crate) fn row_base(spec: PlanSpec) -> Result<Plan, PlanError> {
-        Plan::build(spec, true)
+    pub(crate) fn row_base(spec: PlanSpec) -> Result<PairPlan, PlanError> {
+        PairPlan::build(spec, true)
     }
 
-    fn build(spec: PlanSpec, row_base: bool) -> Result<Plan, PlanError> {
+    fn build(spec: PlanSpec, row_base: bool) -> Result<PairPlan, PlanError> {
         let pos = POSITIVE.0;
         for (name, b) in [
             ("building1", &spec.building1),
@@ -577,7 +724,7 @@ impl Plan {
             });
             total += len;
         }
-        Ok(Plan {
+        Ok(PairPlan {
             spec,
             blocks,
             total,
@@ -648,7 +795,7 @@ impl Plan {
     }
 
     /// Run `index`, its scale left unset (NaN) until its buildings' periods are known
-    /// ([`Plan::scale`]).
+    /// ([`PairPlan::scale`]).
     pub(crate) fn decode(&self, index: u64) -> RunSpec {
         assert!(
             index < self.total,
@@ -725,7 +872,7 @@ impl Plan {
 
     /// The runs that differ in their motion before any contact: one per record, intensity,
     /// sample and building values, with the first law's first contact values and the first gap
-    /// (what a separation study needs: [`Plan::motion_run`]). A sample axis that sets no
+    /// (what a separation study needs: [`PairPlan::motion_run`]). A sample axis that sets no
     /// building value moves nothing and counts once.
     pub fn motions(&self) -> Motions {
         let d = &self.blocks[0].dims;
@@ -745,7 +892,7 @@ impl Plan {
         }
     }
 
-    /// Motion `m` of [`Plan::motions`], as the run of the plan that has it (its sample `None`
+    /// Motion `m` of [`PairPlan::motions`], as the run of the plan that has it (its sample `None`
     /// where the samples move nothing).
     pub fn motion_run(&self, m: u64) -> RunSpec {
         let mut run = self.run(self.motion_index(m));
@@ -755,7 +902,7 @@ impl Plan {
         run
     }
 
-    /// The index of the run that has motion `m` ([`Plan::motion_run`]).
+    /// The index of the run that has motion `m` ([`PairPlan::motion_run`]).
     pub(crate) fn motion_index(&self, m: u64) -> u64 {
         let b = &self.blocks[0];
         let mut dims = b.dims;

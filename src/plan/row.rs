@@ -18,7 +18,9 @@ use crate::plan::config::{
     RawRecord, RawRun, RawSample,
 };
 use crate::plan::sample::refused_draw;
-use crate::plan::{check_axis, config, Check, Plan, RunSpec, DAMPING, GAP, MASS, PERIOD, POSITIVE};
+use crate::plan::{
+    check_axis, config, Check, PairPlan, RunSpec, DAMPING, GAP, MASS, PERIOD, POSITIVE,
+};
 use serde::Deserialize;
 use std::path::Path;
 
@@ -73,12 +75,6 @@ pub struct RawRowConfig {
     #[serde(default)]
     pub intensity: RawIntensity,
     pub sample: Option<RawSample>,
-}
-
-/// Does config `text` describe a row (`[[building]]` entries)? Text that is not TOML is not.
-pub fn is_row_config(text: &str) -> bool {
-    text.parse::<toml::Table>()
-        .is_ok_and(|t| t.contains_key("building"))
 }
 
 /// One building's axes.
@@ -178,7 +174,7 @@ pub struct RowSamples {
 pub struct RowPlan {
     /// Laws, formulas, `e`, stiffness, records, intensities and the scheme, with placeholder
     /// buildings and gap.
-    pub base: Plan,
+    pub base: PairPlan,
     pub buildings: Vec<ShearAxes>,
     /// m, per adjacent pair.
     pub gaps: Vec<Vec<f64>>,
@@ -277,7 +273,7 @@ impl RowPlan {
         run
     }
 
-    /// The runs that differ in their motion before any contact ([`Plan::motions`]): per
+    /// The runs that differ in their motion before any contact ([`PairPlan::motions`]): per
     /// record and intensity, the samples (one where they set no building value) and every
     /// building's values, the gaps at their first values.
     pub fn motions(&self) -> crate::plan::Motions {
@@ -324,7 +320,7 @@ impl RowPlan {
     }
 
     /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`
-    /// ([`Plan::cost_before`] of the base runs, each repeated for the row's own axes).
+    /// ([`PairPlan::cost_before`] of the base runs, each repeated for the row's own axes).
     pub fn cost_before(&self, end: u64, record_cost: &[u64]) -> u128 {
         let (whole, part) = (end / self.per_base, end % self.per_base);
         let mut cost = self.base.cost_before(whole, record_cost) * self.per_base as u128;

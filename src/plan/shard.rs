@@ -1,8 +1,7 @@
 //! Deterministic cost-balanced shards of a plan (`--shard I/N`, for Slurm job arrays or
 //! Kubernetes Indexed Jobs): contiguous run ranges that tile the plan.
 
-use crate::plan::row::RowPlan;
-use crate::plan::Plan;
+use crate::plan::{PairPlan, Plan};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
@@ -25,22 +24,17 @@ impl Shard {
 /// The runs of shard `shard`: contiguous ranges cut where the cumulative estimated cost reaches
 /// `k / N` of the total. A run's cost is its number of record intervals (record plus tail): the
 /// free stepping that every run pays; contact work is not known before the run. Shards of one
-/// plan tile `0..len` exactly. Each cut is a binary search over [`Plan::cost_before`], so a
+/// plan tile `0..len` exactly. Each cut is a binary search over [`PairPlan::cost_before`], so a
 /// shard of 1e8 runs is planned in microseconds.
 pub fn shard_range(plan: &Plan, shard: Shard) -> Range<u64> {
-    let costs = record_costs(plan);
-    cut_by_cost(plan.len(), |end| plan.cost_before(end, &costs), shard)
-}
-
-/// [`shard_range`] for a row of multi-storey buildings: every run of a row has the same
-/// buildings' storeys, so a run's cost is again its record's intervals.
-pub fn row_shard_range(plan: &RowPlan, shard: Shard) -> Range<u64> {
-    let costs = record_costs(&plan.base);
+    // Every run of a row has the same buildings' storeys, so for pairs and rows alike a run's
+    // cost is its record's intervals.
+    let costs = record_costs(plan.contact());
     cut_by_cost(plan.len(), |end| plan.cost_before(end, &costs), shard)
 }
 
 /// Each record's intervals (record plus tail), at least 1.
-fn record_costs(plan: &Plan) -> Vec<u64> {
+fn record_costs(plan: &PairPlan) -> Vec<u64> {
     plan.spec
         .records
         .iter()
@@ -79,7 +73,7 @@ mod tests {
     use super::*;
 
     /// Two records of different lengths, so runs differ in cost: 3 x 2 x 2 = 12 runs.
-    fn plan() -> Plan {
+    fn plan() -> PairPlan {
         crate::plan::config::parse_builtin(
             r#"
 [building1]
@@ -140,7 +134,7 @@ synthetic = { seed = 2, duration_s = 8.0 }
         for count in [1, 2, 3, 5, 12, 13, 40] {
             let mut next = 0;
             for index in 0..count {
-                let r = shard_range(&plan, Shard { index, count });
+                let r = shard_range(&Plan::Pair(plan.clone()), Shard { index, count });
                 assert_eq!(
                     r.start, next,
                     "shard {index}/{count} starts where the last ended"

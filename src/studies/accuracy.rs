@@ -7,7 +7,7 @@ use crate::engine::gpu::{GpuContext, GpuError, GpuOptions, Precision};
 use crate::engine::{Engine, EngineError};
 use crate::physics::model::{RunOutput, Status};
 use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
-use crate::plan::Plan;
+use crate::plan::PairPlan;
 use crate::studies::plot::{Panel, Series};
 
 /// One path at one setting.
@@ -99,7 +99,7 @@ pub fn errors(truth: &[RunOutput], out: &[RunOutput]) -> Errors {
 }
 
 /// Every run of `plan` on `engine`: outputs in run order and runs per second.
-fn collect(plan: &Plan, engine: Engine) -> Result<(Vec<RunOutput>, f64), GpuError> {
+fn collect(plan: &PairPlan, engine: Engine) -> Result<(Vec<RunOutput>, f64), GpuError> {
     let (outs, report) = engine.collect(plan)?;
     Ok((outs, report.summary.runs_per_second()))
 }
@@ -114,7 +114,7 @@ fn cpu<'c>(scheme: Scheme) -> Engine<'c> {
 
 /// The reference at `tol`, then every path at every setting. `progress` hears each point.
 pub fn study(
-    plan: &Plan,
+    plan: &PairPlan,
     ctx: Option<&GpuContext>,
     settings: &[f64],
     tol: f64,

@@ -9,7 +9,7 @@ use crate::engine::gpu::{GpuError, GpuTimes};
 use crate::engine::{Engine, Summary};
 use crate::physics::model::RunOutput;
 use crate::plan::row::RowPlan;
-use crate::plan::{Plan, RunSpec};
+use crate::plan::{PairPlan, RunSpec};
 use std::time::Instant;
 
 /// The bench's contact (without its gap) and record, as config text: both suites use them.
@@ -61,7 +61,7 @@ gap_m = {}
 }
 
 /// The bench plan for about `n` runs.
-pub fn plan(n: u64) -> Plan {
+pub fn plan(n: u64) -> PairPlan {
     crate::plan::config::parse_builtin(&config(n), "bench.toml").expect("bench config is valid")
 }
 
@@ -121,7 +121,7 @@ impl Row {
 
 /// Formats each chunk's rows as CSV into a sink, timing it (the cost a real sweep pays).
 struct CsvSink<'a> {
-    plan: &'a Plan,
+    plan: &'a PairPlan,
     w: std::io::Sink,
     seconds: f64,
 }
@@ -150,7 +150,7 @@ fn label(engine: &Engine) -> String {
 
 /// Every run of `plan` on `engine`, each chunk's rows formatted as CSV (into a sink): the CPU
 /// fast path on all threads of the current pool, or the GPU path.
-pub fn run(plan: &Plan, engine: &Engine) -> Result<Row, GpuError> {
+pub fn run(plan: &PairPlan, engine: &Engine) -> Result<Row, GpuError> {
     let mut sink = CsvSink {
         plan,
         w: std::io::sink(),
@@ -179,7 +179,7 @@ pub fn run(plan: &Plan, engine: &Engine) -> Result<Row, GpuError> {
 
 /// Every run of `plan` on `engine` folded by `--aggregate by` (on the device for the GPU):
 /// `readback` is the fold and its partials' readback, `csv` writing the summary.
-pub fn fold(plan: &Plan, engine: &Engine, by: &[String]) -> Result<Row, GpuError> {
+pub fn fold(plan: &PairPlan, engine: &Engine, by: &[String]) -> Result<Row, GpuError> {
     let mut agg = Aggregator::new(by, &[]).map_err(|e| GpuError::Other {
         message: e.to_string(),
     })?;

@@ -15,7 +15,7 @@ use crate::physics::solver::separation::{separation, LevelSeparation, Separation
 use crate::plan::columns::{contact_and_motion, num, CONTACT_AND_MOTION};
 use crate::plan::intensity::TARGET_COLUMNS;
 use crate::plan::row::{level_name, RowPlan};
-use crate::plan::{Motions, Plan};
+use crate::plan::{Motions, PairPlan};
 use crate::studies::fragility::{fit, Fit, Level, NoFit};
 use crate::studies::plot::{Panel, Series};
 use rayon::prelude::*;
@@ -29,12 +29,21 @@ const PAIR_STOREY_M: f64 = 3.0;
 /// The sweep a study runs over: a pair config or a row config.
 #[derive(Clone, Copy)]
 pub enum Scenes<'a> {
-    Pairs(&'a Plan),
+    Pairs(&'a PairPlan),
     Rows(&'a RowPlan),
 }
 
+impl<'a> From<&'a crate::plan::Plan> for Scenes<'a> {
+    fn from(plan: &'a crate::plan::Plan) -> Scenes<'a> {
+        match plan {
+            crate::plan::Plan::Pair(p) => Scenes::Pairs(p),
+            crate::plan::Plan::Row(r) => Scenes::Rows(r),
+        }
+    }
+}
+
 impl Scenes<'_> {
-    fn base(&self) -> &Plan {
+    fn base(&self) -> &PairPlan {
         match self {
             Scenes::Pairs(p) => p,
             Scenes::Rows(r) => &r.base,
@@ -105,7 +114,7 @@ impl Scenes<'_> {
 
     /// Motion `m`'s parameter cells, in [`Scenes::parameter_header`] order.
     fn cells(&self, m: u64) -> Vec<String> {
-        let motion_cells = |plan: &Plan, spec: &crate::plan::RunSpec| {
+        let motion_cells = |plan: &PairPlan, spec: &crate::plan::RunSpec| {
             let mut c = vec![m.to_string()];
             // record, the targets, scale_factor, pga_g
             c.extend(contact_and_motion(plan, spec).drain(7..CONTACT_AND_MOTION));

@@ -7,7 +7,7 @@ use pounding::physics::restitution::Formula;
 use pounding::plan::config::{self, ConfigError};
 use std::path::Path;
 
-fn parse(text: &str) -> Result<pounding::plan::Plan, ConfigError> {
+fn parse(text: &str) -> Result<pounding::plan::PairPlan, ConfigError> {
     config::parse(text, Path::new("t.toml"), Path::new("."), &records_dir())
 }
 
@@ -39,10 +39,10 @@ pga_g = [0.2, 0.4]
 
 #[test]
 fn shipped_configs_load() {
-    let q = config::load(Path::new("configs/quickstart.toml")).unwrap();
+    let q = config::load_pair(Path::new("configs/quickstart.toml")).unwrap();
     assert_eq!(q.len(), 2700);
     for (name, runs) in [("e", 70), ("period", 100), ("damping", 105), ("gap", 100)] {
-        let p = config::load(Path::new(&format!("configs/paper-{name}.toml")))
+        let p = config::load_pair(Path::new(&format!("configs/paper-{name}.toml")))
             .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(p.len(), runs, "paper-{name}");
         assert_eq!(p.spec.records.len(), 5);
@@ -253,7 +253,7 @@ fn path_records_resolve_against_the_config() {
     );
     let cfg = d.path().join("c.toml");
     std::fs::write(&cfg, text).unwrap();
-    let p = config::load(&cfg).unwrap();
+    let p = config::load_pair(&cfg).unwrap();
     assert_eq!(p.spec.records[0].name, "mine");
     assert_eq!(p.spec.records[0].npts(), 4);
 }

@@ -39,7 +39,7 @@ pga_g = 0.4
 "#;
 
 /// The plan is cut to the first 6 s of each record to keep the reference affordable.
-pub fn mixed_plan() -> pounding::plan::Plan {
+pub fn mixed_plan() -> pounding::plan::PairPlan {
     let mut plan = config::parse(
         MIXED,
         Path::new("mixed.toml"),
@@ -51,7 +51,7 @@ pub fn mixed_plan() -> pounding::plan::Plan {
         let n = (6.0 / r.dt) as usize;
         std::sync::Arc::make_mut(r).accel.truncate(n);
     }
-    pounding::plan::Plan::new(plan.spec.clone()).unwrap()
+    pounding::plan::PairPlan::new(plan.spec.clone()).unwrap()
 }
 
 /// Measured on this grid (1,632 runs; see README "Integration schemes"): peak-force error

@@ -303,7 +303,7 @@ fn motions_are_the_distinct_motions_of_the_plan() {
     use pounding::plan::config;
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let cfg = root.join("configs/quickstart.toml");
-    let plan = config::load(&cfg).unwrap();
+    let plan = config::load_pair(&cfg).unwrap();
     let key = |r: &pounding::plan::RunSpec| {
         format!(
             "{} {} {} {} {} {} {} {}",

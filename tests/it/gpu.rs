@@ -125,7 +125,7 @@ use pounding::engine::gpu::{GpuContext, GpuOptions};
 use pounding::engine::Engine;
 use pounding::physics::model::RunOutput;
 use pounding::physics::solver::{FastOptions, FreeResponse, Scheme};
-use pounding::plan::{Plan, RunSpec};
+use pounding::plan::{PairPlan, RunSpec};
 use std::sync::OnceLock;
 
 /// The GPU-vs-CPU grid: every law and every formula, e from 0.1 (overdamped contact) to 1,
@@ -174,8 +174,8 @@ const WIDE_FAST: FastOptions = FastOptions {
     energy: true,
 };
 
-fn wide() -> &'static (Plan, Vec<(RunSpec, RunOutput)>) {
-    static WIDE_CPU: OnceLock<(Plan, Vec<(RunSpec, RunOutput)>)> = OnceLock::new();
+fn wide() -> &'static (PairPlan, Vec<(RunSpec, RunOutput)>) {
+    static WIDE_CPU: OnceLock<(PairPlan, Vec<(RunSpec, RunOutput)>)> = OnceLock::new();
     WIDE_CPU.get_or_init(|| {
         let plan = pounding::plan::config::parse(
             WIDE,
@@ -330,7 +330,7 @@ fn gpu_f32_error_against_cpu_f64() {
 fn gpu_f32_impact_counts_differ_only_at_grazing_contacts() {
     let Some(_) = ctx() else { return };
     let quick =
-        pounding::plan::config::load(std::path::Path::new("configs/quickstart.toml")).unwrap();
+        pounding::plan::config::load_pair(std::path::Path::new("configs/quickstart.toml")).unwrap();
     let quick_cpu = collect(&quick, &Scheme::Fast(FastOptions::default()), 8);
     let (wide_plan, wide_cpu) = wide();
     let mut differ = 0;
@@ -358,7 +358,7 @@ fn gpu_f32_impact_counts_differ_only_at_grazing_contacts() {
     eprintln!("{differ} runs with different impact counts, each explained by grazing contacts");
 }
 
-fn csv_text(plan: &Plan, rows: &[(RunSpec, RunOutput)]) -> String {
+fn csv_text(plan: &PairPlan, rows: &[(RunSpec, RunOutput)]) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     for (s, o) in rows {
         w.write_record(pounding::plan::columns::row(plan, s, o))

@@ -283,7 +283,7 @@ fn run_case(dir: &Path, case: &Case) -> String {
 /// Both results sane; false (after checking the difference is explained by grazing contacts of
 /// the `truth` run) when their impact counts differ, so peaks are not comparable.
 fn comparable(
-    plan: &pounding::plan::Plan,
+    plan: &pounding::plan::PairPlan,
     s: &pounding::plan::RunSpec,
     what: &str,
     o: &RunOutput,

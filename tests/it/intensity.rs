@@ -49,7 +49,7 @@ fn write(dir: &std::path::Path, intensity: &str) -> std::path::PathBuf {
 #[test]
 fn sa_targets_at_a_swept_building_period_scale_each_run_exactly() {
     let dir = tempdir();
-    let plan = config::load(&write(
+    let plan = config::load_pair(&write(
         dir.path(),
         "sa_g = [0.2, 0.5]\nsa_period_s = \"building1\"",
     ))
@@ -76,7 +76,7 @@ fn sa_targets_at_a_swept_building_period_scale_each_run_exactly() {
 #[test]
 fn sa_avg_targets_over_multiples_of_both_buildings_periods() {
     let dir = tempdir();
-    let plan = config::load(&write(
+    let plan = config::load_pair(&write(
         dir.path(),
         "sa_avg_g = 0.3\nsa_avg_periods_s = [\"0.2*building1\", \"3*building2\"]\nsa_avg_n = 6\nsa_damping = 0.02",
     ))
@@ -98,7 +98,8 @@ fn sa_avg_targets_over_multiples_of_both_buildings_periods() {
 #[test]
 fn a_fixed_period_target_is_one_factor_per_record_and_level() {
     let dir = tempdir();
-    let plan = config::load(&write(dir.path(), "sa_g = [0.1, 0.4]\nsa_period_s = 1.0")).unwrap();
+    let plan =
+        config::load_pair(&write(dir.path(), "sa_g = [0.1, 0.4]\nsa_period_s = 1.0")).unwrap();
     for i in 0..plan.len() {
         let r = plan.run(i);
         let rec = &plan.spec.records[r.record];
@@ -258,7 +259,7 @@ fn bad_spectral_targets_are_refused_by_key() {
             "out of range",
         ),
     ] {
-        let err = config::load(&write(dir.path(), intensity))
+        let err = config::load_pair(&write(dir.path(), intensity))
             .unwrap_err()
             .to_string();
         assert!(

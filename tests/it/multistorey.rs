@@ -651,8 +651,11 @@ fn example_row_configs_load() {
     ] {
         let path = std::path::Path::new(file);
         let text = std::fs::read_to_string(path).unwrap();
-        assert!(pounding::plan::row::is_row_config(&text), "{file}");
-        let plan = pounding::plan::config::load_row_text(&text, path).unwrap();
+        let pounding::plan::Plan::Row(plan) =
+            pounding::plan::config::load_text(&text, path).unwrap()
+        else {
+            panic!("{file} loads as a pair");
+        };
         assert_eq!(plan.len(), runs, "{file}");
         assert_eq!(plan.row(&plan.run(0)).levels.len(), levels, "{file}");
     }
@@ -915,7 +918,7 @@ fn row_sweep_writes_the_chosen_columns() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success());
     assert!(
-        err.contains("`peak_u1_m` is not a column of this row sweep")
+        err.contains("`peak_u1_m` is not a column of this sweep (a row of 3 buildings")
             && err.contains("b1_peak_roof_m"),
         "{err}"
     );

@@ -2,7 +2,8 @@
 //! (the pair kernels) and as two `[[building]]` entries (the row kernels) give the same runs in
 //! the same order: the same impacts, and peaks within 1e-9 under the reference scheme; the two
 //! fast kernels discretise contact differently, within 1e-5 of each other (each is about 6e-4
-//! from the reference here).
+//! from the reference here). Each says which kernel ran; only the config reader tells the kinds
+//! of config apart.
 
 use crate::support::{ok, pound, tempdir};
 use std::collections::HashMap;
@@ -59,14 +60,27 @@ fn sweep(dir: &Path, name: &str, run: &str, pair: bool) -> Vec<HashMap<String, S
     )
     .unwrap();
     let out = dir.join(format!("{name}.csv"));
-    ok(&pound(&[
+    let run = pound(&[
         "sweep",
         cfg.to_str().unwrap(),
         "-o",
         out.to_str().unwrap(),
         "--backend",
         "cpu",
-    ]));
+    ]);
+    ok(&run);
+    // The kernel chosen from the scene is said in the one-line description and the sidecar.
+    let kernel = if pair { "pair" } else { "row" };
+    let said = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        said.contains(&format!("{kernel} kernel on the CPU")),
+        "{said}"
+    );
+    let sidecar = std::fs::read_to_string(dir.join(format!("{name}.csv.meta.toml"))).unwrap();
+    assert!(
+        sidecar.contains(&format!("kernel = \"{kernel}\"")),
+        "{sidecar}"
+    );
     let text = std::fs::read_to_string(&out).unwrap();
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -122,4 +136,57 @@ fn a_pair_and_the_same_row_of_two_give_the_same_runs() {
         &sweep(dir.path(), "row", "", false),
     );
     assert!(d < 1e-5, "fast: pair and row kernels differ by {d:e}");
+}
+
+/// The Rust files under `dir`, recursively.
+fn sources(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut files = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            files.extend(sources(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            files.push(p);
+        }
+    }
+    files
+}
+
+/// One path for every scene: only the config reader tells a pair's config from a row's (no
+/// module outside `src/plan/` reads a config's keys to pick a world), and `pound sweep`'s `run`
+/// is the short sequence the layout describes.
+#[test]
+fn only_the_config_reader_tells_the_kinds_of_config_apart() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let files = sources(&root.join("src"));
+    assert!(files.len() > 50, "{} sources", files.len());
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let rel = f
+            .strip_prefix(root)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        if rel.starts_with("src/plan/") {
+            continue;
+        }
+        for telltale in [
+            "is_row_config",
+            "contains_key(\"building\")",
+            "RawRowConfig",
+        ] {
+            assert!(!text.contains(telltale), "{rel} holds `{telltale}`");
+        }
+    }
+    let sweep = std::fs::read_to_string(root.join("src/cli/sweep.rs")).unwrap();
+    let body: Vec<&str> = sweep
+        .lines()
+        .skip_while(|l| !l.starts_with("pub fn run("))
+        .take_while(|l| *l != "}")
+        .collect();
+    assert!(
+        !body.is_empty() && body.len() < 80,
+        "cli/sweep.rs::run is {} lines",
+        body.len()
+    );
 }

@@ -7,7 +7,7 @@ use pounding::physics::model::{Initial, RunOutput};
 use pounding::physics::solver::{
     simulate, simulate_observed, simulate_shared, FastOptions, FreeResponse, Scheme,
 };
-use pounding::plan::{config, Plan};
+use pounding::plan::{config, PairPlan};
 use std::path::Path;
 
 /// Every law, stiff and soft and equal buildings, a real record with a tail of free vibration
@@ -46,7 +46,7 @@ synthetic = { seed = 3, duration_s = 10.0, dt_s = 0.01 }
 pga_g = 0.4
 "#;
 
-pub fn plan(text: &str) -> Plan {
+pub fn plan(text: &str) -> PairPlan {
     config::parse(
         text,
         Path::new("shared.toml"),

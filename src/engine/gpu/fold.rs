@@ -4,7 +4,7 @@
 use super::sweep::GpuTimes;
 use crate::engine::aggregate::Aggregator;
 use crate::engine::Summary;
-use crate::plan::{Plan, RunSpec};
+use crate::plan::{PairPlan, RunSpec};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -15,7 +15,7 @@ use std::time::Instant;
 /// `max_slots` (or than one buffer holds) is read back and folded on the host instead.
 #[allow(clippy::too_many_arguments)]
 pub fn fold_range(
-    plan: &Plan,
+    plan: &PairPlan,
     runs: std::ops::Range<u64>,
     ctx: &super::GpuContext,
     opts: &super::GpuOptions,

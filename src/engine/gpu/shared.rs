@@ -23,7 +23,7 @@ use super::layout::NO_RESPONSE;
 use super::run::Packed;
 use crate::engine::cpu::{free_motion_stretches, same_free_motion, MIN_SHARED_RUNS};
 use crate::physics::solver::FreeResponse;
-use crate::plan::{Plan, RunSpec};
+use crate::plan::{PairPlan, RunSpec};
 use rayon::prelude::*;
 
 pub const HEADER: usize = 6;
@@ -67,7 +67,7 @@ pub struct Start {
 /// its free motion? Decided on the plan, not the chunk, so that whether a run shares (which
 /// moves an f32 result by rounding: the response is stepped in f64) does not depend on where
 /// chunks end or how a chunk is ordered.
-fn in_long_stretch(plan: &Plan, spec: &RunSpec) -> bool {
+fn in_long_stretch(plan: &PairPlan, spec: &RunSpec) -> bool {
     let same = |j: u64| same_free_motion(spec, &plan.run(j));
     let (mut lo, mut hi) = (spec.index, spec.index);
     while ((hi - lo + 1) as usize) < MIN_SHARED_RUNS && lo > 0 && same(lo - 1) {
@@ -84,7 +84,12 @@ fn in_long_stretch(plan: &Plan, spec: &RunSpec) -> bool {
 /// response, one per stretch of such runs that are consecutive in `packed`: sets
 /// `meta.response` and `start` of those runs, and returns the responses' tables, one after
 /// another. Stretches past `max_reals` in all step their whole records.
-pub fn share(plan: &Plan, specs: &[&RunSpec], packed: &mut [Packed], max_reals: usize) -> Vec<f64> {
+pub fn share(
+    plan: &PairPlan,
+    specs: &[&RunSpec],
+    packed: &mut [Packed],
+    max_reals: usize,
+) -> Vec<f64> {
     let mut stretches: Vec<Vec<usize>> = Vec::new();
     for ks in free_motion_stretches(specs) {
         let len = ks.len();

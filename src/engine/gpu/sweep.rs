@@ -4,7 +4,7 @@
 use crate::engine::Summary;
 use crate::physics::model::RunOutput;
 use crate::physics::solver::Scheme;
-use crate::plan::{Plan, RunSpec};
+use crate::plan::{PairPlan, RunSpec};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -52,7 +52,7 @@ impl GpuTimes {
     /// in f64 (`spec(k)` is the run of `outs[k]`).
     pub(crate) fn finish<'a>(
         &mut self,
-        plan: &Plan,
+        plan: &PairPlan,
         fast: &crate::physics::solver::FastOptions,
         outs: Vec<Option<RunOutput>>,
         spec: impl Fn(usize) -> &'a RunSpec + Sync,
@@ -73,7 +73,7 @@ impl GpuTimes {
 /// The plan's records on the device, and `chunk` capped by what one chunk's buffers may hold:
 /// what every GPU sweep of `plan` starts with.
 pub(crate) fn upload_records(
-    plan: &Plan,
+    plan: &PairPlan,
     ctx: &super::GpuContext,
     opts: &super::GpuOptions,
     chunk: usize,
@@ -86,7 +86,7 @@ pub(crate) fn upload_records(
 
 /// Pack run `spec` of `plan` for the kernel.
 pub(crate) fn pack_run(
-    plan: &Plan,
+    plan: &PairPlan,
     spec: &RunSpec,
     recs: &super::GpuRecords,
     opts: &super::GpuOptions,
@@ -104,7 +104,7 @@ pub(crate) fn pack_run(
 /// response ([`super::shared::share`]) get one, unless `opts` says not to or asks for the energy
 /// balance (the shortcuts skip its integrals).
 pub(crate) fn pack_chunk(
-    plan: &Plan,
+    plan: &PairPlan,
     specs: &[&RunSpec],
     ctx: &super::GpuContext,
     recs: &super::GpuRecords,
@@ -129,7 +129,7 @@ pub(crate) fn pack_chunk(
 /// path in f64. Rows already handed to `sink` stay there if a later chunk fails (device loss,
 /// out of memory).
 pub fn run_range<E: From<super::GpuError>>(
-    plan: &Plan,
+    plan: &PairPlan,
     runs: std::ops::Range<u64>,
     ctx: &super::GpuContext,
     opts: &super::GpuOptions,

@@ -5,7 +5,7 @@ use pounding::engine::gpu::{GpuContext, GpuOptions};
 use pounding::engine::{Engine, Report};
 use pounding::physics::model::RunOutput;
 use pounding::physics::solver::{FastOptions, Scheme};
-use pounding::plan::{Plan, RunSpec};
+use pounding::plan::{PairPlan, RunSpec};
 use std::sync::OnceLock;
 
 /// The shared test device. With `POUND_REQUIRE_GPU=1` (CI) a missing adapter fails the test.
@@ -27,13 +27,13 @@ pub fn ctx() -> Option<&'static GpuContext> {
     .as_ref()
 }
 
-pub fn gpu_collect(plan: &Plan, opts: &GpuOptions, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
+pub fn gpu_collect(plan: &PairPlan, opts: &GpuOptions, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
     gpu_run(plan, opts, chunk).0
 }
 
 /// Every run of `plan` on the shared device, with the engine's report (times, lane tally).
 pub fn gpu_run(
-    plan: &Plan,
+    plan: &PairPlan,
     opts: &GpuOptions,
     chunk: usize,
 ) -> (Vec<(RunSpec, RunOutput)>, Report) {
@@ -68,7 +68,7 @@ pub fn peak_diff(a: &RunOutput, b: &RunOutput) -> f64 {
 /// two impacts that opens less than `tau`, and an approach in free flight that comes within `tau`
 /// of touching without touching. Closest approaches are maxima of the Hermite cubic of `delta`
 /// over each step.
-pub fn grazing_contacts(plan: &Plan, spec: &RunSpec, tau: f64) -> usize {
+pub fn grazing_contacts(plan: &PairPlan, spec: &RunSpec, tau: f64) -> usize {
     use pounding::physics::solver::{simulate_observed, Mode, Sample};
     let pair = spec.pair();
     let delta = |z: &pounding::physics::solver::State| z[0] - z[2] - pair.gap;

@@ -12,7 +12,7 @@ use pounding::physics::contact::{Contact, LawKind};
 use pounding::physics::model::RunOutput;
 use pounding::physics::model::{Oscillator, Pair};
 use pounding::physics::solver::Scheme;
-use pounding::plan::{Plan, RunSpec};
+use pounding::plan::{PairPlan, RunSpec};
 use std::path::PathBuf;
 
 /// The real-records directory (`POUND_RECORDS_DIR`, default `../shared/records`). Tests that need
@@ -97,7 +97,7 @@ pub fn pair(
 }
 
 /// Every run of `plan` with `scheme`, in run order.
-pub fn collect(plan: &Plan, scheme: &Scheme, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
+pub fn collect(plan: &PairPlan, scheme: &Scheme, chunk: usize) -> Vec<(RunSpec, RunOutput)> {
     let mut rows = Vec::new();
     let sink = |c: &[(RunSpec, RunOutput)]| -> Result<(), pounding::engine::gpu::GpuError> {
         rows.extend_from_slice(c);
