@@ -2,8 +2,8 @@
 
 use super::{check_outputs, config_inputs, write_file, BackendArg, Holds};
 use anyhow::{bail, Result};
+use pounding::plan::config;
 use pounding::plan::limits::{MAX_SUBSTEPS_PER_CONTACT, WHY_SUBSTEPS};
-use pounding::plan::{config, Plan};
 use pounding::studies::accuracy;
 use std::path::PathBuf;
 
@@ -85,101 +85,52 @@ pub fn run(a: Args) -> Result<()> {
     )?;
     let finest = settings.iter().cloned().fold(0.0, f64::max);
     super::warn_all(&config, plan.warnings(finest));
-    // The rows' study compares the CPU paths; the pairs' every path (studies::accuracy).
-    let plan = match plan {
-        Plan::Pair(pair) => pair,
-        Plan::Row(plan) => {
-            if backend.get() == pounding::engine::Backend::Gpu {
-                bail!("--backend gpu is not available for the accuracy of rows of multi-storey buildings ([[building]] configs) yet: it compares the CPU paths");
-            }
-            note!(
-                "{}: {} runs of a row; reference at tol {tol:e}, then {} settings on the CPU",
-                config.display(),
-                plan.len(),
-                settings.len()
-            );
-            say!("{}", accuracy::ROW_MARKDOWN_HEADER);
-            let points = accuracy::row_study(&plan, &settings, tol, |p| {
-                let _ = super::say_text(&format!("{}\n", accuracy::row_markdown(p)));
-            });
-            write_file(&output, accuracy::row_csv(&points).as_bytes())?;
-            if let Some(p) = plot {
-                super::save_plot(&p, &accuracy::row_panels(&points), 2)?;
-            }
-            let measured: Vec<Measured> = points
-                .iter()
-                .map(|p| Measured {
-                    path: &p.path,
-                    setting: p.substeps_per_contact,
-                    force_p99: p.force[1],
-                    failed: p.failed,
-                    compared: p.compared,
-                    runs: plan.len(),
-                })
-                .collect();
-            return check_targets(&choices, &measured, &config);
-        }
-    };
-    let ctx = backend
-        .get()
-        .acquire("CPU path only", &mut |l| note!("{l}"))?;
+    let (ctx, paths) = accuracy::paths(&plan, backend.get(), &mut |l| note!("{l}"))?;
     note!(
-        "{}: {} runs; reference at tol {tol:e}, then {} settings on {} paths",
+        "{}: {} runs of {}; reference at tol {tol:e}, then {} settings on {paths}",
         config.display(),
         plan.len(),
+        plan.scene(),
         settings.len(),
-        if ctx.is_some() { 3 } else { 1 }
     );
-    say!("{}", accuracy::MARKDOWN_HEADER);
-    let points = accuracy::study(&plan, ctx.as_ref(), &settings, tol, |p| {
-        let _ = super::say_text(&format!("{}\n", accuracy::markdown_row(p)));
+    say!("{}", accuracy::markdown_header(&plan));
+    let points = accuracy::study_plan(&plan, ctx.as_ref(), &settings, tol, |l| {
+        let _ = super::say_text(&format!("{l}\n"));
     })?;
-    write_file(&output, accuracy::csv(&points).as_bytes())?;
+    write_file(&output, points.csv().as_bytes())?;
     if let Some(p) = plot {
-        super::save_plot(&p, &accuracy::panels(&points), 2)?;
+        super::save_plot(&p, &points.panels(), 2)?;
     }
+    let runs = plan.len();
     let measured: Vec<Measured> = points
-        .iter()
-        .map(|p| Measured {
-            path: &p.path,
-            setting: p.substeps_per_contact,
-            force_p99: p.errors.force_p99,
-            failed: p.errors.failed,
-            compared: p.errors.compared,
-            runs: plan.len(),
-        })
+        .verdicts()
+        .into_iter()
+        .map(|verdict| Measured { verdict, runs })
         .collect();
     check_targets(&choices, &measured, &config)
 }
 
-/// One path at one setting, as `--target-error` judges it.
-struct Measured<'a> {
-    path: &'a str,
-    setting: f64,
-    /// p99 relative peak-force error over the compared runs (NaN over none).
-    force_p99: f64,
-    /// Runs that failed on this path or in the reference.
-    failed: u64,
-    /// Runs that pounded and were compared.
-    compared: u64,
+/// One path at one setting, as `--target-error` judges it, of a study of `runs` runs.
+struct Measured {
+    verdict: accuracy::Verdict,
     runs: u64,
 }
 
-impl Measured<'_> {
+impl Measured {
     /// Why this point cannot certify `target`, or None when it meets it. A failed run on either
     /// side is evidence against the target, and no compared run is no evidence for it.
     fn short_of(&self, target: f64) -> Option<String> {
-        if self.failed > 0 {
+        if self.verdict.failed > 0 {
             Some(format!(
                 "{} of {} runs failed (here or in the reference; pound sweep shows their status)",
-                self.failed, self.runs
+                self.verdict.failed, self.runs
             ))
-        } else if self.compared == 0 {
+        } else if self.verdict.compared == 0 {
             Some(format!(
                 "no run was compared (of {}, none pounded with the reference's impact count)",
                 self.runs
             ))
-        } else if self.force_p99.is_nan() || self.force_p99 > target {
+        } else if self.verdict.force_p99.is_nan() || self.verdict.force_p99 > target {
             Some(format!("p99 above {target:e}"))
         } else {
             None
@@ -197,26 +148,26 @@ fn check_targets(
 ) -> Result<()> {
     let mut missed = Vec::new();
     for c in choices {
-        for m in measured
-            .iter()
-            .filter(|m| m.path != "reference" && m.setting == c.substeps_per_contact)
-        {
+        for m in measured.iter().filter(|m| {
+            m.verdict.path != "reference"
+                && m.verdict.substeps_per_contact == c.substeps_per_contact
+        }) {
             let short = m.short_of(c.target);
             say!(
                 "--target-error {:e}: {} substeps per contact, {}: p99 peak-force error {:.2e} over {} runs compared, {} failed ({})",
                 c.target,
                 c.substeps_per_contact,
-                m.path,
-                m.force_p99,
-                m.compared,
-                m.failed,
+                m.verdict.path,
+                m.verdict.force_p99,
+                m.verdict.compared,
+                m.verdict.failed,
                 match &short {
                     None => "met".to_string(),
                     Some(why) => format!("NOT met: {why}"),
                 }
             );
             if short.is_some() {
-                missed.push(format!("{:e} on {}", c.target, m.path));
+                missed.push(format!("{:e} on {}", c.target, m.verdict.path));
             }
         }
     }

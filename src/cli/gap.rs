@@ -4,7 +4,7 @@
 use super::{check_outputs, config_inputs, write_file, Holds};
 use anyhow::{bail, Context, Result};
 use pounding::plan::config;
-use pounding::studies::gap::{GapStudy, PoundingCurve, Scenes};
+use pounding::studies::gap::{GapStudy, PoundingCurve};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -60,14 +60,13 @@ pub fn run(a: Args) -> Result<()> {
         );
     }
     super::warn_all(&a.config, plan.input_warnings());
-    let scenes = Scenes::from(&plan);
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = threads {
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("starting worker threads")?;
     let started = Instant::now();
-    let study = pool.install(|| GapStudy::run(scenes));
+    let study = pool.install(|| GapStudy::run(&plan));
     let seconds = started.elapsed().as_secs_f64();
     let runs = study.len();
     say!(

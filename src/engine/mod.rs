@@ -564,7 +564,7 @@ mod tests {
         .unwrap();
         let by = ["gap_m".to_string()];
         let exceed = ["impacts=0".to_string()];
-        let engine = Engine::cpu(plan.spec.scheme, Some(1)).unwrap();
+        let engine = Engine::cpu(plan.contact.spec.scheme, Some(1)).unwrap();
         let mut host = Aggregator::new(&by, &exceed).unwrap();
         let rows = engine
             .run(
@@ -578,7 +578,7 @@ mod tests {
             )
             .unwrap();
         let mut folded = Aggregator::new(&by, &exceed).unwrap();
-        let report = Engine::cpu(plan.spec.scheme, Some(4))
+        let report = Engine::cpu(plan.contact.spec.scheme, Some(4))
             .unwrap()
             .fold(&plan, 0..plan.len(), &mut folded, |_| {})
             .unwrap();

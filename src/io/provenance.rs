@@ -28,8 +28,25 @@ fn hex(d: impl AsRef<[u8]>) -> String {
 
 impl Fingerprint {
     pub fn of(plan: &PairPlan) -> Fingerprint {
-        let s = &plan.spec;
-        // Debug prints every f64 exactly (shortest round-trip), so equal plans hash equally.
+        Fingerprint::hashed(
+            &plan.contact.spec,
+            &plan.building1,
+            &plan.building2,
+            &plan.gaps,
+            &plan.samples,
+        )
+    }
+
+    /// The hash of the shared axes and a pair's own. Debug prints every f64 exactly (shortest
+    /// round-trip), so equal plans hash equally; the text's layout is that of every earlier
+    /// version, so their sidecars still match (`--resume`, `pound merge`).
+    fn hashed(
+        s: &crate::plan::ContactSpec,
+        building1: &crate::plan::BuildingAxes,
+        building2: &crate::plan::BuildingAxes,
+        gaps: &[f64],
+        samples: &Option<crate::plan::Samples>,
+    ) -> Fingerprint {
         let text = format!(
             "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
             s.laws,
@@ -38,12 +55,12 @@ impl Fingerprint {
             s.k_linear,
             s.beta,
             s.intensities,
-            s.building1,
-            s.building2,
-            s.gaps,
+            building1,
+            building2,
+            gaps,
             s.scheme,
             s.tail,
-            s.samples,
+            samples,
             s.records.iter().map(|r| &r.name).collect::<Vec<_>>(),
         );
         let mut rec = Sha256::new();
@@ -72,9 +89,17 @@ impl Fingerprint {
         }
     }
 
-    /// The fingerprint of a row sweep: its base plan's, with the buildings' and gaps' axes.
+    /// The fingerprint of a row sweep: the shared axes' hash, with the buildings' and gaps'
+    /// axes. The shared axes are hashed in a pair's layout with the one-value building and gap
+    /// axes that earlier versions' row plans carried, so their sidecars still match.
     pub fn of_row(plan: &crate::plan::row::RowPlan) -> Fingerprint {
-        let base = Fingerprint::of(&plan.base);
+        let one = |x: f64| vec![x];
+        let unit = crate::plan::BuildingAxes {
+            mass: one(1.0),
+            period: one(1.0),
+            damping: one(0.05),
+        };
+        let base = Fingerprint::hashed(&plan.contact.spec, &unit, &unit, &one(0.0), &None);
         let text = format!(
             "{}|{:?}|{:?}|{:?}",
             base.plan, plan.buildings, plan.gaps, plan.samples

@@ -545,7 +545,7 @@ synthetic = { seed = 2, duration_s = 2.0 }
 
     fn rows(plan: &PairPlan) -> Vec<(RunSpec, RunOutput)> {
         let mut all = Vec::new();
-        crate::engine::Engine::cpu(plan.spec.scheme, Some(2))
+        crate::engine::Engine::cpu(plan.contact.spec.scheme, Some(2))
             .unwrap()
             .run(
                 plan,

@@ -4,7 +4,7 @@
 
 use crate::physics::model::RunOutput;
 use crate::plan::intensity::target_values;
-use crate::plan::{PairPlan, RunSpec};
+use crate::plan::{ContactPlan, ContactRun, PairPlan, RunSpec};
 
 /// Every column, in file order: the swept parameters, then the status and the outputs. Units are
 /// in the names. The last three, the energy balance, are empty unless it was asked for
@@ -83,7 +83,7 @@ pub const CONTACT_AND_MOTION: usize = 16;
 /// The fields of one row, in [`HEADER`] order.
 pub fn row(plan: &PairPlan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
-    let mut cells = contact_and_motion(plan, spec);
+    let mut cells = contact_and_motion(&plan.contact, &spec.contact());
     cells.extend([
         num(spec.m1),
         num(spec.t1),
@@ -112,7 +112,7 @@ pub fn row(plan: &PairPlan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
 }
 
 /// The first [`CONTACT_AND_MOTION`] fields of a row.
-pub fn contact_and_motion(plan: &PairPlan, spec: &RunSpec) -> Vec<String> {
+pub fn contact_and_motion(plan: &ContactPlan, spec: &ContactRun) -> Vec<String> {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
     let hertz = spec.law.is_hertzian();
     let mut cells = vec![

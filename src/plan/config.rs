@@ -10,7 +10,8 @@ use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
 use crate::plan::intensity::{PeriodRef, SpectralIm};
 use crate::plan::sample::{draw, Dist, Method};
 use crate::plan::{
-    BuildingAxes, Intensity, PairPlan, Plan, PlanError, PlanSpec, SampledAxis, Samples,
+    BuildingAxes, ContactPlan, ContactSpec, Intensity, PairPlan, Plan, PlanError, PlanSpec,
+    SampledAxis, Samples,
 };
 use crate::record::{
     read_record, synthetic, Format, ReadOptions, Record, RecordError, SyntheticSpec, Units,
@@ -709,16 +710,15 @@ pub fn parse(
         path: path.into(),
         message: e.to_string(),
     })?;
-    parse_raw(&raw, path, base, records, None)
+    parse_raw(&raw, path, base, records)
 }
 
 /// [`parse`] of a config already read into its raw form.
-pub(crate) fn parse_raw(
+fn parse_raw(
     raw: &RawConfig,
     path: &Path,
     base: &Path,
     records: &Path,
-    row_buildings: Option<usize>,
 ) -> Result<PairPlan, ConfigError> {
     let invalid = |key: &str, message: String| ConfigError::Invalid {
         path: path.into(),
@@ -726,74 +726,33 @@ pub(crate) fn parse_raw(
         message,
     };
     let axis = |key: &str, a: &Axis| a.values().map_err(|m| invalid(key, m));
-    let opt_axis =
-        |key: &str, a: &Option<Axis>| a.as_ref().map_or(Ok(Vec::new()), |a| axis(key, a));
-
-    let scheme = match raw.run.scheme.as_deref().unwrap_or("fast") {
-        "fast" => {
-            let mut o = FastOptions::default();
-            if let Some(n) = raw.run.substeps_per_contact {
-                if !(n.is_finite()
-                    && (1.0..=crate::plan::limits::MAX_SUBSTEPS_PER_CONTACT).contains(&n))
-                {
-                    return Err(invalid(
-                        "run.substeps_per_contact",
-                        format!(
-                            "{n}: expected 1 to {} ({})",
-                            crate::plan::limits::MAX_SUBSTEPS_PER_CONTACT,
-                            crate::plan::limits::WHY_SUBSTEPS
-                        ),
-                    ));
-                }
-                o.substeps_per_contact = n;
-            }
-            o.energy = raw.run.energy.unwrap_or(false);
-            Scheme::Fast(o)
-        }
-        "reference" => {
-            let tol = raw
-                .run
-                .tol
-                .unwrap_or(crate::physics::solver::reference::DEFAULT_TOL);
-            let tol = crate::plan::limits::check_tol(tol).map_err(|m| invalid("run.tol", m))?;
-            Scheme::Reference(ReferenceOptions::with_tol(tol))
-        }
-        other => {
-            return Err(invalid(
-                "run.scheme",
-                format!("`{other}`: expected fast or reference"),
-            ))
-        }
+    let scheme = parse_scheme(&raw.run, &invalid)?;
+    let (laws, formulas) = parse_laws(&raw.contact, &invalid)?;
+    let count = |key: &str, a: &Option<Axis>| -> Result<usize, ConfigError> {
+        a.as_ref()
+            .map_or(Ok(1), |a| a.count().map_err(|m| invalid(key, m)))
     };
-
-    let mut laws = Vec::new();
-    for (i, k) in raw.contact.law.list().iter().enumerate() {
-        laws.push(LawKind::from_key(k).ok_or_else(|| {
-            invalid(
-                &format!("contact.law[{i}]"),
-                format!("unknown law `{k}`: expected one of {}", LawKind::keys()),
-            )
-        })?);
-    }
-    let mut formulas = Vec::new();
-    for (i, k) in raw
-        .contact
-        .formula
-        .as_ref()
-        .map(Names::list)
-        .unwrap_or_default()
-        .iter()
-        .enumerate()
-    {
-        formulas.push(Formula::from_key(k).ok_or_else(|| {
-            invalid(
-                &format!("contact.formula[{i}]"),
-                format!("unknown formula `{k}`: expected one of {}", Formula::keys()),
-            )
-        })?);
-    }
-
-    check_size(raw, &laws, &invalid)?;
+    let b = |name: &str, r: &RawBuilding| -> Result<[usize; 3], ConfigError> {
+        Ok([
+            count(&format!("{name}.mass_kg"), &r.mass_kg)?,
+            count(&format!("{name}.period_s"), &r.period_s)?,
+            count(&format!("{name}.damping_ratio"), &r.damping_ratio)?,
+        ])
+    };
+    let scene = SceneCounts {
+        samples: raw.sample.as_ref().map_or(1, |s| s.n.max(1)),
+        building1: b("building1", &raw.building1)?,
+        building2: b("building2", &raw.building2)?,
+        gaps: count("contact.gap_m", &raw.contact.gap_m)?,
+    };
+    check_size(
+        &raw.contact,
+        raw.records.len(),
+        &raw.intensity,
+        &laws,
+        scene,
+        &invalid,
+    )?;
     let samples = raw
         .sample
         .as_ref()
@@ -817,11 +776,144 @@ pub(crate) fn parse_raw(
             damping: grid(&format!("{name}.damping_ratio"), &b.damping_ratio)?,
         })
     };
+    let contact = contact_spec(
+        ContactSections {
+            scheme,
+            laws,
+            formulas,
+            contact: &raw.contact,
+            k_linear: raw.contact.k_n_per_m.as_ref(),
+            beta: raw.contact.beta_n_per_m1_5.as_ref(),
+            records: &raw.records,
+            intensity: &raw.intensity,
+            buildings: 2,
+            tail: raw.run.tail_s.unwrap_or(0.0),
+        },
+        base,
+        records,
+        path,
+    )?;
+    let spec = PlanSpec {
+        contact,
+        building1: building("building1", &raw.building1)?,
+        building2: building("building2", &raw.building2)?,
+        gaps: grid("contact.gap_m", &raw.contact.gap_m)?,
+        samples,
+    };
+    PairPlan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
+}
 
-    let intensities = raw.intensity.axis(row_buildings.unwrap_or(2), &invalid)?;
+/// The `[run]` section's scheme.
+fn parse_scheme(
+    run: &RawRun,
+    invalid: &dyn Fn(&str, String) -> ConfigError,
+) -> Result<Scheme, ConfigError> {
+    Ok(match run.scheme.as_deref().unwrap_or("fast") {
+        "fast" => {
+            let mut o = FastOptions::default();
+            if let Some(n) = run.substeps_per_contact {
+                if !(n.is_finite()
+                    && (1.0..=crate::plan::limits::MAX_SUBSTEPS_PER_CONTACT).contains(&n))
+                {
+                    return Err(invalid(
+                        "run.substeps_per_contact",
+                        format!(
+                            "{n}: expected 1 to {} ({})",
+                            crate::plan::limits::MAX_SUBSTEPS_PER_CONTACT,
+                            crate::plan::limits::WHY_SUBSTEPS
+                        ),
+                    ));
+                }
+                o.substeps_per_contact = n;
+            }
+            o.energy = run.energy.unwrap_or(false);
+            Scheme::Fast(o)
+        }
+        "reference" => {
+            let tol = run
+                .tol
+                .unwrap_or(crate::physics::solver::reference::DEFAULT_TOL);
+            let tol = crate::plan::limits::check_tol(tol).map_err(|m| invalid("run.tol", m))?;
+            Scheme::Reference(ReferenceOptions::with_tol(tol))
+        }
+        other => {
+            return Err(invalid(
+                "run.scheme",
+                format!("`{other}`: expected fast or reference"),
+            ))
+        }
+    })
+}
 
+/// The `[contact]` section's laws and formulas.
+fn parse_laws(
+    contact: &RawContact,
+    invalid: &dyn Fn(&str, String) -> ConfigError,
+) -> Result<(Vec<LawKind>, Vec<Formula>), ConfigError> {
+    let mut laws = Vec::new();
+    for (i, k) in contact.law.list().iter().enumerate() {
+        laws.push(LawKind::from_key(k).ok_or_else(|| {
+            invalid(
+                &format!("contact.law[{i}]"),
+                format!("unknown law `{k}`: expected one of {}", LawKind::keys()),
+            )
+        })?);
+    }
+    let mut formulas = Vec::new();
+    for (i, k) in contact
+        .formula
+        .as_ref()
+        .map(Names::list)
+        .unwrap_or_default()
+        .iter()
+        .enumerate()
+    {
+        formulas.push(Formula::from_key(k).ok_or_else(|| {
+            invalid(
+                &format!("contact.formula[{i}]"),
+                format!("unknown formula `{k}`: expected one of {}", Formula::keys()),
+            )
+        })?);
+    }
+    Ok((laws, formulas))
+}
+
+/// The sections every scene shares, as a scene's reader settled them.
+pub(crate) struct ContactSections<'a> {
+    pub scheme: Scheme,
+    pub laws: Vec<LawKind>,
+    pub formulas: Vec<Formula>,
+    pub contact: &'a RawContact,
+    /// `k` and `beta` as the scene gives them (a sampled one holds a placeholder value).
+    pub k_linear: Option<&'a Axis>,
+    pub beta: Option<&'a Axis>,
+    pub records: &'a [RawRecord],
+    pub intensity: &'a RawIntensity,
+    /// The scene's buildings, for the intensity's references to their periods.
+    pub buildings: usize,
+    /// `run.tail_s`
+    pub tail: f64,
+}
+
+/// The axes every scene shares, validated but for the buildings' periods a spectral target
+/// reads (the scene checks those): records read (`path =` beside `base`, `file =` in
+/// `records`), intensities, `e`, `k` and `beta`.
+fn contact_spec(
+    c: ContactSections,
+    base: &Path,
+    records: &Path,
+    path: &Path,
+) -> Result<ContactSpec, ConfigError> {
+    let invalid = |key: &str, message: String| ConfigError::Invalid {
+        path: path.into(),
+        key: key.into(),
+        message,
+    };
+    let axis = |key: &str, a: &Axis| a.values().map_err(|m| invalid(key, m));
+    let opt_axis = |key: &str, a: Option<&Axis>| a.map_or(Ok(Vec::new()), |a| axis(key, a));
+    let intensities = c.intensity.axis(c.buildings, &invalid)?;
     let mut recs = Vec::new();
-    for (i, r) in raw.records.iter().enumerate() {
+    for (i, r) in c.records.iter().enumerate() {
         let key = format!("record[{i}]");
         let rec = load_record(r, base, records).map_err(|e| match e {
             LoadError::Invalid(m) => invalid(&key, m),
@@ -833,61 +925,116 @@ pub(crate) fn parse_raw(
         })?;
         recs.push(Arc::new(rec));
     }
-
-    let spec = PlanSpec {
-        laws,
-        formulas,
-        e: opt_axis("contact.e", &raw.contact.e)?,
-        k_linear: opt_axis("contact.k_n_per_m", &raw.contact.k_n_per_m)?,
-        beta: opt_axis("contact.beta_n_per_m1_5", &raw.contact.beta_n_per_m1_5)?,
+    Ok(ContactSpec {
+        laws: c.laws,
+        formulas: c.formulas,
+        e: opt_axis("contact.e", c.contact.e.as_ref())?,
+        k_linear: opt_axis("contact.k_n_per_m", c.k_linear)?,
+        beta: opt_axis("contact.beta_n_per_m1_5", c.beta)?,
         records: recs,
         intensities,
-        building1: building("building1", &raw.building1)?,
-        building2: building("building2", &raw.building2)?,
-        gaps: grid("contact.gap_m", &raw.contact.gap_m)?,
-        scheme,
-        tail: raw.run.tail_s.unwrap_or(0.0),
-        samples,
+        scheme: c.scheme,
+        tail: c.tail,
+    })
+}
+
+/// The contact plan of a row config ([`crate::plan::row`]): its `[run]`, `[contact]`,
+/// `[[record]]` and `[intensity]` sections, with `k` and `beta` as the row settled them, for a
+/// row of `buildings` buildings.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn parse_contact(
+    run: &RawRun,
+    contact: &RawContact,
+    k_linear: Option<&Axis>,
+    beta: Option<&Axis>,
+    raw_records: &[RawRecord],
+    intensity: &RawIntensity,
+    buildings: usize,
+    (path, base, records): (&Path, &Path, &Path),
+) -> Result<ContactPlan, ConfigError> {
+    let invalid = |key: &str, message: String| ConfigError::Invalid {
+        path: path.into(),
+        key: key.into(),
+        message,
     };
-    let plan = match row_buildings {
-        None => PairPlan::new(spec),
-        Some(_) => PairPlan::row_base(spec),
+    let scheme = parse_scheme(run, &invalid)?;
+    let (laws, formulas) = parse_laws(contact, &invalid)?;
+    // The row checks its whole count once its buildings are read; here the contact runs'.
+    check_size(
+        contact,
+        raw_records.len(),
+        intensity,
+        &laws,
+        SceneCounts::ONE,
+        &invalid,
+    )?;
+    let spec = contact_spec(
+        ContactSections {
+            scheme,
+            laws,
+            formulas,
+            contact,
+            k_linear,
+            beta,
+            records: raw_records,
+            intensity,
+            buildings,
+            tail: run.tail_s.unwrap_or(0.0),
+        },
+        base,
+        records,
+        path,
+    )?;
+    ContactPlan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
+}
+
+/// The sizes of a pair's own axes, for [`check_size`].
+#[derive(Clone, Copy)]
+struct SceneCounts {
+    samples: usize,
+    building1: [usize; 3],
+    building2: [usize; 3],
+    gaps: usize,
+}
+
+impl SceneCounts {
+    /// One scene value per contact run: the contact runs alone.
+    const ONE: SceneCounts = SceneCounts {
+        samples: 1,
+        building1: [1; 3],
+        building2: [1; 3],
+        gaps: 1,
     };
-    plan.map_err(|PlanError { key, message }| invalid(&key, message))
 }
 
 /// Refuse a sweep of more than [`crate::plan::limits::MAX_RUNS`] runs from the axes' sizes alone,
 /// before any axis is built or sample drawn.
 fn check_size(
-    raw: &RawConfig,
+    contact: &RawContact,
+    records: usize,
+    intensity: &RawIntensity,
     laws: &[LawKind],
+    scene: SceneCounts,
     invalid: &dyn Fn(&str, String) -> ConfigError,
 ) -> Result<(), ConfigError> {
     let count = |key: &str, a: &Option<Axis>| -> Result<usize, ConfigError> {
         a.as_ref()
             .map_or(Ok(1), |a| a.count().map_err(|m| invalid(key, m)))
     };
-    let b = |name: &str, r: &RawBuilding| -> Result<[usize; 3], ConfigError> {
-        Ok([
-            count(&format!("{name}.mass_kg"), &r.mass_kg)?,
-            count(&format!("{name}.period_s"), &r.period_s)?,
-            count(&format!("{name}.damping_ratio"), &r.damping_ratio)?,
-        ])
-    };
     let counts = crate::plan::AxisCounts {
-        formulas: raw.contact.formula.as_ref().map_or(0, |f| f.list().len()),
-        e: count("contact.e", &raw.contact.e)?,
-        k_linear: count("contact.k_n_per_m", &raw.contact.k_n_per_m)?,
-        beta: count("contact.beta_n_per_m1_5", &raw.contact.beta_n_per_m1_5)?,
-        records: raw.records.len(),
-        intensities: count("intensity.pga_g", &raw.intensity.pga_g)?
-            * count("intensity.scale", &raw.intensity.scale)?
-            * count("intensity.sa_g", &raw.intensity.sa_g)?
-            * count("intensity.sa_avg_g", &raw.intensity.sa_avg_g)?,
-        samples: raw.sample.as_ref().map_or(1, |s| s.n.max(1)),
-        building1: b("building1", &raw.building1)?,
-        building2: b("building2", &raw.building2)?,
-        gaps: count("contact.gap_m", &raw.contact.gap_m)?,
+        formulas: contact.formula.as_ref().map_or(0, |f| f.list().len()),
+        e: count("contact.e", &contact.e)?,
+        k_linear: count("contact.k_n_per_m", &contact.k_n_per_m)?,
+        beta: count("contact.beta_n_per_m1_5", &contact.beta_n_per_m1_5)?,
+        records,
+        intensities: count("intensity.pga_g", &intensity.pga_g)?
+            * count("intensity.scale", &intensity.scale)?
+            * count("intensity.sa_g", &intensity.sa_g)?
+            * count("intensity.sa_avg_g", &intensity.sa_avg_g)?,
+        samples: scene.samples,
+        building1: scene.building1,
+        building2: scene.building2,
+        gaps: scene.gaps,
     };
     crate::plan::check_run_count(laws, &counts)
         .map(|_| ())

@@ -3,6 +3,7 @@
 //!
 //! - [`config`]: a TOML config (stage 1, raw serde structs) turned into a [`Plan`] (stage 2);
 //!   the one place a config's kind is told;
+//! - [`contact`]: the axes every scene shares (contact, record, intensity, scheme), numbered;
 //! - [`row`]: the axes of a row's buildings and gaps;
 //! - [`sample`]: Latin hypercube and Monte Carlo samples of uncertain parameters;
 //! - [`columns`]: the schema, every run's parameters and outputs as named columns;
@@ -12,16 +13,19 @@
 //!
 //! May import the physics and the records; never the engine, io or studies.
 //!
-//! A pair's runs (below; a row's in [`row`], in the same order) are grouped by contact law. Within a law's block, only the axes that law uses vary
-//! (elastic laws ignore `e` and the formula; linear laws take `k`, Hertz-type laws `beta`), so no
-//! run is a duplicate of another. Axis order, outermost first: law, formula, e, stiffness, record,
-//! intensity, sample, m1, T1, xi1, m2, T2, xi2, gap. A sample (of uncertain parameters, see
+//! Every plan is a [`ContactPlan`] (the shared axes, grouped by contact law: within a law's block
+//! only the axes that law uses vary, so no run is a duplicate of another) with the scene's own
+//! axes below each contact run: run `i` is contact run `i / per_scene` with scene values
+//! `i % per_scene`. A pair's axis order, outermost first: law, formula, e, stiffness, record,
+//! intensity, sample, m1, T1, xi1, m2, T2, xi2, gap; a row's the same with each building's
+//! axes and each gap in place of the pair's ([`row`]). A sample (of uncertain parameters, see
 //! [`Samples`]) sets the parameters it holds; their grid axes then hold one placeholder value.
 //! Run `i` is decoded from its index (mixed radix), so the plan is never expanded in memory and
 //! run numbers do not depend on threads or chunking.
 
 pub mod columns;
 pub mod config;
+pub mod contact;
 pub mod intensity;
 pub mod limits;
 pub mod meaning;
@@ -31,12 +35,9 @@ pub mod shard;
 
 use crate::physics::contact::{Contact, LawKind};
 use crate::physics::model::{Forcing, Oscillator, Pair};
-use crate::physics::restitution::{damping_for, Formula};
 use crate::physics::solver::Scheme;
-use crate::record::{Record, G};
-use std::collections::HashMap;
-use std::sync::Arc;
 
+pub use contact::{ContactPlan, ContactRun, ContactSpec};
 pub use intensity::Intensity;
 
 /// A validated sweep of one scene, the one plan every command holds: the config reader
@@ -66,11 +67,11 @@ impl Plan {
         self.len() == 0
     }
 
-    /// The plan of the contact, record and intensity axes: the pair's own, a row's base.
-    pub fn contact(&self) -> &PairPlan {
+    /// The plan of the axes every scene shares: contact, record, intensity, scheme.
+    pub fn contact(&self) -> &ContactPlan {
         match self {
-            Plan::Pair(p) => p,
-            Plan::Row(r) => &r.base,
+            Plan::Pair(p) => &p.contact,
+            Plan::Row(r) => &r.contact,
         }
     }
 
@@ -82,8 +83,8 @@ impl Plan {
     /// Set the scheme as run (the fingerprint covers it).
     pub fn set_scheme(&mut self, scheme: Scheme) {
         match self {
-            Plan::Pair(p) => p.spec.scheme = scheme,
-            Plan::Row(r) => r.base.spec.scheme = scheme,
+            Plan::Pair(p) => p.contact.spec.scheme = scheme,
+            Plan::Row(r) => r.contact.spec.scheme = scheme,
         }
     }
 
@@ -193,25 +194,15 @@ pub struct BuildingAxes {
     pub damping: Vec<f64>,
 }
 
-/// Everything a plan is built from (engine types; the config layer fills it).
+/// Everything a pair's plan is built from (engine types; the config layer fills it): the axes
+/// every scene shares, and the pair's buildings, gap and samples.
 #[derive(Debug, Clone)]
 pub struct PlanSpec {
-    pub laws: Vec<LawKind>,
-    pub formulas: Vec<Formula>,
-    pub e: Vec<f64>,
-    /// N/m, for linear laws
-    pub k_linear: Vec<f64>,
-    /// N/m^1.5, for Hertz-type laws
-    pub beta: Vec<f64>,
-    pub records: Vec<Arc<Record>>,
-    pub intensities: Vec<Intensity>,
+    pub contact: ContactSpec,
     pub building1: BuildingAxes,
     pub building2: BuildingAxes,
     /// m
     pub gaps: Vec<f64>,
-    pub scheme: Scheme,
-    /// Free vibration after each record, s.
-    pub tail: f64,
     /// Sampled parameters, crossed with every grid axis.
     pub samples: Option<Samples>,
 }
@@ -322,7 +313,7 @@ pub struct PlanError {
     pub message: String,
 }
 
-fn err(key: impl Into<String>, message: impl Into<String>) -> PlanError {
+pub(crate) fn err(key: impl Into<String>, message: impl Into<String>) -> PlanError {
     PlanError {
         key: key.into(),
         message: message.into(),
@@ -396,49 +387,28 @@ pub fn check_run_count(laws: &[LawKind], c: &AxisCounts) -> Result<u64, PlanErro
     }
 }
 
-#[derive(Debug, Clone)]
-struct Block {
-    law: LawKind,
-    start: u64,
-    len: u64,
-    /// Sizes of the 13 axes below the law, outermost first.
-    dims: [usize; NAXES],
-}
-
-/// A validated, numbered sweep.
+/// A validated, numbered sweep of a pair of one-storey buildings: the shared contact axes
+/// ([`ContactPlan`]) and, below each contact run, the pair's: sample, m1, T1, xi1, m2, T2, xi2,
+/// gap, outermost first.
 #[derive(Debug, Clone)]
 pub struct PairPlan {
-    pub spec: PlanSpec,
-    blocks: Vec<Block>,
-    total: u64,
-    /// Dimensionless damping per (law, formula, e index).
-    damping: HashMap<(LawKind, Formula, usize), f64>,
-    /// PGA of each record as read, m/s^2.
-    pgas: Vec<f64>,
-    /// Spectral measures of the records, as runs ask for them.
-    ims: intensity::ImCache,
+    pub contact: ContactPlan,
+    pub building1: BuildingAxes,
+    pub building2: BuildingAxes,
+    /// m
+    pub gaps: Vec<f64>,
+    /// Sampled parameters, crossed with every grid axis.
+    pub samples: Option<Samples>,
+    /// Sizes of the pair's axes below a contact run: samples, m1, T1, xi1, m2, T2, xi2, gap.
+    dims: [usize; 8],
+    per_scene: u64,
 }
 
-/// One run, decoded.
+/// One run of a pair, decoded: the shared contact part ([`ContactRun`], whose fields read
+/// through: `spec.law`, `spec.scale`) and the pair's buildings and gap.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunSpec {
-    pub index: u64,
-    pub law: LawKind,
-    /// None for laws without a formula (elastic and Hunt-Crossley).
-    pub formula: Option<Formula>,
-    /// None for elastic laws.
-    pub e: Option<f64>,
-    /// zeta, or `a` in `chi = a / v0` for Hunt-Crossley laws; 0 for elastic laws.
-    pub damping: f64,
-    /// k (N/m) or beta (N/m^1.5).
-    pub stiffness: f64,
-    pub record: usize,
-    pub intensity: Intensity,
-    pub scale: f64,
-    /// For a spectral target, the periods it was read at (s, from and to).
-    pub im_periods: Option<[f64; 2]>,
-    /// PGA of the scaled record, g.
-    pub pga_g: f64,
+    pub contact: ContactRun,
     pub m1: f64,
     pub t1: f64,
     pub xi1: f64,
@@ -450,7 +420,25 @@ pub struct RunSpec {
     pub sample: Option<usize>,
 }
 
+impl std::ops::Deref for RunSpec {
+    type Target = ContactRun;
+    fn deref(&self) -> &ContactRun {
+        &self.contact
+    }
+}
+
+impl std::ops::DerefMut for RunSpec {
+    fn deref_mut(&mut self) -> &mut ContactRun {
+        &mut self.contact
+    }
+}
+
 impl RunSpec {
+    /// What the run holds but its buildings and gap.
+    pub fn contact(&self) -> ContactRun {
+        self.contact
+    }
+
     pub fn pair(&self) -> Pair {
         let b1 = Oscillator::from_period(self.m1, self.t1, self.xi1);
         let b2 = Oscillator::from_period(self.m2, self.t2, self.xi2);
@@ -511,16 +499,6 @@ pub(crate) fn check_axis(
 
 impl PairPlan {
     pub fn new(spec: PlanSpec) -> Result<PairPlan, PlanError> {
-        PairPlan::build(spec, false)
-    }
-
-    /// The plan of a row's contact, record and intensity axes, its buildings placeholders.
-    pub(crate) fn row_base(spec: PlanSpec) -> Result<PairPlan, PlanError> {
-        PairPlan::build(spec, true)
-    }
-
-    fn build(spec: PlanSpec, row_base: bool) -> Result<PairPlan, PlanError> {
-        let pos = POSITIVE.0;
         for (name, b) in [
             ("building1", &spec.building1),
             ("building2", &spec.building2),
@@ -551,35 +529,6 @@ impl PairPlan {
                 }
             }
         }
-        if spec.laws.is_empty() {
-            return Err(err(
-                "contact.law",
-                format!("is empty: give one or more of {}", LawKind::keys()),
-            ));
-        }
-        if spec.records.is_empty() {
-            return Err(err("record", "no records: add at least one [[record]]"));
-        }
-        if spec.intensities.is_empty() {
-            return Err(err("intensity", "is empty"));
-        }
-        for (i, v) in spec.intensities.iter().enumerate() {
-            let (value, expected) = match v {
-                Intensity::PgaG(_) => (v.value(), "a PGA > 0 g"),
-                Intensity::Scale(_) => (v.value(), "a factor > 0"),
-                Intensity::Spectral { im, .. } if im.average => (v.value(), "an Sa_avg > 0 g"),
-                Intensity::Spectral { .. } => (v.value(), "an Sa > 0 g"),
-            };
-            if !pos(value) {
-                return Err(err(
-                    format!("{}[{i}]", v.key()),
-                    format!(
-                        "{} is out of range: expected {expected}",
-                        crate::plan::limits::show(value)
-                    ),
-                ));
-            }
-        }
         let extremes = |b: &BuildingAxes, axis: SampledAxis| {
             let sampled = spec.samples.iter().flat_map(|s| {
                 let j = s.axes.iter().position(|a| *a == axis);
@@ -590,113 +539,17 @@ impl PairPlan {
         };
         let (lo1, hi1) = extremes(&spec.building1, SampledAxis::Period1);
         let (lo2, hi2) = extremes(&spec.building2, SampledAxis::Period2);
-        // A row's base plan holds placeholder buildings: the row checks its targets' periods
-        // against its own buildings ([`row::RowPlan`]).
-        if !row_base {
-            intensity::check_periods(&spec.intensities, &[lo1, lo2], &[hi1, hi2])
-                .map_err(|(k, m)| err(k, m))?;
-        }
-        if !(spec.tail.is_finite() && (0.0..=crate::plan::limits::MAX_TAIL_S).contains(&spec.tail))
-        {
-            return Err(err(
-                "run.tail_s",
-                format!(
-                    "{} is out of range: expected 0 to {} s ({})",
-                    crate::plan::limits::show(spec.tail),
-                    crate::plan::limits::MAX_TAIL_S,
-                    crate::plan::limits::WHY_TAIL
-                ),
-            ));
-        }
-        for (r, rec) in spec.records.iter().enumerate() {
-            let n = rec.forcing(1.0, spec.tail).intervals() as u64;
-            if n > crate::plan::limits::MAX_INTERVALS {
-                return Err(err(
-                    format!("record[{r}]"),
-                    format!(
-                        "`{}` with a tail of {} s is {n} steps of {} s: expected at most 1e8 per run ({})",
-                        rec.name,
-                        spec.tail,
-                        rec.dt,
-                        crate::plan::limits::WHY_INTERVALS
-                    ),
-                ));
-            }
-        }
-        let damped = spec.laws.iter().any(|l| l.is_damped());
-        let uses_formula = spec.laws.iter().any(|l| l.uses_zeta());
-        if damped {
-            check_axis(
-                "contact.e",
-                &spec.e,
-                |e| e > 0.0 && e <= 1.0,
-                "a coefficient of restitution 0 < e <= 1",
-            )?;
-        }
-        if uses_formula && spec.formulas.is_empty() {
-            return Err(err(
-                "contact.formula",
-                format!(
-                    "is empty: the laws given need one or more of {}",
-                    Formula::keys()
-                ),
-            ));
-        }
-        if spec.laws.iter().any(|l| !l.is_hertzian()) {
-            check_axis(
-                "contact.k_n_per_m",
-                &spec.k_linear,
-                pos,
-                "a stiffness > 0 N/m",
-            )?;
-        }
-        if spec.laws.iter().any(|l| l.is_hertzian()) {
-            check_axis(
-                "contact.beta_n_per_m1_5",
-                &spec.beta,
-                pos,
-                "a stiffness > 0 N/m^1.5",
-            )?;
-        }
-        let mut pgas = Vec::with_capacity(spec.records.len());
-        for (r, rec) in spec.records.iter().enumerate() {
-            let scaled = spec
-                .intensities
-                .iter()
-                .any(|i| !matches!(i, Intensity::Scale(_)));
-            if scaled {
-                // A record of zeros has no PGA or Sa to scale to.
-                rec.scale_to_pga(1.0)
-                    .map_err(|e| err(format!("record[{r}]"), e.to_string()))?;
-            }
-            pgas.push(rec.pga().value);
-        }
-        // Damping per (law, formula, e): printed formulas are cheap, `exact` root-finds once here.
-        let mut damping = HashMap::new();
-        for &law in &spec.laws {
-            if !law.is_damped() {
-                continue;
-            }
-            let formulas: &[Formula] = if law.uses_zeta() {
-                &spec.formulas
-            } else {
-                &[Formula::Exact]
-            };
-            for &f in formulas {
-                for (i, &e) in spec.e.iter().enumerate() {
-                    let d = damping_for(law, f, e)
-                        .map_err(|x| err(format!("contact.e[{i}]"), x.to_string()))?;
-                    damping.insert((law, f, i), d);
-                }
-            }
-        }
+        let contact = ContactPlan::new(spec.contact)?;
+        intensity::check_periods(&contact.spec.intensities, &[lo1, lo2], &[hi1, hi2])
+            .map_err(|(k, m)| err(k, m))?;
+        let c = &contact.spec;
         let counts = AxisCounts {
-            formulas: spec.formulas.len(),
-            e: spec.e.len(),
-            k_linear: spec.k_linear.len(),
-            beta: spec.beta.len(),
-            records: spec.records.len(),
-            intensities: spec.intensities.len(),
+            formulas: c.formulas.len(),
+            e: c.e.len(),
+            k_linear: c.k_linear.len(),
+            beta: c.beta.len(),
+            records: c.records.len(),
+            intensities: c.intensities.len(),
             samples: spec.samples.as_ref().map_or(1, |s| s.points.len()),
             building1: [
                 spec.building1.mass.len(),
@@ -710,149 +563,86 @@ impl PairPlan {
             ],
             gaps: spec.gaps.len(),
         };
-        check_run_count(&spec.laws, &counts)?;
-        let mut blocks = Vec::with_capacity(spec.laws.len());
-        let mut total: u64 = 0;
-        for &law in &spec.laws {
-            let dims = block_dims(law, &counts);
-            let len = dims.iter().map(|&d| d as u64).product();
-            blocks.push(Block {
-                law,
-                start: total,
-                len,
-                dims,
-            });
-            total += len;
-        }
+        check_run_count(&c.laws, &counts)?;
+        let dims = [
+            counts.samples,
+            counts.building1[0],
+            counts.building1[1],
+            counts.building1[2],
+            counts.building2[0],
+            counts.building2[1],
+            counts.building2[2],
+            counts.gaps,
+        ];
         Ok(PairPlan {
-            spec,
-            blocks,
-            total,
-            damping,
-            pgas,
-            ims: intensity::ImCache::default(),
+            contact,
+            building1: spec.building1,
+            building2: spec.building2,
+            gaps: spec.gaps,
+            samples: spec.samples,
+            dims,
+            per_scene: dims.iter().map(|&d| d as u64).product(),
         })
+    }
+
+    /// What the plan was built from (to rebuild it with records changed).
+    pub fn spec(&self) -> PlanSpec {
+        PlanSpec {
+            contact: self.contact.spec.clone(),
+            building1: self.building1.clone(),
+            building2: self.building2.clone(),
+            gaps: self.gaps.clone(),
+            samples: self.samples.clone(),
+        }
     }
 
     /// Inputs that are valid but physically absurd (a units mix-up?), one line each.
     pub fn warnings(&self) -> Vec<String> {
         let first = self.run(0);
-        self.pga_warnings(&[first.t1, first.t2])
-    }
-
-    /// The records scaled past a PGA no earthquake reaches, for buildings of these fundamental
-    /// periods (a spectral target at a building's period scales by the first run's).
-    pub(crate) fn pga_warnings(&self, periods: &[f64]) -> Vec<String> {
-        let mut w = Vec::new();
-        for (r, rec) in self.spec.records.iter().enumerate() {
-            let pga = self
-                .spec
-                .intensities
-                .iter()
-                .map(|i| {
-                    let s = i.scaling(r, rec, self.pgas[r], periods, &self.ims);
-                    self.pgas[r] * s.scale / G
-                })
-                .fold(0.0, f64::max);
-            if pga > crate::plan::limits::WARN_PGA_G {
-                w.push(format!(
-                    "record `{}` reaches a PGA of {pga:.3} g, above {} g where no recorded earthquake reaches: check its units and the intensity",
-                    rec.name,
-                    crate::plan::limits::WARN_PGA_G
-                ));
-            }
-        }
-        w
+        self.contact.pga_warnings(&[first.t1, first.t2])
     }
 
     /// Number of runs.
     pub fn len(&self) -> u64 {
-        self.total
+        self.contact.len() * self.per_scene
     }
 
     pub fn is_empty(&self) -> bool {
-        self.total == 0
+        self.len() == 0
     }
 
     /// Decode run `index` (< `len()`).
     pub fn run(&self, index: u64) -> RunSpec {
-        let mut run = self.decode(index);
-        let periods = [run.t1, run.t2];
-        self.scale(&mut run, &periods);
-        run
-    }
-
-    /// Set `run`'s scale factor, the periods its intensity read and its PGA, for buildings of
-    /// these fundamental periods (left to right).
-    pub(crate) fn scale(&self, run: &mut RunSpec, periods: &[f64]) {
-        let r = run.record;
-        let s = run
-            .intensity
-            .scaling(r, &self.spec.records[r], self.pgas[r], periods, &self.ims);
-        run.scale = s.scale;
-        run.im_periods = s.periods;
-        run.pga_g = self.pgas[r] * s.scale / G;
-    }
-
-    /// Run `index`, its scale left unset (NaN) until its buildings' periods are known
-    /// ([`PairPlan::scale`]).
-    pub(crate) fn decode(&self, index: u64) -> RunSpec {
         assert!(
-            index < self.total,
+            index < self.len(),
             "run {index} out of range (plan has {})",
-            self.total
+            self.len()
         );
-        let block = self
-            .blocks
-            .iter()
-            .find(|b| index < b.start + b.len)
-            .expect("index within total");
-        let mut rem = index - block.start;
-        let mut ix = [0usize; NAXES];
-        for a in (0..NAXES).rev() {
-            let d = block.dims[a] as u64;
+        let mut c = self.contact.decode(index / self.per_scene);
+        let mut rem = index % self.per_scene;
+        let mut ix = [0usize; 8];
+        for a in (0..8).rev() {
+            let d = self.dims[a] as u64;
             ix[a] = (rem % d) as usize;
             rem /= d;
         }
-        let s = &self.spec;
-        let law = block.law;
-        let formula = law.uses_zeta().then(|| s.formulas[ix[0]]);
-        let e = law.is_damped().then(|| s.e[ix[1]]);
-        let damping = if law.is_damped() {
-            self.damping[&(law, formula.unwrap_or(Formula::Exact), ix[1])]
-        } else {
-            0.0
-        };
-        let stiffness = if law.is_hertzian() {
-            s.beta[ix[2]]
-        } else {
-            s.k_linear[ix[2]]
-        };
-        let (record, inten) = (ix[3], ix[4]);
+        let (b1, b2) = (&self.building1, &self.building2);
+        c.index = index;
         let mut run = RunSpec {
-            index,
-            law,
-            formula,
-            e,
-            damping,
-            stiffness,
-            record,
-            intensity: s.intensities[inten],
-            scale: f64::NAN,
-            im_periods: None,
-            pga_g: f64::NAN,
-            m1: s.building1.mass[ix[6]],
-            t1: s.building1.period[ix[7]],
-            xi1: s.building1.damping[ix[8]],
-            m2: s.building2.mass[ix[9]],
-            t2: s.building2.period[ix[10]],
-            xi2: s.building2.damping[ix[11]],
-            gap: s.gaps[ix[12]],
+            contact: c,
+            m1: b1.mass[ix[1]],
+            t1: b1.period[ix[2]],
+            xi1: b1.damping[ix[3]],
+            m2: b2.mass[ix[4]],
+            t2: b2.period[ix[5]],
+            xi2: b2.damping[ix[6]],
+            gap: self.gaps[ix[7]],
             sample: None,
         };
-        if let Some(smp) = &s.samples {
-            run.sample = Some(ix[5]);
-            for (a, &v) in smp.axes.iter().zip(&smp.points[ix[5]]) {
+        if let Some(smp) = &self.samples {
+            run.sample = Some(ix[0]);
+            let law = run.law;
+            for (a, &v) in smp.axes.iter().zip(&smp.points[ix[0]]) {
                 match a {
                     SampledAxis::Mass1 => run.m1 = v,
                     SampledAxis::Period1 => run.t1 = v,
@@ -867,6 +657,8 @@ impl PairPlan {
                 }
             }
         }
+        let periods = [run.t1, run.t2];
+        self.contact.scale(&mut run.contact, &periods);
         run
     }
 
@@ -875,18 +667,18 @@ impl PairPlan {
     /// (what a separation study needs: [`PairPlan::motion_run`]). A sample axis that sets no
     /// building value moves nothing and counts once.
     pub fn motions(&self) -> Motions {
-        let d = &self.blocks[0].dims;
+        let c = &self.contact.spec;
         Motions {
-            records: d[3],
-            intensities: d[4],
+            records: c.records.len(),
+            intensities: c.intensities.len(),
             inner: self.motion_samples() as u64
-                * d[6..12].iter().map(|&x| x as u64).product::<u64>(),
+                * self.dims[1..7].iter().map(|&x| x as u64).product::<u64>(),
         }
     }
 
     /// Samples that move the buildings: all of them, or one where they set no building value.
     fn motion_samples(&self) -> usize {
-        match &self.spec.samples {
+        match &self.samples {
             Some(s) if s.axes.iter().any(|a| a.moves_buildings()) => s.points.len(),
             _ => 1,
         }
@@ -903,46 +695,30 @@ impl PairPlan {
     }
 
     /// The index of the run that has motion `m` ([`PairPlan::motion_run`]).
-    pub(crate) fn motion_index(&self, m: u64) -> u64 {
-        let b = &self.blocks[0];
-        let mut dims = b.dims;
-        dims[5] = self.motion_samples();
-        // Decode over the motion axes (record to xi2), the others at 0.
-        let mut ix = [0usize; NAXES];
-        let mut rem = m;
-        for a in (3..12).rev() {
+    fn motion_index(&self, m: u64) -> u64 {
+        let mut dims = self.dims;
+        dims[0] = self.motion_samples();
+        let inner: u64 = dims[..7].iter().map(|&d| d as u64).product();
+        let contact = self.contact.motion_index(m / inner);
+        // Decode over the motion axes (sample to xi2), the gap at its first value.
+        let mut ix = [0usize; 8];
+        let mut rem = m % inner;
+        for a in (0..7).rev() {
             ix[a] = (rem % dims[a] as u64) as usize;
             rem /= dims[a] as u64;
         }
-        let index = (0..NAXES).fold(0u64, |acc, a| acc * b.dims[a] as u64 + ix[a] as u64);
-        b.start + index
+        let within = (0..8).fold(0u64, |acc, a| acc * self.dims[a] as u64 + ix[a] as u64);
+        contact * self.per_scene + within
     }
 
     /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`:
-    /// in closed form per law block (the record axis repeats with a fixed stride), so
-    /// O(blocks x records), never O(runs).
+    /// O(blocks x records), never O(runs) ([`ContactPlan`]).
     pub fn cost_before(&self, end: u64, record_cost: &[u64]) -> u128 {
-        let mut acc: u128 = 0;
-        for b in &self.blocks {
-            if end <= b.start {
-                break;
-            }
-            let rem = (end - b.start).min(b.len) as u128;
-            let inner: u128 = b.dims[4..].iter().map(|&d| d as u128).product();
-            let nrec = b.dims[3] as u128;
-            let cost = |r: usize| record_cost[r] as u128;
-            let cycle: u128 = inner * (0..b.dims[3]).map(cost).sum::<u128>();
-            let (q, r_rem) = (rem / (inner * nrec), rem % (inner * nrec));
-            let (full, part) = ((r_rem / inner) as usize, r_rem % inner);
-            acc += q * cycle + inner * (0..full).map(cost).sum::<u128>();
-            if part > 0 {
-                acc += part * cost(full);
-            }
-        }
-        acc
+        self.contact
+            .scene_cost_before(end, self.per_scene, record_cost)
     }
 
     pub fn forcing(&self, run: &RunSpec) -> Forcing<'_> {
-        self.spec.records[run.record].forcing(run.scale, self.spec.tail)
+        self.contact.spec.records[run.record].forcing(run.scale, self.contact.spec.tail)
     }
 }

@@ -2,10 +2,10 @@
 //! right) instead of `[building1]` and `[building2]`.
 //!
 //! Everything but the buildings and gaps (laws, formulas, `e`, stiffness, records,
-//! intensities, the scheme) is the pair's plan, validated by the same code: the row plan holds
-//! that plan as its `base` (with placeholder buildings) and adds, below each of its runs, the
-//! axes of each building (floor mass, fundamental period, damping ratio) and each adjacent
-//! pair's gap, outermost first, the last gap innermost.
+//! intensities, the scheme) is the shared [`ContactPlan`], read and validated by the same code
+//! as a pair's; the row plan adds, below each contact run, the axes of each building (floor
+//! mass, fundamental period, damping ratio) and each adjacent pair's gap, outermost first, the
+//! last gap innermost.
 
 use crate::physics::model::Forcing;
 use crate::physics::row::{Row, RowOutput};
@@ -14,12 +14,12 @@ use crate::physics::solver::row::RowScheme;
 use crate::physics::solver::Scheme;
 use crate::plan::columns;
 use crate::plan::config::{
-    draw_sampled, parse_raw, Axis, ConfigError, RawBuilding, RawConfig, RawContact, RawIntensity,
-    RawRecord, RawRun, RawSample,
+    draw_sampled, parse_contact, Axis, ConfigError, RawContact, RawIntensity, RawRecord, RawRun,
+    RawSample,
 };
 use crate::plan::sample::refused_draw;
 use crate::plan::{
-    check_axis, config, Check, PairPlan, RunSpec, DAMPING, GAP, MASS, PERIOD, POSITIVE,
+    check_axis, config, Check, ContactPlan, ContactRun, DAMPING, GAP, MASS, PERIOD, POSITIVE,
 };
 use serde::Deserialize;
 use std::path::Path;
@@ -172,9 +172,9 @@ pub struct RowSamples {
 /// A validated row sweep.
 #[derive(Debug, Clone)]
 pub struct RowPlan {
-    /// Laws, formulas, `e`, stiffness, records, intensities and the scheme, with placeholder
-    /// buildings and gap.
-    pub base: PairPlan,
+    /// Laws, formulas, `e`, stiffness, records, intensities and the scheme: the axes every
+    /// scene shares.
+    pub contact: ContactPlan,
     pub buildings: Vec<ShearAxes>,
     /// m, per adjacent pair.
     pub gaps: Vec<Vec<f64>>,
@@ -186,20 +186,20 @@ pub struct RowPlan {
     /// `contact.gap_m` gives, the first such pair's. `contact.gap_m` is one gap shared by those
     /// pairs, in the grid as under `[sample]`; `gap_right_m` gives a pair an axis of its own.
     gap_axis: Vec<usize>,
-    /// Sizes of the axes below a base run: the samples, then mass, period, damping per
+    /// Sizes of the axes below a contact run: the samples, then mass, period, damping per
     /// building, then the gaps.
     dims: Vec<usize>,
     /// Keys the config gives that no run uses, with why.
     ignored: Vec<String>,
-    per_base: u64,
+    per_scene: u64,
 }
 
 /// One run of a row sweep, decoded.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RowRunSpec {
     pub index: u64,
-    /// Law, formula, `e`, stiffness, record and intensity (its buildings are placeholders).
-    pub base: RunSpec,
+    /// Law, formula, `e`, stiffness, record and intensity.
+    pub contact: ContactRun,
     /// Per building: floor mass (None where fixed per floor), fundamental period, damping ratio.
     pub mass: Vec<Option<f64>>,
     pub period: Vec<f64>,
@@ -211,7 +211,7 @@ pub struct RowRunSpec {
 
 impl RowPlan {
     pub fn len(&self) -> u64 {
-        self.base.len() * self.per_base
+        self.contact.len() * self.per_scene
     }
 
     pub fn is_empty(&self) -> bool {
@@ -219,8 +219,9 @@ impl RowPlan {
     }
 
     pub fn run(&self, index: u64) -> RowRunSpec {
-        let base = self.base.decode(index / self.per_base);
-        let mut rest = index % self.per_base;
+        let mut contact = self.contact.decode(index / self.per_scene);
+        contact.index = index;
+        let mut rest = index % self.per_scene;
         let mut at = vec![0usize; self.dims.len()];
         for (k, &d) in self.dims.iter().enumerate().rev() {
             at[k] = (rest % d as u64) as usize;
@@ -229,7 +230,7 @@ impl RowPlan {
         let nb = self.buildings.len();
         let mut run = RowRunSpec {
             index,
-            base,
+            contact,
             mass: (0..nb)
                 .map(|b| {
                     let a = &self.buildings[b];
@@ -249,7 +250,7 @@ impl RowPlan {
         };
         if let Some(smp) = &self.samples {
             run.sample = Some(at[0]);
-            let law = run.base.law;
+            let law = run.contact.law;
             for (a, &v) in smp.axes.iter().zip(&smp.points[at[0]]) {
                 match *a {
                     RowSampled::Mass(b) => run.mass[b] = Some(v),
@@ -263,13 +264,13 @@ impl RowPlan {
                             }
                         }
                     }
-                    RowSampled::KLinear if !law.is_hertzian() => run.base.stiffness = v,
-                    RowSampled::Beta if law.is_hertzian() => run.base.stiffness = v,
+                    RowSampled::KLinear if !law.is_hertzian() => run.contact.stiffness = v,
+                    RowSampled::Beta if law.is_hertzian() => run.contact.stiffness = v,
                     RowSampled::KLinear | RowSampled::Beta => {}
                 }
             }
         }
-        self.base.scale(&mut run.base, &run.period);
+        self.contact.scale(&mut run.contact, &run.period);
         run
     }
 
@@ -278,14 +279,14 @@ impl RowPlan {
     /// building's values, the gaps at their first values.
     pub fn motions(&self) -> crate::plan::Motions {
         let nb = self.buildings.len();
-        let base = self.base.motions();
         crate::plan::Motions {
+            records: self.contact.spec.records.len(),
+            intensities: self.contact.spec.intensities.len(),
             inner: self.motion_samples() as u64
                 * self.dims[1..1 + 3 * nb]
                     .iter()
                     .map(|&d| d as u64)
                     .product::<u64>(),
-            ..base
         }
     }
 
@@ -303,7 +304,7 @@ impl RowPlan {
         let mut dims = self.dims.clone();
         dims[0] = self.motion_samples();
         let inner: u64 = dims[..1 + 3 * nb].iter().map(|&d| d as u64).product();
-        let base_index = self.base.motion_index(m / inner);
+        let contact = self.contact.motion_index(m / inner);
         let mut rem = m % inner;
         let mut at = vec![0usize; self.dims.len()];
         for k in (0..1 + 3 * nb).rev() {
@@ -312,7 +313,7 @@ impl RowPlan {
         }
         let within =
             (0..self.dims.len()).fold(0u64, |acc, k| acc * self.dims[k] as u64 + at[k] as u64);
-        let mut run = self.run(base_index * self.per_base + within);
+        let mut run = self.run(contact * self.per_scene + within);
         if dims[0] == 1 {
             run.sample = None;
         }
@@ -320,22 +321,17 @@ impl RowPlan {
     }
 
     /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`
-    /// ([`PairPlan::cost_before`] of the base runs, each repeated for the row's own axes).
+    /// (the contact runs', each repeated for the row's own axes).
     pub fn cost_before(&self, end: u64, record_cost: &[u64]) -> u128 {
-        let (whole, part) = (end / self.per_base, end % self.per_base);
-        let mut cost = self.base.cost_before(whole, record_cost) * self.per_base as u128;
-        if part > 0 {
-            cost += part as u128 * record_cost[self.base.run(whole).record] as u128;
-        }
-        cost
+        self.contact
+            .scene_cost_before(end, self.per_scene, record_cost)
     }
 
-    /// What a user should hear before any run: the base plan's warnings (PGA above 5 g), each
-    /// adjacent pair that shares no floor level, and keys the config gives that no run uses.
+    /// What a user should hear before any run: records scaled past 5 g (a target at a
+    /// building's period read at the first run's), each adjacent pair that shares no floor
+    /// level, and keys the config gives that no run uses.
     pub fn warnings(&self) -> Vec<String> {
-        // The base plan's buildings are placeholders: a target at a building's period reads
-        // the row's own.
-        let mut w = self.base.pga_warnings(&self.run(0).period);
+        let mut w = self.contact.pga_warnings(&self.run(0).period);
         w.extend(self.pairs_without_levels());
         w.extend(self.ignored.iter().cloned());
         w
@@ -378,7 +374,7 @@ impl RowPlan {
             return None;
         }
         let dt = self
-            .base
+            .contact
             .spec
             .records
             .iter()
@@ -455,12 +451,12 @@ impl RowPlan {
                 )
             })
             .collect();
-        let s = &run.base;
+        let s = &run.contact;
         Row::new(buildings, run.gaps.clone(), s.law, s.stiffness, s.damping)
     }
 
     pub fn forcing(&self, run: &RowRunSpec) -> Forcing<'_> {
-        self.base.forcing(&run.base)
+        self.contact.forcing(&run.contact)
     }
 
     /// The contact levels' column prefixes, `level_b1f3_b2f3` for floor 3 of building 1
@@ -553,9 +549,7 @@ impl RowPlan {
     pub fn cells(&self, run: &RowRunSpec, out: &RowOutput) -> Vec<String> {
         let num = columns::num;
         let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
-        let mut c = columns::contact_and_motion(&self.base, &run.base);
-        // The base run's number is its index in the base plan; the row's is its own.
-        c[0] = run.index.to_string();
+        let mut c = columns::contact_and_motion(&self.contact, &run.contact);
         for (b, a) in self.buildings.iter().enumerate() {
             c.push(a.storeys().to_string());
             c.push(opt(run.mass[b]));
@@ -605,9 +599,9 @@ impl RowPlan {
         c
     }
 
-    /// The row scheme of the base plan's scheme.
+    /// The row scheme of the plan's scheme.
     pub fn scheme(&self) -> RowScheme {
-        match self.base.spec.scheme {
+        match self.contact.spec.scheme {
             Scheme::Fast(o) => RowScheme::Fast(o),
             Scheme::Reference(o) => RowScheme::Reference(o),
         }
@@ -678,33 +672,22 @@ pub fn parse_row(
         None => None,
     };
     let sampled = |a: RowSampled| samples.as_ref().is_some_and(|s| s.axes.contains(&a));
-    let one = |x: f64| Some(Axis::List(vec![x]));
     let grid_or_sampled = |a: RowSampled, given: Option<&Axis>| {
         config::grid_or_sampled(given, sampled(a)).map_err(|m| invalid(&a.key(), m))
     };
     let k_grid = grid_or_sampled(RowSampled::KLinear, raw.contact.k_n_per_m.as_ref())?;
     let beta_grid = grid_or_sampled(RowSampled::Beta, raw.contact.beta_n_per_m1_5.as_ref())?;
     let shared_gap = grid_or_sampled(RowSampled::SharedGap, raw.contact.gap_m.as_ref())?;
-    let placeholder = RawBuilding {
-        mass_kg: one(1.0),
-        period_s: one(1.0),
-        damping_ratio: one(0.05),
-    };
-    let base_raw = RawConfig {
-        run: raw.run.clone(),
-        building1: placeholder.clone(),
-        building2: placeholder,
-        contact: RawContact {
-            gap_m: one(0.0),
-            k_n_per_m: k_grid,
-            beta_n_per_m1_5: beta_grid,
-            ..raw.contact.clone()
-        },
-        records: raw.records.clone(),
-        intensity: raw.intensity.clone(),
-        sample: None,
-    };
-    let base_plan = parse_raw(&base_raw, path, base, records, Some(nb))?;
+    let contact = parse_contact(
+        &raw.run,
+        &raw.contact,
+        k_grid.as_ref(),
+        beta_grid.as_ref(),
+        &raw.records,
+        &raw.intensity,
+        nb,
+        (path, base, records),
+    )?;
     let axis = |key: &str, a: &Axis, (ok, expected): Check| {
         let v = a.values().map_err(|m| invalid(key, m))?;
         check_axis(key, &v, ok, expected).map_err(|e| invalid(&e.key, e.message))?;
@@ -842,7 +825,7 @@ pub fn parse_row(
         lo.push(l);
         hi.push(h);
     }
-    crate::plan::intensity::check_periods(&base_plan.spec.intensities, &lo, &hi)
+    crate::plan::intensity::check_periods(&contact.spec.intensities, &lo, &hi)
         .map_err(|(k, m)| invalid(&k, m))?;
     let mut dims = vec![samples.as_ref().map_or(1, |s| s.points.len())];
     dims.extend(
@@ -863,11 +846,11 @@ pub fn parse_row(
             .enumerate()
             .map(|(a, g)| if gap_axis[a] == a { g.len() } else { 1 }),
     );
-    let per_base = dims
+    let per_scene = dims
         .iter()
         .try_fold(1u64, |p, &d| p.checked_mul(d as u64))
         .filter(|&p| {
-            p.checked_mul(base_plan.len())
+            p.checked_mul(contact.len())
                 .is_some_and(|n| n <= crate::plan::limits::MAX_RUNS)
         })
         .ok_or_else(|| {
@@ -880,7 +863,7 @@ pub fn parse_row(
             )
         })?;
     Ok(RowPlan {
-        base: base_plan,
+        contact,
         buildings,
         gaps,
         samples,
@@ -888,6 +871,6 @@ pub fn parse_row(
         gap_axis,
         dims,
         ignored,
-        per_base,
+        per_scene,
     })
 }

@@ -1,7 +1,7 @@
 //! Deterministic cost-balanced shards of a plan (`--shard I/N`, for Slurm job arrays or
 //! Kubernetes Indexed Jobs): contiguous run ranges that tile the plan.
 
-use crate::plan::{PairPlan, Plan};
+use crate::plan::{ContactPlan, Plan};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
@@ -34,7 +34,7 @@ pub fn shard_range(plan: &Plan, shard: Shard) -> Range<u64> {
 }
 
 /// Each record's intervals (record plus tail), at least 1.
-fn record_costs(plan: &PairPlan) -> Vec<u64> {
+fn record_costs(plan: &ContactPlan) -> Vec<u64> {
     plan.spec
         .records
         .iter()
@@ -73,7 +73,7 @@ mod tests {
     use super::*;
 
     /// Two records of different lengths, so runs differ in cost: 3 x 2 x 2 = 12 runs.
-    fn plan() -> PairPlan {
+    fn plan() -> crate::plan::PairPlan {
         crate::plan::config::parse_builtin(
             r#"
 [building1]
@@ -123,8 +123,8 @@ synthetic = { seed = 2, duration_s = 8.0 }
         let cost = |r: Range<u64>| -> u64 {
             r.map(|i| {
                 let s = plan.run(i);
-                plan.spec.records[s.record]
-                    .forcing(1.0, plan.spec.tail)
+                plan.contact.spec.records[s.record]
+                    .forcing(1.0, plan.contact.spec.tail)
                     .intervals() as u64
             })
             .sum()

@@ -4,10 +4,10 @@
 //! the runs' energy residuals (the check a user gets on any sweep without a reference).
 
 use crate::engine::gpu::{GpuContext, GpuError, GpuOptions, Precision};
-use crate::engine::{Engine, EngineError};
+use crate::engine::{Backend, Engine, EngineError};
 use crate::physics::model::{RunOutput, Status};
 use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
-use crate::plan::PairPlan;
+use crate::plan::{PairPlan, Plan};
 use crate::studies::plot::{Panel, Series};
 
 /// One path at one setting.
@@ -359,7 +359,7 @@ pub fn row_study(
     use crate::physics::row::RowOutput;
     let solve = |scheme: Scheme| -> (Vec<RowOutput>, f64) {
         let mut p = plan.clone();
-        p.base.spec.scheme = scheme;
+        p.contact.spec.scheme = scheme;
         let mut outs = Vec::with_capacity(plan.len() as usize);
         let s = crate::engine::cpu::run_rows(
             &p,
@@ -483,4 +483,106 @@ pub fn row_csv(points: &[RowPoint]) -> String {
         s.push_str(&format!("{},{}\n", p.path, cells.join(",")));
     }
     s
+}
+
+/// The points of a study of any plan: a pair's (every path) or a row's (the CPU paths).
+pub enum Points {
+    Pairs(Vec<Point>),
+    Rows(Vec<RowPoint>),
+}
+
+/// One path at one setting as `--target-error` judges it: its p99 relative peak-force error
+/// (NaN over no compared run), the runs that failed here or in the reference, the runs compared.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Verdict {
+    pub path: String,
+    pub substeps_per_contact: f64,
+    pub force_p99: f64,
+    pub failed: u64,
+    pub compared: u64,
+}
+
+impl Points {
+    pub fn csv(&self) -> String {
+        match self {
+            Points::Pairs(p) => csv(p),
+            Points::Rows(p) => row_csv(p),
+        }
+    }
+
+    pub fn panels(&self) -> Vec<Panel> {
+        match self {
+            Points::Pairs(p) => panels(p),
+            Points::Rows(p) => row_panels(p),
+        }
+    }
+
+    pub fn verdicts(&self) -> Vec<Verdict> {
+        match self {
+            Points::Pairs(p) => p
+                .iter()
+                .map(|p| Verdict {
+                    path: p.path.clone(),
+                    substeps_per_contact: p.substeps_per_contact,
+                    force_p99: p.errors.force_p99,
+                    failed: p.errors.failed,
+                    compared: p.errors.compared,
+                })
+                .collect(),
+            Points::Rows(p) => p
+                .iter()
+                .map(|p| Verdict {
+                    path: p.path.clone(),
+                    substeps_per_contact: p.substeps_per_contact,
+                    force_p99: p.force[1],
+                    failed: p.failed,
+                    compared: p.compared,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The paths a study of `plan` compares, in words, and the GPU it uses: every path of a pair
+/// (the GPU ones where `backend` finds an adapter), the CPU paths of a row (whose GPU accuracy
+/// study is not built: `--backend gpu` is refused).
+pub fn paths(
+    plan: &Plan,
+    backend: Backend,
+    note: &mut dyn FnMut(String),
+) -> Result<(Option<GpuContext>, String), EngineError> {
+    match plan {
+        Plan::Row(_) if backend == Backend::Gpu => Err(EngineError::GpuUnfit(
+            "the accuracy of rows of multi-storey buildings compares the CPU paths only (its GPU study is not built yet)",
+        )),
+        Plan::Row(_) => Ok((None, "the CPU".into())),
+        Plan::Pair(_) => {
+            let ctx = backend.acquire("CPU path only", note)?;
+            let n = if ctx.is_some() { 3 } else { 1 };
+            Ok((ctx, format!("{n} paths")))
+        }
+    }
+}
+
+/// The markdown table's header of a study of `plan`.
+pub fn markdown_header(plan: &Plan) -> &'static str {
+    match plan {
+        Plan::Pair(_) => MARKDOWN_HEADER,
+        Plan::Row(_) => ROW_MARKDOWN_HEADER,
+    }
+}
+
+/// The study of any plan ([`study`] for a pair, [`row_study`] for a row); `line` gets each
+/// point's markdown row as it is measured.
+pub fn study_plan(
+    plan: &Plan,
+    ctx: Option<&GpuContext>,
+    settings: &[f64],
+    tol: f64,
+    mut line: impl FnMut(String),
+) -> Result<Points, EngineError> {
+    Ok(match plan {
+        Plan::Pair(p) => Points::Pairs(study(p, ctx, settings, tol, |p| line(markdown_row(p)))?),
+        Plan::Row(r) => Points::Rows(row_study(r, settings, tol, |p| line(row_markdown(p)))),
+    })
 }

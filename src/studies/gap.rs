@@ -26,9 +26,9 @@ const CSV_CHUNK: u64 = 4096;
 /// The storey height a pair's one-storey buildings are given: they share their one level.
 const PAIR_STOREY_M: f64 = 3.0;
 
-/// The sweep a study runs over: a pair config or a row config.
+/// The scenes of the plan a study runs over, a pair's or a row's runs.
 #[derive(Clone, Copy)]
-pub enum Scenes<'a> {
+enum Scenes<'a> {
     Pairs(&'a PairPlan),
     Rows(&'a RowPlan),
 }
@@ -43,10 +43,10 @@ impl<'a> From<&'a crate::plan::Plan> for Scenes<'a> {
 }
 
 impl Scenes<'_> {
-    fn base(&self) -> &PairPlan {
+    fn base(&self) -> &crate::plan::ContactPlan {
         match self {
-            Scenes::Pairs(p) => p,
-            Scenes::Rows(r) => &r.base,
+            Scenes::Pairs(p) => &p.contact,
+            Scenes::Rows(r) => &r.contact,
         }
     }
 
@@ -68,7 +68,7 @@ impl Scenes<'_> {
     /// The gaps a config gives pair `a` (placeholders where sampled).
     fn gap_axis(&self, a: usize) -> &[f64] {
         match self {
-            Scenes::Pairs(p) => &p.spec.gaps,
+            Scenes::Pairs(p) => &p.gaps,
             Scenes::Rows(r) => &r.gaps[a],
         }
     }
@@ -79,7 +79,6 @@ impl Scenes<'_> {
         use crate::plan::SampledAxis;
         match self {
             Scenes::Pairs(p) => p
-                .spec
                 .samples
                 .as_ref()
                 .is_some_and(|s| s.axes.contains(&SampledAxis::Gap)),
@@ -114,7 +113,7 @@ impl Scenes<'_> {
 
     /// Motion `m`'s parameter cells, in [`Scenes::parameter_header`] order.
     fn cells(&self, m: u64) -> Vec<String> {
-        let motion_cells = |plan: &PairPlan, spec: &crate::plan::RunSpec| {
+        let motion_cells = |plan: &crate::plan::ContactPlan, spec: &crate::plan::ContactRun| {
             let mut c = vec![m.to_string()];
             // record, the targets, scale_factor, pga_g
             c.extend(contact_and_motion(plan, spec).drain(7..CONTACT_AND_MOTION));
@@ -124,14 +123,14 @@ impl Scenes<'_> {
         match self {
             Scenes::Pairs(p) => {
                 let r = p.motion_run(m);
-                let mut cells = motion_cells(p, &r);
+                let mut cells = motion_cells(&p.contact, &r.contact());
                 cells.extend([r.m1, r.t1, r.xi1, r.m2, r.t2, r.xi2].map(num));
                 cells.push(sample(r.sample));
                 cells
             }
             Scenes::Rows(plan) => {
                 let r = plan.motion_run(m);
-                let mut cells = motion_cells(&plan.base, &r.base);
+                let mut cells = motion_cells(&plan.contact, &r.contact);
                 for (b, a) in plan.buildings.iter().enumerate() {
                     cells.push(a.storeys().to_string());
                     cells.push(r.mass[b].map(num).unwrap_or_default());
@@ -153,7 +152,7 @@ impl Scenes<'_> {
             }
             Scenes::Rows(plan) => {
                 let r = plan.motion_run(m);
-                (r.period, r.base.scale)
+                (r.period, r.contact.scale)
             }
         }
     }
@@ -226,7 +225,8 @@ pub struct GapStudy<'a> {
 
 impl<'a> GapStudy<'a> {
     /// Compute every response (in parallel on the current rayon pool).
-    pub fn run(scenes: Scenes<'a>) -> GapStudy<'a> {
+    pub fn run(plan: &'a crate::plan::Plan) -> GapStudy<'a> {
+        let scenes = Scenes::from(plan);
         let motions = scenes.motions();
         let inner = motions.inner;
         let per_record = inner * motions.intensities as u64;

@@ -45,7 +45,7 @@ fn shipped_configs_load() {
         let p = config::load_pair(Path::new(&format!("configs/paper-{name}.toml")))
             .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(p.len(), runs, "paper-{name}");
-        assert_eq!(p.spec.records.len(), 5);
+        assert_eq!(p.contact.spec.records.len(), 5);
         // Every run is scaled to 0.35 g.
         assert!(
             (0..p.len()).all(|i| (p.run(i).pga_g - 0.35).abs() < 1e-12),
@@ -254,8 +254,8 @@ fn path_records_resolve_against_the_config() {
     let cfg = d.path().join("c.toml");
     std::fs::write(&cfg, text).unwrap();
     let p = config::load_pair(&cfg).unwrap();
-    assert_eq!(p.spec.records[0].name, "mine");
-    assert_eq!(p.spec.records[0].npts(), 4);
+    assert_eq!(p.contact.spec.records[0].name, "mine");
+    assert_eq!(p.contact.spec.records[0].npts(), 4);
 }
 
 #[test]
@@ -273,6 +273,7 @@ fn ranges_expand() {
     ))
     .unwrap();
     let got: Vec<f64> = p
+        .contact
         .spec
         .intensities
         .iter()
@@ -302,7 +303,7 @@ fn record_windows_cut_the_record() {
     )
     .unwrap();
     let cut = parse(&text).unwrap();
-    let (f, c) = (&full.spec.records[0], &cut.spec.records[0]);
+    let (f, c) = (&full.contact.spec.records[0], &cut.contact.spec.records[0]);
     assert_eq!(c.npts(), 151);
     assert!((c.t0 - 1.0).abs() < 1e-12, "t0 {}", c.t0);
     assert_eq!(c.accel[..], f.accel[100..=250]);

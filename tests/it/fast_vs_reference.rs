@@ -47,11 +47,11 @@ pub fn mixed_plan() -> pounding::plan::PairPlan {
         &records_dir(),
     )
     .unwrap();
-    for r in plan.spec.records.iter_mut() {
+    for r in plan.contact.spec.records.iter_mut() {
         let n = (6.0 / r.dt) as usize;
         std::sync::Arc::make_mut(r).accel.truncate(n);
     }
-    pounding::plan::PairPlan::new(plan.spec.clone()).unwrap()
+    pounding::plan::PairPlan::new(plan.spec()).unwrap()
 }
 
 /// Measured on this grid (1,632 runs; see README "Integration schemes"): peak-force error

@@ -328,7 +328,7 @@ fn motions_are_the_distinct_motions_of_the_plan() {
     let rkey = |r: &pounding::plan::row::RowRunSpec| {
         format!(
             "{} {} {:?} {:?} {:?} {:?}",
-            r.base.record, r.base.scale, r.mass, r.period, r.damping, r.sample
+            r.contact.record, r.contact.scale, r.mass, r.period, r.damping, r.sample
         )
     };
     let all: std::collections::BTreeSet<String> =

@@ -739,10 +739,11 @@ fn shard_cuts_are_cheap_and_exact() {
     let small =
         pounding::plan::config::parse(SWEEP, Path::new("s.toml"), d.path(), d.path()).unwrap();
     let costs: Vec<u64> = small
+        .contact
         .spec
         .records
         .iter()
-        .map(|r| r.forcing(1.0, small.spec.tail).intervals().max(1) as u64)
+        .map(|r| r.forcing(1.0, small.contact.spec.tail).intervals().max(1) as u64)
         .collect();
     let mut acc = vec![0u128];
     for i in 0..small.len() {
@@ -881,7 +882,10 @@ fn stiff_structures_failed_runs_and_absurd_inputs() {
         err.contains("warning") && err.contains("PGA of 1000000.000 g"),
         "{err}"
     );
-    assert!(err.contains("exceeds its height (estimated from its period"), "{err}");
+    assert!(
+        err.contains("exceeds its height (estimated from its period"),
+        "{err}"
+    );
     assert!(!stderr(&sweep(&sc.cfg, &sc.path("q.csv"), &[])).contains("warning"));
 }
 

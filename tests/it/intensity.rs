@@ -60,7 +60,7 @@ fn sa_targets_at_a_swept_building_period_scale_each_run_exactly() {
         let r = plan.run(i);
         let target = r.intensity.value();
         assert_eq!(r.im_periods, Some([r.t1, r.t1]));
-        let rec = scaled(&plan.spec.records[r.record], r.scale);
+        let rec = scaled(&plan.contact.spec.records[r.record], r.scale);
         let got = sa(&rec, r.t1, 0.05) / G;
         assert!(
             rel(got, target) < 1e-12,
@@ -85,7 +85,7 @@ fn sa_avg_targets_over_multiples_of_both_buildings_periods() {
         let r = plan.run(i);
         let [from, to] = r.im_periods.unwrap();
         assert_eq!([from, to], [0.2 * r.t1, 3.0 * r.t2]);
-        let rec = scaled(&plan.spec.records[r.record], r.scale);
+        let rec = scaled(&plan.contact.spec.records[r.record], r.scale);
         let periods = log_periods(from, to, 6);
         let got = sa_avg(&rec, &periods, 0.02) / G;
         assert!(rel(got, 0.3) < 1e-12, "run {i}: Sa_avg {got} g");
@@ -102,7 +102,7 @@ fn a_fixed_period_target_is_one_factor_per_record_and_level() {
         config::load_pair(&write(dir.path(), "sa_g = [0.1, 0.4]\nsa_period_s = 1.0")).unwrap();
     for i in 0..plan.len() {
         let r = plan.run(i);
-        let rec = &plan.spec.records[r.record];
+        let rec = &plan.contact.spec.records[r.record];
         let want = r.intensity.value() * G / sa(rec, 1.0, 0.05);
         assert!(rel(r.scale, want) < 1e-15, "run {i}");
         assert_eq!(r.im_periods, Some([1.0, 1.0]));
@@ -156,14 +156,14 @@ sa_period_s = "building[2]"
     for i in 0..plan.len() {
         let r = plan.run(i);
         let t = r.period[2];
-        assert_eq!(r.base.im_periods, Some([t, t]));
-        let rec = scaled(&plan.base.spec.records[0], r.base.scale);
-        assert!(rel(sa(&rec, t, 0.05) / G, r.base.intensity.value()) < 1e-12);
+        assert_eq!(r.contact.im_periods, Some([t, t]));
+        let rec = scaled(&plan.contact.spec.records[0], r.contact.scale);
+        assert!(rel(sa(&rec, t, 0.05) / G, r.contact.intensity.value()) < 1e-12);
     }
     // A warning of an absurd PGA reads the row's own period, not a placeholder's.
     let loud =
         config::load_row_text(&text.replace("sa_g = [0.3, 0.6]", "sa_g = 40.0"), &cfg).unwrap();
-    let pga = loud.run(0).base.pga_g;
+    let pga = loud.run(0).contact.pga_g;
     assert!(pga > 5.0);
     let w = loud.warnings().join("\n");
     assert!(w.contains(&format!("a PGA of {pga:.3} g")), "{pga}: {w}");
@@ -184,10 +184,13 @@ sa_period_s = "building[2]"
         let r = plan.run(i as u64);
         assert_eq!(
             c[col("target_sa_g")].parse::<f64>().unwrap(),
-            r.base.intensity.value()
+            r.contact.intensity.value()
         );
         assert_eq!(c[col("sa_period_s")], c[col("b3_t1_s")]);
-        assert_eq!(c[col("scale_factor")].parse::<f64>().unwrap(), r.base.scale);
+        assert_eq!(
+            c[col("scale_factor")].parse::<f64>().unwrap(),
+            r.contact.scale
+        );
         assert_eq!(c[col("target_pga_g")], "");
         assert_eq!(c[col("target_sa_avg_g")], "");
     }

@@ -285,7 +285,7 @@ fn sampled_rows_take_the_drawn_values() {
         assert_eq!(cell("b3_mass_kg"), p[2], "run {i}");
         // The sampled beta is that of Hertz-type laws (both laws here are).
         assert_eq!(cell("beta_n_per_m1_5"), p[3], "run {i}");
-        assert_eq!(spec.base.stiffness, p[3]);
+        assert_eq!(spec.contact.stiffness, p[3]);
     }
     assert!(seen.iter().all(|&x| x), "every sample is run");
 

@@ -636,13 +636,7 @@ pub fn sweep_rows<E: From<GpuError>>(
     if runs.is_empty() {
         return Ok(Summary::default());
     }
-    let accels: Vec<&[f64]> = plan
-        .base
-        .spec
-        .records
-        .iter()
-        .map(|r| &r.accel[..])
-        .collect();
+    let accels = plan.contact.accels();
     let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
     // Every per-run buffer of a chunk must fit one binding (tall rows carry large blocks).
     let shape = RowShape::of(&RowModel::new(&plan.row(&plan.run(runs.start))));
@@ -661,7 +655,7 @@ pub fn sweep_rows<E: From<GpuError>>(
             .collect();
         let mut packed = PackedRows::new(shape.clone());
         for (s, m) in specs.iter().zip(&models) {
-            packed.push(m, &plan.forcing(s), s.base.record, &recs, &opts.fast);
+            packed.push(m, &plan.forcing(s), s.contact.record, &recs, &opts.fast);
         }
         let (outs, _) = run_rows(ctx, &recs, &packed, opts)?;
         let rows: Vec<(RowRunSpec, RowOutput)> = specs

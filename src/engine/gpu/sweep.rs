@@ -78,7 +78,7 @@ pub(crate) fn upload_records(
     opts: &super::GpuOptions,
     chunk: usize,
 ) -> Result<(super::GpuRecords, u64), super::GpuError> {
-    let accels: Vec<&[f64]> = plan.spec.records.iter().map(|r| &r.accel[..]).collect();
+    let accels = plan.contact.accels();
     let recs = super::GpuRecords::upload(ctx, opts.precision, &accels)?;
     let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
     Ok((recs, chunk))
