@@ -226,8 +226,9 @@ pub fn run(a: Args) -> Result<()> {
         if states.is_some() {
             for s in &mut pl.series {
                 for (n, t) in names.iter().zip(&spec.thresholds) {
-                    if let Some(rest) = s.name.strip_prefix(&format!("> {t}:")) {
-                        s.name = format!("{n} (> {t}):{rest}");
+                    let threshold = pounding::studies::fragility::threshold_name(&spec.edp, *t);
+                    if let Some(rest) = s.name.strip_prefix(&format!("{threshold}:")) {
+                        s.name = format!("{n} ({threshold}):{rest}");
                     }
                 }
             }

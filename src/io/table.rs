@@ -293,9 +293,54 @@ pub fn value_label(column: &str, value: &str) -> String {
     }
 }
 
+/// A value of `column` with its unit, in engineering units where those read better (for legend
+/// entries such as thresholds): `peak_force_n`, 1e6 -> `1 MN`; `dissipated_energy_j`, 2500 ->
+/// `2.5 kJ`; `gap_m`, 0.05 -> `50 mm`; `pga_g`, 0.3 -> `0.3 g`; a ratio or a count as it is.
+pub fn quantity(column: &str, v: f64) -> String {
+    // Four significant digits, trailing zeros dropped.
+    let short = |x: f64| {
+        if x == 0.0 || !x.is_finite() {
+            return format!("{x}");
+        }
+        let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
+        let s = format!("{x:.digits$}");
+        match s.contains('.') {
+            true => s.trim_end_matches('0').trim_end_matches('.').to_string(),
+            false => s,
+        }
+    };
+    let unit = split_unit(column).1;
+    let large = |base: &str| -> String {
+        match v.abs() {
+            a if a >= 1e6 => format!("{} M{base}", short(v / 1e6)),
+            a if a >= 1e3 => format!("{} k{base}", short(v / 1e3)),
+            _ => format!("{} {base}", short(v)),
+        }
+    };
+    match unit {
+        Some(u @ ("N" | "J" | "N/m")) => large(u),
+        Some("m") if v != 0.0 && v.abs() < 1.0 => format!("{} mm", short(v * 1e3)),
+        Some(u) => format!("{} {u}", short(v)),
+        None => short(v),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quantities_in_engineering_units() {
+        assert_eq!(quantity("peak_force_n", 1e6), "1 MN");
+        assert_eq!(quantity("peak_force_n", 3.5e6), "3.5 MN");
+        assert_eq!(quantity("peak_force_n", 0.0), "0 N");
+        assert_eq!(quantity("dissipated_energy_j", 2500.0), "2.5 kJ");
+        assert_eq!(quantity("gap_1_2_m", 0.05), "50 mm");
+        assert_eq!(quantity("peak_u1_m", 1.25), "1.25 m");
+        assert_eq!(quantity("pga_g", 0.3), "0.3 g");
+        assert_eq!(quantity("b2_peak_drift_ratio", 0.005), "0.005");
+        assert_eq!(quantity("impacts", 0.0), "0");
+    }
 
     #[test]
     fn filters_and_labels() {

@@ -546,6 +546,11 @@ pub fn csv(spec: &FragilitySpec, levels: &[Vec<Level>]) -> String {
     s
 }
 
+/// A threshold's legend entry: `> 1 MN` for `peak_force_n` above 1e6 ([`crate::io::table::quantity`]).
+pub fn threshold_name(edp: &str, t: f64) -> String {
+    format!("> {}", crate::io::table::quantity(edp, t))
+}
+
 /// One panel: the observed fractions (points) and the fitted curves (lines), per threshold.
 pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, NoFit>]) -> Panel {
     let mut series = Vec::new();
@@ -558,7 +563,7 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
     for (k, ((t, lv), f)) in spec.thresholds.iter().zip(levels).zip(fits).enumerate() {
         // The EDP is in the title; a threshold's points and its curve share one style; a failed
         // fit says why.
-        let name = format!("> {t}");
+        let name = threshold_name(&spec.edp, *t);
         series.push(Series {
             name: match f {
                 Ok(_) => format!("{name}: observed"),
@@ -586,10 +591,14 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
             });
         }
     }
+    let (edp, im) = (
+        crate::io::table::name(&spec.edp),
+        crate::io::table::name(&spec.im),
+    );
     Panel {
         title: match caption(&spec.filters) {
-            c if c.is_empty() => format!("P({} > threshold) against {}", spec.edp, spec.im),
-            c => format!("P({} > threshold) against {}; {c}", spec.edp, spec.im),
+            c if c.is_empty() => format!("P({edp} > threshold) against {im}"),
+            c => format!("P({edp} > threshold) against {im}; {c}"),
         },
         x_label: label(&spec.im),
         y_label: "probability of exceedance".into(),

@@ -655,17 +655,24 @@ impl<'a> GapStudy<'a> {
                 ..Panel::default()
             });
             let mut series = Vec::new();
-            for c in curves.get(a).into_iter().flatten() {
+            // Each intensity's points and its fitted curve share one style; a failed fit is
+            // named on its points.
+            for (k, c) in curves.get(a).into_iter().flatten().enumerate() {
                 let label = self.intensity_label(c.intensity);
+                let unfitted = if c.fit.is_ok() {
+                    ""
+                } else {
+                    " (no lognormal fit)"
+                };
                 series.push(Series {
-                    name: format!("{label}: share of runs"),
+                    name: format!("{label}: share of runs{unfitted}"),
                     points: c
                         .points
                         .iter()
                         .map(|&(g, n, k)| (g * 1e3, k as f64 / n.max(1) as f64))
                         .collect(),
                     scatter: true,
-                    style: None,
+                    style: Some(k),
                 });
                 if let Ok(f) = &c.fit {
                     let top = c.points.iter().map(|p| p.0).fold(0.0, f64::max);
@@ -682,7 +689,7 @@ impl<'a> GapStudy<'a> {
                             })
                             .collect(),
                         scatter: false,
-                        style: None,
+                        style: Some(k),
                     });
                 }
             }
@@ -752,6 +759,45 @@ fn round_step(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// In the probability-of-pounding panel each intensity's points and its fitted curve share
+    /// one style, and intensities differ; a failed fit is named on its points.
+    #[test]
+    fn pounding_points_and_their_curve_share_a_style() {
+        let plan = crate::plan::config::parse_builtin(
+            "[building1]\nmass_kg = 1.0e5\nperiod_s = [0.2, 0.3, 0.5, 0.8]\ndamping_ratio = 0.05\n[building2]\nmass_kg = 1.0e5\nperiod_s = [0.4, 0.6, 1.0, 1.5]\ndamping_ratio = 0.05\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = 0.0\n[[record]]\nsynthetic = { seed = 3, duration_s = 4.0 }\n[intensity]\npga_g = [0.2, 0.4]\n",
+            "styles.toml",
+        )
+        .unwrap();
+        let plan = crate::plan::Plan::Pair(plan);
+        let study = GapStudy::run(&plan);
+        let gaps = study.gaps_for(0, None);
+        let mut curves = vec![study.pounding(0, &gaps)];
+        assert_eq!(curves[0].len(), 2);
+        let panels = study.panels(&curves);
+        let pounding = panels.last().unwrap();
+        let styles: Vec<(Option<usize>, bool)> = pounding
+            .series
+            .iter()
+            .map(|s| (s.style, s.scatter))
+            .collect();
+        assert_eq!(
+            styles,
+            [
+                (Some(0), true),
+                (Some(0), false),
+                (Some(1), true),
+                (Some(1), false)
+            ],
+            "{:?}",
+            pounding.series.iter().map(|s| &s.name).collect::<Vec<_>>()
+        );
+        curves[0][1].fit = Err(crate::studies::fragility::NoFit::NoneExceed);
+        let panels = study.panels(&curves);
+        let last = panels.last().unwrap();
+        assert_eq!(last.series.len(), 3);
+        assert!(last.series[2].name.ends_with("(no lognormal fit)"));
+    }
 
     #[test]
     fn quantiles_and_round_steps() {

@@ -215,6 +215,10 @@ fn legends_cover_no_point_and_styles_are_distinct() {
     let glyphs = read(&svg).glyphs;
     assert_eq!(glyphs.len(), 6, "{glyphs:?}");
     check(&f, 6, 3);
+    // Thresholds in engineering units, the EDP and the IM in words.
+    for said in ["1 MN: observed", "3 MN: fit", "P(peak force &gt; threshold) against pga"] {
+        assert!(svg.contains(said), "{said}");
+    }
     // A log axis is labelled with values, one at each power of ten it spans.
     let lg = dir.path().join("log.svg");
     ok(&pound(&[
