@@ -342,11 +342,15 @@ fn draw<DB: DrawingBackend>(
         (longest as f64 * 7.0 + 40.0) / 535.0,
         (named.len() as f64 * 20.0 + 20.0) / 380.0,
     );
+    let data_top = y1;
     let (corner, y1) = if named.len() > 1 {
         legend_place(&all, (x0, x1), (y0, y1), w, h)
     } else {
         (SeriesLabelPosition::UpperLeft, y1)
     };
+    // Where the range was raised to make room for the legend, the room above the data carries
+    // no tick labels: a probability axis is not labelled past 1.
+    let above_data = |v: f64| v > data_top + (data_top - y0).abs() * 1e-9;
     let label = |l: &str, log: bool| {
         if log {
             format!("{l}, log scale")
@@ -375,7 +379,15 @@ fn draw<DB: DrawingBackend>(
         }
     };
     let fmt_x = |v: &f64| if p.log_x { log_tick(*v) } else { tick(*v) };
-    let fmt_y = |v: &f64| if p.log_y { log_tick(*v) } else { tick(*v) };
+    let fmt_y = |v: &f64| {
+        if above_data(*v) {
+            String::new()
+        } else if p.log_y {
+            log_tick(*v)
+        } else {
+            tick(*v)
+        }
+    };
     let mut chart = ChartBuilder::on(area)
         .caption(&p.title, ("sans-serif", 18))
         .margin(10)

@@ -215,8 +215,21 @@ fn legends_cover_no_point_and_styles_are_distinct() {
     let glyphs = read(&svg).glyphs;
     assert_eq!(glyphs.len(), 6, "{glyphs:?}");
     check(&f, 6, 3);
+    // The legend sits above the curves, in room the range was raised for: that room carries
+    // no tick labels, so the probability axis is labelled up to 1 and no further.
+    let ticks: Vec<f64> = svg
+        .split("<text")
+        .filter(|t| t.contains("text-anchor=\"end\""))
+        .filter_map(|t| t.split('>').nth(1)?.split('<').next()?.trim().parse().ok())
+        .collect();
+    assert!(ticks.contains(&1.0), "{ticks:?}");
+    assert!(ticks.iter().all(|&v| v <= 1.0), "{ticks:?}");
     // Thresholds in engineering units, the EDP and the IM in words.
-    for said in ["1 MN: observed", "3 MN: fit", "P(peak force &gt; threshold) against pga"] {
+    for said in [
+        "1 MN: observed",
+        "3 MN: fit",
+        "P(peak force &gt; threshold) against pga",
+    ] {
         assert!(svg.contains(said), "{said}");
     }
     // A log axis is labelled with values, one at each power of ten it spans.
