@@ -27,6 +27,8 @@ pub struct Args {
     /// Work-precision plot (SVG, or PNG for a .png name).
     #[arg(long)]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    figure: super::FigureArgs,
     /// Check `--target-error` instead of trying --settings: for each error E, run the setting
     /// it chooses and fail unless every path's p99 peak-force error on CONFIG is at most E.
     #[arg(
@@ -47,6 +49,7 @@ pub fn run(a: Args) -> Result<()> {
         output,
         plot,
         target_error,
+        figure,
     } = a;
     let output = super::default_output(output, "accuracy.csv");
     let text = config::read_text(&config)?;
@@ -99,7 +102,7 @@ pub fn run(a: Args) -> Result<()> {
     })?;
     write_file(&output, points.csv().as_bytes())?;
     if let Some(p) = plot {
-        super::save_plot(&p, &points.panels(), 2)?;
+        super::save_plot(&p, &points.panels(), 2, &figure)?;
     }
     let runs = plan.len();
     let measured: Vec<Measured> = points

@@ -14,6 +14,8 @@ pub struct Args {
     /// Also plot zeta against e for every formula (the seed's Fig. 2): .svg or .png.
     #[arg(long)]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    figure: super::FigureArgs,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -21,7 +23,14 @@ pub fn run(a: Args) -> Result<()> {
     check_outputs(&[], &[("--plot", a.plot.as_deref(), Holds::Plot)])?;
     if let Some(path) = &a.plot {
         // The line below says what was written.
-        pounding::studies::plot::save(path, &formulas::zeta_panels(&es)?, 2)?;
+        let mut panels = formulas::zeta_panels(&es)?;
+        a.figure.apply(&mut panels);
+        pounding::studies::plot::save_sized(
+            path,
+            &panels,
+            2,
+            a.figure.size.unwrap_or(pounding::studies::plot::PANEL),
+        )?;
         note!(
             "zeta(e) of {} formulas -> {}",
             Formula::ALL.len(),

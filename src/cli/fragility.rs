@@ -55,6 +55,8 @@ pub struct Args {
     /// Observed fractions and fitted curves (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    figure: super::FigureArgs,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -239,7 +241,7 @@ pub fn run(a: Args) -> Result<()> {
         if bands.iter().any(|b| b.is_some()) {
             pl.title.push_str(" (grey: 90 % bands)");
         }
-        super::save_plot(p, &[pl], 1)?;
+        super::save_plot(p, &[pl], 1, &a.figure)?;
     }
     Ok(())
 }

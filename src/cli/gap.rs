@@ -22,6 +22,8 @@ pub struct Args {
     /// pounding against the gap (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    figure: super::FigureArgs,
     /// The probability of pounding at each gap, per pair and intensity, with the fitted curve
     /// (CSV).
     #[arg(long)]
@@ -137,7 +139,7 @@ pub fn run(a: Args) -> Result<()> {
         write_file(p, curve_csv(&study, &curves).as_bytes())?;
     }
     if let Some(p) = &a.plot {
-        super::save_plot(p, &study.panels(&curves), 3)?;
+        super::save_plot(p, &study.panels(&curves), 3, &a.figure)?;
     }
     Ok(())
 }

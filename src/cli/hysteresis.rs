@@ -33,6 +33,8 @@ pub struct Args {
     /// The loops as SVG.
     #[arg(long)]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    figure: super::FigureArgs,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -73,7 +75,7 @@ pub fn run(a: Args) -> Result<()> {
     super::say_text(&loops.markdown())?;
     write_file(&output, loops.csv().as_bytes())?;
     if let Some(p) = &a.plot {
-        super::save_plot(p, &[loops.panel()], 1)?;
+        super::save_plot(p, &[loops.panel()], 1, &a.figure)?;
     }
     Ok(())
 }

@@ -32,6 +32,8 @@ pub struct Args {
     /// The curves and the fractiles (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    figure: super::FigureArgs,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -110,7 +112,7 @@ pub fn run(a: Args) -> Result<()> {
     }
     write_file(&output, ida.csv(&spec).as_bytes())?;
     if let Some(p) = &a.plot {
-        super::save_plot(p, &[ida.panel(&spec)], 1)?;
+        super::save_plot(p, &[ida.panel(&spec)], 1, &a.figure)?;
     }
     Ok(())
 }

@@ -266,10 +266,62 @@ pub fn save_plot(
     path: &Path,
     panels: &[pounding::studies::plot::Panel],
     cols: usize,
+    figure: &FigureArgs,
 ) -> Result<()> {
-    pounding::studies::plot::save(path, panels, cols)?;
+    let mut panels = panels.to_vec();
+    figure.apply(&mut panels);
+    pounding::studies::plot::save_sized(
+        path,
+        &panels,
+        cols,
+        figure.size.unwrap_or(pounding::studies::plot::PANEL),
+    )?;
     wrote(path);
     Ok(())
+}
+
+/// How a command's figure is drawn, the same flags on every command that plots.
+#[derive(clap::Args, Clone, Default)]
+pub struct FigureArgs {
+    /// The figure's title: a one-panel figure's, or put before the first panel's own title
+    /// (default: what is plotted).
+    #[arg(long)]
+    pub title: Option<String>,
+    /// Each panel's size in pixels, WIDTHxHEIGHT (each 320 to 4000; default 640x480).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+}
+
+impl FigureArgs {
+    /// Give `panels` the title asked for.
+    pub fn apply(&self, panels: &mut [pounding::studies::plot::Panel]) {
+        match (&self.title, panels) {
+            (Some(t), [only]) => only.title = t.clone(),
+            (Some(t), [first, ..]) => first.title = format!("{t}: {}", first.title),
+            _ => {}
+        }
+    }
+}
+
+/// `--size`: WIDTHxHEIGHT, each within [`pounding::studies::plot::PANEL_SIZES`].
+pub fn parse_size(text: &str) -> std::result::Result<(u32, u32), String> {
+    let range = pounding::studies::plot::PANEL_SIZES;
+    let bad = || {
+        format!(
+            "`{text}`: expected WIDTHxHEIGHT in pixels, each {} to {}, e.g. 1200x800",
+            range.start(),
+            range.end()
+        )
+    };
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    );
+    if !(range.contains(&w) && range.contains(&h)) {
+        return Err(bad());
+    }
+    Ok((w, h))
 }
 
 /// Each warning a config's plan gives, one line each on stderr, named by the config.

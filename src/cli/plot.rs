@@ -31,37 +31,14 @@ pub struct Args {
     log_x: bool,
     #[arg(long)]
     log_y: bool,
-    /// The plot's title (default: what is plotted against what, the aggregation and the
-    /// filters).
-    #[arg(long)]
-    title: Option<String>,
-    /// Size in pixels, WIDTHxHEIGHT (each 320 to 4000; default 640x480).
-    #[arg(long, value_parser = parse_size)]
-    size: Option<(u32, u32)>,
+    /// `--title` (default: what is plotted against what, the aggregation and the filters) and
+    /// `--size`.
+    #[command(flatten)]
+    figure: super::FigureArgs,
     /// Output: .svg, or .png (text in a font built into the binary).
     /// (default: plot.svg, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,
-}
-
-fn parse_size(text: &str) -> std::result::Result<(u32, u32), String> {
-    let range = pounding::studies::plot::PANEL_SIZES;
-    let bad = || {
-        format!(
-            "`{text}`: expected WIDTHxHEIGHT in pixels, each {} to {}, e.g. 1200x800",
-            range.start(),
-            range.end()
-        )
-    };
-    let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (
-        w.trim().parse().map_err(|_| bad())?,
-        h.trim().parse().map_err(|_| bad())?,
-    );
-    if !(range.contains(&w) && range.contains(&h)) {
-        return Err(bad());
-    }
-    Ok((w, h))
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -93,9 +70,7 @@ pub fn run(a: Args) -> Result<()> {
         log_y: a.log_y,
     };
     let (mut p, failed) = panel(&table, &spec)?;
-    if let Some(t) = a.title {
-        p.title = t;
-    }
+    a.figure.apply(std::slice::from_mut(&mut p));
     if failed > 0 {
         note!(
             "{}: {failed} rows left out: runs whose status is not ok, or values that are not finite",
@@ -129,7 +104,7 @@ pub fn run(a: Args) -> Result<()> {
         &output,
         std::slice::from_ref(&p),
         1,
-        a.size.unwrap_or(pounding::studies::plot::PANEL),
+        a.figure.size.unwrap_or(pounding::studies::plot::PANEL),
     )?;
     note!(
         "{} series, {points} points -> {}",

@@ -70,6 +70,8 @@ pub enum Cmd {
         /// Sa against the period (.svg or .png).
         #[arg(long)]
         plot: Option<PathBuf>,
+        #[command(flatten)]
+        figure: super::FigureArgs,
     },
 }
 
@@ -130,6 +132,7 @@ pub fn run(cmd: Cmd) -> Result<()> {
             damping,
             output,
             plot,
+            figure,
         } => {
             let output = super::default_output(output, "spectrum.csv");
             let periods = parse_periods(&periods)?;
@@ -144,7 +147,7 @@ pub fn run(cmd: Cmd) -> Result<()> {
                 ],
             )?;
             let rec = record.read()?;
-            spectrum(&rec, &periods, damping, &output, plot.as_deref())
+            spectrum(&rec, &periods, damping, &output, plot.as_deref(), &figure)
         }
     }
 }
@@ -156,6 +159,7 @@ fn spectrum(
     damping: f64,
     output: &std::path::Path,
     plot: Option<&std::path::Path>,
+    figure: &super::FigureArgs,
 ) -> Result<()> {
     use rayon::prelude::*;
     let rows: Vec<(f64, f64)> = periods
@@ -201,7 +205,7 @@ fn spectrum(
                 style: None,
             }],
         };
-        super::save_plot(p, &[panel], 1)?;
+        super::save_plot(p, &[panel], 1, figure)?;
     }
     Ok(())
 }

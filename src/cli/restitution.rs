@@ -17,6 +17,8 @@ pub struct Args {
     /// Achieved against asked e, one panel per law (SVG).
     #[arg(long)]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    figure: super::FigureArgs,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -33,7 +35,7 @@ pub fn run(a: Args) -> Result<()> {
     say!("max |achieved e - asked e| per law and formula (`own`: the law's own chi(e)):\n");
     super::say_text(&fidelity::summary(&rows))?;
     if let Some(p) = &a.plot {
-        super::save_plot(p, &fidelity::panels(&rows), 4)?;
+        super::save_plot(p, &fidelity::panels(&rows), 4, &a.figure)?;
     }
     note!("{} collisions -> {}", rows.len(), output.display());
     Ok(())

@@ -224,6 +224,54 @@ fn legends_cover_no_point_and_styles_are_distinct() {
         .collect();
     assert!(ticks.contains(&1.0), "{ticks:?}");
     assert!(ticks.iter().all(|&v| v <= 1.0), "{ticks:?}");
+    // Every command that plots takes --title and --size: one panel's title replaced, several
+    // panels' first title led by it, each panel the size asked.
+    let titled = dir.path().join("titled.svg");
+    ok(&pound(&[
+        "fragility",
+        &s(&runs),
+        "--edp",
+        "impacts",
+        "--threshold",
+        "0",
+        "-o",
+        &s(&dir.path().join("t.csv")),
+        "--plot",
+        &s(&titled),
+        "--title",
+        "Fig. 7",
+        "--size",
+        "900x700",
+    ]));
+    let t = std::fs::read_to_string(&titled).unwrap();
+    assert!(
+        t.contains("Fig. 7") && !t.contains("against pga"),
+        "title replaced"
+    );
+    assert!(t.contains("width=\"900\" height=\"700\""));
+    let panels = dir.path().join("panels.svg");
+    ok(&pound(&[
+        "restitution",
+        "--e",
+        "0.5,0.8",
+        "-o",
+        &s(&dir.path().join("r.csv")),
+        "--plot",
+        &s(&panels),
+        "--title",
+        "Fig. 8",
+        "--size",
+        "400x360",
+    ]));
+    let t = std::fs::read_to_string(&panels).unwrap();
+    assert!(
+        t.contains("Fig. 8: "),
+        "the first panel's title led by the figure's"
+    );
+    assert!(
+        t.contains("width=\"1600\" height=\"720\""),
+        "two rows of four 400x360 panels"
+    );
     // Thresholds in engineering units, the EDP and the IM in words.
     for said in [
         "1 MN: observed",
