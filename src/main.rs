@@ -61,6 +61,7 @@ fn run(cmd: cli::Cmd) -> anyhow::Result<()> {
         Cmd::Paper => cli::paper::run(),
         Cmd::Restitution(a) => cli::restitution::run(a),
         Cmd::Hysteresis(a) => cli::hysteresis::run(a),
+        Cmd::Trace(a) => cli::trace::run(a),
         Cmd::Record { cmd } => cli::record::run(cmd),
         Cmd::Init(a) => cli::start::init(a),
         Cmd::Columns(a) => cli::start::columns(a),

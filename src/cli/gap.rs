@@ -1,7 +1,7 @@
 //! `pound gap`: the separation each adjacent pair of a sweep's buildings needs, exactly and by
 //! the code rules, with the probability of pounding against the gap.
 
-use super::{check_outputs, config_inputs, write_file, Holds};
+use super::{write_file, Holds};
 use anyhow::{bail, Context, Result};
 use pounding::plan::config;
 use pounding::studies::gap::{GapStudy, PoundingCurve};
@@ -39,10 +39,8 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<()> {
     let output = super::default_output(a.output.clone(), "gaps.csv");
-    let text = config::read_text(&a.config)?;
-    let records = config::input_files(&text, &a.config);
-    check_outputs(
-        &config_inputs(&a.config, &records),
+    let text = super::config_checked(
+        &a.config,
         &[
             ("-o", Some(&output), Holds::Csv),
             ("--plot", a.plot.as_deref(), Holds::Plot),

@@ -60,6 +60,7 @@ pub mod record;
 pub mod restitution;
 pub mod start;
 pub mod sweep;
+pub mod trace;
 
 #[derive(Subcommand)]
 pub enum Cmd {
@@ -103,6 +104,9 @@ pub enum Cmd {
     Restitution(restitution::Args),
     /// Force against penetration through one isolated impact (the seed's Fig. 5), per e.
     Hysteresis(hysteresis::Args),
+    /// One run of a sweep, whole: its time history at every record step and located event
+    /// (CSV, plot) and its row as the sweep writes it (pairs).
+    Trace(trace::Args),
     /// Print a commented starting config that runs as is: `pound init pair > my.toml`.
     Init(start::InitArgs),
     /// The output columns of a sweep (of CONFIG, or of a pair), with units and meanings.
@@ -329,6 +333,15 @@ pub fn warn_all(config: &Path, warnings: impl IntoIterator<Item = String>) {
     for w in warnings {
         note!("warning: {}: {w}", config.display());
     }
+}
+
+/// The text of `config`, once `outputs` are checked against it and the record files it names
+/// (none may replace an input).
+pub fn config_checked(config: &Path, outputs: &[(&str, Option<&Path>, Holds)]) -> Result<String> {
+    let text = pounding::plan::config::read_text(config)?;
+    let records = pounding::plan::config::input_files(&text, config);
+    check_outputs(&config_inputs(config, &records), outputs)?;
+    Ok(text)
 }
 
 /// A config and the record files it names, as the inputs its outputs must not replace.

@@ -2,7 +2,8 @@
 //! throughput ([`bench`](mod@bench)), restitution fidelity and hysteresis loops ([`fidelity`]), the
 //! formulas' zeta(e) ([`formulas`]), fragility curves ([`fragility`]) with
 //! named damage states ([`damage_states`]), incremental dynamic analysis summaries ([`ida`]), sensitivity plots
-//! ([`sensitivity`]), the seed paper's checks ([`paper`]), and drawing them ([`plot`]).
+//! ([`sensitivity`]), one run's time history ([`trace`]), the seed paper's checks ([`paper`]), and drawing
+//! them ([`plot`]).
 //!
 //! The top layer of the library: may import every layer below; nothing below imports it.
 
@@ -17,3 +18,4 @@ pub mod ida;
 pub mod paper;
 pub mod plot;
 pub mod sensitivity;
+pub mod trace;

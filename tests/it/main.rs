@@ -24,3 +24,4 @@ mod shared;
 mod start;
 mod studies;
 pub mod support;
+mod trace;

@@ -1,0 +1,60 @@
+//! `pound trace`: one run of a sweep, whole: its time history and its row.
+
+use super::{write_file, Holds};
+use anyhow::Result;
+use pounding::plan::config;
+use pounding::studies::trace;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The sweep config (a pair: [building1] and [building2]).
+    config: PathBuf,
+    /// The run's number, as in the sweep's `run` column.
+    #[arg(long)]
+    run: u64,
+    /// The time history at every record step and located event: displacements, velocities,
+    /// absolute floor accelerations, penetration, contact force, contact mode.
+    /// (default: trace.csv, numbered `-2`, `-3`, ... where that file exists)
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Displacements and contact force against time, force against penetration (.svg or .png).
+    #[arg(long)]
+    plot: Option<PathBuf>,
+    #[command(flatten)]
+    figure: super::FigureArgs,
+}
+
+pub fn run(a: Args) -> Result<()> {
+    let output = super::default_output(a.output.clone(), "trace.csv");
+    let text = super::config_checked(
+        &a.config,
+        &[
+            ("-o", Some(&output), Holds::Csv),
+            ("--plot", a.plot.as_deref(), Holds::Plot),
+        ],
+    )?;
+    let plan = config::load_text(&text, &a.config)?;
+    let t = trace::trace(&plan, a.run)?;
+    // The run's row, as the sweep writes it: the trace's peaks are the sweep's.
+    let pounding::plan::Plan::Pair(pair) = &plan else {
+        unreachable!("trace refuses rows")
+    };
+    say!("{}", pounding::plan::columns::header().join(","));
+    say!(
+        "{}",
+        pounding::plan::columns::row(pair, &t.spec, &t.output).join(",")
+    );
+    write_file(&output, t.csv().as_bytes())?;
+    note!(
+        "run {} of {}: {} samples (record steps and located events) -> {}",
+        a.run,
+        a.config.display(),
+        t.samples.len(),
+        output.display()
+    );
+    if let Some(p) = &a.plot {
+        super::save_plot(p, &t.panels(), 3, &a.figure)?;
+    }
+    Ok(())
+}
