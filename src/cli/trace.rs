@@ -37,14 +37,8 @@ pub fn run(a: Args) -> Result<()> {
     let plan = config::load_text(&text, &a.config)?;
     let t = trace::trace(&plan, a.run)?;
     // The run's row, as the sweep writes it: the trace's peaks are the sweep's.
-    let pounding::plan::Plan::Pair(pair) = &plan else {
-        unreachable!("trace refuses rows")
-    };
     say!("{}", pounding::plan::columns::header().join(","));
-    say!(
-        "{}",
-        pounding::plan::columns::row(pair, &t.spec, &t.output).join(",")
-    );
+    say!("{}", t.row.join(","));
     write_file(&output, t.csv().as_bytes())?;
     note!(
         "run {} of {}: {} samples (record steps and located events) -> {}",

@@ -472,6 +472,19 @@ impl Aggregator {
         self.outputs.iter().map(|(o, _)| o.as_str())
     }
 
+    /// Fold in finished runs of a row of buildings, by their cells (a summary built by
+    /// [`Aggregator::for_plan`]).
+    pub fn add_row_runs(
+        &mut self,
+        plan: &crate::plan::row::RowPlan,
+        rows: &[(crate::plan::row::RowRunSpec, crate::physics::row::RowOutput)],
+    ) {
+        let status = plan.parameter_columns();
+        for (s, o) in rows {
+            self.add_cells(&plan.cells(s, o), status);
+        }
+    }
+
     /// Fold in one row given as its cells (in the header's order): grouped by the text of its
     /// `by` cells; a row whose status is not `ok` is a failure. An empty or unreadable output
     /// cell of an `ok` row counts as NaN (the zero bucket).

@@ -234,17 +234,6 @@ pub enum Chunk<'a> {
 }
 
 impl Chunk<'_> {
-    pub fn len(&self) -> usize {
-        match self {
-            Chunk::Pairs(_, rows) => rows.len(),
-            Chunk::Rows(_, rows) => rows.len(),
-        }
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Runs in which a building's peak displacement exceeds its height: physically absurd (a
     /// units mix-up?). A pair's height is estimated from its period, a row's is the sum of its
     /// storey heights.
@@ -421,22 +410,17 @@ impl<'c> Engine<'c> {
     ) -> Result<Report, GpuError> {
         match plan {
             Plan::Pair(p) => self.fold(p, runs, agg, progress),
-            Plan::Row(r) => {
-                let status = r.parameter_columns();
-                self.sweep(
-                    plan,
-                    runs,
-                    |c: Chunk<'_>| -> Result<(), GpuError> {
-                        if let Chunk::Rows(_, rows) = c {
-                            for (s, o) in rows {
-                                agg.add_cells(&r.cells(s, o), status);
-                            }
-                        }
-                        Ok(())
-                    },
-                    progress,
-                )
-            }
+            Plan::Row(_) => self.sweep(
+                plan,
+                runs,
+                |c: Chunk<'_>| -> Result<(), GpuError> {
+                    if let Chunk::Rows(r, rows) = c {
+                        agg.add_row_runs(r, rows);
+                    }
+                    Ok(())
+                },
+                progress,
+            ),
         }
     }
 

@@ -236,10 +236,7 @@ impl RunRows for RowPlan {
         RowPlan::cells(self, spec, out)
     }
     fn fold(&self, agg: &mut Aggregator, rows: &[(RowRunSpec, RowOutput)]) {
-        let status = self.parameter_columns();
-        for (s, o) in rows {
-            agg.add_cells(&RowPlan::cells(self, s, o), status);
-        }
+        agg.add_row_runs(self, rows)
     }
 }
 

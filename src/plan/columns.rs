@@ -83,7 +83,7 @@ pub const CONTACT_AND_MOTION: usize = 16;
 /// The fields of one row, in [`HEADER`] order.
 pub fn row(plan: &PairPlan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
-    let mut cells = contact_and_motion(&plan.contact, &spec.contact());
+    let mut cells = contact_and_motion(&plan.contact, &spec.contact);
     cells.extend([
         num(spec.m1),
         num(spec.t1),

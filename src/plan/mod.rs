@@ -434,11 +434,6 @@ impl std::ops::DerefMut for RunSpec {
 }
 
 impl RunSpec {
-    /// What the run holds but its buildings and gap.
-    pub fn contact(&self) -> ContactRun {
-        self.contact
-    }
-
     pub fn pair(&self) -> Pair {
         let b1 = Oscillator::from_period(self.m1, self.t1, self.xi1);
         let b2 = Oscillator::from_period(self.m2, self.t2, self.xi2);

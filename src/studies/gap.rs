@@ -14,8 +14,8 @@ use crate::physics::shear::ShearBuilding;
 use crate::physics::solver::separation::{separation, LevelSeparation, Separation};
 use crate::plan::columns::{contact_and_motion, num, CONTACT_AND_MOTION};
 use crate::plan::intensity::TARGET_COLUMNS;
-use crate::plan::row::{level_name, RowPlan};
-use crate::plan::{Motions, PairPlan};
+use crate::plan::row::level_name;
+use crate::plan::{Motions, Plan};
 use crate::studies::fragility::{fit, Fit, Level, NoFit};
 use crate::studies::plot::{Panel, Series};
 use rayon::prelude::*;
@@ -26,50 +26,32 @@ const CSV_CHUNK: u64 = 4096;
 /// The storey height a pair's one-storey buildings are given: they share their one level.
 const PAIR_STOREY_M: f64 = 3.0;
 
-/// The scenes of the plan a study runs over, a pair's or a row's runs.
+/// The plan a study runs over, with what the study reads of its scenes (a pair's or a row's).
 #[derive(Clone, Copy)]
-enum Scenes<'a> {
-    Pairs(&'a PairPlan),
-    Rows(&'a RowPlan),
-}
-
-impl<'a> From<&'a crate::plan::Plan> for Scenes<'a> {
-    fn from(plan: &'a crate::plan::Plan) -> Scenes<'a> {
-        match plan {
-            crate::plan::Plan::Pair(p) => Scenes::Pairs(p),
-            crate::plan::Plan::Row(r) => Scenes::Rows(r),
-        }
-    }
-}
+struct Scenes<'a>(&'a Plan);
 
 impl Scenes<'_> {
     fn base(&self) -> &crate::plan::ContactPlan {
-        match self {
-            Scenes::Pairs(p) => &p.contact,
-            Scenes::Rows(r) => &r.contact,
-        }
+        self.0.contact()
     }
 
     pub fn motions(&self) -> Motions {
-        match self {
-            Scenes::Pairs(p) => p.motions(),
-            Scenes::Rows(r) => r.motions(),
-        }
+        self.0.motions()
     }
 
     /// Buildings in a scene.
     pub fn building_count(&self) -> usize {
-        match self {
-            Scenes::Pairs(_) => 2,
-            Scenes::Rows(r) => r.buildings.len(),
+        match self.0 {
+            Plan::Pair(_) => 2,
+            Plan::Row(r) => r.buildings.len(),
         }
     }
 
     /// The gaps a config gives pair `a` (placeholders where sampled).
     fn gap_axis(&self, a: usize) -> &[f64] {
-        match self {
-            Scenes::Pairs(p) => &p.gaps,
-            Scenes::Rows(r) => &r.gaps[a],
+        match self.0 {
+            Plan::Pair(p) => &p.gaps,
+            Plan::Row(r) => &r.gaps[a],
         }
     }
 
@@ -77,12 +59,12 @@ impl Scenes<'_> {
     fn gap_sampled(&self, a: usize) -> bool {
         use crate::plan::row::RowSampled;
         use crate::plan::SampledAxis;
-        match self {
-            Scenes::Pairs(p) => p
+        match self.0 {
+            Plan::Pair(p) => p
                 .samples
                 .as_ref()
                 .is_some_and(|s| s.axes.contains(&SampledAxis::Gap)),
-            Scenes::Rows(r) => r.samples.as_ref().is_some_and(|s| {
+            Plan::Row(r) => r.samples.as_ref().is_some_and(|s| {
                 s.axes
                     .iter()
                     .any(|x| *x == RowSampled::Gap(a) || *x == RowSampled::SharedGap)
@@ -95,11 +77,11 @@ impl Scenes<'_> {
         let mut h: Vec<String> = vec!["run".into(), "record".into()];
         h.extend(TARGET_COLUMNS.map(String::from));
         h.extend(["scale_factor", "pga_g"].map(String::from));
-        match self {
-            Scenes::Pairs(_) => {
+        match self.0 {
+            Plan::Pair(_) => {
                 h.extend(["m1_kg", "t1_s", "xi1", "m2_kg", "t2_s", "xi2"].map(String::from))
             }
-            Scenes::Rows(r) => {
+            Plan::Row(r) => {
                 for b in 1..=r.buildings.len() {
                     for c in ["storeys", "mass_kg", "t1_s", "xi"] {
                         h.push(format!("b{b}_{c}"));
@@ -120,15 +102,15 @@ impl Scenes<'_> {
             c
         };
         let sample = |s: Option<usize>| s.map(|s| s.to_string()).unwrap_or_default();
-        match self {
-            Scenes::Pairs(p) => {
+        match self.0 {
+            Plan::Pair(p) => {
                 let r = p.motion_run(m);
-                let mut cells = motion_cells(&p.contact, &r.contact());
+                let mut cells = motion_cells(&p.contact, &r.contact);
                 cells.extend([r.m1, r.t1, r.xi1, r.m2, r.t2, r.xi2].map(num));
                 cells.push(sample(r.sample));
                 cells
             }
-            Scenes::Rows(plan) => {
+            Plan::Row(plan) => {
                 let r = plan.motion_run(m);
                 let mut cells = motion_cells(&plan.contact, &r.contact);
                 for (b, a) in plan.buildings.iter().enumerate() {
@@ -145,12 +127,12 @@ impl Scenes<'_> {
 
     /// Motion `m`'s fundamental periods as given (s), and its record's scale.
     fn periods(&self, m: u64) -> (Vec<f64>, f64) {
-        match self {
-            Scenes::Pairs(p) => {
+        match self.0 {
+            Plan::Pair(p) => {
                 let r = p.motion_run(m);
                 (vec![r.t1, r.t2], r.scale)
             }
-            Scenes::Rows(plan) => {
+            Plan::Row(plan) => {
                 let r = plan.motion_run(m);
                 (r.period, r.contact.scale)
             }
@@ -159,15 +141,15 @@ impl Scenes<'_> {
 
     /// Motion `m`'s buildings, left to right.
     fn buildings(&self, m: u64) -> Vec<ShearBuilding> {
-        match self {
-            Scenes::Pairs(p) => {
+        match self.0 {
+            Plan::Pair(p) => {
                 let r = p.motion_run(m);
                 let single = |m: f64, t: f64, xi: f64| {
                     ShearBuilding::single(&Oscillator::from_period(m, t, xi), xi, PAIR_STOREY_M)
                 };
                 vec![single(r.m1, r.t1, r.xi1), single(r.m2, r.t2, r.xi2)]
             }
-            Scenes::Rows(plan) => plan.row(&plan.motion_run(m)).buildings,
+            Plan::Row(plan) => plan.row(&plan.motion_run(m)).buildings,
         }
     }
 }
@@ -225,8 +207,8 @@ pub struct GapStudy<'a> {
 
 impl<'a> GapStudy<'a> {
     /// Compute every response (in parallel on the current rayon pool).
-    pub fn run(plan: &'a crate::plan::Plan) -> GapStudy<'a> {
-        let scenes = Scenes::from(plan);
+    pub fn run(plan: &'a Plan) -> GapStudy<'a> {
+        let scenes = Scenes(plan);
         let motions = scenes.motions();
         let inner = motions.inner;
         let per_record = inner * motions.intensities as u64;

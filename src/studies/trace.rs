@@ -23,8 +23,9 @@ pub enum TraceError {
 #[derive(Debug, Clone)]
 pub struct Trace {
     pub spec: RunSpec,
-    /// The run's output: the sweep's row for this run.
     pub output: RunOutput,
+    /// The run's cells as the sweep writes them ([`crate::plan::columns::header`] order).
+    pub row: Vec<String>,
     pub samples: Vec<Sample>,
 }
 
@@ -50,6 +51,7 @@ pub fn trace(plan: &Plan, run: u64) -> Result<Trace, TraceError> {
         Some(&mut |s: &Sample| samples.push(*s)),
     );
     Ok(Trace {
+        row: crate::plan::columns::row(pair, &spec, &output),
         spec,
         output,
         samples,
@@ -71,10 +73,9 @@ pub const HEADER: [&str; 10] = [
 ];
 
 impl Trace {
-    /// Each sample's absolute floor accelerations, from the equations of motion
+    /// A sample's absolute floor accelerations in the pair `p`, from the equations of motion
     /// `m (u'' + ag) + c u' + k u = -+F` (the contact pushes building 1 back, building 2 on).
-    fn accelerations(&self, s: &Sample) -> [f64; 2] {
-        let p = self.spec.pair();
+    fn accelerations(p: &crate::physics::model::Pair, s: &Sample) -> [f64; 2] {
         let z = &s.z;
         [
             0.0 - (p.b1.c * z[1] + p.b1.k * z[0] + s.force) / p.b1.m,
@@ -85,11 +86,12 @@ impl Trace {
     /// The samples as CSV ([`HEADER`]).
     pub fn csv(&self) -> String {
         let num = crate::plan::columns::num;
+        let pair = self.spec.pair();
         let mut s = HEADER.join(",");
         s.push('\n');
         for x in &self.samples {
             let z = &x.z;
-            let [a1, a2] = self.accelerations(x);
+            let [a1, a2] = Self::accelerations(&pair, x);
             let penetration = (z[0] - z[2] - self.spec.gap).max(0.0);
             let mut cells: Vec<String> =
                 [x.t, z[0], z[1], z[2], z[3], a1, a2, penetration, x.force]
