@@ -100,10 +100,14 @@ impl Fingerprint {
             damping: one(0.05),
         };
         let base = Fingerprint::hashed(&plan.contact.spec, &unit, &unit, &one(0.0), &None);
-        let text = format!(
+        let mut text = format!(
             "{}|{:?}|{:?}|{:?}",
             base.plan, plan.buildings, plan.gaps, plan.samples
         );
+        // Elastic rows hash as they did before storeys could yield.
+        if plan.yielding.iter().any(Option::is_some) {
+            text.push_str(&format!("|{:?}", plan.yielding));
+        }
         Fingerprint {
             plan: hex(Sha256::digest(text.as_bytes())),
             ..base

@@ -119,6 +119,26 @@ pub struct BuildingOutput {
     pub peak_accel: f64,
     /// The floor of that acceleration (from 1; 0 while the building has not moved).
     pub accel_floor: u32,
+    /// Residual drift, ductility and hysteretic energy, where its storeys yield.
+    pub inelastic: Option<InelasticOutput>,
+}
+
+/// What a yielding building reports besides the elastic peaks.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct InelasticOutput {
+    /// Largest `|p_j| / h_j` over the storeys at rest after the motion; NaN where the run did
+    /// not settle (`solver::row::yielding::SETTLE_PERIODS`) or failed.
+    pub residual_drift_ratio: f64,
+    /// Its storey (from 1; 0 when no storey yielded).
+    pub residual_storey: u32,
+    /// Largest `max_t |d_j| / d_y,j` over the storeys.
+    pub peak_ductility: f64,
+    /// Its storey (from 1).
+    pub ductility_storey: u32,
+    /// `sum_j int f_j dp_j`: the springs' work less the elastic energy they hold at the end, J.
+    pub hysteretic_energy: f64,
+    /// Storeys that yielded at least once.
+    pub yielded_storeys: u32,
 }
 
 /// Per-run results of a row. The totals gather the levels: impacts summed, the largest peak

@@ -54,6 +54,39 @@ pub struct ShearBuilding {
     /// Storey heights, m.
     pub heights: Vec<f64>,
     pub damping: Damping,
+    /// Bilinear storey springs (None: every storey linear elastic).
+    pub yielding: Option<Yielding>,
+}
+
+/// Storeys that yield: storey `j` is a bilinear spring with kinematic hardening (physics.md
+/// section 8; OpenSees `Steel01` without isotropic hardening): initial stiffness `k_j`, yield
+/// force `force[j]`, post-yield stiffness `post_yield[j] k_j`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Yielding {
+    /// Yield force per storey, N (> 0).
+    pub force: Vec<f64>,
+    /// Post-yield stiffness ratio `b` per storey, `0 <= b < 1` (0: elastic-perfectly-plastic).
+    pub post_yield: Vec<f64>,
+}
+
+impl Yielding {
+    /// Yield forces `F_y,j = k_j theta_y,j h_j` from yield drift ratios `theta_y` (per storey).
+    pub fn from_drift_ratio(
+        stiffness: &[f64],
+        heights: &[f64],
+        theta_y: &[f64],
+        post_yield: Vec<f64>,
+    ) -> Yielding {
+        Yielding {
+            force: stiffness
+                .iter()
+                .zip(heights)
+                .zip(theta_y)
+                .map(|((k, h), t)| k * t * h)
+                .collect(),
+            post_yield,
+        }
+    }
 }
 
 impl ShearBuilding {
@@ -71,6 +104,7 @@ impl ShearBuilding {
             stiffness: profile.to_vec(),
             heights,
             damping,
+            yielding: None,
         };
         let w1 = b.eigen().0[0].sqrt();
         let target = 2.0 * std::f64::consts::PI / period;
@@ -88,6 +122,7 @@ impl ShearBuilding {
             stiffness: vec![o.k],
             heights: vec![height],
             damping: Damping::Modal(xi),
+            yielding: None,
         }
     }
 
@@ -292,6 +327,7 @@ mod tests {
             stiffness: vec![k; n],
             heights: vec![3.0; n],
             damping,
+            yielding: None,
         }
     }
 
@@ -324,6 +360,7 @@ mod tests {
             stiffness: vec![9e7, 6e8, 5.5e8, 4e8, 3e8],
             heights: vec![4.0, 3.0, 3.0, 3.0, 3.0],
             damping: Damping::Rayleigh(0.05),
+            yielding: None,
         };
         let md = b.modes();
         let n = b.storeys();

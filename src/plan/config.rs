@@ -632,6 +632,30 @@ fn is_row_config(text: &str) -> bool {
         .is_ok_and(|t| t.contains_key("building"))
 }
 
+/// Yielding storeys need a storey height and belong to `[[building]]`: a pair's `[building1]`
+/// or `[building2]` that gives one is told how to write it.
+fn refuse_yielding_pair(text: &str, path: &Path) -> Result<(), ConfigError> {
+    let Ok(table) = text.parse::<toml::Table>() else {
+        return Ok(());
+    };
+    for b in ["building1", "building2"] {
+        let Some(keys) = table.get(b).and_then(|v| v.as_table()) else {
+            continue;
+        };
+        if let Some(k) = keys
+            .keys()
+            .find(|k| k.starts_with("yield_") || *k == "post_yield_ratio")
+        {
+            return Err(ConfigError::Invalid {
+                path: path.into(),
+                key: format!("{b}.{k}"),
+                message: "yielding storeys are given per [[building]]: write the pair as a row of two one-storey buildings ([[building]] with storeys = 1 and storey_height_m; configs/inelastic-pair.toml)".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Validate config `text` read from `path` (records resolved beside it and in
 /// [`records_dir`]): a pair's or a row's plan, as the config describes.
 pub fn load_text(text: &str, path: &Path) -> Result<Plan, ConfigError> {
@@ -640,6 +664,7 @@ pub fn load_text(text: &str, path: &Path) -> Result<Plan, ConfigError> {
     Ok(if is_row_config(text) {
         Plan::Row(crate::plan::row::parse_row(text, path, &base, &records)?)
     } else {
+        refuse_yielding_pair(text, path)?;
         Plan::Pair(parse(text, path, &base, &records)?)
     })
 }

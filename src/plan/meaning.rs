@@ -136,7 +136,7 @@ const ENERGY: [(&str, &str, &str); 2] = [
 ];
 
 /// Per building `k`: suffix, unit, meaning.
-const PER_BUILDING: [(&str, &str, &str); 9] = [
+const PER_BUILDING: [(&str, &str, &str); 15] = [
     ("storeys", "-", "storeys of building {k}"),
     (
         "mass_kg",
@@ -165,6 +165,28 @@ const PER_BUILDING: [(&str, &str, &str); 9] = [
         "accel_floor",
         "-",
         "the floor of that acceleration (from 1)",
+    ),
+    (
+        "residual_drift_ratio",
+        "-",
+        "largest residual interstorey drift ratio of building {k} at rest after the motion (yielding storeys; empty where the run did not settle)",
+    ),
+    ("residual_storey", "-", "the storey of that residual drift (from 1)"),
+    (
+        "peak_ductility",
+        "-",
+        "largest storey ductility demand of building {k}: peak drift / yield drift",
+    ),
+    ("ductility_storey", "-", "the storey of that ductility (from 1)"),
+    (
+        "hysteretic_energy_j",
+        "J",
+        "hysteretic energy of building {k}'s storeys: their work less the elastic energy they hold at the end",
+    ),
+    (
+        "yielded_storeys",
+        "-",
+        "storeys of building {k} that yielded",
     ),
 ];
 
@@ -271,6 +293,13 @@ mod tests {
             .text
             .contains("floor 3 of building 1 meets floor 2 of building 2"));
         assert_eq!(meaning("b12_peak_drift_ratio").unwrap().unit, "-");
+        for c in crate::plan::row::BUILDING_OUTPUTS
+            .iter()
+            .chain(&crate::plan::row::INELASTIC_OUTPUTS)
+        {
+            assert!(meaning(&format!("b3_{c}")).is_some(), "{c}");
+        }
+        assert_eq!(meaning("b2_hysteretic_energy_j").unwrap().unit, "J");
         assert_eq!(
             meaning("gap_2_3_m").unwrap().text,
             "gap between buildings 2 and 3"

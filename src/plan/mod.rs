@@ -97,6 +97,14 @@ impl Plan {
         }
     }
 
+    /// Do some building's storeys yield?
+    pub fn yields(&self) -> bool {
+        match self {
+            Plan::Pair(_) => false,
+            Plan::Row(r) => r.yielding.iter().any(Option::is_some),
+        }
+    }
+
     /// The most storeys of any building (1 for a pair).
     pub fn max_storeys(&self) -> usize {
         match self {
@@ -110,12 +118,23 @@ impl Plan {
     pub fn scene(&self) -> String {
         match self {
             Plan::Pair(_) => "a pair of one-storey buildings".into(),
-            Plan::Row(r) => format!(
-                "a row of {} buildings ({} storeys, {} contact levels)",
-                r.buildings.len(),
-                r.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
-                r.row(&r.run(0)).levels.len(),
-            ),
+            Plan::Row(r) => {
+                let yielding: Vec<String> = (0..r.buildings.len())
+                    .filter(|&b| r.yielding[b].is_some())
+                    .map(|b| (b + 1).to_string())
+                    .collect();
+                format!(
+                    "a row of {} buildings ({} storeys, {} contact levels{})",
+                    r.buildings.len(),
+                    r.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
+                    r.row(&r.run(0)).levels.len(),
+                    if yielding.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; yielding storeys in building {}", yielding.join(", "))
+                    }
+                )
+            }
         }
     }
 

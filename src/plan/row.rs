@@ -9,7 +9,7 @@
 
 use crate::physics::model::Forcing;
 use crate::physics::row::{Row, RowOutput};
-use crate::physics::shear::{Damping, ShearBuilding, MAX_STOREYS};
+use crate::physics::shear::{Damping, ShearBuilding, Yielding, MAX_STOREYS};
 use crate::physics::solver::row::RowScheme;
 use crate::physics::solver::Scheme;
 use crate::plan::columns;
@@ -60,6 +60,77 @@ pub struct RawShearBuilding {
     pub damping: Option<String>,
     /// The gap to the next building (default `contact.gap_m`).
     pub gap_right_m: Option<Axis>,
+    /// Yielding storeys (physics.md section 8): one of `yield_drift_ratio` (`F_y = k theta_y
+    /// h`), `yield_force_n` (per storey) or `yield_base_shear_coefficient` (`C_y`: base shear
+    /// strength `C_y W`, `W` the weight, storey strengths from `yield_shear_distribution`);
+    /// `post_yield_ratio` (`b`, default 0: elastic-perfectly-plastic). Absent: elastic.
+    pub yield_drift_ratio: Option<PerStorey>,
+    pub yield_force_n: Option<PerStorey>,
+    pub yield_base_shear_coefficient: Option<f64>,
+    /// `inverted_triangular` (lateral forces `~ m_i z_i`, the default) or `uniform` (`~ m_i`).
+    pub yield_shear_distribution: Option<String>,
+    pub post_yield_ratio: Option<PerStorey>,
+    /// Which stiffness the Rayleigh or modal damping is built on: `initial` (the only choice;
+    /// tangent-stiffness damping can create spurious damping forces after yielding).
+    pub damping_stiffness: Option<String>,
+}
+
+/// How strong a yielding building's storeys are.
+#[derive(Debug, Clone, PartialEq)]
+pub enum YieldStrength {
+    /// Per storey, `F_y,j = k_j theta_j h_j`.
+    DriftRatio(Vec<f64>),
+    /// Per storey, N.
+    Force(Vec<f64>),
+    /// Base shear strength `coefficient W` (`W = g sum m`), storey `j` carrying the lateral
+    /// forces above it, `~ m_i z_i` (`triangular`) or `~ m_i`.
+    BaseShear { coefficient: f64, triangular: bool },
+}
+
+/// A yielding building's storeys, as the config gives them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct YieldSpec {
+    pub strength: YieldStrength,
+    /// Post-yield stiffness ratio per storey.
+    pub post_yield: Vec<f64>,
+}
+
+impl YieldSpec {
+    /// The storeys of `b` (its stiffnesses, masses and heights final).
+    pub fn of(&self, b: &ShearBuilding) -> Yielding {
+        let force = match &self.strength {
+            YieldStrength::DriftRatio(theta) => {
+                return Yielding::from_drift_ratio(
+                    &b.stiffness,
+                    &b.heights,
+                    theta,
+                    self.post_yield.clone(),
+                )
+            }
+            YieldStrength::Force(f) => f.clone(),
+            YieldStrength::BaseShear {
+                coefficient,
+                triangular,
+            } => {
+                let z = b.elevations();
+                let w: Vec<f64> = b
+                    .masses
+                    .iter()
+                    .zip(&z)
+                    .map(|(m, z)| if *triangular { m * z } else { *m })
+                    .collect();
+                let total: f64 = w.iter().sum();
+                let base = coefficient * crate::record::G * b.masses.iter().sum::<f64>();
+                (0..w.len())
+                    .map(|j| base * w[j..].iter().sum::<f64>() / total)
+                    .collect()
+            }
+        };
+        Yielding {
+            force,
+            post_yield: self.post_yield.clone(),
+        }
+    }
 }
 
 /// A row config as written.
@@ -192,6 +263,8 @@ pub struct RowPlan {
     /// Keys the config gives that no run uses, with why.
     ignored: Vec<String>,
     per_scene: u64,
+    /// Per building, its yielding storeys (None: elastic).
+    pub yielding: Vec<Option<YieldSpec>>,
 }
 
 /// One run of a row sweep, decoded.
@@ -442,13 +515,15 @@ impl RowPlan {
                 } else {
                     Damping::Rayleigh(run.damping[b])
                 };
-                ShearBuilding::from_period(
+                let mut s = ShearBuilding::from_period(
                     masses,
                     &a.profile,
                     a.heights.clone(),
                     run.period[b],
                     damping,
-                )
+                );
+                s.yielding = self.yielding[b].as_ref().map(|y| y.of(&s));
+                s
             })
             .collect();
         let s = &run.contact;
@@ -502,9 +577,14 @@ impl RowPlan {
         ] {
             h.push(c.into());
         }
-        for b in 1..=nb {
+        for (b, y) in self.yielding.iter().enumerate() {
             for c in BUILDING_OUTPUTS {
-                h.push(format!("b{b}_{c}"));
+                h.push(format!("b{}_{c}", b + 1));
+            }
+            if y.is_some() {
+                for c in INELASTIC_OUTPUTS {
+                    h.push(format!("b{}_{c}", b + 1));
+                }
             }
         }
         for l in self.level_names() {
@@ -541,6 +621,8 @@ impl RowPlan {
                 !skip.contains(&c.as_str())
                     && !c.ends_with("_drift_storey")
                     && !c.ends_with("_accel_floor")
+                    && !c.ends_with("_residual_storey")
+                    && !c.ends_with("_ductility_storey")
             })
             .collect()
     }
@@ -574,7 +656,7 @@ impl RowPlan {
             num(out.dissipated_energy),
             out.substeps.to_string(),
         ]);
-        for b in &out.buildings {
+        for (b, y) in out.buildings.iter().zip(&self.yielding) {
             c.extend([
                 num(b.peak_roof),
                 num(b.peak_drift_ratio),
@@ -582,6 +664,19 @@ impl RowPlan {
                 num(b.peak_accel),
                 b.accel_floor.to_string(),
             ]);
+            if y.is_some() {
+                // A run that failed, or did not settle, has no residual drift: empty.
+                let ie = b.inelastic.unwrap_or_default();
+                let known = |x: f64| if x.is_finite() { num(x) } else { String::new() };
+                c.extend([
+                    known(ie.residual_drift_ratio),
+                    ie.residual_storey.to_string(),
+                    num(ie.peak_ductility),
+                    ie.ductility_storey.to_string(),
+                    num(ie.hysteretic_energy),
+                    ie.yielded_storeys.to_string(),
+                ]);
+            }
         }
         for l in &out.levels {
             c.extend([
@@ -615,6 +710,16 @@ pub const BUILDING_OUTPUTS: [&str; 5] = [
     "drift_storey",
     "peak_accel_m_s2",
     "accel_floor",
+];
+
+/// A yielding building's further output columns (after its `b1_` prefix).
+pub const INELASTIC_OUTPUTS: [&str; 6] = [
+    "residual_drift_ratio",
+    "residual_storey",
+    "peak_ductility",
+    "ductility_storey",
+    "hysteretic_energy_j",
+    "yielded_storeys",
 ];
 
 /// Each contact level's output columns (after its `level_b1f3_b2f3_` prefix).
@@ -713,6 +818,7 @@ pub fn parse_row(
         }
     };
     let mut buildings = Vec::new();
+    let mut yielding = Vec::new();
     let mut gaps = Vec::new();
     let mut shared = Vec::new();
     for (b, r) in raw.building.iter().enumerate() {
@@ -766,6 +872,7 @@ pub fn parse_row(
         let required = |a: RowSampled, given: Option<&Axis>| {
             grid_or_sampled(a, given)?.ok_or_else(|| invalid(&a.key(), config::MISSING.into()))
         };
+        yielding.push(parse_yielding(r, n, &key, &invalid)?);
         let period_s = required(RowSampled::Period(b), r.period_s.as_ref())?;
         let damping_ratio = required(RowSampled::Damping(b), r.damping_ratio.as_ref())?;
         buildings.push(ShearAxes {
@@ -872,5 +979,146 @@ pub fn parse_row(
         dims,
         ignored,
         per_scene,
+        yielding,
     })
+}
+
+/// A building's yielding storeys as its `[[building]]` gives them (`key` names its keys), or
+/// None where it gives none (elastic).
+fn parse_yielding(
+    r: &RawShearBuilding,
+    n: usize,
+    key: &dyn Fn(&str) -> String,
+    invalid: &dyn Fn(&str, String) -> ConfigError,
+) -> Result<Option<YieldSpec>, ConfigError> {
+    match r.damping_stiffness.as_deref() {
+        None | Some("initial") => {}
+        Some("tangent") => return Err(invalid(
+            &key("damping_stiffness"),
+            "`tangent` is not offered: damping on the tangent stiffness can create spurious damping forces once storeys yield; the damping is built on the initial stiffness (`initial`)".into(),
+        )),
+        Some(other) => {
+            return Err(invalid(
+                &key("damping_stiffness"),
+                format!("`{other}`: expected initial"),
+            ))
+        }
+    }
+    // One value for every storey, or one per storey, each within `ok` (`expected` says what).
+    let per_storey = |name: &str, v: &PerStorey, ok: &dyn Fn(f64) -> bool, expected: &str| {
+        let values = match v {
+            PerStorey::One(x) => vec![*x; n],
+            PerStorey::Each(v) if v.len() == n => v.clone(),
+            PerStorey::Each(v) => {
+                return Err(invalid(
+                    &key(name),
+                    format!(
+                        "{} values for {n} storeys: give one, or one per storey",
+                        v.len()
+                    ),
+                ))
+            }
+        };
+        match values.iter().position(|x| !ok(*x)) {
+            Some(i) => Err(invalid(
+                &format!("{}[{i}]", key(name)),
+                format!(
+                    "{} is out of range: expected {expected}",
+                    crate::plan::limits::show(values[i])
+                ),
+            )),
+            None => Ok(values),
+        }
+    };
+    let strengths = [
+        r.yield_drift_ratio.is_some(),
+        r.yield_force_n.is_some(),
+        r.yield_base_shear_coefficient.is_some(),
+    ];
+    let strength = match strengths.iter().filter(|&&x| x).count() {
+        0 => {
+            for (given, name) in [
+                (r.post_yield_ratio.is_some(), "post_yield_ratio"),
+                (
+                    r.yield_shear_distribution.is_some(),
+                    "yield_shear_distribution",
+                ),
+            ] {
+                if given {
+                    return Err(invalid(
+                        &key(name),
+                        "is given, but the storeys have no strength: give yield_drift_ratio, yield_force_n or yield_base_shear_coefficient".into(),
+                    ));
+                }
+            }
+            return Ok(None);
+        }
+        1 => {
+            if let Some(v) = &r.yield_drift_ratio {
+                YieldStrength::DriftRatio(per_storey(
+                    "yield_drift_ratio",
+                    v,
+                    &|x| x > 0.0 && x <= 0.2,
+                    "a drift ratio > 0 and <= 0.2",
+                )?)
+            } else if let Some(v) = &r.yield_force_n {
+                YieldStrength::Force(per_storey(
+                    "yield_force_n",
+                    v,
+                    &|x| x > 0.0 && x.is_finite(),
+                    "a force > 0 N",
+                )?)
+            } else {
+                let c = r.yield_base_shear_coefficient.unwrap_or_default();
+                if !(c > 0.0 && c <= 10.0) {
+                    return Err(invalid(
+                        &key("yield_base_shear_coefficient"),
+                        format!(
+                            "{} is out of range: expected a coefficient > 0 and <= 10 (base shear strength / weight)",
+                            crate::plan::limits::show(c)
+                        ),
+                    ));
+                }
+                let triangular = match r.yield_shear_distribution.as_deref() {
+                    None | Some("inverted_triangular") => true,
+                    Some("uniform") => false,
+                    Some(other) => {
+                        return Err(invalid(
+                            &key("yield_shear_distribution"),
+                            format!("`{other}`: expected inverted_triangular or uniform"),
+                        ))
+                    }
+                };
+                YieldStrength::BaseShear {
+                    coefficient: c,
+                    triangular,
+                }
+            }
+        }
+        _ => {
+            return Err(invalid(
+                &key("yield_drift_ratio"),
+                "give one of yield_drift_ratio, yield_force_n and yield_base_shear_coefficient, not several".into(),
+            ))
+        }
+    };
+    if r.yield_shear_distribution.is_some() && r.yield_base_shear_coefficient.is_none() {
+        return Err(invalid(
+            &key("yield_shear_distribution"),
+            "applies to yield_base_shear_coefficient only".into(),
+        ));
+    }
+    let post_yield = match &r.post_yield_ratio {
+        Some(v) => per_storey(
+            "post_yield_ratio",
+            v,
+            &|x| (0.0..1.0).contains(&x),
+            "a ratio >= 0 and < 1",
+        )?,
+        None => vec![0.0; n],
+    };
+    Ok(Some(YieldSpec {
+        strength,
+        post_yield,
+    }))
 }

@@ -2,27 +2,12 @@
 //! and for a row of multi-storey buildings; identical buildings; the runs it covers; bad input.
 
 use crate::support::run::{ok, pound};
-use crate::support::tempdir;
+use crate::support::{table, tempdir};
 use std::collections::HashMap;
 use std::path::Path;
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-/// A CSV as its header and rows, keyed by column name.
-fn table(path: &Path) -> Vec<HashMap<String, String>> {
-    let mut rd = csv::Reader::from_path(path).unwrap();
-    let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
-    rd.records()
-        .map(|r| {
-            header
-                .iter()
-                .cloned()
-                .zip(r.unwrap().iter().map(String::from))
-                .collect()
-        })
-        .collect()
 }
 
 /// `pound sweep CFG -o OUT` on the CPU, read back.

@@ -12,6 +12,7 @@ mod gpu;
 mod gpu_rows;
 mod hard;
 mod hostile;
+mod inelastic;
 mod intensity;
 mod layers;
 pub mod multistorey;

@@ -57,16 +57,7 @@ fn setup(dir: &Path) -> std::path::PathBuf {
 }
 
 fn sweep(cfg: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
-    let mut args = vec![
-        "sweep",
-        cfg.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--backend",
-        "cpu",
-    ];
-    args.extend_from_slice(extra);
-    pound(&args)
+    crate::support::sweep_cpu(cfg, out, extra)
 }
 
 /// `pound sweep` on the CPU, started in the background (to be killed).

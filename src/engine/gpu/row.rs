@@ -605,6 +605,7 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32]) -> Option<RowOutput> {
                 drift_storey: bc[BC_DRIFT_STOREY],
                 peak_accel: bs[BS_ACCEL],
                 accel_floor: bc[BC_ACCEL_FLOOR],
+                inelastic: None,
             }
         })
         .collect();

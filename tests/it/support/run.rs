@@ -54,3 +54,36 @@ pub fn pound_with_file_limit(args: &[&str], limit: u64) -> std::process::Output 
     }
     cmd.output().expect("run pound")
 }
+
+/// `pound sweep CONFIG -o OUT --backend cpu EXTRA...`.
+pub fn sweep_cpu(
+    cfg: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> std::process::Output {
+    let mut args = vec![
+        "sweep",
+        cfg.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--backend",
+        "cpu",
+    ];
+    args.extend_from_slice(extra);
+    pound(&args)
+}
+
+/// A CSV as its rows, keyed by column name.
+pub fn table(path: &std::path::Path) -> Vec<std::collections::HashMap<String, String>> {
+    let mut rd = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
+    rd.records()
+        .map(|r| {
+            header
+                .iter()
+                .cloned()
+                .zip(r.unwrap().iter().map(String::from))
+                .collect()
+        })
+        .collect()
+}

@@ -241,8 +241,15 @@ fn run_with(
     // In a row of two, a level that touches moves both buildings.
     let can_stand = standing != Standing::None && m.buildings.len() > 2;
     let mut lookouts: Vec<Lookout> = Vec::new();
-    for i in 0..forcing.intervals() {
-        let seg = Segment::of(forcing, i);
+    // Yielding storeys: the static response to their plastic loads (free steps are exact about
+    // it), their spring states for the substeps, and the buildings one may yield in.
+    let yields = !m.storeys.is_empty();
+    let mut q_static = vec![0.0; n];
+    let mut storey_modes = Vec::with_capacity(m.storeys.len());
+    let mut yield_watch = vec![false; m.buildings.len()];
+    let mut i = 0;
+    while let Some(seg) = super::yielding::next_segment(m, forcing, i, &mut run) {
+        i += 1;
         let z = run.z.clone();
         // The exact free step of every mode: the step itself when no level may touch, and the
         // buildings' that stand still through a step of substeps (none in a row of two).
@@ -250,11 +257,18 @@ fn run_with(
         z1.copy_from_slice(&z);
         work.clear();
         if can_stand || !any_contact {
+            if yields {
+                m.static_offsets(&z, &mut q_static);
+            }
             for k in 0..n {
                 let (a0, a1) = (m.part[k] * seg.a0, m.part[k] * seg.a1);
-                (z1[k], z1[n + k]) = props[k].step(z[k], z[n + k], a0, a1);
+                let q = if yields { z[k] - q_static[k] } else { z[k] };
+                (z1[k], z1[n + k]) = props[k].step(q, z[n + k], a0, a1);
+                if yields {
+                    z1[k] += q_static[k];
+                }
                 if let Some(f) = &forms {
-                    let (vv, agv) = f[k].integrals(z[k], z[n + k], a0, a1);
+                    let (vv, agv) = f[k].integrals(q, z[n + k], a0, a1);
                     z1[2 * n + nl] -= agv;
                     z1[2 * n + nl + 1] += m.two_xi_w[k] * vv;
                     work.push((agv, vv));
@@ -263,9 +277,18 @@ fn run_with(
         }
         may_touch.fill(None);
         let mut bounded = false;
-        if !any_contact {
+        // A storey that yields, or may in the exact free step, moves its building in substeps.
+        let mut yielding = false;
+        if yields && (can_stand || !any_contact) {
             m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
             bounded = true;
+            yielding = m.yield_watch(&run.storey_modes, (&z, &z1), &bounds, dt, &mut yield_watch);
+        }
+        if !any_contact {
+            if !bounded {
+                m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
+                bounded = true;
+            }
             // The floors at both ends are needed for the peaks if the step is free; the levels
             // read their penetrations from them (O(1) each), and weigh each mode's bound only
             // where the building's coarse bound leaves the touch open.
@@ -299,7 +322,7 @@ fn run_with(
                     touching |= t;
                 }
             }
-            if touching {
+            if touching || yielding {
                 run.drop_free_ends();
             } else {
                 run.free_step(&seg, z1.clone());
@@ -318,6 +341,11 @@ fn run_with(
                 if ls.mode != Mode::Free || *may == Some(true) {
                     active[lm.buildings.0] = true;
                     active[lm.buildings.1] = true;
+                }
+            }
+            if yielding {
+                for (a, w) in active.iter_mut().zip(&yield_watch) {
+                    *a |= *w;
                 }
             }
         }
@@ -446,10 +474,12 @@ fn run_with(
                 let (z0, trial) = loop {
                     let z0 = run.z.clone();
                     run.level_modes(&mut modes);
+                    storey_modes.clone_from(&run.storey_modes);
                     let motion = Motion {
                         levels: &modes,
                         active: &moving,
                         energy: o.energy,
+                        storeys: &storey_modes,
                     };
                     let trial = rk4(sm, &motion, &seg, t, &z0, hs, &mut stages);
                     // A building standing still that a moving neighbour may reach in this
@@ -481,6 +511,7 @@ fn run_with(
                     levels: &modes,
                     active: &moving,
                     energy: o.energy,
+                    storeys: &storey_modes,
                 };
                 let step = |x: f64| rk4(sm, &motion, &seg, t, &z0, x, &mut stages);
                 t += run.accept(
@@ -613,6 +644,7 @@ mod tests {
             levels: &levels,
             active: &[true; 3],
             energy: true,
+            storeys: &[],
         };
         super::super::rhs(&m, &motion, 0.7, &z, &mut fz);
         super::super::rhs(&sub, &motion, 0.7, &y, &mut fy);

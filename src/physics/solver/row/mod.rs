@@ -17,6 +17,7 @@
 
 pub mod fast;
 pub mod reference;
+pub mod yielding;
 
 use super::events::{error_margin, fourth_derivative_bound, hidden_rise, locate, touch};
 use super::hermite::{cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak};
@@ -24,8 +25,9 @@ use super::tracker::ForceHistory;
 use super::{Mode, Segment};
 use crate::physics::contact::Contact;
 use crate::physics::model::{EnergyBalance, Forcing, Status};
-use crate::physics::row::{BuildingOutput, LevelOutput, Row, RowOutput};
+use crate::physics::row::{BuildingOutput, InelasticOutput, LevelOutput, Row, RowOutput};
 use crate::physics::shear::Modes;
+use yielding::{StoreyMode, StoreyModel};
 
 pub use fast::RowFastOptions;
 
@@ -47,6 +49,8 @@ pub(crate) struct BuildingModel {
     /// Its slice of the state holds floor displacements and velocities instead of modes
     /// (in the fast scheme's contact substeps, [`RowModel::substep_model`]).
     pub in_floors: bool,
+    /// Index of its storey 0 in [`RowModel::storeys`] where its storeys yield.
+    pub first_storey: Option<usize>,
 }
 
 /// Buildings of this many storeys or more take their contact substeps in floor coordinates.
@@ -118,6 +122,8 @@ pub struct RowModel {
     pub(crate) part: Vec<f64>,
     pub(crate) buildings: Vec<BuildingModel>,
     pub(crate) levels: Vec<LevelModel>,
+    /// The yielding storeys, building by building (none in an elastic row).
+    pub(crate) storeys: Vec<StoreyModel>,
 }
 
 impl RowScheme {
@@ -132,9 +138,10 @@ impl RowScheme {
 impl RowModel {
     pub fn new(row: &Row) -> RowModel {
         let mut buildings = Vec::new();
+        let mut storeys = Vec::new();
         let mut off = 0;
         let (mut w2, mut two_xi_w, mut part) = (vec![], vec![], vec![]);
-        for b in &row.buildings {
+        for (k, b) in row.buildings.iter().enumerate() {
             let modes = b.modes();
             for i in 0..modes.count() {
                 w2.push(modes.omega[i] * modes.omega[i]);
@@ -156,9 +163,33 @@ impl RowModel {
                         .fold(0.0, |a: f64, row| a.max(row[i].abs()))
                 })
                 .collect();
+            let first_storey = b.yielding.as_ref().map(|y| {
+                let first = storeys.len();
+                for j in 0..n {
+                    let modal_row: Vec<f64> = (0..n)
+                        .map(|i| {
+                            modes.shape[j][i] - if j == 0 { 0.0 } else { modes.shape[j - 1][i] }
+                        })
+                        .collect();
+                    storeys.push(StoreyModel {
+                        building: k,
+                        storey: j,
+                        k: b.stiffness[j],
+                        d_y: y.force[j] / b.stiffness[j],
+                        b: y.post_yield[j],
+                        height: b.heights[j],
+                        off,
+                        row: modal_row.clone(),
+                        psi: modal_row.clone(),
+                        modal_row,
+                    });
+                }
+                first
+            });
             buildings.push(BuildingModel {
                 off,
                 shape_max,
+                first_storey,
                 modes,
                 heights: b.heights.clone(),
                 masses: b.masses.clone(),
@@ -195,6 +226,7 @@ impl RowModel {
             part,
             buildings,
             levels,
+            storeys,
         }
     }
 
@@ -226,6 +258,7 @@ impl RowModel {
                 l.psi_b = vec![1.0 / bb.masses[l.floors.1]];
             }
         }
+        m.storeys_to_coordinates();
         Some(m)
     }
 
@@ -284,7 +317,7 @@ impl RowModel {
 
     /// Length of the state vector.
     pub(crate) fn len(&self) -> usize {
-        2 * self.n + self.levels.len() + 2
+        2 * self.n + self.levels.len() + 2 + 2 * self.storeys.len()
     }
 
     /// The state at rest.
@@ -321,12 +354,17 @@ impl RowModel {
         self.w2[i].sqrt() + self.two_xi_w[i]
     }
 
-    /// Kinetic plus strain energy, J.
+    /// Kinetic plus strain energy (what the springs hold), J, in modal state `z`.
     pub(crate) fn mechanical_energy(&self, z: &[f64]) -> f64 {
         let n = self.n;
-        (0..n)
+        let modal: f64 = (0..n)
             .map(|i| 0.5 * (z[n + i] * z[n + i] + self.w2[i] * z[i] * z[i]))
-            .sum()
+            .sum();
+        if self.storeys.is_empty() {
+            modal
+        } else {
+            modal + self.plastic_strain_correction(z)
+        }
     }
 }
 
@@ -492,6 +530,15 @@ impl RowModel {
         out: &mut Vec<f64>,
     ) {
         let n = self.n;
+        // About the static response to the plastic loads: the motion the propagator steps.
+        let mut shift = [Vec::new(), Vec::new()];
+        if !self.storeys.is_empty() {
+            for (s, z) in shift.iter_mut().zip([z0, z1]) {
+                s.resize(n, 0.0);
+                self.static_offsets(z, s);
+            }
+        }
+        let at = |s: &Vec<f64>, k: usize| s.get(k).copied().unwrap_or(0.0);
         out.clear();
         out.extend((0..n).map(|k| {
             let osc = crate::physics::model::Oscillator {
@@ -504,7 +551,13 @@ impl RowModel {
                 a1: seg.a1 * self.part[k],
                 ..*seg
             };
-            let q = z0[k].abs().max(z1[k].abs());
+            let q = if shift[0].is_empty() {
+                z0[k].abs().max(z1[k].abs())
+            } else {
+                (z0[k] - at(&shift[0], k))
+                    .abs()
+                    .max((z1[k] - at(&shift[1], k)).abs())
+            };
             let qd = z0[n + k].abs().max(z1[n + k].abs());
             fourth_derivative_bound(&osc, q, qd, &s)
         }));
@@ -523,6 +576,8 @@ pub(crate) struct Motion<'a> {
     pub active: &'a [bool],
     /// Integrate the input and damping work (the energy balance); else their slots stay.
     pub energy: bool,
+    /// Each yielding storey's spring state.
+    pub storeys: &'a [StoreyMode],
 }
 
 /// The right-hand side at ground acceleration `ag`, into `out`.
@@ -574,6 +629,9 @@ pub(crate) fn rhs(m: &RowModel, motion: &Motion, ag: f64, z: &[f64], out: &mut [
             }
         }
     }
+    if !m.storeys.is_empty() {
+        plastic_rhs(m, motion, z, out);
+    }
     for (l, (lm, &(mode, v0))) in m.levels.iter().zip(lv).enumerate() {
         if mode == Mode::Free {
             out[2 * n + l] = 0.0;
@@ -590,6 +648,39 @@ pub(crate) fn rhs(m: &RowModel, motion: &Motion, ag: f64, z: &[f64], out: &mut [
     }
     out[2 * n + nl] = e_in;
     out[2 * n + nl + 1] = e_damp;
+}
+
+/// The yielding storeys' part of the right-hand side: each plastic load on the accelerations,
+/// and while a storey yields, its plastic drift rate `(1 - b) d'` and plastic work rate
+/// `f p'`.
+fn plastic_rhs(m: &RowModel, motion: &Motion, z: &[f64], out: &mut [f64]) {
+    let (n, ns) = (m.n, m.storeys.len());
+    for (s, sm) in m.storeys.iter().enumerate() {
+        let ps = m.plastic_slot(s);
+        (out[ps], out[ps + ns]) = (0.0, 0.0);
+        if !motion.active[sm.building] {
+            continue;
+        }
+        let p = z[ps];
+        let kp = sm.k * p;
+        for (i, psi) in sm.psi.iter().enumerate() {
+            out[n + sm.off + i] += psi * kp;
+        }
+        if let StoreyMode::Yielding(_) = motion.storeys[s] {
+            let dp = (1.0 - sm.b) * sm.drift(z, n);
+            out[ps] = dp;
+            out[ps + ns] = sm.k * (sm.drift(z, 0) - p) * dp;
+        }
+    }
+}
+
+/// One yielding storey's record (its spring state is in [`RowRun::storey_modes`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct StoreyState {
+    /// It has yielded at least once.
+    pub yielded: bool,
+    /// Its largest `|d| / h`.
+    pub peak_drift_ratio: f64,
 }
 
 /// The contact state of one level and its impact bookkeeping.
@@ -639,6 +730,9 @@ struct Floors {
     /// Scratch: modal accelerations and jerks.
     acc: Vec<f64>,
     jrk: Vec<f64>,
+    /// Scratch of a yielding building: its plastic loads' accelerations and their rates.
+    pl_acc: Vec<f64>,
+    pl_jerk: Vec<f64>,
 }
 
 impl Floors {
@@ -652,18 +746,50 @@ impl Floors {
             jerk: v.clone(),
             force: v.clone(),
             acc: v.clone(),
-            jrk: v,
+            jrk: v.clone(),
+            pl_acc: v.clone(),
+            pl_jerk: v,
         }
     }
 
-    /// Fill from state `z` at ground acceleration `ag`, with `self.force` already set.
+    /// Building `k`'s plastic loads (`M^-1 D^T K p` and its rate) in state `z`, into `pl_acc`
+    /// and `pl_jerk`: in its modes, or in its floors when `floors`.
+    fn plastic(&mut self, m: &RowModel, k: usize, z: &[f64], storeys: &[StoreyMode], floors: bool) {
+        self.pl_acc.fill(0.0);
+        self.pl_jerk.fill(0.0);
+        m.add_plastic(k, z, storeys, &mut self.pl_acc, &mut self.pl_jerk);
+        let b = &m.buildings[k];
+        if floors && !b.in_floors {
+            // M^-1 g = Phi Phi^T g: the modal loads back to the floors.
+            let sh = &b.modes.shape;
+            let (g, gd): (Vec<f64>, Vec<f64>) = (self.pl_acc.clone(), self.pl_jerk.clone());
+            for (j, row) in sh.iter().enumerate() {
+                self.pl_acc[j] = dot(row, &g);
+                self.pl_jerk[j] = dot(row, &gd);
+            }
+        }
+    }
+
+    /// Fill building `k` (`b`) from state `z` at ground acceleration `ag`, with `self.force`
+    /// already set; `storeys`: the yielding storeys' spring states.
     #[allow(clippy::needless_range_loop)] // floor j of five vectors
-    fn fill(&mut self, m: &RowModel, b: &BuildingModel, z: &[f64], ag: f64) {
+    fn fill(
+        &mut self,
+        m: &RowModel,
+        (k, b): (usize, &BuildingModel),
+        z: &[f64],
+        ag: f64,
+        storeys: &[StoreyMode],
+    ) {
         let n = m.n;
         let nb = b.n();
         let o = b.off;
+        let yields = b.first_storey.is_some();
         // Below FLOOR_SUBSTEPS_FROM storeys the modes' four products cost no more.
         if let Some(f) = b.floor_form.as_ref().filter(|_| nb >= FLOOR_SUBSTEPS_FROM) {
+            if yields {
+                self.plastic(m, k, z, storeys, true);
+            }
             // With Rayleigh damping, from the floors' motion: the structural acceleration (no
             // ground, no contact) `-a0 u' - M^-1 K (u + a1 u')`, and the jerk
             // `-a0 u''_s - M^-1 K (u' + a1 u''_s)` of the structural-and-ground acceleration
@@ -683,7 +809,10 @@ impl Floors {
             let (u, v) = (&self.u, &self.v);
             f.k_over_m(|j| u[j] + f.a1 * v[j], &mut self.acc);
             for j in 0..nb {
-                let acc = -f.a0 * v[j] - self.acc[j];
+                let mut acc = -f.a0 * v[j] - self.acc[j];
+                if yields {
+                    acc += self.pl_acc[j];
+                }
                 self.acc[j] = acc;
                 let a_abs = acc + self.force[j] / b.masses[j];
                 self.a_abs[j] = a_abs;
@@ -693,16 +822,28 @@ impl Floors {
             f.k_over_m(|j| v[j] + f.a1 * (acc[j] - ag), &mut self.jrk);
             for j in 0..nb {
                 self.jerk[j] = -f.a0 * (self.acc[j] - ag) - self.jrk[j];
+                if yields {
+                    self.jerk[j] += self.pl_jerk[j];
+                }
             }
             return;
+        }
+        if yields {
+            self.plastic(m, k, z, storeys, false);
         }
         // Modal accelerations without ground and contact (they enter floor by floor below), and
         // the jerk of the structural part, with the ground's contribution to q''.
         for i in 0..nb {
-            let acc = -m.two_xi_w[o + i] * z[n + o + i] - m.w2[o + i] * z[o + i];
+            let mut acc = -m.two_xi_w[o + i] * z[n + o + i] - m.w2[o + i] * z[o + i];
+            if yields {
+                acc += self.pl_acc[i];
+            }
             self.acc[i] = acc;
             let qdd = acc - m.part[o + i] * ag;
             self.jrk[i] = -m.two_xi_w[o + i] * qdd - m.w2[o + i] * z[n + o + i];
+            if yields {
+                self.jrk[i] += self.pl_jerk[i];
+            }
         }
         let sh = &b.modes.shape;
         for j in 0..nb {
@@ -746,6 +887,12 @@ pub(crate) struct RowRun<'m> {
     /// for events and tracked ([`RowRun::set_active`]).
     pub active: Vec<bool>,
     level_on: Vec<bool>,
+    /// Each yielding storey's spring state, and its record.
+    pub storey_modes: Vec<StoreyMode>,
+    storeys: Vec<StoreyState>,
+    /// No storey can yield again after the run's end (set by the scheme,
+    /// [`RowModel::settled`]): the plastic drifts are the residual drifts.
+    pub settled: bool,
 }
 
 impl<'m> RowRun<'m> {
@@ -771,10 +918,16 @@ impl<'m> RowRun<'m> {
             touched: vec![false; m.buildings.len()],
             active: vec![true; m.buildings.len()],
             level_on: vec![true; m.levels.len()],
+            storey_modes: vec![StoreyMode::Elastic; m.storeys.len()],
+            storeys: vec![StoreyState::default(); m.storeys.len()],
+            settled: false,
             z,
         };
         let z = run.z.clone();
         run.transitions(t0, &z, &z);
+        if !m.storeys.is_empty() {
+            run.storey_transitions();
+        }
         run
     }
 
@@ -841,6 +994,11 @@ impl<'m> RowRun<'m> {
         let h = t - seg.t0;
         let z0 = self.z.clone();
         if h > 0.0 {
+            // About the static response to its plastic loads (constant: it stood still).
+            let mut qs = vec![0.0; n];
+            if b.first_storey.is_some() {
+                modal.static_offsets(&z0, &mut qs);
+            }
             for i in b.off..b.off + b.n() {
                 let osc = crate::physics::model::Oscillator {
                     m: 1.0,
@@ -849,10 +1007,12 @@ impl<'m> RowRun<'m> {
                 };
                 let (a0, a1) = (modal.part[i] * seg.a0, modal.part[i] * seg.at(t));
                 let p = crate::physics::propagator::Propagator::new(&osc, h);
-                (self.z[i], self.z[n + i]) = p.step(z0[i], z0[n + i], a0, a1);
+                let q0 = z0[i] - qs[i];
+                let (q1, v1) = p.step(q0, z0[n + i], a0, a1);
+                (self.z[i], self.z[n + i]) = (q1 + qs[i], v1);
                 if self.energy {
                     let f = crate::physics::propagator::EnergyForms::new(&osc, h);
-                    let (vv, agv) = f.integrals(z0[i], z0[n + i], a0, a1);
+                    let (vv, agv) = f.integrals(q0, z0[n + i], a0, a1);
                     self.z[2 * n + nl] -= agv;
                     self.z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
                 }
@@ -901,7 +1061,7 @@ impl<'m> RowRun<'m> {
         for (end, z, a) in [(0, z0, ag.0), (1, z1, ag.1)] {
             let f = &mut self.floors[k][end];
             f.force.fill(0.0);
-            f.fill(modal, bm, z, a);
+            f.fill(modal, (k, bm), z, a, &self.storey_modes);
         }
         self.raise_building(k, bm, h, true);
     }
@@ -916,17 +1076,102 @@ impl<'m> RowRun<'m> {
         self.levels.iter().any(|l| l.mode != Mode::Free)
     }
 
-    /// The largest event value of the levels (positive once any level's mode must end).
+    /// Is some storey on a bounding line?
+    pub fn any_yielding(&self) -> bool {
+        self.storey_modes
+            .iter()
+            .any(|m| matches!(m, StoreyMode::Yielding(_)))
+    }
+
+    /// The largest event value of the levels and the storeys of the moving buildings (positive
+    /// once any level's contact mode or storey's spring state must end).
     fn event_max(&self, z: &[f64]) -> f64 {
         let n = self.m.n;
-        self.m
+        let levels = self
+            .m
             .levels
             .iter()
             .zip(&self.levels)
             .zip(&self.level_on)
             .filter(|(_, &on)| on)
             .map(|((lm, ls), _)| lm.event_value(n, ls.mode, ls.v0, z))
-            .fold(f64::NEG_INFINITY, f64::max)
+            .fold(f64::NEG_INFINITY, f64::max);
+        if self.m.storeys.is_empty() {
+            return levels;
+        }
+        self.m
+            .storeys
+            .iter()
+            .zip(&self.storey_modes)
+            .enumerate()
+            .filter(|(_, (sm, _))| self.active[sm.building])
+            .map(|(s, (sm, &mode))| {
+                let p = z[self.m.plastic_slot(s)];
+                sm.event_value(mode, sm.drift(z, 0), sm.drift(z, n), p)
+            })
+            .fold(levels, f64::max)
+    }
+
+    /// The earliest fraction of a step `z0 -> z1` (length `h`) at which an elastic storey's
+    /// back drift could rise past its band between the ends (both inside it).
+    fn hidden_yield(&self, z0: &[f64], z1: &[f64], h: f64) -> Option<f64> {
+        let n = self.m.n;
+        let mut first: Option<f64> = None;
+        for (s, (sm, &mode)) in self.m.storeys.iter().zip(&self.storey_modes).enumerate() {
+            if mode != StoreyMode::Elastic || !self.active[sm.building] {
+                continue;
+            }
+            let p = self.m.plastic_slot(s);
+            let e0 = sm.edges(sm.drift(z0, 0), sm.drift(z0, n), z0[p]);
+            let e1 = sm.edges(sm.drift(z1, 0), sm.drift(z1, n), z1[p]);
+            for (a, b) in e0.iter().zip(&e1) {
+                if let Some(x) = hidden_rise(a.0, a.1, b.0, b.1, h) {
+                    first = Some(first.map_or(x, |f| f.min(x)));
+                }
+            }
+        }
+        first
+    }
+
+    /// The storeys' spring changes that the events at the run's state call for: yield onset
+    /// on a bounding line when moving outwards, unloading when the drift velocity reverses. A
+    /// storey that reached its bounding line already turning back (a grazing touch, located
+    /// just past its turning point) takes the return map instead: its plastic drift moves by
+    /// the overshoot, `(1 - b)` times it, as OpenSees' `Steel01` would, so it is on its band
+    /// again and stays elastic (with the work of that flow).
+    fn storey_transitions(&mut self) {
+        let m = self.m;
+        let (n, ns) = (m.n, m.storeys.len());
+        for (s, sm) in m.storeys.iter().enumerate() {
+            if !self.active[sm.building] {
+                continue;
+            }
+            let slot = m.plastic_slot(s);
+            let z = &mut self.z;
+            let (d, r, p) = (sm.drift(z, 0), sm.drift(z, n), z[slot]);
+            let mode = self.storey_modes[s];
+            if sm.event_value(mode, d, r, p) <= 0.0 {
+                continue;
+            }
+            // The plastic load's rate at the last piece's end was the old state's.
+            self.ends_valid = false;
+            self.storey_modes[s] = match mode {
+                StoreyMode::Elastic => {
+                    let sign = sm.back_drift(d, p).signum();
+                    self.storeys[s].yielded = true;
+                    if sign * r > 0.0 {
+                        StoreyMode::Yielding(sign)
+                    } else {
+                        let p_new = (1.0 - sm.b) * (d - sign * sm.d_y);
+                        let f_mid = sm.k * (d - 0.5 * (p + p_new));
+                        z[slot + ns] += f_mid * (p_new - p);
+                        z[slot] = p_new;
+                        StoreyMode::Elastic
+                    }
+                }
+                StoreyMode::Yielding(_) => StoreyMode::Elastic,
+            };
+        }
     }
 
     /// Set the contact forces on each building's floors in state `z` into `floors[.][end]`.
@@ -985,14 +1230,14 @@ impl<'m> RowRun<'m> {
             self.set_floor_forces(z0, 0);
             for (k, bm) in m.buildings.iter().enumerate() {
                 if self.active[k] {
-                    self.floors[k][0].fill(m, bm, z0, ag.0);
+                    self.floors[k][0].fill(m, (k, bm), z0, ag.0, &self.storey_modes);
                 }
             }
         }
         self.set_floor_forces(z1, 1);
         for (k, bm) in m.buildings.iter().enumerate() {
             if self.active[k] {
-                self.floors[k][1].fill(m, bm, z1, ag.1);
+                self.floors[k][1].fill(m, (k, bm), z1, ag.1, &self.storey_modes);
             }
         }
     }
@@ -1078,6 +1323,10 @@ impl<'m> RowRun<'m> {
                 if p > out.peak_drift_ratio {
                     out.peak_drift_ratio = p;
                     out.drift_storey = j as u32 + 1;
+                }
+                if let Some(first) = bm.first_storey {
+                    let st = &mut self.storeys[first + j];
+                    st.peak_drift_ratio = raise(st.peak_drift_ratio, y, d, a);
                 }
                 let p = if free {
                     raise_cubic_peak(
@@ -1214,6 +1463,10 @@ impl<'m> RowRun<'m> {
                 .fold(None, |acc: Option<f64>, s| {
                     Some(acc.map_or(s, |a| a.min(s)))
                 });
+            let hidden = match (hidden, self.hidden_yield(&z0, &trial, h)) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            };
             if let Some(s) = hidden {
                 let zs = step(s * h);
                 let fs = self.event_max(&zs);
@@ -1239,6 +1492,9 @@ impl<'m> RowRun<'m> {
             self.track(t, x, &z0, &zb, (ag(t), ag(t + x)));
             self.transitions(t + x, &zb, &z0);
             self.z = zb;
+            if !self.m.storeys.is_empty() {
+                self.storey_transitions();
+            }
             x
         } else {
             self.track(t, h, &z0, &trial, (ag(t), ag(t + h)));
@@ -1254,14 +1510,46 @@ impl<'m> RowRun<'m> {
         advanced
     }
 
+    /// What the yielding building whose storeys start at `first` reports at the end (in modal
+    /// coordinates); `settled`: its plastic drifts are its residual drifts.
+    fn inelastic(&self, first: usize, settled: bool) -> InelasticOutput {
+        let m = self.m;
+        let ns = m.storeys.len();
+        let b = m.storeys[first].building;
+        let mut out = InelasticOutput::default();
+        let mut residual: f64 = 0.0;
+        for (s, sm) in m.storeys.iter().enumerate().skip(first) {
+            if sm.building != b {
+                break;
+            }
+            let p = self.z[m.plastic_slot(s)];
+            let st = &self.storeys[s];
+            if p.abs() / sm.height > residual {
+                residual = p.abs() / sm.height;
+                out.residual_storey = sm.storey as u32 + 1;
+            }
+            let mu = st.peak_drift_ratio * sm.height / sm.d_y;
+            if mu > out.peak_ductility {
+                out.peak_ductility = mu;
+                out.ductility_storey = sm.storey as u32 + 1;
+            }
+            out.hysteretic_energy += self.z[m.plastic_slot(s) + ns];
+            out.yielded_storeys += st.yielded as u32;
+        }
+        out.residual_drift_ratio = if settled { residual } else { f64::NAN };
+        out
+    }
+
     /// End the run with `status`, after `substeps` steps of integration work.
     pub fn finish(mut self, status: Status, substeps: u64) -> RowOutput {
         self.leave_substeps();
         let m = self.m;
         let n = m.n;
         let nl = m.levels.len();
+        let ns = m.storeys.len();
+        let hysteretic: f64 = (0..ns).map(|s| self.z[m.plastic_slot(s) + ns]).sum();
         let energy = self.energy.then(|| {
-            let contact: f64 = (0..nl).map(|l| self.z[2 * n + l]).sum();
+            let contact: f64 = (0..nl).map(|l| self.z[2 * n + l]).sum::<f64>() + hysteretic;
             EnergyBalance::close(
                 self.e_initial,
                 self.z[2 * n + nl],
@@ -1275,6 +1563,15 @@ impl<'m> RowRun<'m> {
             if ls.mode != Mode::Free {
                 ls.end_impact();
             }
+        }
+        let settled = self.settled && status == Status::Ok;
+        let inelastic: Vec<Option<InelasticOutput>> = m
+            .buildings
+            .iter()
+            .map(|b| b.first_storey.map(|first| self.inelastic(first, settled)))
+            .collect();
+        for (b, x) in self.buildings.iter_mut().zip(inelastic) {
+            b.inelastic = x;
         }
         let mut out = RowOutput {
             status,

@@ -6,6 +6,7 @@
 //! amplitude would ask for needless accuracy), and of each level in contact against the
 //! impact's scales.
 
+use super::yielding::StoreyMode;
 use super::{rhs, LevelModes, Motion, RowModel, RowRun};
 use crate::physics::model::{Forcing, Status};
 use crate::physics::row::RowOutput;
@@ -18,7 +19,7 @@ use crate::physics::solver::{impact_step, Mode, Segment};
 #[allow(clippy::too_many_arguments)]
 fn dopri(
     m: &RowModel,
-    lv: &LevelModes,
+    (lv, storeys): (&LevelModes, &[StoreyMode]),
     seg: &Segment,
     t: f64,
     z: &[f64],
@@ -33,6 +34,7 @@ fn dopri(
             levels: lv,
             active: &active,
             energy: true,
+            storeys,
         };
         rhs(m, &motion, seg.at(tt), y, &mut out);
         out
@@ -70,6 +72,14 @@ fn dopri(
         err = err.max(de.abs() / (rtol * ds));
         err = err.max(lm.ddelta(n, &ev).abs() / (rtol * vs));
     }
+    // Plastic drifts against the yield drift, plastic work against its own size.
+    let ns = m.storeys.len();
+    for (s, sm) in m.storeys.iter().enumerate() {
+        let (p, w) = (m.plastic_slot(s), m.plastic_slot(s) + ns);
+        err = err.max(ev[p].abs() / (rtol * sm.d_y));
+        let sc = z[w].abs().max(y[w].abs());
+        err = err.max(ev[w].abs() / (rtol * 1e-6 * sm.k * sm.d_y * sm.d_y + rtol * sc));
+    }
     (y, err)
 }
 
@@ -84,8 +94,10 @@ pub(crate) fn run(
     let mut steps: u64 = 0;
     let mut h = forcing.dt / 8.0;
     let mut modes = Vec::with_capacity(m.levels.len());
-    for i in 0..forcing.intervals() {
-        let seg = Segment::of(forcing, i);
+    let mut storeys = Vec::with_capacity(m.storeys.len());
+    let mut i = 0;
+    while let Some(seg) = super::yielding::next_segment(m, forcing, i, &mut run) {
+        i += 1;
         let mut t = seg.t0;
         let t1 = seg.t1();
         while t1 - t > 1e-12 * seg.dt {
@@ -106,7 +118,8 @@ pub(crate) fn run(
                 }
             }
             run.level_modes(&mut modes);
-            let (trial, err) = dopri(m, &modes, &seg, t, &z0, hs, o.rtol);
+            storeys.clone_from(&run.storey_modes);
+            let (trial, err) = dopri(m, (&modes, &storeys), &seg, t, &z0, hs, o.rtol);
             if err.is_nan() || err > 1.0 {
                 let finite = trial.iter().all(|x| x.is_finite());
                 match retry(&seg, t, hs, err, finite) {
@@ -136,7 +149,7 @@ pub(crate) fn run(
                 h = h_touch;
                 continue;
             }
-            let step = |x: f64| dopri(m, &modes, &seg, t, &z0, x, o.rtol).0;
+            let step = |x: f64| dopri(m, (&modes, &storeys), &seg, t, &z0, x, o.rtol).0;
             t += run.accept(&seg, t, hs, trial, 1e-13, 100, step);
             h = hs * (0.9 * err.max(1e-12).powf(-0.2)).min(5.0);
         }
