@@ -115,7 +115,7 @@ SCENES = [
 ]
 
 
-def run_opensees(ops, tmp, scene, ag, dt_rec, dt, duration):
+def run_opensees(ops, tmp, scene, ag, dt_rec, dt, duration, tail=TAIL_S):
     ops.wipe()
     ops.model("basic", "-ndm", 1, "-ndf", 1)
     tags = iter(range(1, 1_000_000))
@@ -169,7 +169,7 @@ def run_opensees(ops, tmp, scene, ag, dt_rec, dt, duration):
     force = os.path.join(tmp, "force.txt")
     ops.recorder("Node", "-file", disp, "-precision", 14, "-node", *all_nodes, "-dof", 1, "disp")
     ops.recorder("Element", "-file", force, "-precision", 14, "-ele", *contact_eles, "force")
-    steps = int(round((duration + TAIL_S) / dt))
+    steps = int(round((duration + tail) / dt))
     if ops.analyze(steps, dt) != 0:
         raise RuntimeError(f"OpenSees failed on {scene['name']}")
     ops.wipe()

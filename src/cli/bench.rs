@@ -43,6 +43,10 @@ pub struct Args {
     /// Runs per GPU sweep of the multi-storey suite (default: `--storey-runs`).
     #[arg(long)]
     storey_gpu_runs: Option<u64>,
+    /// With `--storeys`: also each suite's yielding twin (every storey yielding at 0.5 % drift,
+    /// 3 % hardening; CPU), and its time against the elastic suite's.
+    #[arg(long, requires = "storeys")]
+    yielding: bool,
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -51,7 +55,7 @@ pub fn run(a: Args) -> Result<()> {
         return run_storeys(
             storeys,
             (a.storey_runs, gpu_runs),
-            a.precision.get(),
+            (a.precision.get(), a.yielding),
             a.output.as_deref(),
         );
     }
@@ -127,7 +131,7 @@ pub fn run(a: Args) -> Result<()> {
 fn run_storeys(
     storeys: &[usize],
     (runs, gpu_runs): (u64, u64),
-    precision: pounding::engine::gpu::Precision,
+    (precision, yielding): (pounding::engine::gpu::Precision, bool),
     output: Option<&std::path::Path>,
 ) -> Result<()> {
     use pounding::physics::shear::MAX_STOREYS;
@@ -148,15 +152,26 @@ fn run_storeys(
     };
     let mut rows = Vec::new();
     for &n in storeys {
-        let r = bench::run_storeys(n, &bench::row_plan(n, runs));
+        let r = bench::run_storeys(n, &bench::row_plan(n, runs, false));
         note!(
             "{} runs of two {n}-storey buildings on CPU: {:.0} runs/s",
             r.summary.runs,
             r.summary.runs_per_second()
         );
+        let elastic = r.summary.runs_per_second();
         rows.push(r);
+        if yielding {
+            let r = bench::run_storeys(n, &bench::row_plan(n, runs, true));
+            note!(
+                "{} runs of two yielding {n}-storey buildings on CPU: {:.0} runs/s ({:.2}x the elastic suite's time per run)",
+                r.summary.runs,
+                r.summary.runs_per_second(),
+                elastic / r.summary.runs_per_second()
+            );
+            rows.push(r);
+        }
         if let Some(ctx) = &ctx {
-            let r = bench::run_storeys_gpu(n, &bench::row_plan(n, gpu_runs), ctx, &opts)?;
+            let r = bench::run_storeys_gpu(n, &bench::row_plan(n, gpu_runs, false), ctx, &opts)?;
             note!(
                 "{} runs of two {n}-storey buildings on GPU: {:.0} runs/s",
                 r.summary.runs,

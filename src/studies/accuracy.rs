@@ -302,7 +302,16 @@ pub struct RowPoint {
     /// above): the largest count difference, and the largest relative peak-force error.
     pub count_gap_max: u32,
     pub differing_force_max: f64,
+    /// Where storeys yield: median and p99 of the residual drift ratio's error against the
+    /// building's peak drift ratio (a residual near 0 has no relative error of its own), then
+    /// of the peak ductility's relative error, over the yielding buildings of the runs
+    /// compared; a run whose residual is not settled on either side is left out.
+    pub yielding: Option<[f64; 4]>,
 }
+
+/// The further columns of [`row_markdown`] where storeys yield.
+const YIELDING_COLUMNS: &str =
+    " residual drift med | residual drift p99 | ductility med | ductility p99 |";
 
 /// The columns of [`row_markdown`].
 pub const ROW_MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | force med | force p99 | roof med | roof p99 | drift med | drift p99 | accel med | accel p99 | impacts differ | failed | residual med | residual p99 | count gap max | differing force max |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
@@ -344,7 +353,11 @@ pub fn row_markdown(p: &RowPoint) -> String {
             _ => figure(*x),
         })
         .collect();
-    format!("| {} | {} |", p.path, cells.join(" | "))
+    let mut line = format!("| {} | {} |", p.path, cells.join(" | "));
+    for x in p.yielding.iter().flatten() {
+        line.push_str(&format!(" {} |", figure(*x)));
+    }
+    line
 }
 
 /// The multi-storey work-precision study: the row sweep `plan` by the reference at `tol`, then
@@ -375,8 +388,10 @@ pub fn row_study(
         (outs, s.runs_per_second())
     };
     let med_p99 = |mut v: Vec<f64>| [quantile(&mut v, 0.5), quantile(&mut v, 0.99)];
+    let yields = plan.yielding.iter().any(Option::is_some);
     let point = |path: &str, setting: f64, rate: f64, truth: &[RowOutput], out: &[RowOutput]| {
         let (mut f, mut u, mut d, mut a, mut r) = (vec![], vec![], vec![], vec![], vec![]);
+        let (mut res, mut mu) = (vec![], vec![]);
         let (mut differ, mut failed) = (0usize, 0u64);
         let (mut gap_max, mut differing_force) = (0u32, 0.0f64);
         for (t, o) in truth.iter().zip(out) {
@@ -402,6 +417,15 @@ pub fn row_study(
                 u.push(rel(bo.peak_roof, bt.peak_roof));
                 d.push(rel(bo.peak_drift_ratio, bt.peak_drift_ratio));
                 a.push(rel(bo.peak_accel, bt.peak_accel));
+                if let (Some(yt), Some(yo)) = (bt.inelastic, bo.inelastic) {
+                    mu.push(rel(yo.peak_ductility, yt.peak_ductility));
+                    if yt.residual_drift_ratio.is_finite() && yo.residual_drift_ratio.is_finite() {
+                        res.push(
+                            (yo.residual_drift_ratio - yt.residual_drift_ratio).abs()
+                                / bt.peak_drift_ratio.max(f64::MIN_POSITIVE),
+                        );
+                    }
+                }
             }
         }
         let compared = f.len() as u64;
@@ -419,6 +443,10 @@ pub fn row_study(
             residual: med_p99(r),
             count_gap_max: gap_max,
             differing_force_max: differing_force,
+            yielding: yields.then(|| {
+                let ([r0, r1], [m0, m1]) = (med_p99(res), med_p99(mu));
+                [r0, r1, m0, m1]
+            }),
         }
     };
     let (truth, rate) = solve(Scheme::Reference(ReferenceOptions::with_tol(tol)));
@@ -447,6 +475,21 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
         ("drift ratio", |p| p.drift),
         ("floor acceleration", |p| p.accel),
     ];
+    let yielding: [(&str, Pick); 2] = [
+        ("residual drift (of the peak drift)", |p| {
+            let y = p.yielding.unwrap_or([f64::NAN; 4]);
+            [y[0], y[1]]
+        }),
+        ("ductility", |p| {
+            let y = p.yielding.unwrap_or([f64::NAN; 4]);
+            [y[2], y[3]]
+        }),
+    ];
+    let extra = if points.iter().any(|p| p.yielding.is_some()) {
+        &yielding[..]
+    } else {
+        &[]
+    };
     let panel = |title: &str, at: usize| Panel {
         title: title.into(),
         x_label: "relative error".into(),
@@ -455,6 +498,7 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
         log_y: true,
         series: quantities
             .iter()
+            .chain(extra)
             .map(|(name, pick)| Series {
                 name: name.to_string(),
                 points: points
@@ -473,11 +517,16 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
 
 /// The multi-storey study's points as CSV.
 pub fn row_csv(points: &[RowPoint]) -> String {
-    let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99,count_gap_max,differing_force_max\n");
+    let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99,count_gap_max,differing_force_max");
+    if points.iter().any(|p| p.yielding.is_some()) {
+        s.push_str(",residual_drift_median,residual_drift_p99,ductility_median,ductility_p99");
+    }
+    s.push('\n');
     for p in points {
         let cells: Vec<String> = p
             .numbers()
             .iter()
+            .chain(p.yielding.iter().flatten())
             .map(|x| shown(*x, "", |x| x.to_string()))
             .collect();
         s.push_str(&format!("{},{}\n", p.path, cells.join(",")));
@@ -565,10 +614,19 @@ pub fn paths(
 }
 
 /// The markdown table's header of a study of `plan`.
-pub fn markdown_header(plan: &Plan) -> &'static str {
+pub fn markdown_header(plan: &Plan) -> String {
     match plan {
-        Plan::Pair(_) => MARKDOWN_HEADER,
-        Plan::Row(_) => ROW_MARKDOWN_HEADER,
+        Plan::Pair(_) => MARKDOWN_HEADER.into(),
+        Plan::Row(_) if plan.yields() => {
+            let (names, rule) = ROW_MARKDOWN_HEADER
+                .split_once('\n')
+                .expect("a header and its rule");
+            format!(
+                "{names}{YIELDING_COLUMNS}\n{rule}{}",
+                "---:|".repeat(YIELDING_COLUMNS.matches('|').count())
+            )
+        }
+        Plan::Row(_) => ROW_MARKDOWN_HEADER.into(),
     }
 }
 

@@ -289,10 +289,25 @@ gap_m = {g}
     )
 }
 
-/// The multi-storey suite's plan of two `storeys`-storey buildings, about `n` runs.
-pub fn row_plan(storeys: usize, n: u64) -> RowPlan {
+/// The multi-storey suite's yielding twin: [`row_config`] with every storey yielding at 0.5 %
+/// drift with 3 % hardening (docs/inelastic.md).
+pub fn yielding_row_config(storeys: usize, n: u64) -> String {
+    row_config(storeys, n).replace(
+        "damping_ratio = 0.05\n",
+        "damping_ratio = 0.05\nyield_drift_ratio = 0.005\npost_yield_ratio = 0.03\n",
+    )
+}
+
+/// The multi-storey suite's plan of two `storeys`-storey buildings, about `n` runs (their
+/// storeys `yielding`: [`yielding_row_config`]).
+pub fn row_plan(storeys: usize, n: u64, yielding: bool) -> RowPlan {
+    let text = if yielding {
+        yielding_row_config(storeys, n)
+    } else {
+        row_config(storeys, n)
+    };
     crate::plan::row::parse_row(
-        &row_config(storeys, n),
+        &text,
         std::path::Path::new("bench-rows.toml"),
         std::path::Path::new("."),
         std::path::Path::new("."),
@@ -304,6 +319,8 @@ pub fn row_plan(storeys: usize, n: u64) -> RowPlan {
 #[derive(Debug, Clone, PartialEq)]
 pub struct StoreyRow {
     pub storeys: usize,
+    /// The yielding twin of the suite ([`yielding_row_config`]).
+    pub yielding: bool,
     /// `cpu (T threads)` or `gpu PRECISION (ADAPTER)`.
     pub backend: String,
     pub summary: Summary,
@@ -338,6 +355,7 @@ pub fn run_storeys(storeys: usize, plan: &RowPlan) -> StoreyRow {
     .unwrap_or_else(|e| match e {});
     StoreyRow {
         storeys,
+        yielding: plan.yielding.iter().any(Option::is_some),
         backend: format!("cpu ({} threads)", rayon::current_num_threads()),
         summary,
         csv,
@@ -371,6 +389,7 @@ pub fn run_storeys_gpu(
     )?;
     Ok(StoreyRow {
         storeys,
+        yielding: false,
         backend: format!("gpu {} ({})", opts.precision.key(), ctx.info.name),
         summary,
         csv,
@@ -386,8 +405,9 @@ pub fn storey_table(rows: &[StoreyRow]) -> String {
         let m = &r.summary;
         let per_s = |x: u64| x as f64 / m.seconds.max(1e-12);
         s.push_str(&format!(
-            "| {} | {} | {} | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} |\n",
+            "| {}{} | {} | {} | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} |\n",
             r.storeys,
+            if r.yielding { ", yielding" } else { "" },
             m.runs,
             r.backend,
             m.seconds,
@@ -428,12 +448,16 @@ mod tests {
         }
         for storeys in [1, 3, crate::physics::shear::MAX_STOREYS] {
             for &n in &sizes {
-                let runs = row_plan(storeys, n).len();
+                let runs = row_plan(storeys, n, false).len();
                 assert!(
                     runs >= n && runs <= 2 * n + 20,
                     "{storeys} storeys, {n}: {runs}"
                 );
             }
+            // The yielding twin: the same runs, every building yielding.
+            let twin = row_plan(storeys, 200, true);
+            assert_eq!(twin.len(), row_plan(storeys, 200, false).len());
+            assert!(twin.yielding.iter().all(Option::is_some));
         }
     }
 }

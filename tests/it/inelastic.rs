@@ -377,3 +377,28 @@ fn opensees_cross_check() {
         worst[0], worst[1], worst[2]
     );
 }
+
+/// `pound accuracy` on a yielding row adds the residual drift's and the ductility's errors to
+/// the rows' table and CSV; at the default setting both are small against the reference.
+#[test]
+fn accuracy_measures_residual_drift_and_ductility() {
+    let dir = tempdir();
+    let csv = dir.path().join("accuracy.csv");
+    let out = ok(&pound(&[
+        "accuracy",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/configs/inelastic-row.toml"),
+        "--backend",
+        "cpu",
+        "--settings",
+        "64",
+        "-o",
+        csv.to_str().unwrap(),
+    ]));
+    assert!(out.contains("residual drift p99 | ductility med"), "{out}");
+    let rows = table(&csv);
+    let fast = rows.iter().find(|r| r["path"] == "cpu-fast-f64").unwrap();
+    for col in ["residual_drift_p99", "ductility_p99"] {
+        let x = num(fast, col);
+        assert!(x.is_finite() && x < 1e-3, "{col} = {x}");
+    }
+}
