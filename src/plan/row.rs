@@ -24,6 +24,14 @@ use crate::plan::{
 use serde::Deserialize;
 use std::path::Path;
 
+/// A yield drift ratio: > 0 and at most 0.2.
+const YIELD_DRIFT: Check = (|x| x > 0.0 && x <= 0.2, "a drift ratio > 0 and <= 0.2");
+/// A base-shear coefficient (base shear strength over weight): > 0 and at most 10.
+const YIELD_SHEAR: Check = (
+    |x| x > 0.0 && x <= 10.0,
+    "a coefficient > 0 and <= 10 (base shear strength / weight)",
+);
+
 /// One value for every storey, or one per storey (bottom to top).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(untagged)]
@@ -64,15 +72,25 @@ pub struct RawShearBuilding {
     /// h`), `yield_force_n` (per storey) or `yield_base_shear_coefficient` (`C_y`: base shear
     /// strength `C_y W`, `W` the weight, storey strengths from `yield_shear_distribution`);
     /// `post_yield_ratio` (`b`, default 0: elastic-perfectly-plastic). Absent: elastic.
-    pub yield_drift_ratio: Option<PerStorey>,
+    pub yield_drift_ratio: Option<YieldDrift>,
     pub yield_force_n: Option<PerStorey>,
-    pub yield_base_shear_coefficient: Option<f64>,
+    pub yield_base_shear_coefficient: Option<Axis>,
     /// `inverted_triangular` (lateral forces `~ m_i z_i`, the default) or `uniform` (`~ m_i`).
     pub yield_shear_distribution: Option<String>,
     pub post_yield_ratio: Option<PerStorey>,
     /// Which stiffness the Rayleigh or modal damping is built on: `initial` (the only choice;
     /// tangent-stiffness damping can create spurious damping forces after yielding).
     pub damping_stiffness: Option<String>,
+}
+
+/// `yield_drift_ratio` as written: one value for every storey, one per storey, or a range
+/// table (`{ from, to, n }`): an axis of values each for every storey.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum YieldDrift {
+    One(f64),
+    Each(Vec<f64>),
+    Axis(crate::plan::config::RangeSpec),
 }
 
 /// How strong a yielding building's storeys are.
@@ -93,25 +111,44 @@ pub struct YieldSpec {
     pub strength: YieldStrength,
     /// Post-yield stiffness ratio per storey.
     pub post_yield: Vec<f64>,
+    /// Where the strength's one value (a yield drift ratio for every storey, or a base-shear
+    /// coefficient) is an axis: its values (one placeholder where it is sampled). A run's
+    /// value ([`RowRunSpec::yield_value`]) replaces the strength's.
+    pub axis: Option<Vec<f64>>,
 }
 
 impl YieldSpec {
-    /// The storeys of `b` (its stiffnesses, masses and heights final).
-    pub fn of(&self, b: &ShearBuilding) -> Yielding {
+    /// The name of the swept or sampled value: `yield_drift_ratio` or
+    /// `yield_base_shear_coefficient`.
+    pub fn value_name(&self) -> &'static str {
+        match self.strength {
+            YieldStrength::BaseShear { .. } => "yield_base_shear_coefficient",
+            _ => "yield_drift_ratio",
+        }
+    }
+
+    /// The storeys of `b` (its stiffnesses, masses and heights final), with the run's `value`
+    /// of the swept strength where it has one.
+    pub fn of(&self, b: &ShearBuilding, value: Option<f64>) -> Yielding {
         let force = match &self.strength {
             YieldStrength::DriftRatio(theta) => {
+                let theta = match value {
+                    Some(v) => vec![v; theta.len()],
+                    None => theta.clone(),
+                };
                 return Yielding::from_drift_ratio(
                     &b.stiffness,
                     &b.heights,
-                    theta,
+                    &theta,
                     self.post_yield.clone(),
-                )
+                );
             }
             YieldStrength::Force(f) => f.clone(),
             YieldStrength::BaseShear {
                 coefficient,
                 triangular,
             } => {
+                let coefficient = value.unwrap_or(*coefficient);
                 let z = b.elevations();
                 let w: Vec<f64> = b
                     .masses
@@ -185,6 +222,10 @@ pub enum RowSampled {
     KLinear,
     /// `contact.beta_n_per_m1_5`, for Hertz-type laws.
     Beta,
+    /// `building[b].yield_drift_ratio`: every storey's yield drift ratio.
+    YieldDrift(usize),
+    /// `building[b].yield_base_shear_coefficient`.
+    YieldShear(usize),
 }
 
 impl RowSampled {
@@ -198,6 +239,8 @@ impl RowSampled {
             RowSampled::SharedGap => "contact.gap_m".into(),
             RowSampled::KLinear => "contact.k_n_per_m".into(),
             RowSampled::Beta => "contact.beta_n_per_m1_5".into(),
+            RowSampled::YieldDrift(b) => format!("building[{b}].yield_drift_ratio"),
+            RowSampled::YieldShear(b) => format!("building[{b}].yield_base_shear_coefficient"),
         }
     }
 
@@ -208,6 +251,7 @@ impl RowSampled {
             .collect();
         all.extend((0..nb - 1).map(Self::Gap));
         all.extend([Self::SharedGap, Self::KLinear, Self::Beta]);
+        all.extend((0..nb).flat_map(|b| [Self::YieldDrift(b), Self::YieldShear(b)]));
         all
     }
 
@@ -217,6 +261,8 @@ impl RowSampled {
             RowSampled::Period(_) => PERIOD,
             RowSampled::Damping(_) => DAMPING,
             RowSampled::Gap(_) | RowSampled::SharedGap => GAP,
+            RowSampled::YieldDrift(_) => YIELD_DRIFT,
+            RowSampled::YieldShear(_) => YIELD_SHEAR,
             _ => POSITIVE,
         }
     }
@@ -227,7 +273,11 @@ impl RowSampled {
     pub fn moves_buildings(self) -> bool {
         matches!(
             self,
-            RowSampled::Mass(_) | RowSampled::Period(_) | RowSampled::Damping(_)
+            RowSampled::Mass(_)
+                | RowSampled::Period(_)
+                | RowSampled::Damping(_)
+                | RowSampled::YieldDrift(_)
+                | RowSampled::YieldShear(_)
         )
     }
 }
@@ -265,6 +315,8 @@ pub struct RowPlan {
     per_scene: u64,
     /// Per building, its yielding storeys (None: elastic).
     pub yielding: Vec<Option<YieldSpec>>,
+    /// Per building, the index in `dims` of its swept or sampled strength (after the gaps).
+    yield_dim: Vec<Option<usize>>,
 }
 
 /// One run of a row sweep, decoded.
@@ -280,6 +332,8 @@ pub struct RowRunSpec {
     pub gaps: Vec<f64>,
     /// Index of the sample that set the sampled parameters (None without sampling).
     pub sample: Option<usize>,
+    /// Per building, the value of its swept or sampled strength (None where fixed or elastic).
+    pub yield_value: Vec<Option<f64>>,
 }
 
 impl RowPlan {
@@ -320,6 +374,12 @@ impl RowPlan {
                 .map(|a| self.gaps[a][at[1 + 3 * nb + self.gap_axis[a]]])
                 .collect(),
             sample: None,
+            yield_value: (0..nb)
+                .map(|b| {
+                    let axis = self.yielding[b].as_ref()?.axis.as_ref()?;
+                    Some(axis[at[self.yield_dim[b]?]])
+                })
+                .collect(),
         };
         if let Some(smp) = &self.samples {
             run.sample = Some(at[0]);
@@ -340,6 +400,9 @@ impl RowPlan {
                     RowSampled::KLinear if !law.is_hertzian() => run.contact.stiffness = v,
                     RowSampled::Beta if law.is_hertzian() => run.contact.stiffness = v,
                     RowSampled::KLinear | RowSampled::Beta => {}
+                    RowSampled::YieldDrift(b) | RowSampled::YieldShear(b) => {
+                        run.yield_value[b] = Some(v)
+                    }
                 }
             }
         }
@@ -349,7 +412,8 @@ impl RowPlan {
 
     /// The runs that differ in their motion before any contact ([`PairPlan::motions`]): per
     /// record and intensity, the samples (one where they set no building value) and every
-    /// building's values, the gaps at their first values.
+    /// building's values, the gaps at their first values. Of an elastic row: a swept strength
+    /// is not counted here (the gap study, its one user, refuses yielding rows).
     pub fn motions(&self) -> crate::plan::Motions {
         let nb = self.buildings.len();
         crate::plan::Motions {
@@ -522,7 +586,9 @@ impl RowPlan {
                     run.period[b],
                     damping,
                 );
-                s.yielding = self.yielding[b].as_ref().map(|y| y.of(&s));
+                s.yielding = self.yielding[b]
+                    .as_ref()
+                    .map(|y| y.of(&s, run.yield_value[b]));
                 s
             })
             .collect();
@@ -558,6 +624,9 @@ impl RowPlan {
         for b in 1..=nb {
             for c in ["storeys", "mass_kg", "t1_s", "xi"] {
                 h.push(format!("b{b}_{c}"));
+            }
+            if let Some(y) = self.swept_yield(b - 1) {
+                h.push(format!("b{b}_{}", y.value_name()));
             }
         }
         for a in 1..nb {
@@ -600,7 +669,16 @@ impl RowPlan {
 
     /// The number of parameter columns, which lead the header: the status column's index.
     pub fn parameter_columns(&self) -> usize {
-        columns::CONTACT_AND_MOTION + 4 * self.buildings.len() + self.gaps.len() + 1
+        let swept = (0..self.buildings.len())
+            .filter(|&b| self.swept_yield(b).is_some())
+            .count();
+        columns::CONTACT_AND_MOTION + 4 * self.buildings.len() + swept + self.gaps.len() + 1
+    }
+
+    /// Building `b`'s yielding storeys where their strength is swept or sampled (it then has
+    /// a parameter column, `bk_yield_drift_ratio` or `bk_yield_base_shear_coefficient`).
+    fn swept_yield(&self, b: usize) -> Option<&YieldSpec> {
+        self.yielding[b].as_ref().filter(|y| y.axis.is_some())
     }
 
     /// The outputs an `--aggregate` summary folds per group (as magnitudes): the row's totals,
@@ -637,6 +715,9 @@ impl RowPlan {
             c.push(opt(run.mass[b]));
             c.push(num(run.period[b]));
             c.push(num(run.damping[b]));
+            if self.swept_yield(b).is_some() {
+                c.push(opt(run.yield_value[b]));
+            }
         }
         c.extend(run.gaps.iter().map(|&g| num(g)));
         c.push(run.sample.map(|s| s.to_string()).unwrap_or_default());
@@ -872,7 +953,11 @@ pub fn parse_row(
         let required = |a: RowSampled, given: Option<&Axis>| {
             grid_or_sampled(a, given)?.ok_or_else(|| invalid(&a.key(), config::MISSING.into()))
         };
-        yielding.push(parse_yielding(r, n, &key, &invalid)?);
+        let sampled_yield = (
+            sampled(RowSampled::YieldDrift(b)),
+            sampled(RowSampled::YieldShear(b)),
+        );
+        yielding.push(parse_yielding(r, n, sampled_yield, &key, &invalid)?);
         let period_s = required(RowSampled::Period(b), r.period_s.as_ref())?;
         let damping_ratio = required(RowSampled::Damping(b), r.damping_ratio.as_ref())?;
         buildings.push(ShearAxes {
@@ -953,6 +1038,15 @@ pub fn parse_row(
             .enumerate()
             .map(|(a, g)| if gap_axis[a] == a { g.len() } else { 1 }),
     );
+    // Each swept or sampled strength: an axis after the gaps (none in an elastic row).
+    let yield_dim: Vec<Option<usize>> = yielding
+        .iter()
+        .map(|y: &Option<YieldSpec>| {
+            let axis = y.as_ref()?.axis.as_ref()?;
+            dims.push(axis.len());
+            Some(dims.len() - 1)
+        })
+        .collect();
     let per_scene = dims
         .iter()
         .try_fold(1u64, |p, &d| p.checked_mul(d as u64))
@@ -980,6 +1074,7 @@ pub fn parse_row(
         ignored,
         per_scene,
         yielding,
+        yield_dim,
     })
 }
 
@@ -988,9 +1083,29 @@ pub fn parse_row(
 fn parse_yielding(
     r: &RawShearBuilding,
     n: usize,
+    (sampled_drift, sampled_shear): (bool, bool),
     key: &dyn Fn(&str) -> String,
     invalid: &dyn Fn(&str, String) -> ConfigError,
 ) -> Result<Option<YieldSpec>, ConfigError> {
+    for (sampled, given, name) in [
+        (
+            sampled_drift,
+            r.yield_drift_ratio.is_some(),
+            "yield_drift_ratio",
+        ),
+        (
+            sampled_shear,
+            r.yield_base_shear_coefficient.is_some(),
+            "yield_base_shear_coefficient",
+        ),
+    ] {
+        if sampled && given {
+            return Err(invalid(
+                &key(name),
+                format!("{} is sampled under [sample]: remove it here", key(name)),
+            ));
+        }
+    }
     match r.damping_stiffness.as_deref() {
         None | Some("initial") => {}
         Some("tangent") => return Err(invalid(
@@ -1031,10 +1146,17 @@ fn parse_yielding(
         }
     };
     let strengths = [
-        r.yield_drift_ratio.is_some(),
+        r.yield_drift_ratio.is_some() || sampled_drift,
         r.yield_force_n.is_some(),
-        r.yield_base_shear_coefficient.is_some(),
+        r.yield_base_shear_coefficient.is_some() || sampled_shear,
     ];
+    // The strength's one value as an axis (a placeholder where sampled).
+    let mut axis = None;
+    let values = |name: &str, a: &Axis, (ok, expected): Check| {
+        let v = a.values().map_err(|m| invalid(&key(name), m))?;
+        check_axis(&key(name), &v, ok, expected).map_err(|e| invalid(&e.key, e.message))?;
+        Ok(v)
+    };
     let strength = match strengths.iter().filter(|&&x| x).count() {
         0 => {
             for (given, name) in [
@@ -1054,12 +1176,25 @@ fn parse_yielding(
             return Ok(None);
         }
         1 => {
-            if let Some(v) = &r.yield_drift_ratio {
+            if sampled_drift {
+                axis = Some(vec![f64::NAN]);
+                YieldStrength::DriftRatio(vec![f64::NAN; n])
+            } else if let Some(v) = &r.yield_drift_ratio {
+                let one = match v {
+                    YieldDrift::One(x) => PerStorey::One(*x),
+                    YieldDrift::Each(v) => PerStorey::Each(v.clone()),
+                    YieldDrift::Axis(range) => {
+                        let v = values("yield_drift_ratio", &Axis::Range(range.clone()), YIELD_DRIFT)?;
+                        let first = v[0];
+                        axis = Some(v);
+                        PerStorey::One(first)
+                    }
+                };
                 YieldStrength::DriftRatio(per_storey(
                     "yield_drift_ratio",
-                    v,
-                    &|x| x > 0.0 && x <= 0.2,
-                    "a drift ratio > 0 and <= 0.2",
+                    &one,
+                    &YIELD_DRIFT.0,
+                    YIELD_DRIFT.1,
                 )?)
             } else if let Some(v) = &r.yield_force_n {
                 YieldStrength::Force(per_storey(
@@ -1069,16 +1204,20 @@ fn parse_yielding(
                     "a force > 0 N",
                 )?)
             } else {
-                let c = r.yield_base_shear_coefficient.unwrap_or_default();
-                if !(c > 0.0 && c <= 10.0) {
-                    return Err(invalid(
-                        &key("yield_base_shear_coefficient"),
-                        format!(
-                            "{} is out of range: expected a coefficient > 0 and <= 10 (base shear strength / weight)",
-                            crate::plan::limits::show(c)
-                        ),
-                    ));
-                }
+                let c = match &r.yield_base_shear_coefficient {
+                    Some(a) => {
+                        let v = values("yield_base_shear_coefficient", a, YIELD_SHEAR)?;
+                        let first = v[0];
+                        if v.len() > 1 {
+                            axis = Some(v);
+                        }
+                        first
+                    }
+                    None => {
+                        axis = Some(vec![f64::NAN]);
+                        f64::NAN
+                    }
+                };
                 let triangular = match r.yield_shear_distribution.as_deref() {
                     None | Some("inverted_triangular") => true,
                     Some("uniform") => false,
@@ -1102,7 +1241,8 @@ fn parse_yielding(
             ))
         }
     };
-    if r.yield_shear_distribution.is_some() && r.yield_base_shear_coefficient.is_none() {
+    if r.yield_shear_distribution.is_some() && !matches!(strength, YieldStrength::BaseShear { .. })
+    {
         return Err(invalid(
             &key("yield_shear_distribution"),
             "applies to yield_base_shear_coefficient only".into(),
@@ -1120,5 +1260,6 @@ fn parse_yielding(
     Ok(Some(YieldSpec {
         strength,
         post_yield,
+        axis,
     }))
 }

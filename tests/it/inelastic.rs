@@ -402,3 +402,70 @@ fn accuracy_measures_residual_drift_and_ductility() {
         assert!(x.is_finite() && x < 1e-3, "{col} = {x}");
     }
 }
+
+/// A yield drift ratio given as a range is an axis (every storey the value of the run), and a
+/// base-shear coefficient can be sampled; each has its parameter column, and each run's
+/// strength is the one its column says: the ductility is the peak drift over the run's yield
+/// drift.
+#[test]
+fn strengths_are_axes_and_samples() {
+    let dir = tempdir();
+    let swept = shipped("inelastic-row.toml").replace(
+        "yield_drift_ratio = 0.005",
+        "yield_drift_ratio = { from = 0.003, to = 0.007, n = 3 }",
+    );
+    let rows = sweep(dir.path(), "swept", &swept, &[]);
+    assert_eq!(rows.len(), 18);
+    let mut thetas: Vec<String> = rows
+        .iter()
+        .map(|r| r["b1_yield_drift_ratio"].clone())
+        .collect();
+    thetas.dedup();
+    assert_eq!(thetas.len(), 18, "the strength is the innermost axis");
+    for r in &rows {
+        let theta = num(r, "b1_yield_drift_ratio");
+        let mu = num(r, "b1_peak_ductility");
+        let drift = num(r, "b1_peak_drift_ratio");
+        assert!(
+            (mu * theta - drift).abs() < 1e-9 * drift,
+            "{theta} {mu} {drift}"
+        );
+    }
+    let sampled = shipped("inelastic-pair.toml")
+        .replace("yield_base_shear_coefficient = 0.15\n", "")
+        + r#"
+[sample]
+n = 5
+seed = 4
+[[sample.axis]]
+key = "building[0].yield_base_shear_coefficient"
+dist = "uniform"
+min = 0.1
+max = 0.3
+"#;
+    let rows = sweep(dir.path(), "sampled", &sampled, &[]);
+    assert_eq!(rows.len(), 30);
+    let w = 2.0 * std::f64::consts::PI / 0.6;
+    for r in &rows {
+        let c = num(r, "b1_yield_base_shear_coefficient");
+        assert!((0.1..=0.3).contains(&c), "{c}");
+        let d_y = c * 9.80665 / (w * w);
+        let (drift, mu) = (
+            num(r, "b1_peak_drift_ratio") * 3.5,
+            num(r, "b1_peak_ductility"),
+        );
+        assert!((drift / mu - d_y).abs() < 1e-9 * d_y);
+    }
+    // A strength both given and sampled is refused, naming it.
+    let both = shipped("inelastic-pair.toml")
+        + "\n[sample]\nn = 2\nseed = 1\n[[sample.axis]]\nkey = \"building[0].yield_base_shear_coefficient\"\ndist = \"uniform\"\nmin = 0.1\nmax = 0.2\n";
+    let cfg = dir.path().join("both.toml");
+    std::fs::write(&cfg, both).unwrap();
+    let out = pound(&["sweep", cfg.to_str().unwrap(), "-o", "/dev/null"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("building[0].yield_base_shear_coefficient is sampled"),
+        "{err}"
+    );
+}
