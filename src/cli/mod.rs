@@ -65,7 +65,7 @@ pub mod trace;
 #[derive(Subcommand)]
 pub enum Cmd {
     /// Run every run of a sweep config and write one CSV row per run. A starting config:
-    /// `pound init pair|row|fragility|gap`; the config keys: README.md, "A config"; the
+    /// `pound init pair|row|fragility|gap|inelastic`; the config keys: README.md, "A config"; the
     /// columns with units and meanings: `pound columns CONFIG`.
     Sweep(sweep::Args),
     /// GPU adapters.

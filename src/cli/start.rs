@@ -18,6 +18,9 @@ pub enum Kind {
     Fragility,
     /// A period grid for `pound gap`: the separation two buildings need.
     Gap,
+    /// A yielding frame that pounds, over records and intensities, for the fragility of its
+    /// ductility demand or residual drift (120 runs).
+    Inelastic,
 }
 
 impl Kind {
@@ -39,6 +42,10 @@ impl Kind {
             Kind::Gap => (
                 include_str!("../../configs/gap-example.toml"),
                 "pound gap my.toml -o gaps.csv --plot gaps.svg",
+            ),
+            Kind::Inelastic => (
+                include_str!("../../configs/inelastic-fragility.toml"),
+                "pound sweep my.toml -o runs.csv && pound fragility runs.csv --edp b1_peak_ductility --threshold 1,2,4",
             ),
         }
     }

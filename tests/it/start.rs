@@ -11,6 +11,7 @@ fn every_template_runs_as_is() {
         ("row", "sweep"),
         ("fragility", "sweep"),
         ("gap", "gap"),
+        ("inelastic", "sweep"),
     ] {
         let out = pound(&["init", kind]);
         let text = ok(&out);
