@@ -18,6 +18,10 @@
 //!    accelerations: the cubic Hermite with their rates over free record steps, the samples at
 //!    substep ends and events in contact steps, where a contact force's spike makes them
 //!    converge with the substep (as the force peak's samples do).
+//! 5. Yielding storeys ([`super::yielding`]): free steps are exact about the static response to
+//!    the plastic loads; a step in which a storey yields, or may reach its band edge (bounded as a
+//!    touch), is taken in substeps by its building, yield onset and unloading located as
+//!    events; after the record the run goes on at rest until no storey can yield again.
 
 use super::{rhs, Motion, RowModel, RowRun, FLOOR_SUBSTEPS_FROM};
 use crate::physics::model::{Forcing, Oscillator, Status};
