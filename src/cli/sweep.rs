@@ -142,6 +142,7 @@ pub fn run(a: Args) -> Result<()> {
     let target = flags.target(&config_text)?;
     let mut plan = config::load_text(&config_text, &flags.config)?;
     let chosen = flags.settle_scheme(&mut plan, &config_text)?;
+    plan.ask_storey_columns(flags.columns.as_deref().unwrap_or_default());
     let gpu = pounding::engine::gpu_for(
         &plan,
         flags.backend,

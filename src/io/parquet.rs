@@ -32,9 +32,16 @@ fn kind(column: &str) -> Kind {
     match column {
         "run" | "impacts" | "substeps" | "sample" => Kind::Int,
         "law" | "formula" | "record" | "status" => Kind::Text,
-        c if ["_impacts", "_storeys", "_drift_storey", "_accel_floor"]
-            .iter()
-            .any(|end| c.ends_with(end)) =>
+        c if [
+            "_impacts",
+            "_storeys",
+            "_drift_storey",
+            "_accel_floor",
+            "_residual_storey",
+            "_ductility_storey",
+        ]
+        .iter()
+        .any(|end| c.ends_with(end)) =>
         {
             Kind::Int
         }

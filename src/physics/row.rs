@@ -141,6 +141,18 @@ pub struct InelasticOutput {
     pub yielded_storeys: u32,
 }
 
+/// What one yielding storey reports (with `--columns` asking for it).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StoreyOutput {
+    /// `p_j / h_j` at rest after the motion, signed (positive: the floor above to the right);
+    /// NaN where the run did not settle.
+    pub residual_drift_ratio: f64,
+    /// `max_t |d_j| / d_y,j`.
+    pub peak_ductility: f64,
+    /// `int f_j dp_j`, J.
+    pub hysteretic_energy: f64,
+}
+
 /// Per-run results of a row. The totals gather the levels: impacts summed, the largest peak
 /// force (with its impact velocity), the earliest first impact, contact time and dissipated
 /// energy summed.
@@ -160,6 +172,8 @@ pub struct RowOutput {
     /// Record steps taken whole by the exact modal propagators.
     pub free_steps: u64,
     pub energy: Option<EnergyBalance>,
+    /// Every yielding storey, building by building, bottom to top (none in an elastic row).
+    pub storeys: Vec<StoreyOutput>,
 }
 
 impl RowOutput {

@@ -255,6 +255,25 @@ pub fn meaning(column: &str) -> Option<Meaning> {
             }
         }
     }
+    // bK_sJ_<output>: a yielding storey's own columns
+    if let Some((k, rest)) = column.strip_prefix('b').and_then(|r| r.split_once("_s")) {
+        if let Some((j, suffix)) = rest.split_once('_') {
+            let text = match suffix {
+                "residual_drift_ratio" => Some(("-", "residual drift ratio of storey {j} of building {k} at rest after the motion, signed (empty where the run did not settle)")),
+                "peak_ductility" => Some(("-", "ductility demand of storey {j} of building {k}: its peak drift / its yield drift")),
+                "hysteretic_energy_j" => Some(("J", "hysteretic energy of storey {j} of building {k}")),
+                _ => None,
+            };
+            if let (Some(k), Some(j), Some((unit, text))) = (number(k), number(j), text) {
+                return Some(Meaning {
+                    unit,
+                    text: text
+                        .replace("{j}", &j.to_string())
+                        .replace("{k}", &k.to_string()),
+                });
+            }
+        }
+    }
     // bK_<output>
     if let Some((k, suffix)) = column.strip_prefix('b').and_then(|r| r.split_once('_')) {
         if let (Some(k), Some(m)) = (number(k), PER_BUILDING.iter().find(|m| m.0 == suffix)) {
@@ -300,6 +319,16 @@ mod tests {
             assert!(meaning(&format!("b3_{c}")).is_some(), "{c}");
         }
         assert_eq!(meaning("b2_hysteretic_energy_j").unwrap().unit, "J");
+        for c in crate::plan::row::STOREY_OUTPUTS {
+            assert!(meaning(&format!("b2_s14_{c}")).is_some(), "{c}");
+            assert!(crate::plan::row::RowPlan::asks_storey_columns(&format!(
+                "b2_s14_{c}"
+            )));
+        }
+        assert!(!crate::plan::row::RowPlan::asks_storey_columns(
+            "b2_peak_ductility"
+        ));
+        assert!(meaning("b2_s_peak_ductility").is_none());
         assert_eq!(
             meaning("gap_2_3_m").unwrap().text,
             "gap between buildings 2 and 3"

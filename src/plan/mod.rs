@@ -97,6 +97,16 @@ impl Plan {
         }
     }
 
+    /// Write each yielding storey's own columns too, where `columns` (`--columns`) asks for one
+    /// of them (`b1_s2_peak_ductility`); a pair has none.
+    pub fn ask_storey_columns(&mut self, columns: &[String]) {
+        if let Plan::Row(r) = self {
+            r.storey_columns |= columns
+                .iter()
+                .any(|c| crate::plan::row::RowPlan::asks_storey_columns(c));
+        }
+    }
+
     /// Do some building's storeys yield?
     pub fn yields(&self) -> bool {
         match self {

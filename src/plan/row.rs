@@ -8,7 +8,7 @@
 //! last gap innermost.
 
 use crate::physics::model::Forcing;
-use crate::physics::row::{Row, RowOutput};
+use crate::physics::row::{Row, RowOutput, StoreyOutput};
 use crate::physics::shear::{Damping, ShearBuilding, Yielding, MAX_STOREYS};
 use crate::physics::solver::row::RowScheme;
 use crate::physics::solver::Scheme;
@@ -317,6 +317,9 @@ pub struct RowPlan {
     pub yielding: Vec<Option<YieldSpec>>,
     /// Per building, the index in `dims` of its swept or sampled strength (after the gaps).
     yield_dim: Vec<Option<usize>>,
+    /// Write each yielding storey's columns too (`bk_sj_...`, [`STOREY_OUTPUTS`]): set where
+    /// `--columns` asks for one ([`RowPlan::asks_storey_columns`]).
+    pub storey_columns: bool,
 }
 
 /// One run of a row sweep, decoded.
@@ -654,6 +657,13 @@ impl RowPlan {
                 for c in INELASTIC_OUTPUTS {
                     h.push(format!("b{}_{c}", b + 1));
                 }
+                if self.storey_columns {
+                    for j in 1..=self.buildings[b].storeys() {
+                        for c in STOREY_OUTPUTS {
+                            h.push(format!("b{}_s{j}_{c}", b + 1));
+                        }
+                    }
+                }
             }
         }
         for l in self.level_names() {
@@ -737,7 +747,8 @@ impl RowPlan {
             num(out.dissipated_energy),
             out.substeps.to_string(),
         ]);
-        for (b, y) in out.buildings.iter().zip(&self.yielding) {
+        let mut storeys = out.storeys.iter();
+        for (k, (b, y)) in out.buildings.iter().zip(&self.yielding).enumerate() {
             c.extend([
                 num(b.peak_roof),
                 num(b.peak_drift_ratio),
@@ -757,6 +768,20 @@ impl RowPlan {
                     num(ie.hysteretic_energy),
                     ie.yielded_storeys.to_string(),
                 ]);
+                for _ in 0..self.buildings[k].storeys() {
+                    let st = storeys.next().copied().unwrap_or(StoreyOutput {
+                        residual_drift_ratio: f64::NAN,
+                        peak_ductility: f64::NAN,
+                        hysteretic_energy: f64::NAN,
+                    });
+                    if self.storey_columns {
+                        c.extend([
+                            known(st.residual_drift_ratio),
+                            known(st.peak_ductility),
+                            known(st.hysteretic_energy),
+                        ]);
+                    }
+                }
             }
         }
         for l in &out.levels {
@@ -802,6 +827,29 @@ pub const INELASTIC_OUTPUTS: [&str; 6] = [
     "hysteretic_energy_j",
     "yielded_storeys",
 ];
+
+/// A yielding storey's output columns with `--columns` (after its `b1_s2_` prefix: building 1,
+/// storey 2 from the ground).
+pub const STOREY_OUTPUTS: [&str; 3] = [
+    "residual_drift_ratio",
+    "peak_ductility",
+    "hysteretic_energy_j",
+];
+
+impl RowPlan {
+    /// Does `column` name a yielding storey's own column (`b1_s2_peak_ductility`)?
+    pub fn asks_storey_columns(column: &str) -> bool {
+        column
+            .strip_prefix('b')
+            .and_then(|r| r.split_once("_s"))
+            .and_then(|(k, rest)| {
+                let (j, suffix) = rest.split_once('_')?;
+                let digits = |x: &str| !x.is_empty() && x.bytes().all(|c| c.is_ascii_digit());
+                (digits(k) && digits(j) && STOREY_OUTPUTS.contains(&suffix)).then_some(())
+            })
+            .is_some()
+    }
+}
 
 /// Each contact level's output columns (after its `level_b1f3_b2f3_` prefix).
 pub const LEVEL_OUTPUTS: [&str; 4] = [
@@ -1075,6 +1123,7 @@ pub fn parse_row(
         per_scene,
         yielding,
         yield_dim,
+        storey_columns: false,
     })
 }
 

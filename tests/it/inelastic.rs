@@ -469,3 +469,47 @@ max = 0.3
         "{err}"
     );
 }
+
+/// `--columns` asking for a yielding storey's own columns gets them: each storey's residual
+/// drift, ductility and hysteretic energy, which the building's columns gather (the largest
+/// |residual| and ductility over its storeys, the hysteretic energies summed). Without the ask
+/// they are not written.
+#[test]
+fn columns_ask_for_each_storey() {
+    let dir = tempdir();
+    let cfg = dir.path().join("row.toml");
+    std::fs::write(&cfg, shipped("inelastic-row.toml")).unwrap();
+    let mut columns = vec![
+        "b1_residual_drift_ratio".to_string(),
+        "b1_peak_ductility".into(),
+        "b1_hysteretic_energy_j".into(),
+    ];
+    for j in 1..=6 {
+        for c in [
+            "residual_drift_ratio",
+            "peak_ductility",
+            "hysteretic_energy_j",
+        ] {
+            columns.push(format!("b1_s{j}_{c}"));
+        }
+    }
+    let out = dir.path().join("storeys.csv");
+    ok(&sweep_cpu(&cfg, &out, &["--columns", &columns.join(",")]));
+    for r in table(&out) {
+        let storey = |j: usize, c: &str| num(&r, &format!("b1_s{j}_{c}"));
+        let residual = (1..=6)
+            .map(|j| storey(j, "residual_drift_ratio").abs())
+            .fold(0.0, f64::max);
+        let mu = (1..=6)
+            .map(|j| storey(j, "peak_ductility"))
+            .fold(0.0, f64::max);
+        let energy: f64 = (1..=6).map(|j| storey(j, "hysteretic_energy_j")).sum();
+        assert_eq!(residual, num(&r, "b1_residual_drift_ratio"));
+        assert_eq!(mu, num(&r, "b1_peak_ductility"));
+        let e = num(&r, "b1_hysteretic_energy_j");
+        assert!((energy - e).abs() <= 1e-12 * e.max(1.0), "{energy} {e}");
+    }
+    let plain = dir.path().join("plain.csv");
+    ok(&sweep_cpu(&cfg, &plain, &[]));
+    assert!(!table(&plain)[0].contains_key("b1_s1_peak_ductility"));
+}

@@ -25,7 +25,9 @@ use super::tracker::ForceHistory;
 use super::{Mode, Segment};
 use crate::physics::contact::Contact;
 use crate::physics::model::{EnergyBalance, Forcing, Status};
-use crate::physics::row::{BuildingOutput, InelasticOutput, LevelOutput, Row, RowOutput};
+use crate::physics::row::{
+    BuildingOutput, InelasticOutput, LevelOutput, Row, RowOutput, StoreyOutput,
+};
 use crate::physics::shear::Modes;
 use yielding::{StoreyMode, StoreyModel};
 
@@ -1573,6 +1575,21 @@ impl<'m> RowRun<'m> {
         for (b, x) in self.buildings.iter_mut().zip(inelastic) {
             b.inelastic = x;
         }
+        let storeys = m
+            .storeys
+            .iter()
+            .zip(&self.storeys)
+            .enumerate()
+            .map(|(s, (sm, st))| StoreyOutput {
+                residual_drift_ratio: if settled {
+                    self.z[m.plastic_slot(s)] / sm.height
+                } else {
+                    f64::NAN
+                },
+                peak_ductility: st.peak_drift_ratio * sm.height / sm.d_y,
+                hysteretic_energy: self.z[m.plastic_slot(s) + ns],
+            })
+            .collect();
         let mut out = RowOutput {
             status,
             levels: self.levels.iter().map(|l| l.out).collect(),
@@ -1580,6 +1597,7 @@ impl<'m> RowRun<'m> {
             substeps,
             free_steps: self.free_steps,
             energy,
+            storeys,
             ..RowOutput::default()
         };
         out.gather();
