@@ -501,6 +501,9 @@ mod tests {
                     assert_eq!(ie.yielded_storeys, 0);
                 }
             }
+            for st in std::mem::take(&mut o.storeys) {
+                assert_eq!((st.residual_drift_ratio, st.hysteretic_energy), (0.0, 0.0));
+            }
             o
         };
         for scheme in schemes() {
