@@ -151,6 +151,31 @@ pub struct StoreyOutput {
     pub peak_ductility: f64,
     /// `int f_j dp_j`, J.
     pub hysteretic_energy: f64,
+    /// It yielded at least once.
+    pub yielded: bool,
+}
+
+impl InelasticOutput {
+    /// Gather a building's storeys (bottom to top): the largest `|residual|` and ductility with
+    /// their storeys, the hysteretic energies summed, the storeys that yielded.
+    pub fn gather(storeys: &[StoreyOutput]) -> InelasticOutput {
+        let mut out = InelasticOutput::default();
+        let mut residual: f64 = 0.0;
+        for (j, st) in storeys.iter().enumerate() {
+            if st.residual_drift_ratio.abs() > residual {
+                residual = st.residual_drift_ratio.abs();
+                out.residual_storey = j as u32 + 1;
+            }
+            if st.peak_ductility > out.peak_ductility {
+                out.peak_ductility = st.peak_ductility;
+                out.ductility_storey = j as u32 + 1;
+            }
+            out.hysteretic_energy += st.hysteretic_energy;
+            out.yielded_storeys += st.yielded as u32;
+        }
+        out.residual_drift_ratio = residual;
+        out
+    }
 }
 
 /// Per-run results of a row. The totals gather the levels: impacts summed, the largest peak

@@ -773,6 +773,7 @@ impl RowPlan {
                         residual_drift_ratio: f64::NAN,
                         peak_ductility: f64::NAN,
                         hysteretic_energy: f64::NAN,
+                        yielded: false,
                     });
                     if self.storey_columns {
                         c.extend([

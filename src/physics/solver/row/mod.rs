@@ -762,12 +762,13 @@ impl Floors {
         m.add_plastic(k, z, storeys, &mut self.pl_acc, &mut self.pl_jerk);
         let b = &m.buildings[k];
         if floors && !b.in_floors {
-            // M^-1 g = Phi Phi^T g: the modal loads back to the floors.
-            let sh = &b.modes.shape;
-            let (g, gd): (Vec<f64>, Vec<f64>) = (self.pl_acc.clone(), self.pl_jerk.clone());
-            for (j, row) in sh.iter().enumerate() {
-                self.pl_acc[j] = dot(row, &g);
-                self.pl_jerk[j] = dot(row, &gd);
+            // M^-1 g = Phi Phi^T g: the modal loads back to the floors. The modal loads move to
+            // the `acc` and `jrk` scratch, which the floor form overwrites after this.
+            std::mem::swap(&mut self.pl_acc, &mut self.acc);
+            std::mem::swap(&mut self.pl_jerk, &mut self.jrk);
+            for (j, row) in b.modes.shape.iter().enumerate() {
+                self.pl_acc[j] = dot(row, &self.acc);
+                self.pl_jerk[j] = dot(row, &self.jrk);
             }
         }
     }
@@ -997,10 +998,12 @@ impl<'m> RowRun<'m> {
         let z0 = self.z.clone();
         if h > 0.0 {
             // About the static response to its plastic loads (constant: it stood still).
-            let mut qs = vec![0.0; n];
-            if b.first_storey.is_some() {
+            let qs = b.first_storey.map(|_| {
+                let mut qs = vec![0.0; n];
                 modal.static_offsets(&z0, &mut qs);
-            }
+                qs
+            });
+            let shift = |i: usize| qs.as_ref().map_or(0.0, |q| q[i]);
             for i in b.off..b.off + b.n() {
                 let osc = crate::physics::model::Oscillator {
                     m: 1.0,
@@ -1009,9 +1012,9 @@ impl<'m> RowRun<'m> {
                 };
                 let (a0, a1) = (modal.part[i] * seg.a0, modal.part[i] * seg.at(t));
                 let p = crate::physics::propagator::Propagator::new(&osc, h);
-                let q0 = z0[i] - qs[i];
+                let q0 = z0[i] - shift(i);
                 let (q1, v1) = p.step(q0, z0[n + i], a0, a1);
-                (self.z[i], self.z[n + i]) = (q1 + qs[i], v1);
+                (self.z[i], self.z[n + i]) = (q1 + shift(i), v1);
                 if self.energy {
                     let f = crate::physics::propagator::EnergyForms::new(&osc, h);
                     let (vv, agv) = f.integrals(q0, z0[n + i], a0, a1);
@@ -1512,36 +1515,6 @@ impl<'m> RowRun<'m> {
         advanced
     }
 
-    /// What the yielding building whose storeys start at `first` reports at the end (in modal
-    /// coordinates); `settled`: its plastic drifts are its residual drifts.
-    fn inelastic(&self, first: usize, settled: bool) -> InelasticOutput {
-        let m = self.m;
-        let ns = m.storeys.len();
-        let b = m.storeys[first].building;
-        let mut out = InelasticOutput::default();
-        let mut residual: f64 = 0.0;
-        for (s, sm) in m.storeys.iter().enumerate().skip(first) {
-            if sm.building != b {
-                break;
-            }
-            let p = self.z[m.plastic_slot(s)];
-            let st = &self.storeys[s];
-            if p.abs() / sm.height > residual {
-                residual = p.abs() / sm.height;
-                out.residual_storey = sm.storey as u32 + 1;
-            }
-            let mu = st.peak_drift_ratio * sm.height / sm.d_y;
-            if mu > out.peak_ductility {
-                out.peak_ductility = mu;
-                out.ductility_storey = sm.storey as u32 + 1;
-            }
-            out.hysteretic_energy += self.z[m.plastic_slot(s) + ns];
-            out.yielded_storeys += st.yielded as u32;
-        }
-        out.residual_drift_ratio = if settled { residual } else { f64::NAN };
-        out
-    }
-
     /// End the run with `status`, after `substeps` steps of integration work.
     pub fn finish(mut self, status: Status, substeps: u64) -> RowOutput {
         self.leave_substeps();
@@ -1566,30 +1539,35 @@ impl<'m> RowRun<'m> {
                 ls.end_impact();
             }
         }
-        let settled = self.settled && status == Status::Ok;
-        let inelastic: Vec<Option<InelasticOutput>> = m
-            .buildings
-            .iter()
-            .map(|b| b.first_storey.map(|first| self.inelastic(first, settled)))
-            .collect();
-        for (b, x) in self.buildings.iter_mut().zip(inelastic) {
-            b.inelastic = x;
-        }
-        let storeys = m
+        // Each storey's outputs, which each yielding building gathers; the residual drifts are
+        // known only once the run settled.
+        let mut storeys: Vec<StoreyOutput> = m
             .storeys
             .iter()
             .zip(&self.storeys)
             .enumerate()
             .map(|(s, (sm, st))| StoreyOutput {
-                residual_drift_ratio: if settled {
-                    self.z[m.plastic_slot(s)] / sm.height
-                } else {
-                    f64::NAN
-                },
+                residual_drift_ratio: self.z[m.plastic_slot(s)] / sm.height,
                 peak_ductility: st.peak_drift_ratio * sm.height / sm.d_y,
                 hysteretic_energy: self.z[m.plastic_slot(s) + ns],
+                yielded: st.yielded,
             })
             .collect();
+        let settled = self.settled && status == Status::Ok;
+        for (b, bm) in self.buildings.iter_mut().zip(&m.buildings) {
+            b.inelastic = bm.first_storey.map(|first| {
+                let mut ie = InelasticOutput::gather(&storeys[first..first + bm.n()]);
+                if !settled {
+                    ie.residual_drift_ratio = f64::NAN;
+                }
+                ie
+            });
+        }
+        if !settled {
+            for st in storeys.iter_mut() {
+                st.residual_drift_ratio = f64::NAN;
+            }
+        }
         let mut out = RowOutput {
             status,
             levels: self.levels.iter().map(|l| l.out).collect(),
