@@ -16,8 +16,10 @@
 // per-run blocks (P_*, M_*, S_*, C_*, LS_*, LC_*, BS_*, BC_*, MW). Then contact.wgsl and
 // hermite.wgsl. So a kernel carries exactly the loops its row needs.
 //
-// The state z is [q (NM), q' (NM), w (one per level), e_in, e_damp], as on the CPU; this kernel
-// does not integrate the energy balance (the host refuses to ask for it), so the last two stay 0.
+// The state z is [q (NM), q' (NM), w (one per level), e_in, e_damp, then each yielding storey's
+// plastic drift and plastic work], as on the CPU; this kernel does not integrate the energy
+// balance (the host refuses to ask for it), so e_in and e_damp stay 0. Yielding storeys
+// (yielding.wgsl) enter where `NS > 0`, a constant.
 
 alias ZA = array<real, ZLEN>;
 
@@ -193,6 +195,11 @@ fn side_bound(b: u32, f: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function,
     let o = B_OFF[b];
     for (var i = 0u; i < B_N[b]; i++) {
         let k = o + i;
+        if (NS > 0u) {
+            // About the static response to the plastic loads (yield_watch's bounds).
+            s += abs(shape_at(b, f, i)) * MBND[k];
+            continue;
+        }
         let sk = Seg(seg.a0 * PART[k], seg.a1 * PART[k], seg.dt);
         let q = max(abs((*z0)[k]), abs((*z1)[k]));
         let qd = max(abs((*z0)[NM + k]), abs((*z1)[NM + k]));
@@ -225,6 +232,9 @@ fn rhs(ag: real, z: ptr<function, ZA>, out: ptr<function, ZA>) {
         let v = (*z)[NM + i];
         (*out)[i] = v;
         (*out)[NM + i] = -TXW[i] * v - W2[i] * (*z)[i] - PART[i] * ag;
+    }
+    if (NS > 0u) {
+        plastic_rhs(z, out);
     }
     for (var l = 0u; l < NL; l++) {
         if (LMODE[l] == MODE_FREE) {
@@ -275,6 +285,9 @@ fn event_max(z: ptr<function, ZA>) -> real {
     for (var l = 0u; l < NL; l++) {
         m = max(m, event_value(l, LMODE[l], LV0[l], z));
     }
+    if (NS > 0u) {
+        m = storey_event_max(z, m);
+    }
     return m;
 }
 
@@ -299,12 +312,22 @@ fn fill(b: u32, e: u32, z: ptr<function, ZA>, ag: real) {
     let o = B_OFF[b];
     var acc: array<real, MAXN>;
     var jrk: array<real, MAXN>;
+    let yields = NS > 0u && B_S0[b] < NS;
+    if (yields) {
+        plastic_loads(b, z);
+    }
     for (var i = 0u; i < n; i++) {
         let k = o + i;
-        let a = -TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k];
+        var a = -TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k];
+        if (yields) {
+            a += PLA[i];
+        }
         acc[i] = a;
         let qdd = a - PART[k] * ag;
         jrk[i] = -TXW[k] * qdd - W2[k] * (*z)[NM + k];
+        if (yields) {
+            jrk[i] += PLJ[i];
+        }
     }
     for (var j = 0u; j < n; j++) {
         var u: real = 0.0;
@@ -374,13 +397,19 @@ fn track_buildings(z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1:
                 ba0 = FL[fli(0u, 2u, k - 1u)]; ba1 = FL[fli(1u, 2u, k - 1u)];
             }
             let inv_h = 1.0 / height_at(b, j);
-            let p = raise(free, drift,
-                (FL[fli(0u, 0u, k)] - bu0) * inv_h, (FL[fli(1u, 0u, k)] - bu1) * inv_h,
-                (FL[fli(0u, 1u, k)] - bv0) * inv_h, (FL[fli(1u, 1u, k)] - bv1) * inv_h,
-                (FL[fli(0u, 2u, k)] - ba0) * inv_h, (FL[fli(1u, 2u, k)] - ba1) * inv_h, h);
+            let y0 = (FL[fli(0u, 0u, k)] - bu0) * inv_h;
+            let y1 = (FL[fli(1u, 0u, k)] - bu1) * inv_h;
+            let d0 = (FL[fli(0u, 1u, k)] - bv0) * inv_h;
+            let d1 = (FL[fli(1u, 1u, k)] - bv1) * inv_h;
+            let a0 = (FL[fli(0u, 2u, k)] - ba0) * inv_h;
+            let a1 = (FL[fli(1u, 2u, k)] - ba1) * inv_h;
+            let p = raise(free, drift, y0, y1, d0, d1, a0, a1, h);
             if (p > drift) {
                 drift = p;
                 rcount[cb + BC_DRIFT_STOREY] = j + 1u;
+            }
+            if (NS > 0u) {
+                raise_storey(b, j, free, y0, y1, d0, d1, a0, a1, h);
             }
             var pa: real;
             if (free) {
@@ -576,6 +605,9 @@ fn accept(tau: real, h_in: real, trial_in: ptr<function, ZA>, seg: Seg, z0: ptr<
                 best = s;
             }
         }
+        if (NS > 0u) {
+            best = hidden_yield(z0, &trial, h, best);
+        }
         if (best >= 0.0) {
             var zs: ZA;
             rk4(seg, tau, z0, best * h, &zs);
@@ -594,6 +626,9 @@ fn accept(tau: real, h_in: real, trial_in: ptr<function, ZA>, seg: Seg, z0: ptr<
         let x = locate(h, f0, f1, tol, seg, tau, z0, out);
         track(tau, x, z0, out, seg_at(seg, tau), seg_at(seg, tau + x));
         transitions(tau + x, out, z0);
+        if (NS > 0u) {
+            storey_transitions(out);
+        }
         return x;
     }
     track(tau, h, z0, &trial, seg_at(seg, tau), seg_at(seg, tau + h));
@@ -634,6 +669,10 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
         contact = contact || LMODE[l] != MODE_FREE;
     }
     if (!contact) {
+        // Yielding storeys: the step is exact about the static response to the plastic loads.
+        if (NS > 0u) {
+            static_offsets(z);
+        }
         var z1 = *z;
         for (var b = 0u; b < NB; b++) {
             for (var i = 0u; i < B_N[b]; i++) {
@@ -641,12 +680,23 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
                 let c = MB[b] + MW * i + 3u;
                 let a0 = PART[k] * seg.a0;
                 let a1 = PART[k] * seg.a1;
-                let u = (*z)[k];
+                var u = (*z)[k];
+                if (NS > 0u) {
+                    u = u - QS[k];
+                }
                 let v = (*z)[NM + k];
                 z1[k] = models[c] * u + models[c + 1u] * v + models[c + 2u] * a0 + models[c + 3u] * a1;
+                if (NS > 0u) {
+                    z1[k] = z1[k] + QS[k];
+                }
                 z1[NM + k] = models[c + 4u] * u + models[c + 5u] * v + models[c + 6u] * a0
                     + models[c + 7u] * a1;
             }
+        }
+        // A storey that yields, or may in the free step, takes the step in substeps.
+        var yielding = false;
+        if (NS > 0u) {
+            yielding = yield_watch(seg, z, &z1, dt);
         }
         var touching = false;
         for (var l = 0u; l < NL; l++) {
@@ -660,7 +710,7 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
             use_level(l);
             h = min(h, min(impact_step(v_est, a_est, PER_CONTACT), h_rate_of(d_est, LV0[l])));
         }
-        if (!touching) {
+        if (!touching && !yielding) {
             track(0.0, dt, z, &z1, seg.a0, seg.a1);
             FREE_STEPS = FREE_STEPS + 1u;
             *z = z1;
@@ -749,6 +799,15 @@ fn piece(seg: Seg, z: ptr<function, ZA>) {
     }
 }
 
+// Has the run ended? At the record's end, or with yielding storeys once it settled
+// (yielding::next_segment) or its settling time ran out.
+fn ended() -> bool {
+    if (NS == 0u) {
+        return CI >= INTERVALS;
+    }
+    return CI >= INTERVALS && (SETTLED != 0u || CI >= END);
+}
+
 // One lane's work in a dispatch: at most disp.budget units of run run_ids[lane]; returns the
 // units it did.
 fn integrate_run(lane: u32) -> u32 {
@@ -761,7 +820,10 @@ fn integrate_run(lane: u32) -> u32 {
     STATUS = rcount[RC + C_STATUS];
     CI = rcount[RC + C_I];
     INTERVALS = rmeta[rm + M_INTERVALS];
-    if (STATUS != STATUS_OK || CI >= INTERVALS) {
+    if (NS > 0u) {
+        load_storeys(rm);
+    }
+    if (STATUS != STATUS_OK || ended()) {
         return 0u;
     }
     RP = r * P_STRIDE;
@@ -799,11 +861,19 @@ fn integrate_run(lane: u32) -> u32 {
     for (var i = 0u; i < ZLEN; i++) { z[i] = rstate[RS + i]; }
     var budget = disp.budget;
     loop {
-        if (STATUS != STATUS_OK || CI >= INTERVALS || budget == 0u) {
+        // After the record, a run with yielding storeys ends once none can yield again.
+        if (NS > 0u && STATUS == STATUS_OK && CI >= INTERVALS && SETTLED == 0u && settles(&z)) {
+            SETTLED = 1u;
+        }
+        if (STATUS != STATUS_OK || ended() || budget == 0u) {
             break;
         }
         budget = budget - 1u;
-        let seg = Seg(sample(CI), sample(CI + 1u), DT);
+        var seg = Seg(sample(CI), sample(CI + 1u), DT);
+        if (NS > 0u && CI >= INTERVALS) {
+            // The settling tail: free vibration, the ground at rest.
+            seg = Seg(0.0, 0.0, DT);
+        }
         if (CJ == 0u) {
             begin_interval(seg, &z);
         } else {
@@ -823,7 +893,10 @@ fn integrate_run(lane: u32) -> u32 {
     rcount[RC + C_PIECES] = PIECES;
     rcount[RC + C_SUBSTEPS] = SUBSTEPS;
     rcount[RC + C_FREE_STEPS] = FREE_STEPS;
-    if (STATUS == STATUS_OK && CI < INTERVALS) {
+    if (NS > 0u) {
+        store_storeys();
+    }
+    if (STATUS == STATUS_OK && !ended()) {
         next_ids[atomicAdd(&tally.active_runs, 1u)] = r;
     }
     return disp.budget - budget;

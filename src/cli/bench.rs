@@ -151,33 +151,39 @@ fn run_storeys(
         ..Default::default()
     };
     let mut rows = Vec::new();
-    for &n in storeys {
-        let r = bench::run_storeys(n, &bench::row_plan(n, runs, false));
-        note!(
-            "{} runs of two {n}-storey buildings on CPU: {:.0} runs/s",
-            r.summary.runs,
-            r.summary.runs_per_second()
-        );
-        let elastic = r.summary.runs_per_second();
-        rows.push(r);
-        if yielding {
-            let r = bench::run_storeys(n, &bench::row_plan(n, runs, true));
+    // Each suite, then its yielding twin with its time per run against the suite's.
+    let mut say = |r: bench::StoreyRow, on: &str, elastic: &mut f64| {
+        let (n, rate) = (r.storeys, r.summary.runs_per_second());
+        if r.yielding {
             note!(
-                "{} runs of two yielding {n}-storey buildings on CPU: {:.0} runs/s ({:.2}x the elastic suite's time per run)",
+                "{} runs of two yielding {n}-storey buildings on {on}: {rate:.0} runs/s ({:.2}x the elastic suite's time per run)",
                 r.summary.runs,
-                r.summary.runs_per_second(),
-                elastic / r.summary.runs_per_second()
+                *elastic / rate
             );
-            rows.push(r);
+        } else {
+            note!(
+                "{} runs of two {n}-storey buildings on {on}: {rate:.0} runs/s",
+                r.summary.runs
+            );
+            *elastic = rate;
+        }
+        rows.push(r);
+    };
+    let twins: &[bool] = if yielding { &[false, true] } else { &[false] };
+    for &n in storeys {
+        let mut elastic = 0.0;
+        for &y in twins {
+            say(
+                bench::run_storeys(n, &bench::row_plan(n, runs, y)),
+                "CPU",
+                &mut elastic,
+            );
         }
         if let Some(ctx) = &ctx {
-            let r = bench::run_storeys_gpu(n, &bench::row_plan(n, gpu_runs, false), ctx, &opts)?;
-            note!(
-                "{} runs of two {n}-storey buildings on GPU: {:.0} runs/s",
-                r.summary.runs,
-                r.summary.runs_per_second()
-            );
-            rows.push(r);
+            for &y in twins {
+                let r = bench::run_storeys_gpu(n, &bench::row_plan(n, gpu_runs, y), ctx, &opts)?;
+                say(r, "GPU", &mut elastic);
+            }
         }
     }
     let table = bench::storey_table(&rows);

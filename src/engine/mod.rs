@@ -184,9 +184,6 @@ impl Kernel {
         };
         match Kernel::of(plan) {
             Kernel::Pair => None,
-            Kernel::Row if plan.yields() => Some(EngineError::GpuUnfit(
-                "yielding storeys run on the CPU only so far (the row kernel has no yielding storeys yet)",
-            )),
             // The row kernel runs the fast scheme without the energy balance; the rows'
             // calibration is of the CPU's f64 (the GPU in f64 agrees with it to 3.7e-6,
             // BENCHMARKS.md; f32 adds up to 7.2e-5).

@@ -202,6 +202,31 @@ pub struct RowOutput {
 }
 
 impl RowOutput {
+    /// Each yielding building's outputs from its storeys in `self.storeys` (`spans`: each
+    /// building's storeys there, None where it is elastic); the residual drifts are known only
+    /// where the run `settled` (else NaN, not a guess). The CPU schemes and the GPU row
+    /// kernel's readback both end with this.
+    pub(crate) fn gather_storeys(
+        &mut self,
+        spans: &[Option<std::ops::Range<usize>>],
+        settled: bool,
+    ) {
+        for (b, span) in self.buildings.iter_mut().zip(spans) {
+            b.inelastic = span.clone().map(|r| {
+                let mut ie = InelasticOutput::gather(&self.storeys[r]);
+                if !settled {
+                    ie.residual_drift_ratio = f64::NAN;
+                }
+                ie
+            });
+        }
+        if !settled {
+            for st in self.storeys.iter_mut() {
+                st.residual_drift_ratio = f64::NAN;
+            }
+        }
+    }
+
     /// Fill the totals from the levels.
     pub(crate) fn gather(&mut self) {
         self.impacts = self.levels.iter().map(|l| l.impacts).sum();

@@ -389,7 +389,7 @@ pub fn run_storeys_gpu(
     )?;
     Ok(StoreyRow {
         storeys,
-        yielding: false,
+        yielding: plan.yielding.iter().any(Option::is_some),
         backend: format!("gpu {} ({})", opts.precision.key(), ctx.info.name),
         summary,
         csv,

@@ -20,8 +20,9 @@ use crate::engine::Summary;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::Propagator;
-use crate::physics::row::{BuildingOutput, LevelOutput, RowOutput};
+use crate::physics::row::{BuildingOutput, LevelOutput, RowOutput, StoreyOutput};
 use crate::physics::solver::fast::LOCATE_ITERATIONS;
+use crate::physics::solver::row::yielding::settle_intervals;
 use crate::physics::solver::row::{simulate_row, RowModel, RowScheme};
 use crate::physics::solver::FastOptions;
 use crate::plan::row::{RowPlan, RowRunSpec};
@@ -63,6 +64,12 @@ pub const LC_STRIDE: usize = 4;
 pub const BC_DRIFT_STOREY: usize = 0;
 pub const BC_ACCEL_FLOOR: usize = 1;
 pub const BC_STRIDE: usize = 2;
+// Rows with yielding storeys add, after the buildings' counters: whether the run settled
+// (`RowModel::settled`), then per storey its spring state (`SM_*` in `shaders/yielding.wgsl`)
+// and whether it has yielded.
+pub const SC_MODE: usize = 0;
+pub const SC_YIELDED: usize = 1;
+pub const SC_STRIDE: usize = 2;
 // A run's state (reals): z, the local time, then each level's (LS_*), then each building's.
 pub const LS_V0: usize = 0;
 pub const LS_TAU_ONSET: usize = 1;
@@ -85,6 +92,15 @@ pub const BS_STRIDE: usize = 3;
 /// Reals per mode in a building model: `w^2`, `2 xi w`, the participation, then the
 /// propagator's `uu, uv, ua0, ua1, vu, vv, va0, va1`.
 pub const MW: usize = 11;
+/// Reals per yielding storey after its building's model block: `k`, `d_y`, `b`, then its
+/// modal row (the drift in the building's modes).
+pub const STOREY_HEAD: usize = 3;
+
+/// The band's slack in f32 (`row::yielding::YIELD_SLACK` is f64's): a storey leaves its band edge
+/// inside the band once f32 has rounded its back drift `d - p / (1 - b)`, whose terms are up
+/// to the ductility times `d_y` (a few 1e-7 each): 1e-4 of `d_y` keeps an unloading storey
+/// from re-yielding on rounding at ductilities up to a few hundred.
+pub const F32_YIELD_SLACK: f64 = 1e-4;
 
 /// lavapipe ends a shader's loops after about 65,535 back edges per invocation, counted over
 /// all its loops (see [`super::run::CPU_ADAPTER_BUDGET`]): a dispatch's units on a software
@@ -97,6 +113,8 @@ const SOFTWARE_LOOP_TRIPS: u64 = 60_000;
 pub struct RowShape {
     pub storeys: Vec<usize>,
     pub levels: Vec<[usize; 3]>,
+    /// Each building: do its storeys yield?
+    pub yielding: Vec<bool>,
 }
 
 impl RowShape {
@@ -108,7 +126,32 @@ impl RowShape {
                 .iter()
                 .map(|l| [l.buildings.0, l.floors.0, l.floors.1])
                 .collect(),
+            yielding: m
+                .buildings
+                .iter()
+                .map(|b| b.first_storey.is_some())
+                .collect(),
         }
+    }
+
+    /// An elastic row's shape.
+    pub fn elastic(storeys: Vec<usize>, levels: Vec<[usize; 3]>) -> RowShape {
+        let yielding = vec![false; storeys.len()];
+        RowShape {
+            storeys,
+            levels,
+            yielding,
+        }
+    }
+
+    /// The yielding storeys (every storey of each yielding building).
+    fn yielding_storeys(&self) -> usize {
+        self.storeys
+            .iter()
+            .zip(&self.yielding)
+            .filter(|(_, &y)| y)
+            .map(|(n, _)| n)
+            .sum()
     }
 
     fn modes(&self) -> usize {
@@ -116,7 +159,12 @@ impl RowShape {
     }
 
     fn zlen(&self) -> usize {
-        2 * self.modes() + self.levels.len() + 2
+        2 * self.modes() + self.levels.len() + 2 + 2 * self.yielding_storeys()
+    }
+
+    /// A yielding row's extra block: one more meta word (the settle end), counter and state.
+    fn yields(&self) -> usize {
+        (self.yielding_storeys() > 0) as usize
     }
 
     fn p_stride(&self) -> usize {
@@ -124,7 +172,7 @@ impl RowShape {
     }
 
     fn m_stride(&self) -> usize {
-        M_MODELS + self.storeys.len()
+        M_MODELS + self.storeys.len() + self.yields()
     }
 
     fn s_levels(&self) -> usize {
@@ -135,16 +183,24 @@ impl RowShape {
         self.s_levels() + LS_STRIDE * self.levels.len()
     }
 
-    fn s_stride(&self) -> usize {
+    fn s_storeys(&self) -> usize {
         self.s_buildings() + BS_STRIDE * self.storeys.len()
+    }
+
+    fn s_stride(&self) -> usize {
+        self.s_storeys() + self.yielding_storeys()
     }
 
     fn c_buildings(&self) -> usize {
         C_LEVELS + LC_STRIDE * self.levels.len()
     }
 
-    fn c_stride(&self) -> usize {
+    fn c_settled(&self) -> usize {
         self.c_buildings() + BC_STRIDE * self.storeys.len()
+    }
+
+    fn c_stride(&self) -> usize {
+        self.c_settled() + self.yields() * (1 + SC_STRIDE * self.yielding_storeys())
     }
 
     /// Bytes of a run's largest per-run block in `precision` (the chunk's cap follows from it).
@@ -153,9 +209,9 @@ impl RowShape {
         reals.max(4 * self.c_stride().max(self.m_stride()))
     }
 
-    /// Reals of one building's model block.
-    fn model_len(n: usize) -> usize {
-        MW * n + n * n + 2 * n
+    /// Reals of one building's model block (with its storeys' where they yield).
+    fn model_len(n: usize, yields: bool) -> usize {
+        MW * n + n * n + 2 * n + if yields { n * (STOREY_HEAD + n) } else { 0 }
     }
 
     /// The shape and layout as WGSL constants, prepended to `row.wgsl`.
@@ -186,10 +242,14 @@ impl RowShape {
         };
         let mut s = String::new();
         let mut c = |name: &str, v: usize| s.push_str(&format!("const {name}: u32 = {v}u;\n"));
+        let ns = self.yielding_storeys();
         c("NB", nb);
         c("NM", self.modes());
         c("NL", nl);
         c("NLA", nla);
+        c("NS", ns);
+        c("NSA", ns.max(1));
+        c("PS0", 2 * self.modes() + nl + 2);
         c("ZLEN", self.zlen());
         c("MAXN", *self.storeys.iter().max().unwrap_or(&1));
         c("FLEN", 10 * self.modes());
@@ -210,6 +270,7 @@ impl RowShape {
             ("M_REC_LEN", M_REC_LEN),
             ("M_INTERVALS", M_INTERVALS),
             ("M_MODELS", M_MODELS),
+            ("M_SETTLE_END", M_MODELS + nb),
             ("M_STRIDE", self.m_stride()),
             ("C_STATUS", C_STATUS),
             ("C_SUBSTEPS", C_SUBSTEPS),
@@ -220,6 +281,12 @@ impl RowShape {
             ("C_FREE_STEPS", C_FREE_STEPS),
             ("C_LEVELS", C_LEVELS),
             ("C_BUILDINGS", self.c_buildings()),
+            ("C_SETTLED", self.c_settled()),
+            ("C_STOREYS", self.c_settled() + 1),
+            ("SC_MODE", SC_MODE),
+            ("SC_YIELDED", SC_YIELDED),
+            ("SC_STRIDE", SC_STRIDE),
+            ("STOREY_HEAD", STOREY_HEAD),
             ("C_STRIDE", self.c_stride()),
             ("LC_MODE", LC_MODE),
             ("LC_IMPACTS", LC_IMPACTS),
@@ -232,6 +299,7 @@ impl RowShape {
             ("S_TAU", self.zlen()),
             ("S_LEVELS", self.s_levels()),
             ("S_BUILDINGS", self.s_buildings()),
+            ("S_STOREYS", self.s_storeys()),
             ("S_STRIDE", self.s_stride()),
             ("LS_V0", LS_V0),
             ("LS_TAU_ONSET", LS_TAU_ONSET),
@@ -266,6 +334,22 @@ impl RowShape {
         a("L_A", "NLA", &pick(0));
         a("L_FA", "NLA", &pick(1));
         a("L_FB", "NLA", &pick(2));
+        // The yielding storeys: each one's building and storey, each building's first (NS
+        // where it is elastic).
+        let (mut sb, mut sj, mut first) = (Vec::new(), Vec::new(), Vec::new());
+        for (b, (&n, &y)) in self.storeys.iter().zip(&self.yielding).enumerate() {
+            first.push(if y { sb.len() } else { ns });
+            if y {
+                sb.extend(std::iter::repeat_n(b, n));
+                sj.extend(0..n);
+            }
+        }
+        if ns == 0 {
+            (sb, sj) = (vec![0], vec![0]);
+        }
+        a("S_B", "NSA", &sb);
+        a("S_J", "NSA", &sj);
+        a("B_S0", "NB", &first);
         s
     }
 
@@ -278,16 +362,23 @@ impl RowShape {
         let zlen = self.zlen() as u64;
         let sq: u64 = self.storeys.iter().map(|&n| (n * n + 2 * n) as u64).sum();
         let level = 4 * nmax + 1;
-        let rhs = nm + nl * (2 * level + 2 * nmax) + 1;
+        // Yielding storeys (none in an elastic row): each one's drift and rate are products
+        // with its modal row.
+        let ns = self.yielding_storeys() as u64;
+        let storeys = ns * (2 * nmax + 4);
+        let rhs = nm + nl * (2 * level + 2 * nmax) + 1 + storeys + ns * nmax;
         let rk4 = 4 * rhs + 4 * zlen;
-        let event_max = nl * level;
+        let event_max = nl * level + storeys;
         let forces = nm + nl * level;
         let track = 5 * nm + 2 * forces + 2 * sq + nl + nm + nl * (3 * level);
-        let transitions = nl * (3 * level);
+        let track = track + 2 * (storeys + ns * nmax) + ns;
+        let transitions = nl * (3 * level) + storeys;
         let locate = LOCATE_ITERATIONS as u64 * (2 * (rk4 + event_max) + 1);
         let accept = 4 * event_max + nl * (2 * level) + rk4 + locate + track + transitions;
+        let accept = accept + storeys;
         let piece = rk4 + accept + zlen;
         let begin = nl + nm + nl * (6 * level + 2 * nmax) + track + zlen;
+        let begin = begin + 3 * nm * (ns > 0) as u64 + 2 * storeys + ns * nmax;
         piece.max(begin) + 1
     }
 }
@@ -319,6 +410,8 @@ pub struct PackedRows {
     meta: Vec<u32>,
     models: ModelTable,
     runs: usize,
+    /// Each run's yielding storeys' heights and yield drifts (for their outputs).
+    storey_scales: Vec<[f64; 2]>,
 }
 
 fn law_code(l: LawKind) -> u32 {
@@ -333,6 +426,7 @@ impl PackedRows {
             meta: Vec::new(),
             models: ModelTable::default(),
             runs: 0,
+            storey_scales: Vec::new(),
         }
     }
 
@@ -390,6 +484,11 @@ impl PackedRows {
             let at = self.models.add(block);
             self.meta.push(at);
         }
+        if !m.storeys.is_empty() {
+            self.meta.push(settle_intervals(m, forcing) as u32);
+            self.storey_scales
+                .extend(m.storeys.iter().map(|s| [s.height, s.d_y]));
+        }
         self.runs += 1;
     }
 }
@@ -401,7 +500,7 @@ fn model_blocks(m: &RowModel, dt: f64) -> Vec<Vec<f64>> {
         .iter()
         .map(|b| {
             let n = b.n();
-            let mut block = Vec::with_capacity(RowShape::model_len(n));
+            let mut block = Vec::with_capacity(RowShape::model_len(n, b.first_storey.is_some()));
             for i in 0..n {
                 let k = b.off + i;
                 let osc = Oscillator {
@@ -429,6 +528,16 @@ fn model_blocks(m: &RowModel, dt: f64) -> Vec<Vec<f64>> {
             }
             block.extend_from_slice(&b.masses);
             block.extend_from_slice(&b.heights);
+            if let Some(first) = b.first_storey {
+                for s in &m.storeys[first..first + n] {
+                    block.extend([s.k, s.d_y, s.b]);
+                    block.extend_from_slice(&s.modal_row);
+                }
+            }
+            debug_assert_eq!(
+                block.len(),
+                RowShape::model_len(n, b.first_storey.is_some())
+            );
             block
         })
         .collect()
@@ -558,7 +667,8 @@ pub fn run_rows(
         .map(|r| {
             let s = &reals[r * shape.s_stride()..(r + 1) * shape.s_stride()];
             let c = &words[r * shape.c_stride()..(r + 1) * shape.c_stride()];
-            output(shape, s, c)
+            let ns = shape.yielding_storeys();
+            output(shape, s, c, &chunk.storey_scales[r * ns..(r + 1) * ns])
         })
         .collect();
     times.readback = t.elapsed();
@@ -566,8 +676,9 @@ pub fn run_rows(
 }
 
 /// A run's results from its final state and counters (what `RowRun::finish` does on the CPU,
-/// without the energy balance); None for a run handed back.
-fn output(shape: &RowShape, s: &[f64], c: &[u32]) -> Option<RowOutput> {
+/// without the energy balance), `scales`: its yielding storeys' heights and yield drifts; None
+/// for a run handed back.
+fn output(shape: &RowShape, s: &[f64], c: &[u32], scales: &[[f64; 2]]) -> Option<RowOutput> {
     let status = match c[C_STATUS] {
         STATUS_HANDOFF => return None,
         STATUS_OK => Status::Ok,
@@ -617,6 +728,33 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32]) -> Option<RowOutput> {
         free_steps: c[C_FREE_STEPS] as u64,
         ..RowOutput::default()
     };
+    let ns = shape.yielding_storeys();
+    if ns > 0 {
+        let ps = 2 * shape.modes() + shape.levels.len() + 2;
+        out.storeys = scales
+            .iter()
+            .enumerate()
+            .map(|(k, &[height, d_y])| StoreyOutput {
+                residual_drift_ratio: s[ps + k] / height,
+                peak_ductility: s[shape.s_storeys() + k] * height / d_y,
+                hysteretic_energy: s[ps + ns + k],
+                yielded: c[shape.c_settled() + 1 + SC_STRIDE * k + SC_YIELDED] != 0,
+            })
+            .collect();
+        let mut first = 0;
+        let spans: Vec<_> = shape
+            .storeys
+            .iter()
+            .zip(&shape.yielding)
+            .map(|(&n, &y)| {
+                let span = y.then(|| first..first + n);
+                first += if y { n } else { 0 };
+                span
+            })
+            .collect();
+        let settled = c[shape.c_settled()] != 0 && status == Status::Ok;
+        out.gather_storeys(&spans, settled);
+    }
     out.gather();
     Some(out)
 }

@@ -51,6 +51,7 @@ pub const CONTACT_WGSL: &str = include_str!("../../../shaders/contact.wgsl");
 pub const HERMITE_WGSL: &str = include_str!("../../../shaders/hermite.wgsl");
 pub const FAST_WGSL: &str = include_str!("../../../shaders/fast.wgsl");
 pub const ROW_WGSL: &str = include_str!("../../../shaders/row.wgsl");
+pub const YIELDING_WGSL: &str = include_str!("../../../shaders/yielding.wgsl");
 pub const LANES_WGSL: &str = include_str!("../../../shaders/lanes.wgsl");
 pub const AGGREGATE_WGSL: &str = include_str!("../../../shaders/aggregate.wgsl");
 
@@ -83,9 +84,15 @@ pub fn fast_source(precision: Precision, energy: bool) -> String {
 
 /// `shaders/row.wgsl` for `precision`, after the prelude and the row's shape `constants`
 /// ([`super::row::RowShape::wgsl_constants`]).
+/// Every row kernel carries `yielding.wgsl`; its functions are entered only where the shape
+/// has yielding storeys (`NS > 0`, a constant), so an elastic row's kernel compiles none of it.
 pub fn row_source(precision: Precision, constants: &str) -> String {
+    let slack = match precision {
+        Precision::F64 => crate::physics::solver::row::yielding::YIELD_SLACK,
+        Precision::F32 => super::row::F32_YIELD_SLACK,
+    };
     format!(
-        "{}{constants}{CONTACT_WGSL}{HERMITE_WGSL}{ROW_WGSL}{LANES_WGSL}",
+        "{}{constants}const YIELD_SLACK: real = {slack:e};\n{CONTACT_WGSL}{HERMITE_WGSL}{ROW_WGSL}{YIELDING_WGSL}{LANES_WGSL}",
         prelude(precision)
     )
 }

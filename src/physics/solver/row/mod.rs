@@ -25,9 +25,7 @@ use super::tracker::ForceHistory;
 use super::{Mode, Segment};
 use crate::physics::contact::Contact;
 use crate::physics::model::{EnergyBalance, Forcing, Status};
-use crate::physics::row::{
-    BuildingOutput, InelasticOutput, LevelOutput, Row, RowOutput, StoreyOutput,
-};
+use crate::physics::row::{BuildingOutput, LevelOutput, Row, RowOutput, StoreyOutput};
 use crate::physics::shear::Modes;
 use yielding::{StoreyMode, StoreyModel};
 
@@ -1539,9 +1537,8 @@ impl<'m> RowRun<'m> {
                 ls.end_impact();
             }
         }
-        // Each storey's outputs, which each yielding building gathers; the residual drifts are
-        // known only once the run settled.
-        let mut storeys: Vec<StoreyOutput> = m
+        // Each storey's outputs, which each yielding building gathers.
+        let storeys: Vec<StoreyOutput> = m
             .storeys
             .iter()
             .zip(&self.storeys)
@@ -1553,21 +1550,6 @@ impl<'m> RowRun<'m> {
                 yielded: st.yielded,
             })
             .collect();
-        let settled = self.settled && status == Status::Ok;
-        for (b, bm) in self.buildings.iter_mut().zip(&m.buildings) {
-            b.inelastic = bm.first_storey.map(|first| {
-                let mut ie = InelasticOutput::gather(&storeys[first..first + bm.n()]);
-                if !settled {
-                    ie.residual_drift_ratio = f64::NAN;
-                }
-                ie
-            });
-        }
-        if !settled {
-            for st in storeys.iter_mut() {
-                st.residual_drift_ratio = f64::NAN;
-            }
-        }
         let mut out = RowOutput {
             status,
             levels: self.levels.iter().map(|l| l.out).collect(),
@@ -1578,6 +1560,9 @@ impl<'m> RowRun<'m> {
             storeys,
             ..RowOutput::default()
         };
+        if ns > 0 {
+            out.gather_storeys(&m.storey_spans(), self.settled && status == Status::Ok);
+        }
         out.gather();
         out
     }

@@ -115,6 +115,14 @@ impl StoreyModel {
 }
 
 impl RowModel {
+    /// Each building's yielding storeys in [`RowModel::storeys`] (None: elastic).
+    pub(crate) fn storey_spans(&self) -> Vec<Option<std::ops::Range<usize>>> {
+        self.buildings
+            .iter()
+            .map(|b| b.first_storey.map(|f| f..f + b.n()))
+            .collect()
+    }
+
     /// Slot of storey `s`'s plastic drift in the state; its plastic work follows `ns` later.
     #[inline]
     pub(crate) fn plastic_slot(&self, s: usize) -> usize {
@@ -271,13 +279,33 @@ pub(crate) fn next_segment(
         run.settled = true;
         return None;
     }
-    let t0 = forcing.t0 + i as f64 * forcing.dt;
-    (t0 < m.settle_until(forcing.t0 + intervals as f64 * forcing.dt)).then_some(Segment {
-        t0,
+    (i < settle_intervals(m, forcing)).then_some(Segment {
+        t0: forcing.t0 + i as f64 * forcing.dt,
         dt: forcing.dt,
         a0: 0.0,
         a1: 0.0,
     })
+}
+
+/// The end of a run that has not settled, in record steps: the steps `i` after the record
+/// with `t0 + i dt` before [`RowModel::settle_until`] are its settling tail.
+pub(crate) fn settle_intervals(m: &RowModel, forcing: &Forcing) -> usize {
+    let intervals = forcing.intervals();
+    let t = |i: usize| forcing.t0 + i as f64 * forcing.dt;
+    let until = m.settle_until(t(intervals));
+    let guess = ((until - forcing.t0) / forcing.dt).ceil();
+    let mut i = if guess.is_finite() {
+        (guess.max(0.0) as usize).max(intervals)
+    } else {
+        intervals
+    };
+    while i > intervals && t(i - 1) >= until {
+        i -= 1;
+    }
+    while t(i) < until {
+        i += 1;
+    }
+    i
 }
 
 #[cfg(test)]
