@@ -143,6 +143,18 @@ pub struct Group {
     pub failures: u64,
     pub exceed: Vec<u64>,
     pub stats: Vec<Sketch>,
+    /// Per `--exceed`, `ok` runs whose cell was empty (neither exceeding nor not; see
+    /// [`may_be_empty`]).
+    pub undecided: Vec<u64>,
+    /// Per output, `ok` runs whose cell was empty (not in its statistics).
+    pub no_value: Vec<u64>,
+}
+
+/// Can an output column of an `ok` run be empty? A yielding building's residual drift (and its
+/// storey) where the run did not settle: not known, so neither a value nor a zero
+/// (docs/inelastic.md). The summary counts such runs apart for these columns.
+pub fn may_be_empty(column: &str) -> bool {
+    column.ends_with("residual_drift_ratio") || column.ends_with("residual_storey")
 }
 
 impl Group {
@@ -150,6 +162,8 @@ impl Group {
         Group {
             exceed: vec![0; nexceed],
             stats: vec![Sketch::default(); noutputs],
+            undecided: vec![0; nexceed],
+            no_value: vec![0; noutputs],
             ..Default::default()
         }
     }
@@ -172,6 +186,28 @@ impl Group {
         }
         for (s, &v) in self.stats.iter_mut().zip(x) {
             s.add(v);
+        }
+    }
+
+    /// Fold in one row's outputs, None where its cell was empty: such a run is counted apart
+    /// (`undecided`, `no_value`), neither exceeding nor in the statistics.
+    fn add_cell_values(&mut self, ok: bool, x: &[Option<f64>], exceed: &[(usize, f64)]) {
+        self.runs += 1;
+        if !ok {
+            self.failures += 1;
+            return;
+        }
+        for (k, &(i, t)) in exceed.iter().enumerate() {
+            match x[i] {
+                Some(v) => self.exceed[k] += (v > t) as u64,
+                None => self.undecided[k] += 1,
+            }
+        }
+        for ((s, n), v) in self.stats.iter_mut().zip(self.no_value.iter_mut()).zip(x) {
+            match v {
+                Some(v) => s.add(*v),
+                None => *n += 1,
+            }
         }
     }
 
@@ -486,8 +522,9 @@ impl Aggregator {
     }
 
     /// Fold in one row given as its cells (in the header's order): grouped by the text of its
-    /// `by` cells; a row whose status is not `ok` is a failure. An empty or unreadable output
-    /// cell of an `ok` row counts as NaN (the zero bucket).
+    /// `by` cells; a row whose status is not `ok` is a failure. An empty output cell of an `ok`
+    /// row is counted apart (no value: a residual drift not known); an unreadable one counts
+    /// as NaN (the zero bucket).
     pub fn add_cells(&mut self, cells: &[String], status_at: usize) {
         let label: Vec<String> = self.by.iter().map(|(_, i, _)| cells[*i].clone()).collect();
         let next = self.groups.len() as u32;
@@ -497,14 +534,17 @@ impl Aggregator {
         if id == next {
             self.groups.push((label, Group::new(nexceed, nout)));
         }
-        let x: Vec<f64> = self
+        let x: Vec<Option<f64>> = self
             .outputs
             .iter()
-            .map(|(_, i)| cells[*i].parse::<f64>().map_or(f64::NAN, f64::abs))
+            .map(|(_, i)| {
+                let c = &cells[*i];
+                (!c.is_empty()).then(|| c.parse::<f64>().map_or(f64::NAN, f64::abs))
+            })
             .collect();
         let ok = cells[status_at] == Status::Ok.key();
         let exceed = &self.exceed;
-        self.groups[id as usize].1.add_values(ok, &x, exceed);
+        self.groups[id as usize].1.add_cell_values(ok, &x, exceed);
     }
 
     /// The (output index, threshold) pairs of `--exceed`.
