@@ -171,27 +171,14 @@ impl Group {
     /// Fold in one run: `exceed` holds (output index, threshold) pairs. Failed runs are
     /// counted, not summarised. The per-run body of `shaders/aggregate.wgsl`, line for line.
     pub fn add(&mut self, o: &RunOutput, exceed: &[(usize, f64)]) {
-        self.add_values(o.status == Status::Ok, &outputs(o), exceed);
+        // A pair's outputs are never empty.
+        self.add_values(o.status == Status::Ok, &outputs(o).map(Some), exceed);
     }
 
-    /// Fold in one run's summarised outputs `x` (magnitudes, in the aggregator's output order).
-    fn add_values(&mut self, ok: bool, x: &[f64], exceed: &[(usize, f64)]) {
-        self.runs += 1;
-        if !ok {
-            self.failures += 1;
-            return;
-        }
-        for (k, &(i, t)) in exceed.iter().enumerate() {
-            self.exceed[k] += (x[i] > t) as u64;
-        }
-        for (s, &v) in self.stats.iter_mut().zip(x) {
-            s.add(v);
-        }
-    }
-
-    /// Fold in one row's outputs, None where its cell was empty: such a run is counted apart
-    /// (`undecided`, `no_value`), neither exceeding nor in the statistics.
-    fn add_cell_values(&mut self, ok: bool, x: &[Option<f64>], exceed: &[(usize, f64)]) {
+    /// Fold in one run's summarised outputs `x` (magnitudes, in the aggregator's output order),
+    /// None where its cell was empty: such a run is counted apart (`undecided`, `no_value`),
+    /// neither exceeding nor in the statistics.
+    fn add_values(&mut self, ok: bool, x: &[Option<f64>], exceed: &[(usize, f64)]) {
         self.runs += 1;
         if !ok {
             self.failures += 1;
@@ -544,7 +531,7 @@ impl Aggregator {
             .collect();
         let ok = cells[status_at] == Status::Ok.key();
         let exceed = &self.exceed;
-        self.groups[id as usize].1.add_cell_values(ok, &x, exceed);
+        self.groups[id as usize].1.add_values(ok, &x, exceed);
     }
 
     /// The (output index, threshold) pairs of `--exceed`.

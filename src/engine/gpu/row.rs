@@ -154,12 +154,31 @@ impl RowShape {
             .sum()
     }
 
+    /// Each building's first yielding storey among the yielding storeys (None: elastic).
+    fn first_storeys(&self) -> Vec<Option<usize>> {
+        let mut next = 0;
+        self.storeys
+            .iter()
+            .zip(&self.yielding)
+            .map(|(&n, &y)| {
+                let first = y.then_some(next);
+                next += if y { n } else { 0 };
+                first
+            })
+            .collect()
+    }
+
     fn modes(&self) -> usize {
         self.storeys.iter().sum()
     }
 
+    /// The state slot of the first plastic drift (`RowModel::plastic_slot(0)`).
+    fn plastic_slot0(&self) -> usize {
+        2 * self.modes() + self.levels.len() + 2
+    }
+
     fn zlen(&self) -> usize {
-        2 * self.modes() + self.levels.len() + 2 + 2 * self.yielding_storeys()
+        self.plastic_slot0() + 2 * self.yielding_storeys()
     }
 
     /// A yielding row's extra block: one more meta word (the settle end), counter and state.
@@ -197,6 +216,10 @@ impl RowShape {
 
     fn c_settled(&self) -> usize {
         self.c_buildings() + BC_STRIDE * self.storeys.len()
+    }
+
+    fn c_storeys(&self) -> usize {
+        self.c_settled() + 1
     }
 
     fn c_stride(&self) -> usize {
@@ -249,7 +272,7 @@ impl RowShape {
         c("NLA", nla);
         c("NS", ns);
         c("NSA", ns.max(1));
-        c("PS0", 2 * self.modes() + nl + 2);
+        c("PS0", self.plastic_slot0());
         c("ZLEN", self.zlen());
         c("MAXN", *self.storeys.iter().max().unwrap_or(&1));
         c("FLEN", 10 * self.modes());
@@ -282,7 +305,7 @@ impl RowShape {
             ("C_LEVELS", C_LEVELS),
             ("C_BUILDINGS", self.c_buildings()),
             ("C_SETTLED", self.c_settled()),
-            ("C_STOREYS", self.c_settled() + 1),
+            ("C_STOREYS", self.c_storeys()),
             ("SC_MODE", SC_MODE),
             ("SC_YIELDED", SC_YIELDED),
             ("SC_STRIDE", SC_STRIDE),
@@ -336,10 +359,11 @@ impl RowShape {
         a("L_FB", "NLA", &pick(2));
         // The yielding storeys: each one's building and storey, each building's first (NS
         // where it is elastic).
-        let (mut sb, mut sj, mut first) = (Vec::new(), Vec::new(), Vec::new());
-        for (b, (&n, &y)) in self.storeys.iter().zip(&self.yielding).enumerate() {
-            first.push(if y { sb.len() } else { ns });
-            if y {
+        let firsts = self.first_storeys();
+        let first: Vec<usize> = firsts.iter().map(|f| f.unwrap_or(ns)).collect();
+        let (mut sb, mut sj) = (Vec::new(), Vec::new());
+        for (b, (&n, f)) in self.storeys.iter().zip(&firsts).enumerate() {
+            if f.is_some() {
                 sb.extend(std::iter::repeat_n(b, n));
                 sj.extend(0..n);
             }
@@ -730,7 +754,7 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], scales: &[[f64; 2]]) -> Option
     };
     let ns = shape.yielding_storeys();
     if ns > 0 {
-        let ps = 2 * shape.modes() + shape.levels.len() + 2;
+        let ps = shape.plastic_slot0();
         out.storeys = scales
             .iter()
             .enumerate()
@@ -738,19 +762,12 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], scales: &[[f64; 2]]) -> Option
                 residual_drift_ratio: s[ps + k] / height,
                 peak_ductility: s[shape.s_storeys() + k] * height / d_y,
                 hysteretic_energy: s[ps + ns + k],
-                yielded: c[shape.c_settled() + 1 + SC_STRIDE * k + SC_YIELDED] != 0,
+                yielded: c[shape.c_storeys() + SC_STRIDE * k + SC_YIELDED] != 0,
             })
             .collect();
-        let mut first = 0;
-        let spans: Vec<_> = shape
-            .storeys
-            .iter()
-            .zip(&shape.yielding)
-            .map(|(&n, &y)| {
-                let span = y.then(|| first..first + n);
-                first += if y { n } else { 0 };
-                span
-            })
+        let spans: Vec<_> = (shape.first_storeys().into_iter())
+            .zip(&shape.storeys)
+            .map(|(f, &n)| f.map(|f| f..f + n))
             .collect();
         let settled = c[shape.c_settled()] != 0 && status == Status::Ok;
         out.gather_storeys(&spans, settled);
