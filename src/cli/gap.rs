@@ -50,13 +50,6 @@ pub fn run(a: Args) -> Result<()> {
     let gaps = a.gaps.as_deref().map(parse_gaps).transpose()?;
     let threads = a.threads.map(super::sweep::check_threads).transpose()?;
     let plan = config::load_text(&text, &a.config)?;
-    // The required gap is read from the uncoupled buildings' exact elastic responses.
-    if plan.yields() {
-        bail!(
-            "{}: yielding storeys: the gap study computes the uncoupled buildings' elastic responses; the required gap of yielding buildings is not computed yet (docs/inelastic.md)",
-            a.config.display()
-        );
-    }
     // A pair that cannot touch floor to floor has no required gap to give.
     let apart = plan.pairs_without_levels();
     if !apart.is_empty() {
@@ -73,16 +66,25 @@ pub fn run(a: Args) -> Result<()> {
     }
     let pool = pool.build().context("starting worker threads")?;
     let started = Instant::now();
-    let study = pool.install(|| GapStudy::run(&plan));
+    let study = pool
+        .install(|| GapStudy::run(&plan))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", a.config.display()))?;
     let seconds = started.elapsed().as_secs_f64();
     let runs = study.len();
-    say!(
-        "{runs} runs ({} responses, each serving every intensity) in {seconds:.3} s on {} threads: {:.0} runs/s; {} record steps refined",
-        study.responses(),
-        pool.current_num_threads(),
-        runs as f64 / seconds.max(1e-9),
-        study.refined_steps()
-    );
+    let threads = pool.current_num_threads();
+    let rate = runs as f64 / seconds.max(1e-9);
+    if study.per_run() {
+        say!(
+            "{runs} runs (yielding storeys: one response per run, by the row scheme; no error bound) in {seconds:.3} s on {threads} threads: {rate:.0} runs/s; {} substeps",
+            study.substeps()
+        );
+    } else {
+        say!(
+            "{runs} runs ({} responses, each serving every intensity) in {seconds:.3} s on {threads} threads: {rate:.0} runs/s; {} record steps refined",
+            study.responses(),
+            study.refined_steps()
+        );
+    }
     let summary = study.summary();
     say!("\n| pair | rule | runs | floors close | median rule / exact | p10 | p90 | unconservative |\n|---|---|---:|---:|---:|---:|---:|---:|");
     for s in &summary {

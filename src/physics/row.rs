@@ -199,6 +199,20 @@ pub struct RowOutput {
     pub energy: Option<EnergyBalance>,
     /// Every yielding storey, building by building, bottom to top (none in an elastic row).
     pub storeys: Vec<StoreyOutput>,
+    /// Per contact level, its floors' closing and peaks, where the run was asked to track them
+    /// (the separation of uncoupled buildings); empty otherwise.
+    pub closings: Vec<LevelClosing>,
+}
+
+/// What a contact level's two floors do over a run: the largest closing
+/// `max_t (u_left - u_right)` (from 0 at rest) and when it is reached (None while it stays at
+/// or below 0), and each floor's peak `max_t |u|`, m.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LevelClosing {
+    pub closing: f64,
+    pub time: Option<f64>,
+    pub peak_left: f64,
+    pub peak_right: f64,
 }
 
 impl RowOutput {

@@ -414,47 +414,48 @@ impl RowPlan {
     }
 
     /// The runs that differ in their motion before any contact ([`PairPlan::motions`]): per
-    /// record and intensity, the samples (one where they set no building value) and every
-    /// building's values, the gaps at their first values. Of an elastic row: a swept strength
-    /// is not counted here (the gap study, its one user, refuses yielding rows).
+    /// record and intensity, the samples (one where they set no building value), every
+    /// building's values and swept strengths, the gaps at their first values.
     pub fn motions(&self) -> crate::plan::Motions {
-        let nb = self.buildings.len();
+        let dims = self.motion_dims();
         crate::plan::Motions {
             records: self.contact.spec.records.len(),
             intensities: self.contact.spec.intensities.len(),
-            inner: self.motion_samples() as u64
-                * self.dims[1..1 + 3 * nb]
-                    .iter()
-                    .map(|&d| d as u64)
-                    .product::<u64>(),
+            inner: dims.iter().map(|&(_, d)| d as u64).product(),
         }
     }
 
-    fn motion_samples(&self) -> usize {
-        match &self.samples {
+    /// The axes below a contact run that move the buildings, as (index in `dims`, size): the
+    /// samples (one where they set no building value), each building's mass, period and
+    /// damping, and each swept strength.
+    fn motion_dims(&self) -> Vec<(usize, usize)> {
+        let nb = self.buildings.len();
+        let samples = match &self.samples {
             Some(s) if s.axes.iter().any(|a| a.moves_buildings()) => s.points.len(),
             _ => 1,
-        }
+        };
+        std::iter::once((0, samples))
+            .chain((1..1 + 3 * nb).map(|k| (k, self.dims[k])))
+            .chain(self.yield_dim.iter().flatten().map(|&k| (k, self.dims[k])))
+            .collect()
     }
 
     /// Motion `m` of [`RowPlan::motions`], as the run of the plan that has it (its sample
     /// `None` where the samples move nothing).
     pub fn motion_run(&self, m: u64) -> RowRunSpec {
-        let nb = self.buildings.len();
-        let mut dims = self.dims.clone();
-        dims[0] = self.motion_samples();
-        let inner: u64 = dims[..1 + 3 * nb].iter().map(|&d| d as u64).product();
+        let dims = self.motion_dims();
+        let inner: u64 = dims.iter().map(|&(_, d)| d as u64).product();
         let contact = self.contact.motion_index(m / inner);
         let mut rem = m % inner;
         let mut at = vec![0usize; self.dims.len()];
-        for k in (0..1 + 3 * nb).rev() {
-            at[k] = (rem % dims[k] as u64) as usize;
-            rem /= dims[k] as u64;
+        for &(k, d) in dims.iter().rev() {
+            at[k] = (rem % d as u64) as usize;
+            rem /= d as u64;
         }
         let within =
             (0..self.dims.len()).fold(0u64, |acc, k| acc * self.dims[k] as u64 + at[k] as u64);
         let mut run = self.run(contact * self.per_scene + within);
-        if dims[0] == 1 {
+        if dims[0].1 == 1 {
             run.sample = None;
         }
         run
@@ -687,7 +688,7 @@ impl RowPlan {
 
     /// Building `b`'s yielding storeys where their strength is swept or sampled (it then has
     /// a parameter column, `bk_yield_drift_ratio` or `bk_yield_base_shear_coefficient`).
-    fn swept_yield(&self, b: usize) -> Option<&YieldSpec> {
+    pub fn swept_yield(&self, b: usize) -> Option<&YieldSpec> {
         self.yielding[b].as_ref().filter(|y| y.axis.is_some())
     }
 

@@ -5,13 +5,16 @@
 //! and the probability of pounding against the gap, with a lognormal fit (the fragility fit of
 //! [`crate::studies::fragility`], the gap in the place of the intensity).
 //!
-//! Responses are linear in the record's scale, so one response per record and building values
-//! serves every intensity.
+//! Elastic responses are linear in the record's scale, so one response per record and building
+//! values serves every intensity. Where storeys yield they are not: every run is its own
+//! response ([`yielding_separation`]).
 
 use crate::physics::model::Oscillator;
 use crate::physics::separation::{cqc_rho, Rule};
 use crate::physics::shear::ShearBuilding;
-use crate::physics::solver::separation::{separation, LevelSeparation, Separation};
+use crate::physics::solver::separation::{
+    separation, yielding_separation, LevelSeparation, Separation,
+};
 use crate::plan::columns::{contact_and_motion, num, CONTACT_AND_MOTION};
 use crate::plan::intensity::TARGET_COLUMNS;
 use crate::plan::row::level_name;
@@ -86,6 +89,9 @@ impl Scenes<'_> {
                     for c in ["storeys", "mass_kg", "t1_s", "xi"] {
                         h.push(format!("b{b}_{c}"));
                     }
+                    if let Some(y) = r.swept_yield(b - 1) {
+                        h.push(format!("b{b}_{}", y.value_name()));
+                    }
                 }
             }
         }
@@ -118,6 +124,9 @@ impl Scenes<'_> {
                     cells.push(r.mass[b].map(num).unwrap_or_default());
                     cells.push(num(r.period[b]));
                     cells.push(num(r.damping[b]));
+                    if plan.swept_yield(b).is_some() {
+                        cells.push(r.yield_value[b].map(num).unwrap_or_default());
+                    }
                 }
                 cells.push(sample(r.sample));
                 cells
@@ -135,6 +144,25 @@ impl Scenes<'_> {
             Plan::Row(plan) => {
                 let r = plan.motion_run(m);
                 (r.period, r.contact.scale)
+            }
+        }
+    }
+
+    /// Motion `m`'s response: its separation at unit scale where the buildings are elastic,
+    /// else at its own scale.
+    fn response(&self, m: u64, record: usize) -> Result<Separation, String> {
+        match self.0 {
+            Plan::Row(plan) if self.0.yields() => {
+                let run = plan.motion_run(m);
+                let buildings = plan.row(&run).buildings;
+                yielding_separation(&buildings, &plan.forcing(&run), &plan.scheme())
+            }
+            _ => {
+                let spec = &self.base().spec;
+                Ok(separation(
+                    &self.buildings(m),
+                    &spec.records[record].forcing(1.0, spec.tail),
+                ))
             }
         }
     }
@@ -195,8 +223,9 @@ pub struct GapRun {
 pub struct GapStudy<'a> {
     scenes: Scenes<'a>,
     motions: Motions,
-    /// One per record and inner motion, at unit scale.
+    /// One per record and inner motion, at unit scale; or, where storeys yield, one per run.
     responses: Vec<Separation>,
+    per_run: bool,
     /// Per run, what each adjacent pair needs.
     pair_gaps: Vec<Vec<Option<PairGap>>>,
     /// The contact levels' column prefixes (the same in every run).
@@ -206,25 +235,33 @@ pub struct GapStudy<'a> {
 }
 
 impl<'a> GapStudy<'a> {
-    /// Compute every response (in parallel on the current rayon pool).
-    pub fn run(plan: &'a Plan) -> GapStudy<'a> {
+    /// Compute every response (in parallel on the current rayon pool). Err: the first run
+    /// whose response could not be computed, and why (only where storeys yield).
+    pub fn run(plan: &'a Plan) -> Result<GapStudy<'a>, String> {
         let scenes = Scenes(plan);
         let motions = scenes.motions();
+        let per_run = plan.yields();
         let inner = motions.inner;
         let per_record = inner * motions.intensities as u64;
-        let responses: Vec<Separation> = (0..motions.records as u64 * inner)
+        let count = if per_run {
+            motions.len()
+        } else {
+            motions.records as u64 * inner
+        };
+        let responses: Vec<Separation> = (0..count)
             .into_par_iter()
             .map(|u| {
-                // The response's first intensity, at unit scale.
-                let m = (u / inner) * per_record + u % inner;
-                let record = (u / inner) as usize;
-                let spec = &scenes.base().spec;
-                separation(
-                    &scenes.buildings(m),
-                    &spec.records[record].forcing(1.0, spec.tail),
-                )
+                // Elastic: the response's first intensity, at unit scale.
+                let (m, record) = if per_run {
+                    (u, motions.record_and_intensity(u).0)
+                } else {
+                    ((u / inner) * per_record + u % inner, (u / inner) as usize)
+                };
+                scenes
+                    .response(m, record)
+                    .map_err(|e| format!("run {m}: {e}"))
             })
-            .collect();
+            .collect::<Result<_, _>>()?;
         let first = responses.first();
         let level_names = first.map_or(Vec::new(), |s| {
             s.levels
@@ -237,6 +274,7 @@ impl<'a> GapStudy<'a> {
             scenes,
             motions,
             responses,
+            per_run,
             level_names,
             level_pairs,
             pair_gaps: Vec::new(),
@@ -249,7 +287,7 @@ impl<'a> GapStudy<'a> {
                 study.pairs_of(&study.scaled(m, scale), &periods)
             })
             .collect();
-        study
+        Ok(study)
     }
 
     /// Run `m`'s separation: its response, scaled to its intensity (per run: a spectral target
@@ -258,9 +296,23 @@ impl<'a> GapStudy<'a> {
         self.scaled(m, self.scenes.periods(m).1)
     }
 
-    /// Run `m`'s response, scaled by `scale`.
+    /// Run `m`'s response, scaled by `scale` (where storeys yield, its own at its scale).
     fn scaled(&self, m: u64, scale: f64) -> Separation {
-        self.responses[self.motions.response(m) as usize].scaled(scale)
+        if self.per_run {
+            self.responses[m as usize].clone()
+        } else {
+            self.responses[self.motions.response(m) as usize].scaled(scale)
+        }
+    }
+
+    /// Does every run have its own response (storeys yield: not linear in the scale)?
+    pub fn per_run(&self) -> bool {
+        self.per_run
+    }
+
+    /// Substeps taken where storeys yield, over all responses.
+    pub fn substeps(&self) -> u64 {
+        self.responses.iter().map(|s| s.substeps).sum()
     }
 
     /// Runs in the study.
@@ -422,7 +474,7 @@ impl<'a> GapStudy<'a> {
                 c.extend(Rule::ALL.map(|r| num(r.gap(l.peak_left, l.peak_right, rho))));
             }
         }
-        c.push(num(run.separation.error_bound));
+        c.push(opt(run.separation.error_bound));
         c
     }
 
@@ -752,7 +804,7 @@ mod tests {
         )
         .unwrap();
         let plan = crate::plan::Plan::Pair(plan);
-        let study = GapStudy::run(&plan);
+        let study = GapStudy::run(&plan).unwrap();
         let gaps = study.gaps_for(0, None);
         let mut curves = vec![study.pounding(0, &gaps)];
         assert_eq!(curves[0].len(), 2);

@@ -237,6 +237,64 @@ fn required_gaps_of_a_row_are_where_row_sweeps_stop_pounding() {
     }
 }
 
+/// Yielding storeys (the shipped yielding pair, the right one's yield drift an axis): each run
+/// is its own response (not linear in the scale), its strength has its column, and its
+/// required gap is where `pound sweep` stops pounding on a 1 mm grid; the error bound is
+/// left empty (none is known where storeys yield).
+#[test]
+fn yielding_required_gap_is_where_sweeps_stop_pounding() {
+    let dir = tempdir();
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/inelastic-pair.toml"),
+    )
+    .unwrap()
+    .replace(
+        "yield_drift_ratio = 0.004",
+        "yield_drift_ratio = { from = 0.003, to = 0.006, n = 2 }",
+    );
+    let cfg = dir.path().join("pair.toml");
+    std::fs::write(&cfg, &base).unwrap();
+    let out = dir.path().join("gaps.csv");
+    let said = ok(&pound(&["gap", s(&cfg), "-o", s(&out)]));
+    assert!(
+        said.contains("6 runs (yielding storeys: one response per run"),
+        "{said}"
+    );
+    let gaps = table(&out);
+    assert_eq!(gaps.len(), 6);
+    let key = |r: &HashMap<String, String>| {
+        format!("{} {}", r["target_pga_g"], r["b2_yield_drift_ratio"])
+    };
+    let mut keys: Vec<String> = gaps.iter().map(key).collect();
+    keys.dedup();
+    assert_eq!(keys.len(), 6, "{keys:?}");
+    for r in &gaps {
+        assert_eq!(r["error_bound_m"], "");
+        assert!(num(r, "required_gap_m") > 0.0);
+    }
+    // Not linear in the scale: 0.5 g does not need 2.5 times what 0.2 g needs.
+    let of = |k: &str| num(gaps.iter().find(|r| key(r) == k).unwrap(), "required_gap_m");
+    let ratio = of("0.5 0.003") / of("0.2 0.003");
+    assert!((ratio - 2.5).abs() > 1e-3, "{ratio}");
+    let largest = gaps
+        .iter()
+        .map(|r| num(r, "required_gap_m"))
+        .fold(0.0, f64::max);
+    let grid: Vec<String> = grid_past(largest).iter().map(|g| g.to_string()).collect();
+    std::fs::write(
+        &cfg,
+        base.replace(
+            "gap_right_m = [0.01, 0.02]",
+            &format!("gap_right_m = [{}]", grid.join(", ")),
+        ),
+    )
+    .unwrap();
+    let swept = dir.path().join("sweep.csv");
+    let sweep = sweep_table(&cfg, &swept);
+    let checked = check_against_sweep(&gaps, &sweep, &key, "required_gap_m", "gap_1_2_m");
+    assert!(checked + 2 >= sweep.len(), "{checked} of {}", sweep.len());
+}
+
 /// Buildings of equal period and damping move as one: no gap is needed, DDC says so too
 /// (rho = 1), the ratios are left empty and no rule counts as unconservative; the five records
 /// of the seed paper are read by path.

@@ -156,7 +156,7 @@ pub(crate) fn run(m: &RowModel, forcing: &Forcing, z0: Vec<f64>, o: &FastOptions
     // Contact substeps run in floor coordinates where the damping allows (O(N) each), and only
     // for the buildings that contact may reach.
     let sub = m.substep_model();
-    run_with(m, sub.as_ref(), Standing::Grown, forcing, z0, o).0
+    run_with(m, sub.as_ref(), Standing::Grown, forcing, z0, o, false).0
 }
 
 /// The fast scheme with every building in every substep: the twin of the GPU row kernel
@@ -170,7 +170,23 @@ pub fn simulate_whole_row(
     o: &FastOptions,
 ) -> RowOutput {
     let sub = m.substep_model();
-    run_with(m, sub.as_ref(), Standing::None, forcing, z0, o).0
+    run_with(m, sub.as_ref(), Standing::None, forcing, z0, o, false).0
+}
+
+/// The fast scheme from rest with every building in every substep, tracking the levels'
+/// closings ([`super::simulate_uncoupled`]).
+pub(crate) fn run_uncoupled(m: &RowModel, forcing: &Forcing, o: &FastOptions) -> RowOutput {
+    let sub = m.substep_model();
+    run_with(
+        m,
+        sub.as_ref(),
+        Standing::None,
+        forcing,
+        m.at_rest(),
+        o,
+        true,
+    )
+    .0
 }
 
 /// Which buildings stand still through a record step of substeps (stepped exactly at its end).
@@ -196,7 +212,8 @@ struct Tally {
 }
 
 /// [`run`] with the contact substeps in `sub` (None: in modes, as the reference) and the
-/// buildings standing still as `standing` says.
+/// buildings standing still as `standing` says, tracking the levels' closings where
+/// `closings` (with no building standing still).
 fn run_with(
     m: &RowModel,
     sub: Option<&RowModel>,
@@ -204,6 +221,7 @@ fn run_with(
     forcing: &Forcing,
     z0: Vec<f64>,
     o: &FastOptions,
+    closings: bool,
 ) -> (RowOutput, Tally) {
     let mut tally = Tally::default();
     let finish = |run: RowRun, status: Status, substeps: u32, tally: Tally| {
@@ -223,6 +241,14 @@ fn run_with(
     let rates = m.building_rates();
     let mut run = RowRun::start(m, z0, forcing.t0);
     run.energy = o.energy;
+    if closings {
+        debug_assert_eq!(
+            standing,
+            Standing::None,
+            "closings need every building moving"
+        );
+        run.track_closings();
+    }
     let mut substeps: u32 = 0;
     let len = m.len();
     let mut stages = Stages {
@@ -720,7 +746,7 @@ mod tests {
             energy: true,
             ..FastOptions::default()
         };
-        run_with(m, sub, standing, &forcing, m.at_rest(), &o)
+        run_with(m, sub, standing, &forcing, m.at_rest(), &o, false)
     }
 
     /// [`run_on`] with the scheme's substep coordinates.

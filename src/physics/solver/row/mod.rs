@@ -20,12 +20,17 @@ pub mod reference;
 pub mod yielding;
 
 use super::events::{error_margin, fourth_derivative_bound, hidden_rise, locate, touch};
-use super::hermite::{cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak};
+use super::hermite::{
+    cubic_max_bound, hermite_range, quintic_max_bound, quintic_range, raise_cubic_peak,
+    raise_quintic_peak,
+};
 use super::tracker::ForceHistory;
 use super::{Mode, Segment};
 use crate::physics::contact::Contact;
 use crate::physics::model::{EnergyBalance, Forcing, Status};
-use crate::physics::row::{BuildingOutput, LevelOutput, Row, RowOutput, StoreyOutput};
+use crate::physics::row::{
+    BuildingOutput, LevelClosing, LevelOutput, Row, RowOutput, StoreyOutput,
+};
 use crate::physics::shear::Modes;
 use yielding::{StoreyMode, StoreyModel};
 
@@ -894,6 +899,8 @@ pub(crate) struct RowRun<'m> {
     /// No storey can yield again after the run's end (set by the scheme,
     /// [`RowModel::settled`]): the plastic drifts are the residual drifts.
     pub settled: bool,
+    /// Per level, its floors' closing and peaks, where asked for ([`RowRun::track_closings`]).
+    closings: Option<Vec<LevelClosing>>,
 }
 
 impl<'m> RowRun<'m> {
@@ -922,6 +929,7 @@ impl<'m> RowRun<'m> {
             storey_modes: vec![StoreyMode::Elastic; m.storeys.len()],
             storeys: vec![StoreyState::default(); m.storeys.len()],
             settled: false,
+            closings: None,
             z,
         };
         let z = run.z.clone();
@@ -930,6 +938,49 @@ impl<'m> RowRun<'m> {
             run.storey_transitions();
         }
         run
+    }
+
+    /// Track each level's closing and its floors' peaks from here on (into
+    /// [`RowOutput::closings`]). Every piece must move both buildings of every level: no
+    /// building may stand still.
+    pub fn track_closings(&mut self) {
+        self.closings = Some(vec![LevelClosing::default(); self.m.levels.len()]);
+    }
+
+    /// Raise each level's closing and its floors' peaks over a piece `t0 -> t0 + h` between
+    /// the floors' kinematics at its ends (no contact acts: the quintic Hermite, as the
+    /// buildings' peaks).
+    fn raise_closings(&mut self, t0: f64, h: f64) {
+        let Some(closings) = self.closings.as_mut() else {
+            return;
+        };
+        for (c, lm) in closings.iter_mut().zip(&self.m.levels) {
+            let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+            let ([a0, a1], [b0, b1]) = (&self.floors[a], &self.floors[b]);
+            let y = [a0.u[fa] - b0.u[fb], a1.u[fa] - b1.u[fb]];
+            let d = [a0.v[fa] - b0.v[fb], a1.v[fa] - b1.v[fb]];
+            let acc = [a0.a_rel[fa] - b0.a_rel[fb], a1.a_rel[fa] - b1.a_rel[fb]];
+            if quintic_max_bound(y, d, acc, h) > c.closing {
+                let (hi, s) = quintic_range(y, d, acc, h)[1];
+                if hi > c.closing {
+                    (c.closing, c.time) = (hi, Some(t0 + s * h));
+                }
+            }
+            c.peak_left = raise_quintic_peak(
+                c.peak_left,
+                [a0.u[fa], a1.u[fa]],
+                [a0.v[fa], a1.v[fa]],
+                [a0.a_rel[fa], a1.a_rel[fa]],
+                h,
+            );
+            c.peak_right = raise_quintic_peak(
+                c.peak_right,
+                [b0.u[fb], b1.u[fb]],
+                [b0.v[fb], b1.v[fb]],
+                [b0.a_rel[fb], b1.a_rel[fb]],
+                h,
+            );
+        }
     }
 
     /// Take the state into `sub` (the modal model's [`RowModel::substep_model`]) for a record
@@ -1356,6 +1407,7 @@ impl<'m> RowRun<'m> {
         let m = self.m;
         let n = m.n;
         self.track_buildings(z0, z1, ag, h);
+        self.raise_closings(t0, h);
         self.ends_valid = true;
         let nl = m.levels.len();
         self.e_peak = self.e_peak.max(self.e_initial + z1[2 * n + nl]);
@@ -1558,6 +1610,7 @@ impl<'m> RowRun<'m> {
             free_steps: self.free_steps,
             energy,
             storeys,
+            closings: self.closings.unwrap_or_default(),
             ..RowOutput::default()
         };
         if ns > 0 {
@@ -1575,6 +1628,22 @@ pub enum RowScheme {
     Reference(super::ReferenceOptions),
 }
 
+/// Simulate `m`'s buildings from rest as if no contact could ever act, tracking each level's
+/// closing and its floors' peaks ([`RowOutput::closings`]; the separation of yielding
+/// buildings). The levels' gaps must be beyond reach ([`UNCOUPLED_GAP_M`]). The fast scheme
+/// moves every building in every substep here, so that both floors of a level share each
+/// piece.
+pub fn simulate_uncoupled(m: &RowModel, forcing: &Forcing, scheme: &RowScheme) -> RowOutput {
+    match scheme {
+        RowScheme::Fast(o) => fast::run_uncoupled(m, forcing, o),
+        RowScheme::Reference(o) => reference::run_tracked(m, forcing, m.at_rest(), o, true),
+    }
+}
+
+/// The gap given each level of a row simulated uncoupled: far beyond any floor's reach (a run
+/// that closes it reports impacts, which the caller refuses).
+pub const UNCOUPLED_GAP_M: f64 = 1e6;
+
 /// Simulate one run of a row from state `z0` (see [`RowModel::at_rest`],
 /// [`RowModel::state_of_floors`]) over the forcing's whole duration.
 pub fn simulate_row(
@@ -1585,6 +1654,6 @@ pub fn simulate_row(
 ) -> RowOutput {
     match scheme {
         RowScheme::Fast(o) => fast::run(m, forcing, z0, o),
-        RowScheme::Reference(o) => reference::run(m, forcing, z0, o),
+        RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false),
     }
 }

@@ -83,14 +83,20 @@ fn dopri(
     (y, err)
 }
 
-pub(crate) fn run(
+/// The reference scheme's run from `z0`, tracking the levels' closings where `closings`
+/// ([`RowRun::track_closings`]).
+pub(crate) fn run_tracked(
     m: &RowModel,
     forcing: &Forcing,
     z0: Vec<f64>,
     o: &ReferenceOptions,
+    closings: bool,
 ) -> RowOutput {
     let n = m.n;
     let mut run = RowRun::start(m, z0, forcing.t0);
+    if closings {
+        run.track_closings();
+    }
     let mut steps: u64 = 0;
     let mut h = forcing.dt / 8.0;
     let mut modes = Vec::with_capacity(m.levels.len());
