@@ -104,6 +104,26 @@ fn duration_estimate(v: real) -> real {
     return K.tc_coef;
 }
 
+// Contact::onset_cut: from `elapsed` since the onset (approaching) to the next point of the
+// graded mesh tc (k / N)^4 more than `tol` ahead; "infinite" (a huge step) where the law needs
+// none.
+fn onset_cut(elapsed: real, v0: real, per_contact: real, tol: real) -> real {
+    if (K.law != LAW_NONLINEAR_VISCOELASTIC) {
+        return BIG;
+    }
+    let tc = duration_estimate(v0);
+    var k = ceil(per_contact * sqrt(sqrt(max(elapsed, 0.0) / tc)));
+    for (var i = 0u; i < 3u; i++) {
+        let s = k / per_contact;
+        let cut = tc * (s * s) * (s * s) - elapsed;
+        if (cut > tol) {
+            return cut;
+        }
+        k = k + 1.0;
+    }
+    return BIG;
+}
+
 // solver::impact_step, `per_contact` substeps per impact.
 fn impact_step(v: real, a: real, per_contact: real) -> real {
     let tc = duration_estimate(v);

@@ -513,12 +513,19 @@ fn piece(seg: Seg) {
     let tol = max(LOCATE_TOL * h, 4.0 * EPS * dt);
     if (tau_target - S.tau > tol) {
         C.substeps = C.substeps + 1u;
-        C.pieces = C.pieces + 1u;
+        // Cut at the graded mesh after a touch (onset_cut); such pieces do not count against
+        // the cap on event cuts.
+        var hs = tau_target - S.tau;
+        if (C.mode == MODE_APPROACH) {
+            hs = min(hs, onset_cut(since_onset(S.tau), S.v0, P.substeps_per_contact, tol));
+        }
+        if (hs == tau_target - S.tau) {
+            C.pieces = C.pieces + 1u;
+        }
         if (C.substeps > disp.max_substeps || C.pieces > MAX_PIECES_PER_SUBSTEP) {
             C.status = STATUS_STEP_LIMIT;
         } else {
             let z = ZS;
-            let hs = tau_target - S.tau;
             let trial = rk4(C.mode, S.v0, seg, S.tau, z, hs);
             var znew: Z;
             S.tau = S.tau + accept(S.tau, hs, trial, seg, z, &znew);

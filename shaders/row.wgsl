@@ -777,12 +777,22 @@ fn piece(seg: Seg, z: ptr<function, ZA>) {
     let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
     if (tau_target - TAU > tol) {
         SUBSTEPS = SUBSTEPS + 1u;
-        PIECES = PIECES + 1u;
+        // Cut at the graded mesh after a touch (RowRun::onset_cut); such pieces do not count
+        // against the cap on event cuts.
+        var hs = tau_target - TAU;
+        for (var l = 0u; l < NL; l++) {
+            if (LMODE[l] == MODE_APPROACH) {
+                use_level(l);
+                hs = min(hs, onset_cut(since_onset(l, TAU), LV0[l], PER_CONTACT, tol));
+            }
+        }
+        if (hs == tau_target - TAU) {
+            PIECES = PIECES + 1u;
+        }
         if (SUBSTEPS > disp.max_substeps || PIECES > MAX_PIECES_PER_SUBSTEP) {
             STATUS = STATUS_STEP_LIMIT;
         } else {
             var z0 = *z;
-            let hs = tau_target - TAU;
             var trial: ZA;
             rk4(seg, TAU, &z0, hs, &trial);
             var znew: ZA;

@@ -106,6 +106,14 @@ pub(crate) fn rk4(
     std::array::from_fn(|i| z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
 }
 
+/// The shortest piece a graded cut may make at time `t` in substeps of `h`: a billionth of
+/// the substep, and more than the resolution of `t` (a shorter piece would not move the time
+/// on, and the substep would never end).
+#[inline]
+pub(crate) fn cut_tolerance(t: f64, h: f64) -> f64 {
+    (1e-9 * h).max(8.0 * f64::EPSILON * t.abs())
+}
+
 /// A free run checks whether it can end early (the shared response's `can_end`) every this
 /// many record steps: the check costs about a tenth of a free step.
 const END_CHECK_EVERY: usize = 8;
@@ -224,11 +232,24 @@ pub(crate) fn run(
             let mut pieces = 0;
             while t_target - t > 1e-9 * h {
                 substeps += 1;
-                pieces += 1;
+                // Cut at the graded mesh after a touch (`Contact::onset_cut`); such pieces
+                // do not count against the cap on event cuts.
+                let mut hs = t_target - t;
+                if run.mode == Mode::Approach {
+                    let since = t - run.tr.onset_time();
+                    hs = hs.min(pair.contact.onset_cut(
+                        since,
+                        run.tr.v0,
+                        o.substeps_per_contact,
+                        cut_tolerance(t, h),
+                    ));
+                }
+                if hs == t_target - t {
+                    pieces += 1;
+                }
                 if substeps > o.max_substeps || pieces > MAX_PIECES_PER_SUBSTEP {
                     return run.finish(Status::StepLimit, substeps as u64);
                 }
-                let hs = t_target - t;
                 let (z0, mode, v0) = (run.z, run.mode, run.tr.v0);
                 let step = |x: f64| rk4(pair, mode, v0, &seg, t, &z0, x);
                 t += run.accept(t, hs, step(hs), LOCATE_TOLERANCE, LOCATE_ITERATIONS, step);

@@ -29,7 +29,8 @@ use crate::physics::propagator::{EnergyForms, Propagator};
 use crate::physics::row::RowOutput;
 use crate::physics::solver::events::error_margin;
 use crate::physics::solver::fast::{
-    FastOptions, LOCATE_ITERATIONS, LOCATE_TOLERANCE, MAX_PIECES_PER_SUBSTEP, SUSTAINED,
+    cut_tolerance, FastOptions, LOCATE_ITERATIONS, LOCATE_TOLERANCE, MAX_PIECES_PER_SUBSTEP,
+    SUSTAINED,
 };
 use crate::physics::solver::hermite::{cubic_max_bound, hermite_range};
 use crate::physics::solver::{impact_step, Mode, Segment};
@@ -496,11 +497,16 @@ fn run_with(
             let mut pieces = 0;
             while t_target - t > 1e-9 * h {
                 substeps += 1;
-                pieces += 1;
+                // Cut at the graded mesh after a touch, as the pair's scheme; such pieces do
+                // not count against the cap on event cuts.
+                let cut = run.onset_cut(t, o.substeps_per_contact, cut_tolerance(t, h));
+                let hs = (t_target - t).min(cut);
+                if hs == t_target - t {
+                    pieces += 1;
+                }
                 if substeps > o.max_substeps || pieces > MAX_PIECES_PER_SUBSTEP {
                     return finish(run, Status::StepLimit, substeps, tally);
                 }
-                let hs = t_target - t;
                 let (z0, trial) = loop {
                     let z0 = run.z.clone();
                     run.level_modes(&mut modes);

@@ -1126,6 +1126,21 @@ impl<'m> RowRun<'m> {
         out.extend(self.levels.iter().map(|l| (l.mode, l.v0)));
     }
 
+    /// The shortest [`Contact::onset_cut`] at `t` of the checked levels that approach.
+    pub fn onset_cut(&self, t: f64, per_contact: f64, tol: f64) -> f64 {
+        self.m
+            .levels
+            .iter()
+            .zip(&self.levels)
+            .zip(&self.level_on)
+            .filter(|((_, ls), &on)| on && ls.mode == Mode::Approach)
+            .map(|((lm, ls), _)| {
+                lm.contact
+                    .onset_cut(t - ls.t_onset, ls.v0, per_contact, tol)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
     pub fn any_contact(&self) -> bool {
         self.levels.iter().any(|l| l.mode != Mode::Free)
     }
