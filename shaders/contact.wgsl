@@ -104,7 +104,7 @@ fn duration_estimate(v: real) -> real {
     return K.tc_coef;
 }
 
-// Contact::onset_cut: from `elapsed` since the onset (approaching) to the next point of the
+// Contact::onset_cut: from `elapsed` since the onset (approaching) to the first point of the
 // graded mesh tc (k / N)^4 more than `tol` ahead; "infinite" (a huge step) where the law needs
 // none.
 fn onset_cut(elapsed: real, v0: real, per_contact: real, tol: real) -> real {
@@ -112,7 +112,7 @@ fn onset_cut(elapsed: real, v0: real, per_contact: real, tol: real) -> real {
         return BIG;
     }
     let tc = duration_estimate(v0);
-    var k = ceil(per_contact * sqrt(sqrt(max(elapsed, 0.0) / tc)));
+    var k = ceil(per_contact * sqrt(sqrt((max(elapsed, 0.0) + tol) / tc)));
     for (var i = 0u; i < 3u; i++) {
         let s = k / per_contact;
         let cut = tc * (s * s) * (s * s) - elapsed;

@@ -264,9 +264,10 @@ impl Contact {
             return f64::INFINITY;
         }
         let tc = self.duration_estimate(v0);
-        let mut k = (per_contact * (elapsed.max(0.0) / tc).sqrt().sqrt()).ceil();
-        // The shaders have ceil, not floor: the point at or just past `elapsed`, then the next
-        // while that one is within `tol` (rounding may leave the point just reached).
+        // The first point past `elapsed + tol` (where the mesh is denser than `tol`, as near
+        // the onset in f32, the first one that is not), then the next while rounding leaves it
+        // within `tol`.
+        let mut k = (per_contact * ((elapsed.max(0.0) + tol) / tc).sqrt().sqrt()).ceil();
         for _ in 0..3 {
             let s = k / per_contact;
             let cut = tc * (s * s) * (s * s) - elapsed;
