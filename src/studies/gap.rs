@@ -225,7 +225,6 @@ pub struct GapStudy<'a> {
     motions: Motions,
     /// One per record and inner motion, at unit scale; or, where storeys yield, one per run.
     responses: Vec<Separation>,
-    per_run: bool,
     /// Per run, what each adjacent pair needs.
     pair_gaps: Vec<Vec<Option<PairGap>>>,
     /// The contact levels' column prefixes (the same in every run).
@@ -274,7 +273,6 @@ impl<'a> GapStudy<'a> {
             scenes,
             motions,
             responses,
-            per_run,
             level_names,
             level_pairs,
             pair_gaps: Vec::new(),
@@ -298,7 +296,7 @@ impl<'a> GapStudy<'a> {
 
     /// Run `m`'s response, scaled by `scale` (where storeys yield, its own at its scale).
     fn scaled(&self, m: u64, scale: f64) -> Separation {
-        if self.per_run {
+        if self.per_run() {
             self.responses[m as usize].clone()
         } else {
             self.responses[self.motions.response(m) as usize].scaled(scale)
@@ -307,7 +305,7 @@ impl<'a> GapStudy<'a> {
 
     /// Does every run have its own response (storeys yield: not linear in the scale)?
     pub fn per_run(&self) -> bool {
-        self.per_run
+        self.scenes.0.yields()
     }
 
     /// Substeps taken where storeys yield, over all responses.

@@ -536,7 +536,8 @@ pub fn yielding_separation(
     let gaps = vec![UNCOUPLED_GAP_M; buildings.len() - 1];
     // The contact law is never reached; it only has to be valid.
     let row = Row::new(buildings.to_vec(), gaps, LawKind::Linear, 1.0, 0.0);
-    let out = simulate_uncoupled(&RowModel::new(&row), forcing, scheme);
+    let model = RowModel::new(&row);
+    let out = simulate_uncoupled(&model, forcing, scheme);
     if out.status != Status::Ok {
         return Err(format!("the run ended early ({})", out.status.key()));
     }
@@ -562,12 +563,11 @@ pub fn yielding_separation(
         levels,
         refined_steps: 0,
         substeps: out.substeps,
-        fundamental: buildings
+        // The model's modes: each building's were computed once, for the run.
+        fundamental: model
+            .buildings
             .iter()
-            .map(|b| {
-                let m = b.modes();
-                (m.omega[0], m.xi[0])
-            })
+            .map(|b| (b.modes.omega[0], b.modes.xi[0]))
             .collect(),
         error_bound: None,
     })

@@ -1126,15 +1126,21 @@ impl<'m> RowRun<'m> {
         out.extend(self.levels.iter().map(|l| (l.mode, l.v0)));
     }
 
-    /// The shortest [`Contact::onset_cut`] at `t` of the checked levels that approach.
-    pub fn onset_cut(&self, t: f64, per_contact: f64, tol: f64) -> f64 {
+    /// The checked levels ([`RowRun::level_on`]) in contact mode `mode`.
+    fn levels_in(&self, mode: Mode) -> impl Iterator<Item = (&LevelModel, &LevelState)> {
         self.m
             .levels
             .iter()
             .zip(&self.levels)
             .zip(&self.level_on)
-            .filter(|((_, ls), &on)| on && ls.mode == Mode::Approach)
-            .map(|((lm, ls), _)| {
+            .filter(move |((_, ls), &on)| on && ls.mode == mode)
+            .map(|(l, _)| l)
+    }
+
+    /// The shortest [`Contact::onset_cut`] at `t` of the checked levels that approach.
+    pub fn onset_cut(&self, t: f64, per_contact: f64, tol: f64) -> f64 {
+        self.levels_in(Mode::Approach)
+            .map(|(lm, ls)| {
                 lm.contact
                     .onset_cut(t - ls.t_onset, ls.v0, per_contact, tol)
             })
@@ -1515,13 +1521,8 @@ impl<'m> RowRun<'m> {
         let mut f1 = self.event_max(&trial);
         if f1 <= 0.0 {
             let hidden = self
-                .m
-                .levels
-                .iter()
-                .zip(&self.levels)
-                .zip(&self.level_on)
-                .filter(|((_, ls), &on)| on && ls.mode == Mode::Free)
-                .filter_map(|((lm, _), _)| {
+                .levels_in(Mode::Free)
+                .filter_map(|(lm, _)| {
                     hidden_rise(
                         lm.delta(&z0),
                         lm.ddelta(n, &z0),
