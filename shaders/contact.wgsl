@@ -61,6 +61,37 @@ fn contact_force(d: real, dd: real, v0: real, approaching: bool) -> real {
     }
 }
 
+// Contact::force_rate: the rate of contact_force along a motion with penetration rate dd and
+// acceleration ddd, on the same branch.
+fn contact_force_rate(d: real, dd: real, ddd: real, v0: real, approaching: bool) -> real {
+    let k = K.stiffness;
+    let c = K.damping;
+    switch K.law {
+        case LAW_LINEAR: { return k * dd; }
+        case LAW_KELVIN_VOIGT, LAW_KELVIN_VOIGT_NO_TENSION: { return k * dd + c * ddd; }
+        case LAW_MODIFIED_LINEAR: {
+            var r = k * dd;
+            if (approaching) { r = r + c * ddd; }
+            return r;
+        }
+        case LAW_HERTZ: { return 1.5 * k * sqrt(abs(d)) * dd; }
+        case LAW_NONLINEAR_VISCOELASTIC: {
+            let r = sqrt(abs(d));
+            var rate = 1.5 * k * r * dd;
+            if (approaching && r > 0.0) {
+                let q = sqrt(r);
+                rate = rate + c * (0.25 * dd * dd / (r * q) + q * ddd);
+            }
+            return rate;
+        }
+        default: {
+            let r = sqrt(abs(d));
+            let x = chi(v0);
+            return k * r * (1.5 * dd * (1.0 + x * dd) + d * x * ddd);
+        }
+    }
+}
+
 fn gauge(d: real, dd: real, v0: real) -> real {
     if (K.law == LAW_KELVIN_VOIGT_NO_TENSION) {
         return d + min(K.damping / K.stiffness * dd, 0.0);

@@ -93,6 +93,15 @@ fn structural_rel_accel(z: Z) -> real {
     return -(P.c1 * z.v1 + P.k1 * z.u1) / P.m1 + (P.c2 * z.v2 + P.k2 * z.u2) / P.m2;
 }
 
+// solver::force_rate: the rate of force at z in mode (the ground moves both bodies alike).
+fn force_rate(mode: u32, v0: real, z: Z, f: real) -> real {
+    if (mode == MODE_FREE) {
+        return 0.0;
+    }
+    let a = structural_rel_accel(z) - f * (1.0 / P.m1 + 1.0 / P.m2);
+    return contact_force_rate(delta(z), ddelta(z), a, v0, mode == MODE_APPROACH);
+}
+
 fn event_value(mode: u32, v0: real, z: Z) -> real {
     switch mode {
         case MODE_FREE: { return gauge(delta(z), ddelta(z), v0); }
@@ -208,29 +217,6 @@ fn since_onset(tau: real) -> real {
     return real(C.i - C.i_onset) * P.dt + (tau - S.tau_onset);
 }
 
-fn force_sample(t: real, f: real) {
-    S.imp_peak = max(S.imp_peak, f);
-    if (C.nhist == 2u) {
-        let x0 = S.h_t0;
-        let y0 = S.h_f0;
-        let x1 = S.h_t1;
-        let y1 = S.h_f1;
-        S.imp_peak = max(S.imp_peak, parabola_peak(x0, y0, x1, y1, t, f));
-        S.h_t0 = x1;
-        S.h_f0 = y1;
-        S.h_t1 = t;
-        S.h_f1 = f;
-    } else if (C.nhist == 1u) {
-        S.h_t1 = t;
-        S.h_f1 = f;
-        C.nhist = 2u;
-    } else {
-        S.h_t0 = t;
-        S.h_f0 = f;
-        C.nhist = 1u;
-    }
-}
-
 // Tracker::free_step: a free record step's peak displacements from the quintic Hermite.
 fn track_free_step(seg: Seg, z0: Z, z1: Z) {
     let a10 = (-P.c1 * z0.v1 - P.k1 * z0.u1) / P.m1 - seg.a0;
@@ -244,7 +230,7 @@ fn track_free_step(seg: Seg, z0: Z, z1: Z) {
     }
 }
 
-fn track_step(mode: u32, tau0: real, h: real, z0: Z, z1: Z) {
+fn track_step(mode: u32, h: real, z0: Z, z1: Z) {
     let r1 = hermite_range(z0.u1, z0.v1, z1.u1, z1.v1, h);
     S.peak_u1 = max(max(S.peak_u1, abs(r1.hi)), abs(r1.lo));
     let r2 = hermite_range(z0.u2, z0.v2, z1.u2, z1.v2, h);
@@ -258,7 +244,14 @@ fn track_step(mode: u32, tau0: real, h: real, z0: Z, z1: Z) {
         S.peak_penetration = max(S.peak_penetration, rd.hi);
         S.dissipated = z1.w;
         let f = force(mode, S.v0, z1);
-        force_sample(since_onset(tau0 + h), f);
+        let r1 = force_rate(mode, S.v0, z1, f);
+        var f0: real = 0.0;
+        var r0: real = 0.0;
+        if (r1 < 0.0) {
+            f0 = force(mode, S.v0, z0);
+            r0 = force_rate(mode, S.v0, z0, f0);
+        }
+        S.imp_peak = raise_force_peak(S.imp_peak, f0, r0, f, r1, h);
     }
 }
 
@@ -268,11 +261,9 @@ fn onset(tau: real, v0: real, f: real) {
         S.first_impact = P.t0 + real(C.i) * P.dt + tau;
     }
     S.v0 = v0;
-    S.imp_peak = 0.0;
+    S.imp_peak = max(f, 0.0);
     C.i_onset = C.i;
     S.tau_onset = tau;
-    C.nhist = 0u;
-    force_sample(0.0, f);
 }
 
 fn end_impact() {
@@ -333,12 +324,12 @@ fn accept(tau: real, h_in: real, trial_in: Z, seg: Seg, z0: Z, out: ptr<function
         let f0 = event_value(mode, v0, z0);
         let tol = max(LOCATE_TOL * h, 4.0 * EPS * P.dt);
         let l = locate(h, f0, trial, f1, tol, mode, v0, seg, tau, z0);
-        track_step(mode, tau, l.x, z0, l.z);
+        track_step(mode, l.x, z0, l.z);
         C.mode = transition(mode, tau + l.x, l.z, z0);
         *out = l.z;
         return l.x;
     }
-    track_step(mode, tau, h, z0, trial);
+    track_step(mode, h, z0, trial);
     *out = trial;
     C.mode = reapproach(mode, trial);
     return h;

@@ -175,17 +175,13 @@ fn error_margin(bound: real, h: real) -> real {
     return 2.0 * h2 * h2 / 384.0 * bound;
 }
 
-// tracker::ForceHistory::sample's refinement: the vertex of the parabola through the last two
-// samples and (t, f) where they make a local maximum; -BIG where they do not.
-fn parabola_peak(x0: real, y0: real, x1: real, y1: real, t: real, f: real) -> real {
-    if (y1 >= y0 && y1 >= f && x1 > x0 && t > x1) {
-        let d1 = (y1 - y0) / (x1 - x0);
-        let d2 = (f - y1) / (t - x1);
-        let a = (d2 - d1) / (t - x0);
-        if (a < 0.0) {
-            let xv = clamp(0.5 * (x0 + x1) - 0.5 * d1 / a, x0, t);
-            return y0 + d1 * (xv - x0) + a * (xv - x0) * (xv - x1);
-        }
+// tracker::raise_force_peak: peak raised to the force f1 at a contact piece's end and, where
+// the force rises at its start (r0 > 0) and falls at its end (r1 < 0), to the largest value of
+// the cubic Hermite through both ends' forces and rates.
+fn raise_force_peak(peak: real, f0: real, r0: real, f1: real, r1: real, h: real) -> real {
+    var p = max(peak, f1);
+    if (r1 < 0.0 && r0 > 0.0) {
+        p = max(p, hermite_range(f0, r0, f1, r1, h).hi);
     }
-    return -BIG;
+    return p;
 }

@@ -433,32 +433,6 @@ fn since_onset(l: u32, tau: real) -> real {
     return real(CI - rcount[lci(l, LC_I_ONSET)]) * DT + (tau - rstate[lsi(l, LS_TAU_ONSET)]);
 }
 
-// ForceHistory::sample for level l.
-fn force_sample(l: u32, t: real, f: real) {
-    var peak = max(rstate[lsi(l, LS_IMP_PEAK)], f);
-    let nh = rcount[lci(l, LC_NHIST)];
-    if (nh == 2u) {
-        let x0 = rstate[lsi(l, LS_H_T0)];
-        let y0 = rstate[lsi(l, LS_H_F0)];
-        let x1 = rstate[lsi(l, LS_H_T1)];
-        let y1 = rstate[lsi(l, LS_H_F1)];
-        peak = max(peak, parabola_peak(x0, y0, x1, y1, t, f));
-        rstate[lsi(l, LS_H_T0)] = x1;
-        rstate[lsi(l, LS_H_F0)] = y1;
-        rstate[lsi(l, LS_H_T1)] = t;
-        rstate[lsi(l, LS_H_F1)] = f;
-    } else if (nh == 1u) {
-        rstate[lsi(l, LS_H_T1)] = t;
-        rstate[lsi(l, LS_H_F1)] = f;
-        rcount[lci(l, LC_NHIST)] = 2u;
-    } else {
-        rstate[lsi(l, LS_H_T0)] = t;
-        rstate[lsi(l, LS_H_F0)] = f;
-        rcount[lci(l, LC_NHIST)] = 1u;
-    }
-    rstate[lsi(l, LS_IMP_PEAK)] = peak;
-}
-
 // RowRun::track: a piece tau0 -> tau0 + h from z0 to z1 in the current modes.
 fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1: real) {
     track_buildings(z0, z1, ag0, ag1, h);
@@ -478,8 +452,22 @@ fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0:
             rstate[lsi(l, LS_PENETRATION)] = max(pen, hermite_range(y0, d0, y1, d1, h).hi);
         }
         rstate[lsi(l, LS_DISSIPATED)] = (*z1)[2u * NM + l];
-        let f = force(l, mode, LV0[l], z1);
-        force_sample(l, since_onset(l, tau0 + h), f);
+        // The force's rates from the floors' relative accelerations at both ends (FL, with
+        // the contact forces of these modes).
+        let a = L_A[l];
+        let ka = B_OFF[a] + L_FA[l];
+        let kb = B_OFF[a + 1u] + L_FB[l];
+        let approaching = mode == MODE_APPROACH;
+        let v0 = LV0[l];
+        let f = force(l, mode, v0, z1);
+        let r1 = contact_force_rate(y1, d1, FL[fli(1u, 2u, ka)] - FL[fli(1u, 2u, kb)], v0, approaching);
+        var f0: real = 0.0;
+        var r0: real = 0.0;
+        if (r1 < 0.0) {
+            f0 = force(l, mode, v0, z0);
+            r0 = contact_force_rate(y0, d0, FL[fli(0u, 2u, ka)] - FL[fli(0u, 2u, kb)], v0, approaching);
+        }
+        rstate[lsi(l, LS_IMP_PEAK)] = raise_force_peak(rstate[lsi(l, LS_IMP_PEAK)], f0, r0, f, r1, h);
     }
 }
 
@@ -492,9 +480,7 @@ fn onset(l: u32, tau: real, v0: real, f: real) {
     LV0[l] = v0;
     rstate[lsi(l, LS_TAU_ONSET)] = tau;
     rcount[lci(l, LC_I_ONSET)] = CI;
-    rstate[lsi(l, LS_IMP_PEAK)] = 0.0;
-    rcount[lci(l, LC_NHIST)] = 0u;
-    force_sample(l, 0.0, f);
+    rstate[lsi(l, LS_IMP_PEAK)] = max(f, 0.0);
 }
 
 fn end_impact(l: u32) {

@@ -24,7 +24,6 @@ struct State {
     w: real,
     v0: real,
     imp_peak: real,
-    h_t0: real, h_f0: real, h_t1: real, h_f1: real,
     tau_onset: real,
     tau: real,
     peak_force: real, impact_velocity: real, peak_penetration: real, peak_u1: real, peak_u2: real,
@@ -44,7 +43,6 @@ struct Meta {
 
 struct Counters {
     mode: u32,
-    nhist: u32,
     impacts: u32,
     status: u32,
     substeps: u32,

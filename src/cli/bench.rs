@@ -29,7 +29,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
     aggregate: Option<Vec<String>>,
     /// Run the fast scheme at the setting this peak-force error chooses (as `pound sweep
-    /// --target-error`), instead of the default 64 substeps per contact.
+    /// --target-error`), instead of the default (16 substeps per contact, calibrated for 1e-3).
     #[arg(long, value_name = "E")]
     target_error: Option<f64>,
     /// Instead, the multi-storey suite: rows of two buildings of each of these storey counts

@@ -208,6 +208,46 @@ impl Contact {
         }
     }
 
+    /// The time derivative of [`Contact::force`] along a motion with penetration rate `ddelta`
+    /// and acceleration `dddelta`, on the same branch (`approaching`): the peak force inside a
+    /// step is read from the cubic Hermite of the force through both ends' values and rates.
+    /// At the touch of the nonlinear viscoelastic law, where its damping grows as `delta^(1/4)`
+    /// and the rate is unbounded, the damping's share is left out (0: no peak is sought there).
+    #[inline]
+    pub fn force_rate(
+        &self,
+        delta: f64,
+        ddelta: f64,
+        dddelta: f64,
+        v0: f64,
+        approaching: bool,
+    ) -> f64 {
+        let (k, c) = (self.stiffness, self.damping);
+        match self.kind {
+            LawKind::Linear => k * ddelta,
+            LawKind::KelvinVoigt | LawKind::KelvinVoigtNoTension => k * ddelta + c * dddelta,
+            LawKind::ModifiedLinear => k * ddelta + if approaching { c * dddelta } else { 0.0 },
+            LawKind::Hertz => 1.5 * k * delta.abs().sqrt() * ddelta,
+            LawKind::NonlinearViscoelastic => {
+                let r = delta.abs().sqrt();
+                1.5 * k * r * ddelta
+                    + if approaching && r > 0.0 {
+                        let q = r.sqrt();
+                        c * (0.25 * ddelta * ddelta / (r * q) + q * dddelta)
+                    } else {
+                        0.0
+                    }
+            }
+            LawKind::HuntCrossley
+            | LawKind::LankaraniNikravesh
+            | LawKind::Flores
+            | LawKind::HuntCrossleyExact => {
+                let (r, chi) = (delta.abs().sqrt(), self.chi(v0));
+                k * r * (1.5 * ddelta * (1.0 + chi * ddelta) + delta * chi * dddelta)
+            }
+        }
+    }
+
     /// Hunt-Crossley `chi` for an impact at `v0` (floored at [`HC_V0_MIN`]).
     #[inline]
     pub fn chi(&self, v0: f64) -> f64 {

@@ -261,7 +261,7 @@ fn closed_pipe_ends_quietly() {
 }
 
 /// `--target-error` picks the calibrated setting, says so, records it in the sidecar, and the
-/// runs take it (fewer substeps at 1e-2 than at the default 64); a target below the calibration
+/// runs take it (fewer substeps at 1e-2 than at 2e-5); a target below the calibration
 /// is refused. `pound accuracy --target-error` checks the choice on a suite.
 #[test]
 fn target_error_chooses_records_and_is_checked() {
@@ -282,23 +282,26 @@ fn target_error_chooses_records_and_is_checked() {
             .map(|l| l.split(',').nth(i).unwrap().parse::<u64>().unwrap())
             .sum()
     };
-    let (coarse, default) = (d.path().join("coarse.csv"), d.path().join("default.csv"));
+    let (coarse, fine) = (d.path().join("coarse.csv"), d.path().join("fine.csv"));
     let r = sweep(&coarse, &["--target-error", "1e-2", "--backend", "cpu"]);
     ok(&r);
     let err = String::from_utf8_lossy(&r.stderr);
-    assert!(err.contains("16 RK4 substeps per contact"), "{err}");
+    assert!(err.contains("8 RK4 substeps per contact"), "{err}");
     let meta = std::fs::read_to_string(d.path().join("coarse.csv.meta.toml")).unwrap();
     assert!(
-        meta.contains("[target_error]") && meta.contains("substeps_per_contact = 16.0"),
+        meta.contains("[target_error]") && meta.contains("substeps_per_contact = 8.0"),
         "{meta}"
     );
-    ok(&sweep(&default, &["--backend", "cpu"]));
-    let (few, many) = (substeps(&coarse), substeps(&default));
+    let r = sweep(&fine, &["--target-error", "2e-5", "--backend", "cpu"]);
+    ok(&r);
+    assert!(String::from_utf8_lossy(&r.stderr).contains("48 RK4 substeps per contact"));
+    let (few, many) = (substeps(&coarse), substeps(&fine));
     assert!(
         few > 0 && few * 2 < many,
-        "{few} substeps at 1e-2, {many} at 64"
+        "{few} substeps at 1e-2 (8 per contact), {many} at 2e-5 (48)"
     );
     let bad = sweep(&d.path().join("never.csv"), &["--target-error", "1e-6"]);
+    // (below the pairs' calibration: 1.8e-5, the floor of GPU f32)
     assert!(!bad.status.success());
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(
@@ -317,7 +320,7 @@ fn target_error_chooses_records_and_is_checked() {
         d.path().join("a.csv").to_str().unwrap(),
     ]));
     assert!(
-        out.contains("--target-error 1e-2: 16 substeps per contact, cpu-fast-f64")
+        out.contains("--target-error 1e-2: 8 substeps per contact, cpu-fast-f64")
             && out.contains("(met)"),
         "{out}"
     );

@@ -54,34 +54,73 @@ pub fn mixed_plan() -> pounding::plan::PairPlan {
     pounding::plan::PairPlan::new(plan.spec()).unwrap()
 }
 
-/// Measured on this grid (1,632 runs; see README "Integration schemes"): peak-force error
-/// median 6e-7, p99 6e-4, max 1.0e-3 (worst in the nonlinear viscoelastic law, whose
-/// delta^(1/4) damping is singular at first touch and slows RK4's convergence); dissipated energy
-/// max 1.5e-3; peak displacements max 5e-4; impact counts equal on every run. The bounds below
-/// leave 2x headroom over those maxima.
+/// How far the fast scheme may be from the reference on the mixed grid, per run.
+struct Bounds {
+    force: f64,
+    median_force: f64,
+    displacement: f64,
+    dissipated: f64,
+}
+
+/// Measured on this grid (1,632 runs; see README "Integration schemes"), impact counts equal on
+/// every run at both settings: at the default (16 substeps per contact) peak-force error median
+/// 1.6e-6, max 3.6e-5; peak displacements max 8.8e-5; dissipated energy max 6.5e-4; at 64,
+/// 1.2e-8, 5.4e-6, 2.3e-6 and 9.2e-6 (before issue 34's graded pieces and force readout, 64
+/// gave a max of 1.0e-3). The bounds leave 2x to 100x headroom over those maxima.
 #[test]
 fn fast_matches_reference_on_mixed_runs() {
     let plan = mixed_plan();
     assert!(plan.len() >= 300, "{} runs", plan.len());
-    let fast = collect(&plan, &Scheme::Fast(FastOptions::default()), 8);
     let refr = collect(
         &plan,
         &Scheme::Reference(ReferenceOptions::with_tol(1e-7)),
         8,
     );
+    for (fast, bounds) in [
+        (
+            FastOptions::default(),
+            Bounds {
+                force: 1e-4,
+                median_force: 5e-6,
+                displacement: 2e-4,
+                dissipated: 1.5e-3,
+            },
+        ),
+        (
+            crate::support::precise_fast(),
+            Bounds {
+                force: 1.5e-5,
+                median_force: 1e-6,
+                displacement: 5e-6,
+                dissipated: 2e-5,
+            },
+        ),
+    ] {
+        let runs = collect(&plan, &Scheme::Fast(fast), 8);
+        matches_reference(&plan, &runs, &refr, &bounds, fast.substeps_per_contact);
+    }
+}
+
+fn matches_reference(
+    plan: &pounding::plan::PairPlan,
+    fast: &[(pounding::plan::RunSpec, pounding::physics::model::RunOutput)],
+    refr: &[(pounding::plan::RunSpec, pounding::physics::model::RunOutput)],
+    b: &Bounds,
+    setting: f64,
+) {
     let mut force_errs = Vec::new();
     let mut laws_pounded = std::collections::BTreeSet::new();
-    for ((spec, f), (_, r)) in fast.iter().zip(&refr) {
+    let (mut worst_u, mut worst_d) = (0.0f64, 0.0f64);
+    for ((spec, f), (_, r)) in fast.iter().zip(refr) {
         assert_eq!(f.status, Status::Ok, "{spec:?}");
         assert_eq!(r.status, Status::Ok, "{spec:?}");
         assert_eq!(
             f.impacts, r.impacts,
             "{spec:?}: impact counts differ: {f:?} {r:?}"
         );
-        assert!(
-            rel(f.peak_u1, r.peak_u1) < 1e-3 && rel(f.peak_u2, r.peak_u2) < 1e-3,
-            "{spec:?}: {f:?} {r:?}"
-        );
+        let eu = rel(f.peak_u1, r.peak_u1).max(rel(f.peak_u2, r.peak_u2));
+        worst_u = worst_u.max(eu);
+        assert!(eu < b.displacement, "{spec:?}: {f:?} {r:?}");
         if r.impacts == 0 {
             assert_eq!(f.peak_force, 0.0);
             continue;
@@ -89,13 +128,13 @@ fn fast_matches_reference_on_mixed_runs() {
         laws_pounded.insert(spec.law.key());
         let ef = rel(f.peak_force, r.peak_force);
         assert!(
-            ef < 2e-3,
+            ef < b.force,
             "{spec:?}: peak force {} vs {} ({ef:e})",
             f.peak_force,
             r.peak_force
         );
         assert!(
-            rel(f.peak_penetration, r.peak_penetration) < 2e-3,
+            rel(f.peak_penetration, r.peak_penetration) < b.force,
             "{spec:?}: {f:?} {r:?}"
         );
         // At zero gap the bodies touch from rest: the first touch happens at sub-nanometre
@@ -108,10 +147,9 @@ fn fast_matches_reference_on_mixed_runs() {
             );
         }
         if spec.law.is_damped() {
-            assert!(
-                rel(f.dissipated_energy, r.dissipated_energy) < 3e-3,
-                "{spec:?}: {f:?} {r:?}"
-            );
+            let ed = rel(f.dissipated_energy, r.dissipated_energy);
+            worst_d = worst_d.max(ed);
+            assert!(ed < b.dissipated, "{spec:?}: {f:?} {r:?}");
         }
         force_errs.push(ef);
     }
@@ -122,12 +160,20 @@ fn fast_matches_reference_on_mixed_runs() {
     );
     assert!(
         force_errs.len() * 2 > fast.len(),
-        "too few pounding runs: {}",
-        force_errs.len()
+        "too few pounding runs: {} of {}",
+        force_errs.len(),
+        plan.len()
     );
     force_errs.sort_by(f64::total_cmp);
     let median = force_errs[force_errs.len() / 2];
-    assert!(median < 1e-5, "median peak-force error {median:e}");
+    eprintln!(
+        "{setting} substeps/contact: peak force median {median:.1e} max {:.1e}; peak u max {worst_u:.1e}; dissipated max {worst_d:.1e}",
+        force_errs[force_errs.len() - 1]
+    );
+    assert!(
+        median < b.median_force,
+        "median peak-force error {median:e}"
+    );
 }
 
 /// Run numbering and results do not depend on the thread count or chunk size.

@@ -331,11 +331,20 @@ fn gpu_f32_impact_counts_differ_only_at_grazing_contacts() {
     let Some(_) = ctx() else { return };
     let quick =
         pounding::plan::config::load_pair(std::path::Path::new("configs/quickstart.toml")).unwrap();
-    let quick_cpu = collect(&quick, &Scheme::Fast(FastOptions::default()), 8);
+    // At 64 substeps on both sides, the setting the wide grid runs at.
+    let precise = crate::support::precise_fast();
+    let quick_cpu = collect(&quick, &Scheme::Fast(precise), 8);
     let (wide_plan, wide_cpu) = wide();
     let mut differ = 0;
     for (plan, cpu) in [(&quick, &quick_cpu), (wide_plan, wide_cpu)] {
-        let gpu = gpu_collect(plan, &GpuOptions::default(), 100_000);
+        let gpu = gpu_collect(
+            plan,
+            &GpuOptions {
+                fast: precise,
+                ..Default::default()
+            },
+            100_000,
+        );
         for ((s, c), (_, g)) in cpu.iter().zip(&gpu) {
             if c.impacts == g.impacts {
                 continue;
@@ -645,9 +654,11 @@ fn gpu_lane_tally_and_work_counts_match_the_runs() {
 fn gpu_f64_shared_free_response_changes_nothing_but_the_work() {
     let Some(_) = ctx() else { return };
     let plan = crate::shared::plan(crate::shared::SCENES);
+    // At 64 substeps (f64_bound was measured there).
     let stepped_opts = GpuOptions {
         precision: pounding::engine::gpu::Precision::F64,
         share_free_response: false,
+        fast: crate::support::precise_fast(),
         ..Default::default()
     };
     let shared_opts = GpuOptions {
@@ -656,7 +667,7 @@ fn gpu_f64_shared_free_response_changes_nothing_but_the_work() {
     };
     let (stepped, _) = gpu_run(&plan, &stepped_opts, 100_000);
     let (shared, report) = gpu_run(&plan, &shared_opts, 100_000);
-    let cpu = collect(&plan, &Scheme::Fast(FastOptions::default()), 64);
+    let cpu = collect(&plan, &Scheme::Fast(crate::support::precise_fast()), 64);
     let mut bad = Vec::new();
     let (mut worst, mut ended_early) = (0.0f64, 0u64);
     let mut responses = std::collections::HashMap::new();

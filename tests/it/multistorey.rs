@@ -16,7 +16,7 @@ fn schemes() -> [RowScheme; 2] {
     [
         RowScheme::Fast(FastOptions {
             energy: true,
-            ..FastOptions::default()
+            ..crate::support::precise_fast()
         }),
         RowScheme::Reference(ReferenceOptions::default()),
     ]
@@ -761,9 +761,19 @@ fn accuracy_of_a_row_config() {
         out.to_str().unwrap(),
     ]);
     let said = String::from_utf8_lossy(&o.stdout);
+    let chosen = pounding::physics::solver::calibration::for_target_in(
+        pounding::physics::solver::calibration::Suite::Rows,
+        1e-3,
+    )
+    .unwrap();
     let line = said
         .lines()
-        .find(|l| l.starts_with("--target-error 1e-3: 24 substeps per contact, cpu-fast-f64"))
+        .find(|l| {
+            l.starts_with(&format!(
+                "--target-error 1e-3: {} substeps per contact, cpu-fast-f64",
+                chosen.substeps_per_contact
+            ))
+        })
         .unwrap_or_else(|| panic!("{said}"));
     let measured: f64 = line
         .split("p99 peak-force error ")

@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 
 fn schemes() -> [Scheme; 2] {
     [
-        Scheme::Fast(FastOptions::default()),
+        Scheme::Fast(crate::support::precise_fast()),
         Scheme::Reference(ReferenceOptions::default()),
     ]
 }
@@ -134,7 +134,7 @@ fn energy_balance_under_constant_ground_acceleration() {
     };
     let fast = Scheme::Fast(FastOptions {
         energy: true,
-        ..Default::default()
+        ..crate::support::precise_fast()
     });
     let schemes = [fast, Scheme::Reference(ReferenceOptions::default())];
     // Apart; then touching: building 1 (stiffer, heavier) rests against building 2.
@@ -294,7 +294,7 @@ fn fast_scheme_single_collision() {
             v2: -v0 / 2.0,
             ..Default::default()
         },
-        &Scheme::Fast(FastOptions::default()),
+        &Scheme::Fast(crate::support::precise_fast()),
     );
     assert_eq!(out.impacts, 1);
     assert!(rel(out.first_impact.unwrap(), 0.001 / v0) < 1e-9, "{out:?}");

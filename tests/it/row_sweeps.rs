@@ -389,7 +389,7 @@ fn row_target_error_takes_the_rows_calibrated_setting() {
         "{err}"
     );
     // Below the calibration: refused, naming the rows' suite.
-    let r = sweep(&cfg, &dir.path().join("c.csv"), &["--target-error", "1e-6"]);
+    let r = sweep(&cfg, &dir.path().join("c.csv"), &["--target-error", "1e-9"]);
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(
         !r.status.success() && err.contains("configs/accuracy-rows.toml"),

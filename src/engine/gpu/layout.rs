@@ -90,8 +90,6 @@ real_structs! {
         v0,
         /// Peak force of the current impact.
         imp_peak,
-        /// The last two force samples `(time since onset, force)` of the current impact.
-        h_t0, h_f0, h_t1, h_f1,
         /// Local time of the current impact's onset within its record interval.
         tau_onset,
         /// Local time reached within the current record interval.
@@ -133,8 +131,6 @@ pub const NO_RESPONSE: u32 = u32::MAX;
 pub struct Counters {
     /// `MODE_*`
     pub mode: u32,
-    /// Force samples held in `State::h_*` (0, 1 or 2).
-    pub nhist: u32,
     pub impacts: u32,
     /// `STATUS_*`; a run that is not `STATUS_OK` is not stepped again.
     pub status: u32,
@@ -195,7 +191,6 @@ impl Layout for Counters {
         use core::mem::offset_of;
         vec![
             ("mode", offset_of!(Counters, mode)),
-            ("nhist", offset_of!(Counters, nhist)),
             ("impacts", offset_of!(Counters, impacts)),
             ("status", offset_of!(Counters, status)),
             ("substeps", offset_of!(Counters, substeps)),

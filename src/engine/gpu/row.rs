@@ -58,9 +58,8 @@ pub const C_FREE_STEPS: usize = 6;
 pub const C_LEVELS: usize = 7;
 pub const LC_MODE: usize = 0;
 pub const LC_IMPACTS: usize = 1;
-pub const LC_NHIST: usize = 2;
-pub const LC_I_ONSET: usize = 3;
-pub const LC_STRIDE: usize = 4;
+pub const LC_I_ONSET: usize = 2;
+pub const LC_STRIDE: usize = 3;
 pub const BC_DRIFT_STOREY: usize = 0;
 pub const BC_ACCEL_FLOOR: usize = 1;
 pub const BC_STRIDE: usize = 2;
@@ -74,17 +73,13 @@ pub const SC_STRIDE: usize = 2;
 pub const LS_V0: usize = 0;
 pub const LS_TAU_ONSET: usize = 1;
 pub const LS_IMP_PEAK: usize = 2;
-pub const LS_H_T0: usize = 3;
-pub const LS_H_F0: usize = 4;
-pub const LS_H_T1: usize = 5;
-pub const LS_H_F1: usize = 6;
-pub const LS_PEAK_FORCE: usize = 7;
-pub const LS_IMPACT_VELOCITY: usize = 8;
-pub const LS_PENETRATION: usize = 9;
-pub const LS_FIRST_IMPACT: usize = 10;
-pub const LS_CONTACT_TIME: usize = 11;
-pub const LS_DISSIPATED: usize = 12;
-pub const LS_STRIDE: usize = 13;
+pub const LS_PEAK_FORCE: usize = 3;
+pub const LS_IMPACT_VELOCITY: usize = 4;
+pub const LS_PENETRATION: usize = 5;
+pub const LS_FIRST_IMPACT: usize = 6;
+pub const LS_CONTACT_TIME: usize = 7;
+pub const LS_DISSIPATED: usize = 8;
+pub const LS_STRIDE: usize = 9;
 pub const BS_ROOF: usize = 0;
 pub const BS_DRIFT: usize = 1;
 pub const BS_ACCEL: usize = 2;
@@ -313,7 +308,6 @@ impl RowShape {
             ("C_STRIDE", self.c_stride()),
             ("LC_MODE", LC_MODE),
             ("LC_IMPACTS", LC_IMPACTS),
-            ("LC_NHIST", LC_NHIST),
             ("LC_I_ONSET", LC_I_ONSET),
             ("LC_STRIDE", LC_STRIDE),
             ("BC_DRIFT_STOREY", BC_DRIFT_STOREY),
@@ -327,10 +321,6 @@ impl RowShape {
             ("LS_V0", LS_V0),
             ("LS_TAU_ONSET", LS_TAU_ONSET),
             ("LS_IMP_PEAK", LS_IMP_PEAK),
-            ("LS_H_T0", LS_H_T0),
-            ("LS_H_F0", LS_H_F0),
-            ("LS_H_T1", LS_H_T1),
-            ("LS_H_F1", LS_H_F1),
             ("LS_PEAK_FORCE", LS_PEAK_FORCE),
             ("LS_IMPACT_VELOCITY", LS_IMPACT_VELOCITY),
             ("LS_PENETRATION", LS_PENETRATION),

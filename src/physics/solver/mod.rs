@@ -159,6 +159,20 @@ pub(crate) fn force(p: &Pair, mode: Mode, v0: f64, z: &State) -> f64 {
     }
 }
 
+/// The rate of [`force`] at `z` in `mode` (the relative acceleration from the structures and
+/// the contact force itself; the ground's acceleration moves both bodies alike).
+#[inline]
+pub(crate) fn force_rate(p: &Pair, mode: Mode, v0: f64, z: &State, f: f64) -> f64 {
+    match mode {
+        Mode::Free => 0.0,
+        _ => {
+            let a = structural_rel_accel(p, z) - f * (1.0 / p.b1.m + 1.0 / p.b2.m);
+            p.contact
+                .force_rate(delta(p, z), ddelta(z), a, v0, mode == Mode::Approach)
+        }
+    }
+}
+
 // Always inlined: with the energy terms it grew past the inliner's threshold, and the call
 // cost 25 % of the CPU fast path's runs/s. `inv_m` holds the masses' reciprocals, computed
 // once per step by the caller.

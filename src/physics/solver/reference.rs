@@ -2,7 +2,7 @@
 //! component against `atol + rtol |z|`. Steps end on every record sample (where `ag` has kinks),
 //! every non-smooth contact instant is located inside the step (see [`super`]), a free step that
 //! could hide a contact is shortened to the contact time scale, and steps in an impact are capped
-//! at `t_c / contact_steps` so the parabola-refined peak force is resolved to about `rtol` (not
+//! at `t_c / contact_steps` so the peak force is resolved to about `rtol` (not
 //! once the contact is sustained, see [`super::fast::SUSTAINED`]).
 
 use super::events::may_touch;
@@ -27,7 +27,8 @@ impl ReferenceOptions {
     /// Options whose peak force is accurate to about `tol` (relative). Measured global
     /// peak-force errors run to about 36x the local `rtol` (nonlinear viscoelastic contact on a
     /// synthetic record), so `rtol = tol / 100`; the contact cap `0.5 rtol^(-1/3)` keeps the
-    /// parabola-refined peak (error falling as the cube of the step) below that.
+    /// peak read between steps (the force's cubic Hermite; a parabola through samples before,
+    /// whose error fell as the cube of the step, set the cap) below that.
     pub fn with_tol(tol: f64) -> ReferenceOptions {
         let rtol = 0.01 * tol;
         ReferenceOptions {

@@ -3,7 +3,7 @@
 
 use super::events::{event_value, hidden_touch, locate, reapproach, transition};
 use super::hermite::{cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak};
-use super::{ddelta, delta, force, Mode, Sample, Segment, State};
+use super::{ddelta, delta, force, force_rate, Mode, Sample, Segment, State};
 use crate::physics::model::{EnergyBalance, Initial, Oscillator, Pair, RunOutput, Status};
 
 /// Peaks and impact bookkeeping shared by both schemes.
@@ -16,50 +16,24 @@ pub(crate) struct Tracker {
     /// energy balance's scale).
     e_initial: f64,
     e_peak: f64,
-    /// Onset time of the current impact; force-sample times are kept relative to it, as the
-    /// shader does (so f32 times keep their resolution late in a record).
+    /// Onset time of the current impact (the graded cuts after a touch count from it).
     t_onset: f64,
-    hist: ForceHistory,
     impacts_ended: u32,
 }
 
-/// The last two force samples of the current impact, for the parabola refinement of its peak.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct ForceHistory {
-    hist: [(f64, f64); 2],
-    nhist: usize,
-}
-
-impl ForceHistory {
-    /// Record a force sample `f` at `t` after the impact's onset; returns the impact's peak
-    /// raised to it, and to the vertex of the parabola through the last three samples where
-    /// they make a local maximum.
-    #[inline]
-    pub fn sample(&mut self, peak: f64, t: f64, f: f64) -> f64 {
-        let mut peak = peak.max(f);
-        if self.nhist == 2 {
-            let [(x0, y0), (x1, y1)] = self.hist;
-            if y1 >= y0 && y1 >= f && x1 > x0 && t > x1 {
-                let d1 = (y1 - y0) / (x1 - x0);
-                let d2 = (f - y1) / (t - x1);
-                let a = (d2 - d1) / (t - x0);
-                if a < 0.0 {
-                    // Newton form around x0, x1: y(x) = y0 + d1 (x - x0) + a (x - x0)(x - x1).
-                    let xv = (0.5 * (x0 + x1) - 0.5 * d1 / a).clamp(x0, t);
-                    let yv = y0 + d1 * (xv - x0) + a * (xv - x0) * (xv - x1);
-                    peak = peak.max(yv);
-                }
-            }
-            self.hist = [self.hist[1], (t, f)];
-        } else {
-            self.hist[self.nhist] = (t, f);
-            self.nhist += 1;
-        }
+/// `peak` raised to the force `f1` at the end of a contact piece of length `h` and, where the
+/// force rises at its start (`r0 > 0`) and falls at its end (`r1 < 0`), to the largest value of
+/// the cubic Hermite through both ends' forces and rates (`Contact::force_rate`, on the piece's
+/// branch of the law: events end pieces, so no touch or turn lies inside). Its error is
+/// `O(h^4)`, RK4's order; a parabola through three force samples was `O(h^3)`, and across a
+/// turn, where the nonlinear viscoelastic law's damping switches off, `O(h^2)`.
+#[inline]
+pub(crate) fn raise_force_peak(peak: f64, f0: f64, r0: f64, f1: f64, r1: f64, h: f64) -> f64 {
+    let peak = peak.max(f1);
+    if r1 < 0.0 && r0 > 0.0 {
+        peak.max(hermite_range(f0, r0, f1, r1, h).1)
+    } else {
         peak
-    }
-
-    pub fn clear(&mut self) {
-        self.nhist = 0;
     }
 }
 
@@ -72,7 +46,6 @@ impl Tracker {
             e_initial: 0.0,
             e_peak: 0.0,
             t_onset: 0.0,
-            hist: ForceHistory::default(),
             impacts_ended: 0,
         }
     }
@@ -118,7 +91,7 @@ impl Tracker {
 
     /// Account for a step `t0 -> t0 + h` spent in `mode`, from `z0` to `z1`.
     #[inline]
-    pub fn step(&mut self, p: &Pair, mode: Mode, t0: f64, h: f64, z0: &State, z1: &State) {
+    pub fn step(&mut self, p: &Pair, mode: Mode, h: f64, z0: &State, z1: &State) {
         let o = &mut self.out;
         o.peak_u1 = raise_cubic_peak(o.peak_u1, z0[0], z0[1], z1[0], z1[1], h);
         o.peak_u2 = raise_cubic_peak(o.peak_u2, z0[2], z0[3], z1[2], z1[3], h);
@@ -132,13 +105,15 @@ impl Tracker {
             }
             o.dissipated_energy = z1[4];
             let f = force(p, mode, self.v0, z1);
-            self.force_sample(t0 + h - self.t_onset, f);
+            let r1 = force_rate(p, mode, self.v0, z1, f);
+            let (f0, r0) = if r1 < 0.0 {
+                let f0 = force(p, mode, self.v0, z0);
+                (f0, force_rate(p, mode, self.v0, z0, f0))
+            } else {
+                (0.0, 0.0)
+            };
+            self.imp_peak = raise_force_peak(self.imp_peak, f0, r0, f, r1, h);
         }
-    }
-
-    /// A force sample `t` after the onset of the current impact.
-    fn force_sample(&mut self, t: f64, f: f64) {
-        self.imp_peak = self.hist.sample(self.imp_peak, t, f);
     }
 
     #[inline]
@@ -148,10 +123,8 @@ impl Tracker {
             self.out.first_impact = Some(t);
         }
         self.v0 = v0;
-        self.imp_peak = 0.0;
+        self.imp_peak = f.max(0.0);
         self.t_onset = t;
-        self.hist.clear();
-        self.force_sample(0.0, f);
     }
 
     #[inline]
@@ -296,12 +269,12 @@ impl<'a, 'o> Integration<'a, 'o> {
             let tol = (tol_rel * h).max(4.0 * f64::EPSILON * t.abs());
             let eval = |s: &State| event_value(p, mode, v0, s);
             let (x, zb) = locate(h, f0, trial, f1, tol, max_iter, &mut step, eval);
-            self.tr.step(p, mode, t, x, &z0, &zb);
+            self.tr.step(p, mode, x, &z0, &zb);
             self.mode = transition(p, mode, t + x, &zb, &z0, &mut self.tr);
             self.z = zb;
             x
         } else {
-            self.tr.step(p, mode, t, h, &z0, &trial);
+            self.tr.step(p, mode, h, &z0, &trial);
             self.z = trial;
             self.mode = reapproach(mode, &self.z);
             h

@@ -4,7 +4,7 @@ use super::rel;
 use pounding::engine::gpu::{GpuContext, GpuOptions};
 use pounding::engine::{Engine, Report};
 use pounding::physics::model::RunOutput;
-use pounding::physics::solver::{FastOptions, Scheme};
+use pounding::physics::solver::Scheme;
 use pounding::plan::{PairPlan, RunSpec};
 use std::sync::OnceLock;
 
@@ -119,7 +119,7 @@ pub fn grazing_contacts(plan: &PairPlan, spec: &RunSpec, tau: f64) -> usize {
         &pair,
         &plan.forcing(spec),
         &pounding::physics::model::Initial::default(),
-        &Scheme::Fast(FastOptions::default()),
+        &Scheme::Fast(super::precise_fast()),
         Some(&mut obs),
     );
     count

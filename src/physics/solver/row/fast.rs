@@ -13,7 +13,7 @@
 //!    (`Lookout`). Every level's events are located inside the substeps. Buildings of
 //!    `FLOOR_SUBSTEPS_FROM` (4) storeys or more with Rayleigh damping take them in floor
 //!    coordinates (`O(N)` per right-hand side; the same motion, `RowModel::substep_model`).
-//! 4. Peaks: as the pair's (force samples refined by a parabola; displacements and drifts from
+//! 4. Peaks: as the pair's (the force's cubic Hermite over each piece; displacements and drifts from
 //!    the quintic Hermite over free record steps, the cubic inside contact steps). Floor
 //!    accelerations: the cubic Hermite with their rates over free record steps, the samples at
 //!    substep ends and events in contact steps, where a contact force's spike makes them

@@ -24,7 +24,7 @@ use super::hermite::{
     cubic_max_bound, hermite_range, quintic_max_bound, quintic_range, raise_cubic_peak,
     raise_quintic_peak,
 };
-use super::tracker::ForceHistory;
+use super::tracker::raise_force_peak;
 use super::{Mode, Segment};
 use crate::physics::contact::Contact;
 use crate::physics::model::{EnergyBalance, Forcing, Status};
@@ -696,7 +696,6 @@ pub(crate) struct LevelState {
     pub v0: f64,
     pub t_onset: f64,
     imp_peak: f64,
-    hist: ForceHistory,
     pub out: LevelOutput,
 }
 
@@ -708,8 +707,7 @@ impl LevelState {
         }
         self.v0 = v0;
         self.t_onset = t;
-        self.hist.clear();
-        self.imp_peak = self.hist.sample(0.0, 0.0, f);
+        self.imp_peak = f.max(0.0);
     }
 
     fn end_impact(&mut self) {
@@ -1448,8 +1446,23 @@ impl<'m> RowRun<'m> {
                 o.peak_penetration = o.peak_penetration.max(hermite_range(y0, d0, y1, d1, h).1);
             }
             o.dissipated_energy = z1[2 * n + l];
+            // The force's rates from the floors' accelerations at both ends (with the contact
+            // forces of these modes: the ends are recomputed where a mode changes).
+            let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+            let accel = |e: usize| self.floors[a][e].a_rel[fa] - self.floors[b][e].a_rel[fb];
+            let approaching = ls.mode == Mode::Approach;
             let f = lm.force(n, ls.mode, ls.v0, z1);
-            ls.imp_peak = ls.hist.sample(ls.imp_peak, t0 + h - ls.t_onset, f);
+            let r1 = lm.contact.force_rate(y1, d1, accel(1), ls.v0, approaching);
+            let (f0, r0) = if r1 < 0.0 {
+                let f0 = lm.force(n, ls.mode, ls.v0, z0);
+                (
+                    f0,
+                    lm.contact.force_rate(y0, d0, accel(0), ls.v0, approaching),
+                )
+            } else {
+                (0.0, 0.0)
+            };
+            ls.imp_peak = raise_force_peak(ls.imp_peak, f0, r0, f, r1, h);
         }
     }
 
