@@ -369,6 +369,29 @@ mod tests {
         }
     }
 
+    /// The force's rate is the derivative of the force along a motion, for every law and both
+    /// branches: against a central difference of `force` along `delta(t) = d + v t + a t^2 / 2`.
+    #[test]
+    fn force_rate_is_the_derivative_of_the_force() {
+        for l in LawKind::ALL {
+            let stiffness = if l.is_hertzian() { 2.75e9 } else { 1e9 };
+            let c = Contact::new(l, stiffness, 0.3, 5e4);
+            for (d, v, a) in [(2e-3, 0.4, -30.0), (5e-4, -0.2, 12.0), (1e-3, 0.05, -200.0)] {
+                for approaching in [true, false] {
+                    let at =
+                        |t: f64| c.force(d + v * t + 0.5 * a * t * t, v + a * t, 0.3, approaching);
+                    let e = 1e-7;
+                    let numeric = (at(e) - at(-e)) / (2.0 * e);
+                    let rate = c.force_rate(d, v, a, 0.3, approaching);
+                    assert!(
+                        (rate - numeric).abs() <= 1e-6 * numeric.abs().max(1.0),
+                        "{l:?} approaching {approaching} at {d} {v} {a}: {rate} against {numeric}"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn keys_round_trip() {
         for l in LawKind::ALL {

@@ -292,3 +292,21 @@ impl<'a, 'o> Integration<'a, 'o> {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::raise_force_peak;
+
+    /// The cubic Hermite through the ends' values and rates holds a quadratic exactly: the peak
+    /// of `1 - (t - 0.3)^2` over `[0, 1]` from its ends alone; no interior peak is sought where
+    /// the force does not rise then fall.
+    #[test]
+    fn the_peak_inside_a_piece_is_the_hermite_maximum() {
+        let f = |t: f64| 1.0 - (t - 0.3) * (t - 0.3);
+        let r = |t: f64| -2.0 * (t - 0.3);
+        let peak = raise_force_peak(0.0, f(0.0), r(0.0), f(1.0), r(1.0), 1.0);
+        assert!((peak - 1.0).abs() < 1e-15, "{peak}");
+        assert_eq!(raise_force_peak(0.2, 0.1, 1.0, 0.5, 0.3, 1.0), 0.5);
+        assert_eq!(raise_force_peak(0.7, 0.6, -1.0, 0.5, -0.3, 1.0), 0.7);
+    }
+}
