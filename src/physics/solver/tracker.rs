@@ -22,15 +22,27 @@ pub(crate) struct Tracker {
 }
 
 /// `peak` raised to the force `f1` at the end of a contact piece of length `h` and, where the
-/// force rises at its start (`r0 > 0`) and falls at its end (`r1 < 0`), to the largest value of
-/// the cubic Hermite through both ends' forces and rates (`Contact::force_rate`, on the piece's
-/// branch of the law: events end pieces, so no touch or turn lies inside). Its error is
-/// `O(h^4)`, RK4's order; a parabola through three force samples was `O(h^3)`, and across a
-/// turn, where the nonlinear viscoelastic law's damping switches off, `O(h^2)`.
+/// force falls at its end (`r1 < 0`) and rises at its start (`start()`: the start's force and
+/// rate, computed only then), to the largest value of the cubic Hermite through both ends'
+/// forces and rates (`Contact::force_rate`, on the piece's branch of the law: events end
+/// pieces, so no touch or turn lies inside). Its error is `O(h^4)`, RK4's order; a parabola
+/// through three force samples was `O(h^3)`, and across a turn, where the nonlinear
+/// viscoelastic law's damping switches off, `O(h^2)`. (The shaders' twin takes the start's
+/// force and rate as values.)
 #[inline]
-pub(crate) fn raise_force_peak(peak: f64, f0: f64, r0: f64, f1: f64, r1: f64, h: f64) -> f64 {
+pub(crate) fn raise_force_peak(
+    peak: f64,
+    f1: f64,
+    r1: f64,
+    h: f64,
+    start: impl FnOnce() -> (f64, f64),
+) -> f64 {
     let peak = peak.max(f1);
-    if r1 < 0.0 && r0 > 0.0 {
+    if r1 >= 0.0 {
+        return peak;
+    }
+    let (f0, r0) = start();
+    if r0 > 0.0 {
         peak.max(hermite_range(f0, r0, f1, r1, h).1)
     } else {
         peak
@@ -105,14 +117,12 @@ impl Tracker {
             }
             o.dissipated_energy = z1[4];
             let f = force(p, mode, self.v0, z1);
-            let r1 = force_rate(p, mode, self.v0, z1, f);
-            let (f0, r0) = if r1 < 0.0 {
-                let f0 = force(p, mode, self.v0, z0);
-                (f0, force_rate(p, mode, self.v0, z0, f0))
-            } else {
-                (0.0, 0.0)
-            };
-            self.imp_peak = raise_force_peak(self.imp_peak, f0, r0, f, r1, h);
+            let v0 = self.v0;
+            let r1 = force_rate(p, mode, v0, z1, f);
+            self.imp_peak = raise_force_peak(self.imp_peak, f, r1, h, || {
+                let f0 = force(p, mode, v0, z0);
+                (f0, force_rate(p, mode, v0, z0, f0))
+            });
         }
     }
 
@@ -304,9 +314,9 @@ mod tests {
     fn the_peak_inside_a_piece_is_the_hermite_maximum() {
         let f = |t: f64| 1.0 - (t - 0.3) * (t - 0.3);
         let r = |t: f64| -2.0 * (t - 0.3);
-        let peak = raise_force_peak(0.0, f(0.0), r(0.0), f(1.0), r(1.0), 1.0);
+        let peak = raise_force_peak(0.0, f(1.0), r(1.0), 1.0, || (f(0.0), r(0.0)));
         assert!((peak - 1.0).abs() < 1e-15, "{peak}");
-        assert_eq!(raise_force_peak(0.2, 0.1, 1.0, 0.5, 0.3, 1.0), 0.5);
-        assert_eq!(raise_force_peak(0.7, 0.6, -1.0, 0.5, -0.3, 1.0), 0.7);
+        assert_eq!(raise_force_peak(0.2, 0.5, 0.3, 1.0, || (0.1, 1.0)), 0.5);
+        assert_eq!(raise_force_peak(0.7, 0.5, -0.3, 1.0, || (0.6, -1.0)), 0.7);
     }
 }

@@ -1453,16 +1453,13 @@ impl<'m> RowRun<'m> {
             let approaching = ls.mode == Mode::Approach;
             let f = lm.force(n, ls.mode, ls.v0, z1);
             let r1 = lm.contact.force_rate(y1, d1, accel(1), ls.v0, approaching);
-            let (f0, r0) = if r1 < 0.0 {
+            ls.imp_peak = raise_force_peak(ls.imp_peak, f, r1, h, || {
                 let f0 = lm.force(n, ls.mode, ls.v0, z0);
                 (
                     f0,
                     lm.contact.force_rate(y0, d0, accel(0), ls.v0, approaching),
                 )
-            } else {
-                (0.0, 0.0)
-            };
-            ls.imp_peak = raise_force_peak(ls.imp_peak, f0, r0, f, r1, h);
+            });
         }
     }
 
