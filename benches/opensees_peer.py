@@ -105,8 +105,10 @@ def pound_sweep(pound, cfg, out, scheme):
     if scheme:
         cmd += ["--scheme", scheme]
     t = time.perf_counter()
-    subprocess.run(cmd, check=True, stderr=subprocess.DEVNULL)
+    done = subprocess.run(cmd, stderr=subprocess.PIPE, text=True)
     seconds = time.perf_counter() - t
+    if done.returncode != 0:
+        raise SystemExit(f"pound sweep {cfg} failed:\n{done.stderr.strip()}")
     with open(out) as f:
         return seconds, list(csv.DictReader(f))
 
@@ -164,6 +166,10 @@ def main():
     pga_g = a.pga_g if a.pga_g is not None else scene["pga_g"]
     records = os.environ.get("POUND_RECORDS_DIR", "../shared/records")
     path = os.path.join(records, record)
+    if not os.path.isfile(path):
+        raise SystemExit(f"{path}: no such record (records are read from POUND_RECORDS_DIR, default ../shared/records)")
+    if not os.path.isfile(a.pound):
+        raise SystemExit(f"{a.pound}: no pound binary (run from the repository root after cargo build --release, or pass --pound)")
     dt_rec, acc_g = read_at2(path)
     if scene["window"] and not a.record:
         lo, hi = scene["window"]
