@@ -8,17 +8,19 @@ use std::path::PathBuf;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The sweep config (a pair: [building1] and [building2]).
+    /// The sweep config (a pair, [building1] and [building2], or a row of [[building]]).
     config: PathBuf,
     /// The run's number, as in the sweep's `run` column.
     #[arg(long)]
     run: u64,
-    /// The time history at every record step and located event: displacements, velocities,
-    /// absolute floor accelerations, penetration, contact force, contact mode.
+    /// The time history at every record step and located event. A pair: displacements,
+    /// velocities, absolute floor accelerations, penetration, contact force, contact mode. A
+    /// row: every floor's displacement, and each level's penetration, force and mode.
     /// (default: trace.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Displacements and contact force against time, force against penetration (.svg or .png).
+    /// Displacements (a row's roofs) and contact force (per level) against time, force against
+    /// penetration (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
     #[command(flatten)]
@@ -37,14 +39,14 @@ pub fn run(a: Args) -> Result<()> {
     let plan = config::load_text(&text, &a.config)?;
     let t = trace::trace(&plan, a.run)?;
     // The run's row, as the sweep writes it: the trace's peaks are the sweep's.
-    say!("{}", pounding::plan::columns::header().join(","));
+    say!("{}", t.header.join(","));
     say!("{}", t.row.join(","));
     write_file(&output, t.csv().as_bytes())?;
     note!(
         "run {} of {}: {} samples (record steps and located events) -> {}",
         a.run,
         a.config.display(),
-        t.samples.len(),
+        t.len(),
         output.display()
     );
     if let Some(p) = &a.plot {

@@ -607,7 +607,7 @@ impl RowPlan {
     /// The contact levels' column prefixes, `level_b1f3_b2f3` for floor 3 of building 1
     /// against floor 3 of building 2 (buildings and floors from 1). They depend only on storeys
     /// and heights, which no axis sweeps, so every run of the plan has the same levels.
-    fn level_names(&self) -> Vec<String> {
+    pub fn level_names(&self) -> Vec<String> {
         let first = self.run(0);
         self.row(&first)
             .levels

@@ -2,12 +2,15 @@
 //! the sweep uses, at every accepted record step and located event (touch, turn, separation),
 //! with the run's output, whose cells are the sweep's row for that run.
 //!
-//! The CPU fast scheme may settle free stretches from a response shared between runs; the
-//! trace integrates the run alone, which gives the same output (`solver::simulate_shared`).
-//! Pairs only so far: the row scheme has no observer yet.
+//! The CPU fast scheme may settle a pair's free stretches from a response shared between runs;
+//! the trace integrates the run alone, which gives the same output (`solver::simulate_shared`).
+//! A row's trace moves every building in every substep, where the sweep lets buildings that
+//! no contact can reach stand still and steps them exactly: the same output to rounding
+//! (`solver::row::simulate_row_observed`).
 
-use crate::physics::model::RunOutput;
+use crate::physics::solver::row::{simulate_row_observed, RowModel, RowSample};
 use crate::physics::solver::{simulate_observed, Mode, Sample};
+use crate::plan::row::RowPlan;
 use crate::plan::{PairPlan, Plan, RunSpec};
 use crate::studies::plot::{Panel, Series};
 
@@ -15,32 +18,48 @@ use crate::studies::plot::{Panel, Series};
 pub enum TraceError {
     #[error("--run {run}: the sweep has {runs} runs (0 to {})", runs.saturating_sub(1))]
     NoSuchRun { run: u64, runs: u64 },
-    #[error("rows of [[building]] configs are not traced yet (the row scheme has no observer); a [building1]/[building2] pair is")]
-    Rows,
 }
 
 /// The time history of one run.
 #[derive(Debug, Clone)]
 pub struct Trace {
-    pub spec: RunSpec,
-    pub output: RunOutput,
-    /// The run's cells as the sweep writes them ([`crate::plan::columns::header`] order).
+    /// The sweep's header, and the run's cells as the sweep writes them.
+    pub header: Vec<String>,
     pub row: Vec<String>,
-    pub samples: Vec<Sample>,
+    pub history: History,
+}
+
+/// A pair's or a row's samples.
+#[derive(Debug, Clone)]
+pub enum History {
+    Pair {
+        spec: Box<RunSpec>,
+        samples: Vec<Sample>,
+    },
+    Row {
+        index: u64,
+        /// Each level's column prefix (`level_b1f3_b2f3`), in the samples' order.
+        levels: Vec<String>,
+        samples: Vec<RowSample>,
+    },
 }
 
 /// Run `run` of `plan`, observed.
 pub fn trace(plan: &Plan, run: u64) -> Result<Trace, TraceError> {
-    let pair: &PairPlan = match plan {
-        Plan::Pair(p) => p,
-        Plan::Row(_) => return Err(TraceError::Rows),
+    let runs = match plan {
+        Plan::Pair(p) => p.len(),
+        Plan::Row(r) => r.len(),
     };
-    if run >= pair.len() {
-        return Err(TraceError::NoSuchRun {
-            run,
-            runs: pair.len(),
-        });
+    if run >= runs {
+        return Err(TraceError::NoSuchRun { run, runs });
     }
+    Ok(match plan {
+        Plan::Pair(p) => trace_pair(p, run),
+        Plan::Row(r) => trace_row(r, run),
+    })
+}
+
+fn trace_pair(pair: &PairPlan, run: u64) -> Trace {
     let spec = pair.run(run);
     let mut samples = Vec::new();
     let output = simulate_observed(
@@ -50,12 +69,200 @@ pub fn trace(plan: &Plan, run: u64) -> Result<Trace, TraceError> {
         &pair.contact.spec.scheme,
         Some(&mut |s: &Sample| samples.push(*s)),
     );
-    Ok(Trace {
+    Trace {
+        header: crate::plan::columns::header()
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
         row: crate::plan::columns::row(pair, &spec, &output),
-        spec,
-        output,
-        samples,
-    })
+        history: History::Pair {
+            spec: Box::new(spec),
+            samples,
+        },
+    }
+}
+
+fn trace_row(plan: &RowPlan, run: u64) -> Trace {
+    let spec = plan.run(run);
+    let model = RowModel::new(&plan.row(&spec));
+    let mut samples = Vec::new();
+    let output = simulate_row_observed(
+        &model,
+        &plan.forcing(&spec),
+        model.at_rest(),
+        &plan.scheme(),
+        &mut |s: &RowSample| samples.push(s.clone()),
+    );
+    Trace {
+        header: plan.header(),
+        row: plan.cells(&spec, &output),
+        history: History::Row {
+            index: spec.index,
+            levels: plan.level_names(),
+            samples,
+        },
+    }
+}
+
+impl Trace {
+    /// How many samples (record steps and located events) the history holds.
+    pub fn len(&self) -> usize {
+        match &self.history {
+            History::Pair { samples, .. } => samples.len(),
+            History::Row { samples, .. } => samples.len(),
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The samples as CSV: a pair's [`HEADER`], or a row's [`row_header`].
+    pub fn csv(&self) -> String {
+        match &self.history {
+            History::Pair { spec, samples, .. } => pair_csv(spec, samples),
+            History::Row {
+                levels, samples, ..
+            } => row_csv(levels, samples),
+        }
+    }
+
+    /// Displacements and contact force against time, force against penetration.
+    pub fn panels(&self) -> Vec<Panel> {
+        match &self.history {
+            History::Pair { spec, samples, .. } => pair_panels(spec, samples),
+            History::Row {
+                index,
+                levels,
+                samples,
+            } => row_panels(*index, levels, samples),
+        }
+    }
+}
+
+fn mode_name(m: Mode) -> &'static str {
+    match m {
+        Mode::Free => "free",
+        Mode::Approach => "approach",
+        Mode::Restitution => "restitution",
+    }
+}
+
+/// A row trace's columns: the time, each building's floor displacements (`b1_f1_u_m`, floors
+/// from 1 at the lowest), then each level's penetration, force and mode.
+pub fn row_header(levels: &[String], floors: &[usize]) -> Vec<String> {
+    let mut h = vec!["t_s".to_string()];
+    for (b, &n) in floors.iter().enumerate() {
+        h.extend((1..=n).map(|f| format!("b{}_f{f}_u_m", b + 1)));
+    }
+    for l in levels {
+        for c in ["penetration_m", "force_n", "mode"] {
+            h.push(format!("{l}_{c}"));
+        }
+    }
+    h
+}
+
+fn row_csv(levels: &[String], samples: &[RowSample]) -> String {
+    let num = crate::plan::columns::num;
+    let floors: Vec<usize> = samples
+        .first()
+        .map(|s| s.floors.iter().map(Vec::len).collect())
+        .unwrap_or_default();
+    let mut s = row_header(levels, &floors).join(",");
+    s.push('\n');
+    for x in samples {
+        let mut cells = vec![num(x.t)];
+        cells.extend(x.floors.iter().flatten().map(|&u| num(u)));
+        for l in 0..x.forces.len() {
+            cells.push(num(x.penetrations[l]));
+            cells.push(num(x.forces[l]));
+            cells.push(mode_name(x.modes[l]).into());
+        }
+        s.push_str(&cells.join(","));
+        s.push('\n');
+    }
+    s
+}
+
+fn line(name: &str, points: Vec<(f64, f64)>) -> Series {
+    Series {
+        name: name.into(),
+        points,
+        scatter: false,
+        style: None,
+    }
+}
+
+/// A level's column prefix in words: `level_b1f3_b2f3` is "building 1 floor 3 / building 2
+/// floor 3".
+fn level_label(prefix: &str) -> String {
+    let words = |side: &str| {
+        side.strip_prefix('b')
+            .and_then(|r| r.split_once('f'))
+            .map(|(b, f)| format!("building {b} floor {f}"))
+    };
+    prefix
+        .strip_prefix("level_")
+        .and_then(|r| r.split_once('_'))
+        .and_then(|(a, b)| Some(format!("{} / {}", words(a)?, words(b)?)))
+        .unwrap_or_else(|| prefix.to_string())
+}
+
+/// A level's point of a sample (None: not drawn).
+type LevelPoint = dyn Fn(&RowSample, usize) -> Option<(f64, f64)>;
+
+/// Each building's roof displacement and each level's force against time; each level's force
+/// against its penetration.
+fn row_panels(index: u64, levels: &[String], samples: &[RowSample]) -> Vec<Panel> {
+    let buildings = samples.first().map_or(0, |s| s.floors.len());
+    let roofs = (0..buildings)
+        .map(|b| {
+            line(
+                &format!("building {} roof", b + 1),
+                samples
+                    .iter()
+                    .map(|s| (s.t, *s.floors[b].last().unwrap_or(&0.0)))
+                    .collect(),
+            )
+        })
+        .collect();
+    let per_level = |f: &LevelPoint| -> Vec<Series> {
+        levels
+            .iter()
+            .enumerate()
+            .map(|(l, name)| {
+                let label = level_label(name);
+                line(&label, samples.iter().filter_map(|s| f(s, l)).collect())
+            })
+            .filter(|s| s.points.iter().any(|p| p.1 > 0.0))
+            .collect()
+    };
+    vec![
+        Panel {
+            title: format!("Run {index}: roof displacements"),
+            x_label: "t (s)".into(),
+            y_label: "displacement (m)".into(),
+            series: roofs,
+            ..Panel::default()
+        },
+        Panel {
+            title: "Contact force per level".into(),
+            x_label: "t (s)".into(),
+            y_label: "contact force (N)".into(),
+            series: per_level(&|s, l| Some((s.t, s.forces[l]))),
+            ..Panel::default()
+        },
+        Panel {
+            title: "Force against penetration".into(),
+            x_label: "penetration (m)".into(),
+            y_label: "contact force (N)".into(),
+            series: per_level(&|s, l| {
+                (s.modes[l] != Mode::Free).then(|| (s.penetrations[l], s.forces[l]))
+            }),
+            ..Panel::default()
+        },
+    ]
 }
 
 /// The trace's columns.
@@ -72,89 +279,85 @@ pub const HEADER: [&str; 10] = [
     "mode",
 ];
 
-impl Trace {
-    /// A sample's absolute floor accelerations in the pair `p`, from the equations of motion
-    /// `m (u'' + ag) + c u' + k u = -+F` (the contact pushes building 1 back, building 2 on).
-    fn accelerations(p: &crate::physics::model::Pair, s: &Sample) -> [f64; 2] {
-        let z = &s.z;
-        [
-            0.0 - (p.b1.c * z[1] + p.b1.k * z[0] + s.force) / p.b1.m,
-            0.0 - (p.b2.c * z[3] + p.b2.k * z[2] - s.force) / p.b2.m,
-        ]
-    }
+/// A sample's absolute floor accelerations in the pair `p`, from the equations of motion
+/// `m (u'' + ag) + c u' + k u = -+F` (the contact pushes building 1 back, building 2 on).
+fn accelerations(p: &crate::physics::model::Pair, s: &Sample) -> [f64; 2] {
+    let z = &s.z;
+    [
+        0.0 - (p.b1.c * z[1] + p.b1.k * z[0] + s.force) / p.b1.m,
+        0.0 - (p.b2.c * z[3] + p.b2.k * z[2] - s.force) / p.b2.m,
+    ]
+}
 
-    /// The samples as CSV ([`HEADER`]).
-    pub fn csv(&self) -> String {
-        let num = crate::plan::columns::num;
-        let pair = self.spec.pair();
-        let mut s = HEADER.join(",");
+/// A pair's samples as CSV ([`HEADER`]).
+fn pair_csv(spec: &RunSpec, samples: &[Sample]) -> String {
+    let num = crate::plan::columns::num;
+    let pair = spec.pair();
+    let mut s = HEADER.join(",");
+    s.push('\n');
+    for x in samples {
+        let z = &x.z;
+        let [a1, a2] = accelerations(&pair, x);
+        let penetration = (z[0] - z[2] - spec.gap).max(0.0);
+        let mut cells: Vec<String> = [x.t, z[0], z[1], z[2], z[3], a1, a2, penetration, x.force]
+            .map(num)
+            .to_vec();
+        cells.push(mode_name(x.mode).into());
+        s.push_str(&cells.join(","));
         s.push('\n');
-        for x in &self.samples {
-            let z = &x.z;
-            let [a1, a2] = Self::accelerations(&pair, x);
-            let penetration = (z[0] - z[2] - self.spec.gap).max(0.0);
-            let mut cells: Vec<String> =
-                [x.t, z[0], z[1], z[2], z[3], a1, a2, penetration, x.force]
-                    .map(num)
-                    .to_vec();
-            cells.push(
-                match x.mode {
-                    Mode::Free => "free",
-                    Mode::Approach => "approach",
-                    Mode::Restitution => "restitution",
-                }
-                .into(),
-            );
-            s.push_str(&cells.join(","));
-            s.push('\n');
-        }
-        s
     }
+    s
+}
 
-    /// Displacements and the contact force against time, and force against penetration.
-    pub fn panels(&self) -> Vec<Panel> {
-        let gap = self.spec.gap;
-        let at = |f: &dyn Fn(&Sample) -> f64| -> Vec<(f64, f64)> {
-            self.samples.iter().map(|s| (s.t, f(s))).collect()
-        };
-        let line = |name: &str, points| Series {
-            name: name.into(),
-            points,
-            scatter: false,
-            style: None,
-        };
-        vec![
-            Panel {
-                title: format!("Run {}: displacements", self.spec.index),
-                x_label: "t (s)".into(),
-                y_label: "displacement (m)".into(),
-                series: vec![
-                    line("building 1", at(&|s| s.z[0])),
-                    line("building 2", at(&|s| s.z[2])),
-                ],
-                ..Panel::default()
-            },
-            Panel {
-                title: "Contact force".into(),
-                x_label: "t (s)".into(),
-                y_label: "contact force (N)".into(),
-                series: vec![line("contact force", at(&|s| s.force))],
-                ..Panel::default()
-            },
-            Panel {
-                title: "Force against penetration".into(),
-                x_label: "penetration (m)".into(),
-                y_label: "contact force (N)".into(),
-                series: vec![line(
-                    "force against penetration",
-                    self.samples
-                        .iter()
-                        .filter(|s| s.mode != Mode::Free)
-                        .map(|s| ((s.z[0] - s.z[2] - gap).max(0.0), s.force))
-                        .collect(),
-                )],
-                ..Panel::default()
-            },
-        ]
+/// A pair's displacements and contact force against time, and force against penetration.
+fn pair_panels(spec: &RunSpec, samples: &[Sample]) -> Vec<Panel> {
+    let gap = spec.gap;
+    let at = |f: &dyn Fn(&Sample) -> f64| -> Vec<(f64, f64)> {
+        samples.iter().map(|s| (s.t, f(s))).collect()
+    };
+    vec![
+        Panel {
+            title: format!("Run {}: displacements", spec.index),
+            x_label: "t (s)".into(),
+            y_label: "displacement (m)".into(),
+            series: vec![
+                line("building 1", at(&|s| s.z[0])),
+                line("building 2", at(&|s| s.z[2])),
+            ],
+            ..Panel::default()
+        },
+        Panel {
+            title: "Contact force".into(),
+            x_label: "t (s)".into(),
+            y_label: "contact force (N)".into(),
+            series: vec![line("contact force", at(&|s| s.force))],
+            ..Panel::default()
+        },
+        Panel {
+            title: "Force against penetration".into(),
+            x_label: "penetration (m)".into(),
+            y_label: "contact force (N)".into(),
+            series: vec![line(
+                "force against penetration",
+                samples
+                    .iter()
+                    .filter(|s| s.mode != Mode::Free)
+                    .map(|s| ((s.z[0] - s.z[2] - gap).max(0.0), s.force))
+                    .collect(),
+            )],
+            ..Panel::default()
+        },
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn levels_are_named_in_words() {
+        assert_eq!(
+            super::level_label("level_b1f3_b2f12"),
+            "building 1 floor 3 / building 2 floor 12"
+        );
+        assert_eq!(super::level_label("odd"), "odd");
     }
 }

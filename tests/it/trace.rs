@@ -1,5 +1,6 @@
-//! `pound trace`: one run of a sweep, whole. Its row is the sweep's row for that run, byte for
-//! byte (the same integrator, run alone), and its time history stays within the run's peaks.
+//! `pound trace`: one run of a sweep, whole, of a pair or a row. Its row is the sweep's row for
+//! that run, byte for byte (the same integrator, run alone), and its time history stays within
+//! the run's peaks.
 
 use crate::support::{ok, pound, tempdir};
 
@@ -29,22 +30,44 @@ synthetic = { seed = 5, duration_s = 6.0, dt_s = 0.01 }
 pga_g = 0.4
 "#;
 
+/// `pound sweep` of `cfg` on the CPU into `dir`: the CSV's text.
+fn sweep(dir: &std::path::Path, cfg: &std::path::Path) -> String {
+    let results = dir.join("sweep.csv");
+    ok(&pound(&[
+        "sweep",
+        cfg.to_str().unwrap(),
+        "-o",
+        results.to_str().unwrap(),
+        "--backend",
+        "cpu",
+    ]));
+    std::fs::read_to_string(&results).unwrap()
+}
+
+/// `pound trace` of run `run` of `cfg` into `dir`, with its plot: what it printed, and the
+/// trace's CSV.
+fn trace(dir: &std::path::Path, cfg: &std::path::Path, run: usize) -> (String, String) {
+    let out = dir.join(format!("trace-{run}.csv"));
+    let said = ok(&pound(&[
+        "trace",
+        cfg.to_str().unwrap(),
+        "--run",
+        &run.to_string(),
+        "-o",
+        out.to_str().unwrap(),
+        "--plot",
+        dir.join(format!("trace-{run}.svg")).to_str().unwrap(),
+    ]));
+    (said, std::fs::read_to_string(&out).unwrap())
+}
+
 #[test]
 fn a_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
     let dir = tempdir();
     let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
     let cfg = dir.path().join("pair.toml");
     std::fs::write(&cfg, PAIR).unwrap();
-    let results = dir.path().join("sweep.csv");
-    ok(&pound(&[
-        "sweep",
-        &s(&cfg),
-        "-o",
-        &s(&results),
-        "--backend",
-        "cpu",
-    ]));
-    let text = std::fs::read_to_string(&results).unwrap();
+    let text = sweep(dir.path(), &cfg);
     let lines: Vec<&str> = text.lines().collect();
     let head: Vec<&str> = lines[0].split(',').collect();
     let col = |name: &str| head.iter().position(|c| *c == name).unwrap();
@@ -58,20 +81,9 @@ fn a_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
     assert!(pounding.len() >= 4, "{pounding:?}");
     for &i in pounding.iter().step_by(3) {
         let run = i - 1;
-        let out = dir.path().join(format!("trace-{run}.csv"));
-        let said = ok(&pound(&[
-            "trace",
-            &s(&cfg),
-            "--run",
-            &run.to_string(),
-            "-o",
-            &s(&out),
-            "--plot",
-            &s(&dir.path().join(format!("trace-{run}.svg"))),
-        ]));
+        let (said, trace) = trace(dir.path(), &cfg, run);
         let said: Vec<&str> = said.lines().collect();
         assert_eq!(said, [lines[0], lines[i]], "run {run}: the sweep's row");
-        let trace = std::fs::read_to_string(&out).unwrap();
         let mut rows = trace.lines();
         let th: Vec<&str> = rows.next().unwrap().split(',').collect();
         let at = |name: &str| th.iter().position(|c| *c == name).unwrap();
@@ -94,7 +106,7 @@ fn a_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
         );
         assert!(contact > 0, "run {run}: samples in contact");
     }
-    // A run past the sweep, and a row, are refused.
+    // A run past the sweep is refused.
     let bad = pound(&[
         "trace",
         &s(&cfg),
@@ -105,16 +117,82 @@ fn a_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
     ]);
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("the sweep has 16 runs"));
-    let row = dir.path().join("row.toml");
-    std::fs::write(&row, crate::multistorey::ROW_CONFIG).unwrap();
-    let bad = pound(&[
-        "trace",
-        &s(&row),
-        "--run",
-        "0",
-        "-o",
-        &s(&dir.path().join("y.csv")),
-    ]);
-    assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("not traced yet"));
+}
+
+/// A row's trace: its row is the sweep's byte for byte (the buildings that stand still through
+/// a record step of substeps are sampled by their exact free steps, without changing the run),
+/// and every floor's and level's samples stay within and close below the row's located peaks.
+#[test]
+fn a_row_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
+    let dir = tempdir();
+    let cfg = dir.path().join("row.toml");
+    std::fs::write(&cfg, crate::multistorey::ROW_CONFIG).unwrap();
+    let text = sweep(dir.path(), &cfg);
+    let lines: Vec<&str> = text.lines().collect();
+    let head: Vec<&str> = lines[0].split(',').collect();
+    let col = |name: &str| head.iter().position(|c| *c == name).unwrap();
+    let cell = |line: &str, name: &str| -> f64 {
+        line.split(',').nth(col(name)).unwrap().parse().unwrap()
+    };
+    let levels: Vec<&str> = head
+        .iter()
+        .filter_map(|c| c.strip_suffix("_peak_force_n"))
+        .filter(|c| c.starts_with("level_"))
+        .collect();
+    assert!(levels.len() >= 4, "{levels:?}");
+    let mut checked_levels = 0;
+    for i in 1..lines.len() {
+        let run = i - 1;
+        let (said, trace) = trace(dir.path(), &cfg, run);
+        let said: Vec<&str> = said.lines().collect();
+        assert_eq!(said, [lines[0], lines[i]], "run {run}: the sweep's row");
+        let mut rows = trace.lines();
+        let th: Vec<String> = rows.next().unwrap().split(',').map(String::from).collect();
+        let at = |name: &str| {
+            th.iter()
+                .position(|c| c == name)
+                .unwrap_or_else(|| panic!("{name} in {th:?}"))
+        };
+        let samples: Vec<Vec<String>> = rows
+            .map(|r| r.split(',').map(String::from).collect())
+            .collect();
+        let max_of = |name: &str| -> f64 {
+            samples
+                .iter()
+                .map(|c| c[at(name)].parse::<f64>().unwrap().abs())
+                .fold(0.0, f64::max)
+        };
+        // Each building's roof: within its located peak, and close below it.
+        for (b, roof) in [(1, 2), (2, 4), (3, 3)] {
+            let peak = cell(lines[i], &format!("b{b}_peak_roof_m"));
+            let sampled = max_of(&format!("b{b}_f{roof}_u_m"));
+            assert!(
+                sampled <= peak * (1.0 + 1e-12) && sampled > 0.9 * peak,
+                "run {run}, building {b}: {sampled} against {peak}"
+            );
+        }
+        // Each level that pounds: samples in contact, forces within its peak.
+        for l in &levels {
+            let peak = cell(lines[i], &format!("{l}_peak_force_n"));
+            let sampled = max_of(&format!("{l}_force_n"));
+            assert!(
+                sampled <= peak * (1.0 + 1e-12),
+                "run {run}, {l}: {sampled} > {peak}"
+            );
+            let contact = samples
+                .iter()
+                .filter(|c| c[at(&format!("{l}_mode"))] != "free")
+                .count();
+            if cell(lines[i], &format!("{l}_impacts")) > 0.0 {
+                assert!(
+                    sampled > 0.0 && contact > 0,
+                    "run {run}, {l}: no contact sampled"
+                );
+                checked_levels += 1;
+            } else {
+                assert_eq!((sampled, contact), (0.0, 0), "run {run}, {l}");
+            }
+        }
+    }
+    assert!(checked_levels >= 4, "{checked_levels} levels that pound");
 }

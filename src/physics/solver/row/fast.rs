@@ -23,7 +23,7 @@
 //!    touch), is taken in substeps by its building, yield onset and unloading located as
 //!    events; after the record the run goes on at rest until no storey can yield again.
 
-use super::{rhs, Motion, RowModel, RowRun, FLOOR_SUBSTEPS_FROM};
+use super::{rhs, Motion, RowModel, RowObserver, RowRun, FLOOR_SUBSTEPS_FROM};
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
 use crate::physics::row::RowOutput;
@@ -157,7 +157,39 @@ pub(crate) fn run(m: &RowModel, forcing: &Forcing, z0: Vec<f64>, o: &FastOptions
     // Contact substeps run in floor coordinates where the damping allows (O(N) each), and only
     // for the buildings that contact may reach.
     let sub = m.substep_model();
-    run_with(m, sub.as_ref(), Standing::Grown, forcing, z0, o, false).0
+    run_with(
+        m,
+        sub.as_ref(),
+        Standing::Grown,
+        forcing,
+        z0,
+        o,
+        false,
+        None,
+    )
+    .0
+}
+
+/// [`run`] with `observer` hearing every accepted step and event (the same output).
+pub(crate) fn run_observed(
+    m: &RowModel,
+    forcing: &Forcing,
+    z0: Vec<f64>,
+    o: &FastOptions,
+    observer: RowObserver<'_>,
+) -> RowOutput {
+    let sub = m.substep_model();
+    run_with(
+        m,
+        sub.as_ref(),
+        Standing::Grown,
+        forcing,
+        z0,
+        o,
+        false,
+        Some(observer),
+    )
+    .0
 }
 
 /// The fast scheme with every building in every substep: the twin of the GPU row kernel
@@ -171,7 +203,7 @@ pub fn simulate_whole_row(
     o: &FastOptions,
 ) -> RowOutput {
     let sub = m.substep_model();
-    run_with(m, sub.as_ref(), Standing::None, forcing, z0, o, false).0
+    run_with(m, sub.as_ref(), Standing::None, forcing, z0, o, false, None).0
 }
 
 /// The fast scheme from rest with every building in every substep, tracking the levels'
@@ -186,6 +218,7 @@ pub(crate) fn run_uncoupled(m: &RowModel, forcing: &Forcing, o: &FastOptions) ->
         m.at_rest(),
         o,
         true,
+        None,
     )
     .0
 }
@@ -215,14 +248,16 @@ struct Tally {
 /// [`run`] with the contact substeps in `sub` (None: in modes, as the reference) and the
 /// buildings standing still as `standing` says, tracking the levels' closings where
 /// `closings` (with no building standing still).
-fn run_with(
-    m: &RowModel,
-    sub: Option<&RowModel>,
+#[allow(clippy::too_many_arguments)]
+fn run_with<'a>(
+    m: &'a RowModel,
+    sub: Option<&'a RowModel>,
     standing: Standing,
     forcing: &Forcing,
     z0: Vec<f64>,
     o: &FastOptions,
     closings: bool,
+    observer: Option<RowObserver<'a>>,
 ) -> (RowOutput, Tally) {
     let mut tally = Tally::default();
     let finish = |run: RowRun, status: Status, substeps: u32, tally: Tally| {
@@ -242,6 +277,7 @@ fn run_with(
     let rates = m.building_rates();
     let mut run = RowRun::start(m, z0, forcing.t0);
     run.energy = o.energy;
+    run.observer = observer;
     if closings {
         debug_assert_eq!(
             standing,
@@ -579,6 +615,7 @@ mod tests {
     use crate::physics::contact::LawKind;
     use crate::physics::row::Row;
     use crate::physics::shear::{Damping, ShearBuilding};
+    use crate::physics::solver::row::RowSample;
 
     /// Two tall buildings (one with a soft first storey) and a low one, `gaps` apart.
     fn row(gaps: Vec<f64>) -> RowModel {
@@ -740,6 +777,16 @@ mod tests {
     /// One run of `m` under [`ground_motion`] with the energy kept, its substeps in `sub`'s
     /// coordinates.
     fn run_on(m: &RowModel, sub: Option<&RowModel>, standing: Standing) -> (RowOutput, Tally) {
+        run_observed_on(m, sub, standing, None)
+    }
+
+    /// [`run_on`] with `observer` hearing every step and event.
+    fn run_observed_on<'a>(
+        m: &'a RowModel,
+        sub: Option<&'a RowModel>,
+        standing: Standing,
+        observer: Option<RowObserver<'a>>,
+    ) -> (RowOutput, Tally) {
         let accel = ground_motion();
         let forcing = Forcing {
             accel: &accel,
@@ -752,12 +799,52 @@ mod tests {
             energy: true,
             ..FastOptions::default()
         };
-        run_with(m, sub, standing, &forcing, m.at_rest(), &o, false)
+        run_with(m, sub, standing, &forcing, m.at_rest(), &o, false, observer)
     }
 
     /// [`run_on`] with the scheme's substep coordinates.
     fn run_standing(m: &RowModel, standing: Standing) -> (RowOutput, Tally) {
         run_on(m, m.substep_model().as_ref(), standing)
+    }
+
+    /// An observed run samples a building that stands still through the others' substeps by
+    /// its exact free step to the sample's time: at the record steps' ends its floors are those
+    /// of the same row with no contact anywhere (every step exact), to rounding; and observing
+    /// changes no output.
+    #[test]
+    fn an_observer_samples_still_buildings_at_their_exact_motion() {
+        let (a, b, c) = ((8, 0.7, true), (6, 0.45, false), (2, 0.2, false));
+        let observe = |m: &RowModel| {
+            let mut samples = Vec::new();
+            let sub = m.substep_model();
+            let mut hear = |s: &RowSample| samples.push(s.clone());
+            let (out, tally) = run_observed_on(m, sub.as_ref(), Standing::Grown, Some(&mut hear));
+            (out, tally, samples)
+        };
+        let triple = row_of(&[a, b, c], vec![0.01, 1.0]);
+        let (out, tally, samples) = observe(&triple);
+        assert!(tally.still > 100, "{tally:?}");
+        let (unobserved, _) = run_standing(&triple, Standing::Grown);
+        assert_eq!(format!("{out:?}"), format!("{unobserved:?}"));
+        let (_, _, apart) = observe(&row_of(&[a, b, c], vec![1.0, 1.0]));
+        let on_grid = |t: f64| ((t / 0.01).round() * 0.01 - t).abs() < 1e-9;
+        let scale = apart
+            .iter()
+            .flat_map(|s| s.floors[2].iter())
+            .fold(0.0f64, |m, u| m.max(u.abs()));
+        let mut compared = 0;
+        for s in samples.iter().filter(|s| on_grid(s.t)) {
+            let twin = apart
+                .iter()
+                .find(|x| (x.t - s.t).abs() < 1e-9)
+                .expect("every record step sampled");
+            for (u, v) in s.floors[2].iter().zip(&twin.floors[2]) {
+                assert!((u - v).abs() <= 1e-9 * scale, "t {}: {u} against {v}", s.t);
+            }
+            compared += 1;
+        }
+        assert!(compared > 400, "{compared} samples compared");
+        assert!(samples.iter().any(|s| !on_grid(s.t)), "events sampled");
     }
 
     /// A building that no contact reaches stands still through the others' substeps and takes

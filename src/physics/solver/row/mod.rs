@@ -343,10 +343,16 @@ impl RowModel {
         z
     }
 
-    /// Floor displacements of building `b` in state `z`.
+    /// Floor displacements of building `b` in state `z` (in this model's coordinates: its
+    /// modes, or its floors in a substep model).
     pub fn floors(&self, b: usize, z: &[f64]) -> Vec<f64> {
         let bm = &self.buildings[b];
-        bm.modes.to_floors(&z[bm.off..bm.off + bm.n()])
+        let own = &z[bm.off..bm.off + bm.n()];
+        if bm.in_floors {
+            own.to_vec()
+        } else {
+            bm.modes.to_floors(own)
+        }
     }
 
     /// The largest rate of any mode (1/s): `w + 2 xi w`, as [`crate::physics::model::Oscillator::rate`].
@@ -862,6 +868,64 @@ impl Floors {
     }
 }
 
+/// A point of a row's time history handed to an observer after every accepted step and
+/// event (as the pair's [`super::Sample`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RowSample {
+    pub t: f64,
+    /// Each building's floor displacements relative to the ground, m (lowest floor first).
+    pub floors: Vec<Vec<f64>>,
+    /// Each level's penetration (0 where apart), m, contact force, N, and contact mode.
+    pub penetrations: Vec<f64>,
+    pub forces: Vec<f64>,
+    pub modes: Vec<Mode>,
+}
+
+/// What observes a row's run.
+pub type RowObserver<'o> = &'o mut dyn FnMut(&RowSample);
+
+/// Building `k` of `modal`, standing still since `seg.t0` (its modes at `z0`, the row's modal
+/// state then), stepped exactly to `t` into `z`: `Propagator` over `t - seg.t0` about the static
+/// response to its plastic loads (constant while it stands still), with the input and damping
+/// work where `energy`.
+fn step_still(
+    modal: &RowModel,
+    k: usize,
+    seg: &Segment,
+    t: f64,
+    z0: &[f64],
+    z: &mut [f64],
+    energy: bool,
+) {
+    let b = &modal.buildings[k];
+    let (n, nl) = (modal.n, modal.levels.len());
+    let h = t - seg.t0;
+    let qs = b.first_storey.map(|_| {
+        let mut qs = vec![0.0; n];
+        modal.static_offsets(z0, &mut qs);
+        qs
+    });
+    let shift = |i: usize| qs.as_ref().map_or(0.0, |q| q[i]);
+    for i in b.off..b.off + b.n() {
+        let osc = crate::physics::model::Oscillator {
+            m: 1.0,
+            k: modal.w2[i],
+            c: modal.two_xi_w[i],
+        };
+        let (a0, a1) = (modal.part[i] * seg.a0, modal.part[i] * seg.at(t));
+        let p = crate::physics::propagator::Propagator::new(&osc, h);
+        let q0 = z0[i] - shift(i);
+        let (q1, v1) = p.step(q0, z0[n + i], a0, a1);
+        (z[i], z[n + i]) = (q1 + shift(i), v1);
+        if energy {
+            let f = crate::physics::propagator::EnergyForms::new(&osc, h);
+            let (vv, agv) = f.integrals(q0, z0[n + i], a0, a1);
+            z[2 * n + nl] -= agv;
+            z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
+        }
+    }
+}
+
 /// One run of a row being integrated, shared by both schemes (as the pair's `Integration`).
 pub(crate) struct RowRun<'m> {
     /// The model the state is in: `modal`, or its substep model between
@@ -899,6 +963,8 @@ pub(crate) struct RowRun<'m> {
     pub settled: bool,
     /// Per level, its floors' closing and peaks, where asked for ([`RowRun::track_closings`]).
     closings: Option<Vec<LevelClosing>>,
+    /// Hears every accepted step and event ([`RowRun::emit`]).
+    pub observer: Option<RowObserver<'m>>,
 }
 
 impl<'m> RowRun<'m> {
@@ -928,6 +994,7 @@ impl<'m> RowRun<'m> {
             storeys: vec![StoreyState::default(); m.storeys.len()],
             settled: false,
             closings: None,
+            observer: None,
             z,
         };
         let z = run.z.clone();
@@ -1039,36 +1106,10 @@ impl<'m> RowRun<'m> {
     /// substeps' coordinates.
     pub fn activate(&mut self, k: usize, seg: &Segment, t: f64) {
         let modal = self.modal;
-        let b = &modal.buildings[k];
-        let (n, nl) = (modal.n, modal.levels.len());
         let h = t - seg.t0;
         let z0 = self.z.clone();
         if h > 0.0 {
-            // About the static response to its plastic loads (constant: it stood still).
-            let qs = b.first_storey.map(|_| {
-                let mut qs = vec![0.0; n];
-                modal.static_offsets(&z0, &mut qs);
-                qs
-            });
-            let shift = |i: usize| qs.as_ref().map_or(0.0, |q| q[i]);
-            for i in b.off..b.off + b.n() {
-                let osc = crate::physics::model::Oscillator {
-                    m: 1.0,
-                    k: modal.w2[i],
-                    c: modal.two_xi_w[i],
-                };
-                let (a0, a1) = (modal.part[i] * seg.a0, modal.part[i] * seg.at(t));
-                let p = crate::physics::propagator::Propagator::new(&osc, h);
-                let q0 = z0[i] - shift(i);
-                let (q1, v1) = p.step(q0, z0[n + i], a0, a1);
-                (self.z[i], self.z[n + i]) = (q1 + shift(i), v1);
-                if self.energy {
-                    let f = crate::physics::propagator::EnergyForms::new(&osc, h);
-                    let (vv, agv) = f.integrals(q0, z0[n + i], a0, a1);
-                    self.z[2 * n + nl] -= agv;
-                    self.z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
-                }
-            }
+            step_still(modal, k, seg, t, &z0, &mut self.z, self.energy);
             let z1 = self.z.clone();
             self.track_still(k, &z0, &z1, (seg.a0, seg.at(t)), h);
         }
@@ -1463,12 +1504,61 @@ impl<'m> RowRun<'m> {
         }
     }
 
+    /// Hand the observer, if any, the row at time `t` inside the record step `seg`: the moving
+    /// buildings from the state (in the current model), those standing still stepped exactly
+    /// from the step's start to `t` (as [`RowRun::activate`] would, without changing the run).
+    pub fn emit(&mut self, seg: &Segment, t: f64) {
+        if self.observer.is_none() {
+            return;
+        }
+        let (m, modal, n) = (self.m, self.modal, self.m.n);
+        let floors: Vec<Vec<f64>> = (0..m.buildings.len())
+            .map(|k| {
+                if self.active[k] {
+                    m.floors(k, &self.z)
+                } else {
+                    let mut z = self.z.clone();
+                    if t > seg.t0 {
+                        step_still(modal, k, seg, t, &self.z, &mut z, false);
+                    }
+                    modal.floors(k, &z)
+                }
+            })
+            .collect();
+        let sample = RowSample {
+            t,
+            penetrations: m
+                .levels
+                .iter()
+                .map(|lm| {
+                    let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+                    (floors[a][fa] - floors[b][fb] - lm.gap).max(0.0)
+                })
+                .collect(),
+            forces: (m.levels.iter().zip(&self.levels).zip(&self.level_on))
+                .map(|((lm, ls), &on)| {
+                    if on {
+                        lm.force(n, ls.mode, ls.v0, &self.z)
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+            modes: self.levels.iter().map(|ls| ls.mode).collect(),
+            floors,
+        };
+        if let Some(obs) = self.observer.as_mut() {
+            obs(&sample);
+        }
+    }
+
     /// A free record step over `seg` to `z1`, with no possible contact (checked by the caller).
     pub fn free_step(&mut self, seg: &Segment, z1: Vec<f64>) {
         let z0 = std::mem::take(&mut self.z);
         self.track(seg.t0, seg.dt, &z0, &z1, (seg.a0, seg.a1));
         self.free_steps += 1;
         self.z = z1;
+        self.emit(seg, seg.t1());
     }
 
     /// Apply the mode changes that the events at state `z` (time `t`) call for; `before` is
@@ -1588,6 +1678,7 @@ impl<'m> RowRun<'m> {
             }
             h
         };
+        self.emit(seg, t + advanced);
         advanced
     }
 
@@ -1662,7 +1753,7 @@ pub enum RowScheme {
 pub fn simulate_uncoupled(m: &RowModel, forcing: &Forcing, scheme: &RowScheme) -> RowOutput {
     match scheme {
         RowScheme::Fast(o) => fast::run_uncoupled(m, forcing, o),
-        RowScheme::Reference(o) => reference::run_tracked(m, forcing, m.at_rest(), o, true),
+        RowScheme::Reference(o) => reference::run_tracked(m, forcing, m.at_rest(), o, true, None),
     }
 }
 
@@ -1680,6 +1771,21 @@ pub fn simulate_row(
 ) -> RowOutput {
     match scheme {
         RowScheme::Fast(o) => fast::run(m, forcing, z0, o),
-        RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false),
+        RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false, None),
+    }
+}
+
+/// As [`simulate_row`] (the same output), handing `observer` the row after every accepted step
+/// and event.
+pub fn simulate_row_observed(
+    m: &RowModel,
+    forcing: &Forcing,
+    z0: Vec<f64>,
+    scheme: &RowScheme,
+    observer: RowObserver<'_>,
+) -> RowOutput {
+    match scheme {
+        RowScheme::Fast(o) => fast::run_observed(m, forcing, z0, o, observer),
+        RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false, Some(observer)),
     }
 }

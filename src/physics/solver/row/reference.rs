@@ -7,7 +7,7 @@
 //! impact's scales.
 
 use super::yielding::StoreyMode;
-use super::{rhs, LevelModes, Motion, RowModel, RowRun};
+use super::{rhs, LevelModes, Motion, RowModel, RowObserver, RowRun};
 use crate::physics::model::{Forcing, Status};
 use crate::physics::row::RowOutput;
 use crate::physics::solver::fast::SUSTAINED;
@@ -85,15 +85,17 @@ fn dopri(
 
 /// The reference scheme's run from `z0`, tracking the levels' closings where `closings`
 /// ([`RowRun::track_closings`]).
-pub(crate) fn run_tracked(
-    m: &RowModel,
+pub(crate) fn run_tracked<'a>(
+    m: &'a RowModel,
     forcing: &Forcing,
     z0: Vec<f64>,
     o: &ReferenceOptions,
     closings: bool,
+    observer: Option<RowObserver<'a>>,
 ) -> RowOutput {
     let n = m.n;
     let mut run = RowRun::start(m, z0, forcing.t0);
+    run.observer = observer;
     if closings {
         run.track_closings();
     }
