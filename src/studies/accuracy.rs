@@ -18,7 +18,15 @@ pub struct Point {
     pub path: String,
     pub substeps_per_contact: f64,
     pub runs_per_second: f64,
+    /// The work: integration steps per run, averaged over the runs (RK4 substeps on the fast
+    /// paths, accepted and rejected steps on the reference).
+    pub substeps_per_run: f64,
     pub errors: Errors,
+}
+
+/// Mean integration steps per run of `outs` (NaN for no runs).
+fn substeps_per_run(outs: &[RunOutput]) -> f64 {
+    outs.iter().map(|o| o.substeps as f64).sum::<f64>() / outs.len() as f64
 }
 
 /// Relative errors against the reference over the runs both end `ok` with equal impact counts
@@ -128,6 +136,7 @@ pub fn study(
         path: "reference".into(),
         substeps_per_contact: f64::NAN,
         runs_per_second: rps,
+        substeps_per_run: substeps_per_run(&truth),
         errors: errors(&truth, &truth),
     };
     progress(&reference);
@@ -161,6 +170,7 @@ pub fn study(
                 path,
                 substeps_per_contact: spc,
                 runs_per_second: rps,
+                substeps_per_run: substeps_per_run(&outs),
                 errors: errors(&truth, &outs),
             };
             progress(&p);
@@ -188,17 +198,18 @@ impl Errors {
 
 /// The points as CSV.
 pub fn csv(points: &[Point]) -> String {
-    let mut s = String::from("path,substeps_per_contact,runs_per_second,force_median,force_p99,displacement_median,displacement_p99,energy_median,energy_p99,residual_median,residual_p99,impact_count_differs,failed\n");
+    let mut s = String::from("path,substeps_per_contact,runs_per_second,substeps_per_run,force_median,force_p99,displacement_median,displacement_p99,energy_median,energy_p99,residual_median,residual_p99,impact_count_differs,failed\n");
     for p in points {
         let q = p
             .errors
             .quantiles()
             .map(|x| shown(x, "", |x| format!("{x:e}")));
         s.push_str(&format!(
-            "{},{},{:.1},{},{},{}\n",
+            "{},{},{:.1},{:.1},{},{},{}\n",
             p.path,
             shown(p.substeps_per_contact, "", |x| x.to_string()),
             p.runs_per_second,
+            p.substeps_per_run,
             q.join(","),
             p.errors.impact_count_differs,
             p.errors.failed
@@ -244,16 +255,17 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
 }
 
 /// A markdown table header for [`markdown_row`].
-pub const MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | peak force median / p99 | peak u median / p99 | energy median / p99 | energy residual median / p99 | impact counts differ | failed |\n|---|---:|---:|---|---|---|---|---:|---:|";
+pub const MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | substeps/run | peak force median / p99 | peak u median / p99 | energy median / p99 | energy residual median / p99 | impact counts differ | failed |\n|---|---:|---:|---:|---|---|---|---|---:|---:|";
 
 /// One point as a markdown table row.
 pub fn markdown_row(p: &Point) -> String {
     let q = p.errors.quantiles().map(figure);
     format!(
-        "| {} | {} | {:.0} | {} | {:.2} % | {} |",
+        "| {} | {} | {:.0} | {:.0} | {} | {:.2} % | {} |",
         p.path,
         shown(p.substeps_per_contact, "-", |x| x.to_string()),
         p.runs_per_second,
+        p.substeps_per_run,
         [&q[0..2], &q[2..4], &q[4..6], &q[6..8]]
             .map(|pair| pair.join(" / "))
             .join(" | "),
