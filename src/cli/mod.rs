@@ -294,11 +294,26 @@ pub struct FigureArgs {
     /// Each panel's size in pixels, WIDTHxHEIGHT (each 320 to 4000; default 640x480).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Every panel's x-axis label (default: the quantity in words, with its unit). A unit in
+    /// parentheses, (N), (J), (N/m) or (m), is turned into kN, MN, mm... as the default's is.
+    #[arg(long)]
+    pub x_label: Option<String>,
+    /// Every panel's y-axis label, as `--x-label`.
+    #[arg(long)]
+    pub y_label: Option<String>,
 }
 
 impl FigureArgs {
-    /// Give `panels` the title asked for.
+    /// Give `panels` the title and axis labels asked for.
     pub fn apply(&self, panels: &mut [pounding::studies::plot::Panel]) {
+        for p in panels.iter_mut() {
+            if let Some(x) = &self.x_label {
+                p.x_label = x.clone();
+            }
+            if let Some(y) = &self.y_label {
+                p.y_label = y.clone();
+            }
+        }
         match (&self.title, panels) {
             (Some(t), [only]) => only.title = t.clone(),
             (Some(t), [first, ..]) => first.title = format!("{t}: {}", first.title),

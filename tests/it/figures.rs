@@ -242,11 +242,19 @@ fn legends_cover_no_point_and_styles_are_distinct() {
         "Fig. 7",
         "--size",
         "900x700",
+        "--x-label",
+        "Peak ground acceleration, PGA (g)",
+        "--y-label",
+        "Probability of any impact",
     ]));
     let t = std::fs::read_to_string(&titled).unwrap();
     assert!(
         t.contains("Fig. 7") && !t.contains("against pga"),
         "title replaced"
+    );
+    assert!(
+        t.contains("Peak ground acceleration, PGA (g)") && t.contains("Probability of any impact"),
+        "axis labels of one's own"
     );
     assert!(t.contains("width=\"900\" height=\"700\""));
     let panels = dir.path().join("panels.svg");
