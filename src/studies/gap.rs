@@ -626,13 +626,36 @@ impl<'a> GapStudy<'a> {
             } else {
                 format!(", buildings {}", self.pair_name(a))
             };
-            let ratio_label = format!("T{} / T{} (fundamental periods)", a + 2, a + 1);
+            // Against the period ratio; where the pair has one (no period swept or sampled),
+            // against the record instead, so each record's runs stand in a column of their own.
+            let ratios = runs.iter().filter_map(|x| x.1[a].map(|p| p.period_ratio));
+            let (lo, hi) = ratios.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
+                (l.min(x), h.max(x))
+            });
+            let one_ratio = lo.is_finite() && hi <= lo * (1.0 + 1e-9);
+            let x_of = |record: usize, p: &PairGap| {
+                if one_ratio {
+                    (record + 1) as f64
+                } else {
+                    p.period_ratio
+                }
+            };
+            let ratio_label = if one_ratio {
+                format!(
+                    "record, 1 to {} as in the legend (T{} / T{} = {lo:.3})",
+                    records.len(),
+                    a + 2,
+                    a + 1
+                )
+            } else {
+                format!("T{} / T{} (fundamental periods)", a + 2, a + 1)
+            };
             let mut by_record = Vec::new();
             for (r, rec) in records.iter().enumerate() {
                 let points: Vec<(f64, f64)> = runs
                     .iter()
                     .filter(|x| x.0 == r)
-                    .filter_map(|x| x.1[a].map(|p| (p.period_ratio, p.required * 1e3)))
+                    .filter_map(|x| x.1[a].map(|p| (x_of(r, &p), p.required * 1e3)))
                     .collect();
                 if !points.is_empty() {
                     by_record.push(Series {
@@ -647,7 +670,7 @@ impl<'a> GapStudy<'a> {
                 title: format!("Required gap (time history){name}"),
                 x_label: ratio_label.clone(),
                 y_label: "required gap (mm)".into(),
-                log_x: true,
+                log_x: !one_ratio,
                 series: by_record,
                 ..Panel::default()
             });
@@ -659,14 +682,21 @@ impl<'a> GapStudy<'a> {
                     points: runs
                         .iter()
                         .filter_map(|x| {
-                            x.1[a].and_then(|p| p.ratio(k).map(|q| (p.period_ratio, q)))
+                            // With one ratio, the rules stand side by side in each record's
+                            // column.
+                            let dodge = if one_ratio {
+                                0.2 * (k as f64 - 1.0)
+                            } else {
+                                0.0
+                            };
+                            x.1[a].and_then(|p| p.ratio(k).map(|q| (x_of(x.0, &p) + dodge, q)))
                         })
                         .collect(),
                     scatter: true,
                     style: None,
                 })
                 .collect();
-            let xs = rules[0].points.iter().map(|p| p.0);
+            let xs = rules.iter().flat_map(|r| r.points.iter().map(|p| p.0));
             let (lo, hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| {
                 (l.min(x), h.max(x))
             });
@@ -682,7 +712,7 @@ impl<'a> GapStudy<'a> {
                 title: format!("Code rule / time history{name}"),
                 x_label: ratio_label,
                 y_label: "rule gap / required gap".into(),
-                log_x: true,
+                log_x: !one_ratio,
                 series: rules,
                 ..Panel::default()
             });

@@ -330,3 +330,43 @@ fn legends_cover_no_point_and_styles_are_distinct() {
     assert!(decades >= 2, "{y_ticks:?}");
     assert!(svg.contains("log scale") && !svg.contains("log10"));
 }
+
+/// The gap study of one pair of fixed periods draws each record's runs in a column of its own
+/// (the record on a linear axis, the period ratio in the axis label), where a grid of periods
+/// draws them against the period ratio on a log axis: a single ratio made one vertical line.
+#[test]
+fn a_gap_study_of_one_pair_is_drawn_against_the_record() {
+    let dir = tempdir();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let template = ok(&pound(&["init", "gap"]));
+    let grid = "period_s = { from = 0.2, to = 1.5, n = 8 }";
+    assert_eq!(template.matches(grid).count(), 2, "{template}");
+    let draw = |name: &str, text: &str| {
+        let cfg = dir.path().join(format!("{name}.toml"));
+        std::fs::write(&cfg, text).unwrap();
+        let svg = dir.path().join(format!("{name}.svg"));
+        ok(&pound(&[
+            "gap",
+            &s(&cfg),
+            "-o",
+            &s(&dir.path().join(format!("{name}.csv"))),
+            "--plot",
+            &s(&svg),
+        ]));
+        std::fs::read_to_string(&svg).unwrap()
+    };
+    let one = draw(
+        "one",
+        &template
+            .replacen(grid, "period_s = 0.5", 1)
+            .replacen(grid, "period_s = 0.8", 1),
+    );
+    assert!(
+        one.contains("record, 1 to 5 as in the legend (T2 / T1 = 1.600)"),
+        "the record on the x axis"
+    );
+    assert!(!one.contains("log scale"), "no log axis for one ratio");
+    let many = draw("many", &template);
+    assert!(many.contains("T2 / T1 (fundamental periods), log scale"));
+    assert!(!many.contains("record, 1 to"));
+}
