@@ -23,14 +23,7 @@ pub fn run(a: Args) -> Result<()> {
     check_outputs(&[], &[("--plot", a.plot.as_deref(), Holds::Plot)])?;
     if let Some(path) = &a.plot {
         // The line below says what was written.
-        let mut panels = formulas::zeta_panels(&es)?;
-        a.figure.apply(&mut panels);
-        pounding::studies::plot::save_sized(
-            path,
-            &panels,
-            2,
-            a.figure.size.unwrap_or(pounding::studies::plot::PANEL),
-        )?;
+        a.figure.save(path, &formulas::zeta_panels(&es)?, 2)?;
         note!(
             "zeta(e) of {} formulas -> {}",
             Formula::ALL.len(),

@@ -272,14 +272,7 @@ pub fn save_plot(
     cols: usize,
     figure: &FigureArgs,
 ) -> Result<()> {
-    let mut panels = panels.to_vec();
-    figure.apply(&mut panels);
-    pounding::studies::plot::save_sized(
-        path,
-        &panels,
-        cols,
-        figure.size.unwrap_or(pounding::studies::plot::PANEL),
-    )?;
+    figure.save(path, panels, cols)?;
     wrote(path);
     Ok(())
 }
@@ -301,6 +294,35 @@ pub struct FigureArgs {
     /// Every panel's y-axis label, as `--x-label`.
     #[arg(long)]
     pub y_label: Option<String>,
+    /// A PNG's resolution in dots per inch, 48 to 600 (default 96): `--size` is at 96 dpi, so
+    /// 300 draws the same figure with 3.125 times the pixels, text and marks scaled alike. An
+    /// SVG has no resolution and is drawn at `--size`.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(48..=600))]
+    pub dpi: Option<u32>,
+}
+
+impl FigureArgs {
+    /// Save `panels` (their title and labels as asked, `cols` a row) at the size and
+    /// resolution asked for.
+    pub fn save(
+        &self,
+        path: &Path,
+        panels: &[pounding::studies::plot::Panel],
+        cols: usize,
+    ) -> Result<()> {
+        use pounding::studies::plot;
+        let mut panels = panels.to_vec();
+        self.apply(&mut panels);
+        let size = self.size.unwrap_or(plot::PANEL);
+        plot::save_at(
+            path,
+            &panels,
+            cols,
+            size,
+            self.dpi.unwrap_or(plot::BASE_DPI),
+        )?;
+        Ok(())
+    }
 }
 
 impl FigureArgs {

@@ -100,12 +100,7 @@ pub fn run(a: Args) -> Result<()> {
         );
     }
     // The line below says what was written.
-    pounding::studies::plot::save_sized(
-        &output,
-        std::slice::from_ref(&p),
-        1,
-        a.figure.size.unwrap_or(pounding::studies::plot::PANEL),
-    )?;
+    a.figure.save(&output, std::slice::from_ref(&p), 1)?;
     note!(
         "{} series, {points} points -> {}",
         p.series.len(),

@@ -54,12 +54,14 @@ fn marker<DB: DrawingBackend, C: Clone + 'static>(
     k: usize,
     at: C,
     color: RGBAColor,
+    scale: f64,
 ) -> DynElement<'static, DB, C> {
+    let px = |v: u32| (v as f64 * scale).round().max(1.0) as u32;
     match k % MARKERS {
-        0 => Circle::new(at, 3, color.filled()).into_dyn(),
-        1 => TriangleMarker::new(at, 4, color.filled()).into_dyn(),
-        2 => Cross::new(at, 4, color.stroke_width(2)).into_dyn(),
-        _ => Circle::new(at, 4, color.stroke_width(2)).into_dyn(),
+        0 => Circle::new(at, px(3), color.filled()).into_dyn(),
+        1 => TriangleMarker::new(at, px(4), color.filled()).into_dyn(),
+        2 => Cross::new(at, px(4), color.stroke_width(px(2))).into_dyn(),
+        _ => Circle::new(at, px(4), color.stroke_width(px(2))).into_dyn(),
     }
 }
 
@@ -227,6 +229,25 @@ pub fn save_sized(
     cols: usize,
     size: (u32, u32),
 ) -> Result<(), PlotError> {
+    save_at(path, panels, cols, size, BASE_DPI)
+}
+
+/// The resolution a panel's `size` is given at: 96 dots per inch, a screen's.
+pub const BASE_DPI: u32 = 96;
+
+/// The resolutions a PNG may be drawn at, dots per inch.
+pub const DPIS: std::ops::RangeInclusive<u32> = 48..=600;
+
+/// [`save_sized`] with a PNG drawn at `dpi`: `size` (at [`BASE_DPI`]) times `dpi / 96` pixels,
+/// its text, marks and margins scaled alike, so the figure looks the same at a finer
+/// resolution. An SVG is drawn at `size` whatever `dpi` (it has no resolution).
+pub fn save_at(
+    path: &Path,
+    panels: &[Panel],
+    cols: usize,
+    size: (u32, u32),
+    dpi: u32,
+) -> Result<(), PlotError> {
     let png = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
@@ -235,7 +256,8 @@ pub fn save_sized(
         size.1.clamp(*PANEL_SIZES.start(), *PANEL_SIZES.end()),
     );
     if png {
-        self::png(path, panels, cols, size)
+        let scale = dpi.clamp(*DPIS.start(), *DPIS.end()) as f64 / BASE_DPI as f64;
+        self::png(path, panels, cols, size, scale)
     } else {
         svg(path, panels, cols, size)
     }
@@ -252,11 +274,12 @@ fn draw_all<DB: DrawingBackend>(
     panels: &[Panel],
     rows: usize,
     cols: usize,
+    scale: f64,
 ) -> Result<(), String> {
     let e = |e: &dyn std::fmt::Display| e.to_string();
     root.fill(&WHITE).map_err(|x| e(&x))?;
     for (area, p) in root.split_evenly((rows, cols)).iter().zip(panels) {
-        draw(area, p)?;
+        draw(area, p, scale)?;
     }
     root.present().map_err(|x| e(&x))
 }
@@ -275,25 +298,34 @@ pub fn svg(path: &Path, panels: &[Panel], cols: usize, size: (u32, u32)) -> Resu
         panels,
         rows,
         cols,
+        1.0,
     )
     .map_err(fail)?;
     crate::io::atomic::write_atomic(path, text.as_bytes()).map_err(|e| fail(e.to_string()))
 }
 
 /// [`save_sized`] as PNG whatever the name.
-pub fn png(path: &Path, panels: &[Panel], cols: usize, size: (u32, u32)) -> Result<(), PlotError> {
+pub fn png(
+    path: &Path,
+    panels: &[Panel],
+    cols: usize,
+    size: (u32, u32),
+    scale: f64,
+) -> Result<(), PlotError> {
     let fail = |message: String| PlotError {
         path: path.into(),
         message,
     };
     register_font().map_err(fail)?;
-    let (rows, cols, size) = grid(panels, cols, size);
+    let scaled = |v: u32| (v as f64 * scale).round() as u32;
+    let (rows, cols, size) = grid(panels, cols, (scaled(size.0), scaled(size.1)));
     let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
     draw_all(
         BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area(),
         panels,
         rows,
         cols,
+        scale,
     )
     .map_err(fail)?;
     let mut bytes = Vec::new();
@@ -303,10 +335,13 @@ pub fn png(path: &Path, panels: &[Panel], cols: usize, size: (u32, u32)) -> Resu
     crate::io::atomic::write_atomic(path, &bytes).map_err(|e| fail(e.to_string()))
 }
 
+/// One panel, its text, marks and margins `scale` times their size at [`BASE_DPI`].
 fn draw<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     p: &Panel,
+    scale: f64,
 ) -> Result<(), String> {
+    let px = |v: u32| (v as f64 * scale).round().max(1.0) as u32;
     let e = |e: &dyn std::fmt::Display| e.to_string();
     // Linear axes in engineering units: forces in kN or MN, small lengths in mm.
     let biggest = |f: fn(&(f64, f64)) -> f64| {
@@ -389,22 +424,27 @@ fn draw<DB: DrawingBackend>(
         }
     };
     let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, ("sans-serif", 18))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(75)
+        .caption(&p.title, ("sans-serif", 18.0 * scale))
+        .margin(px(10))
+        .x_label_area_size(px(40))
+        .y_label_area_size(px(75))
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(|x| e(&x))?;
-    chart
-        .configure_mesh()
-        .x_desc(label(&x_label, p.log_x))
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(label(&x_label, p.log_x))
         .y_desc(label(&y_label, p.log_y))
         .x_labels(ticks(x0, x1, p.log_x))
         .y_labels(ticks(y0, y1, p.log_y))
         .x_label_formatter(&fmt_x)
-        .y_label_formatter(&fmt_y)
-        .draw()
-        .map_err(|x| e(&x))?;
+        .y_label_formatter(&fmt_y);
+    if scale != 1.0 {
+        // At the base resolution the mesh keeps plotters' own text sizes.
+        mesh.label_style(("sans-serif", 12.0 * scale))
+            .axis_desc_style(("sans-serif", 12.0 * scale))
+            .bold_line_style(BLACK.mix(0.2).stroke_width(px(1)))
+            .light_line_style(BLACK.mix(0.05).stroke_width(px(1)));
+    }
+    mesh.draw().map_err(|x| e(&x))?;
     // Style slots in order of first appearance: a curve and its points share one.
     let mut slots: Vec<usize> = Vec::new();
     for (i, s) in p.series.iter().enumerate() {
@@ -425,7 +465,7 @@ fn draw<DB: DrawingBackend>(
             chart
                 .draw_series(LineSeries::new(
                     data,
-                    RGBColor(175, 175, 175).stroke_width(1),
+                    RGBColor(175, 175, 175).stroke_width(px(1)),
                 ))
                 .map_err(|x| e(&x))?;
         } else if s.scatter {
@@ -435,10 +475,10 @@ fn draw<DB: DrawingBackend>(
                 color
             };
             chart
-                .draw_series(data.into_iter().map(|q| marker(slot, q, fill)))
+                .draw_series(data.into_iter().map(|q| marker(slot, q, fill, scale)))
                 .map_err(|x| e(&x))?
                 .label(&s.name)
-                .legend(move |(x, y)| marker(slot, (x + 8, y), color));
+                .legend(move |(x, y)| marker(slot, (x + px(8) as i32, y), color, scale));
         } else {
             // Markers on the points of a line of data, so that it reads without its colour
             // too; a smooth curve (a fit) takes none, which would pass for observations.
@@ -448,23 +488,28 @@ fn draw<DB: DrawingBackend>(
                 Vec::new()
             };
             chart
-                .draw_series(LineSeries::new(data, color.stroke_width(2)))
+                .draw_series(LineSeries::new(data, color.stroke_width(px(2))))
                 .map_err(|x| e(&x))?
                 .label(&s.name)
-                .legend(move |(x, y)| marker(slot, (x + 8, y), color));
+                .legend(move |(x, y)| marker(slot, (x + px(8) as i32, y), color, scale));
             chart
-                .draw_series(marks.into_iter().map(|q| marker(slot, q, color)))
+                .draw_series(marks.into_iter().map(|q| marker(slot, q, color, scale)))
                 .map_err(|x| e(&x))?;
         }
     }
     if named.len() > 1 {
-        chart
-            .configure_series_labels()
+        let mut legend = chart.configure_series_labels();
+        legend
             .position(corner)
             .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|x| e(&x))?;
+            .border_style(BLACK);
+        if scale != 1.0 {
+            legend
+                .label_font(("sans-serif", 12.0 * scale))
+                .margin(px(5))
+                .legend_area_size(px(30));
+        }
+        legend.draw().map_err(|x| e(&x))?;
     }
     Ok(())
 }

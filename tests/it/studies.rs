@@ -162,6 +162,56 @@ fn plots_from_a_small_sweep() {
     ]));
     let img = image::open(&png).expect("a PNG that decodes");
     assert_eq!((img.width(), img.height()), (640, 480));
+    // --dpi: the same 400x320 panel (at 96 dpi) with twice the pixels at 192 dpi, its text
+    // and marks drawn with about twice the ink; out of range refused.
+    let at_dpi = |dpi: &str| {
+        let out = d.path().join(format!("dpi-{dpi}.png"));
+        let args = [
+            "plot",
+            runs.to_str().unwrap(),
+            "--x",
+            "gap_m",
+            "--y",
+            "peak_force_n",
+            "--by",
+            "pga_g",
+            "--size",
+            "400x320",
+            "--dpi",
+            dpi,
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        ok(&pound(&args));
+        let img = image::open(&out).expect("a PNG that decodes").to_rgb8();
+        let ink = img
+            .pixels()
+            .filter(|p| p.0.iter().any(|&c| c < 128))
+            .count();
+        (
+            img.dimensions(),
+            ink as f64 / (img.width() * img.height()) as f64,
+        )
+    };
+    let ((size_1, ink_1), (size_2, ink_2)) = (at_dpi("96"), at_dpi("192"));
+    assert_eq!((size_1, size_2), ((400, 320), (800, 640)));
+    // Dark pixels (text, axes, marks) cover about the same share of the figure.
+    assert!(
+        (ink_2 / ink_1 - 1.0).abs() < 0.35,
+        "ink share {ink_1} at 96 dpi, {ink_2} at 192"
+    );
+    let bad = pound(&[
+        "plot",
+        runs.to_str().unwrap(),
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--dpi",
+        "1200",
+    ]);
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--dpi"));
     let bad = pound(&[
         "plot",
         runs.to_str().unwrap(),
