@@ -219,7 +219,8 @@ pub fn csv(points: &[Point]) -> String {
 }
 
 /// Work-precision panels: runs/s against the median and the 99th percentile of the peak-force
-/// error, one line per path through its settings.
+/// error, one line per path through its settings, and each setting's points marked and named
+/// in the legend (`16 substeps per contact`), so a point reads as its setting on every path.
 pub fn panels(points: &[Point]) -> Vec<Panel> {
     let mut paths: Vec<&str> = points
         .iter()
@@ -228,25 +229,39 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
         .collect();
     paths.sort();
     paths.dedup();
-    let panel = |title: &str, err: fn(&Errors) -> f64| Panel {
-        title: title.into(),
-        x_label: "peak-force relative error".into(),
-        y_label: "runs/s".into(),
-        log_x: true,
-        log_y: true,
-        series: paths
-            .iter()
-            .map(|path| Series {
-                name: path.to_string(),
-                points: points
-                    .iter()
-                    .filter(|p| p.path == *path)
-                    .map(|p| (err(&p.errors), p.runs_per_second))
-                    .collect(),
-                scatter: false,
-                style: None,
-            })
-            .collect(),
+    let mut settings: Vec<f64> = points
+        .iter()
+        .map(|p| p.substeps_per_contact)
+        .filter(|s| !s.is_nan())
+        .collect();
+    settings.sort_by(f64::total_cmp);
+    settings.dedup();
+    let panel = |title: &str, err: fn(&Errors) -> f64| {
+        let at = |p: &Point| (err(&p.errors), p.runs_per_second);
+        let lines = paths.iter().map(|path| Series {
+            name: path.to_string(),
+            points: points.iter().filter(|p| p.path == *path).map(at).collect(),
+            scatter: false,
+            style: None,
+        });
+        let marks = settings.iter().map(|&s| Series {
+            name: format!("{s} substeps per contact"),
+            points: points
+                .iter()
+                .filter(|p| p.path != "reference" && p.substeps_per_contact == s)
+                .map(at)
+                .collect(),
+            scatter: true,
+            style: None,
+        });
+        Panel {
+            title: title.into(),
+            x_label: "peak-force relative error".into(),
+            y_label: "runs/s".into(),
+            log_x: true,
+            log_y: true,
+            series: lines.chain(marks).collect(),
+        }
     };
     vec![
         panel("median error", |e| e.force_median),

@@ -54,5 +54,9 @@ fn errors_fall_with_more_substeps_on_every_path() {
     pounding::studies::plot::svg(&svg, &panels(points), 2, pounding::studies::plot::PANEL).unwrap();
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("\ncpu-fast-f64\n") && text.contains("\n99th percentile error\n"));
+    // Each setting marked and named in the legend, whatever the number of paths.
+    for setting in ["\n8 substeps per contact\n", "\n64 substeps per contact\n"] {
+        assert!(text.contains(setting), "{setting} in the legend");
+    }
     assert_eq!(csv(points).lines().count(), 1 + points.len());
 }
