@@ -333,7 +333,8 @@ fn legends_cover_no_point_and_styles_are_distinct() {
 
 /// The gap study of one pair of fixed periods draws each record's runs in a column of its own
 /// (the record on a linear axis, the period ratio in the axis label), where a grid of periods
-/// draws them against the period ratio on a log axis: a single ratio made one vertical line.
+/// draws them against the period ratio on a log axis (a single ratio made one vertical line),
+/// its rules' hundreds of points translucent.
 #[test]
 fn a_gap_study_of_one_pair_is_drawn_against_the_record() {
     let dir = tempdir();
@@ -366,7 +367,11 @@ fn a_gap_study_of_one_pair_is_drawn_against_the_record() {
         "the record on the x axis"
     );
     assert!(!one.contains("log scale"), "no log axis for one ratio");
-    let many = draw("many", &template);
+    // A grid of 10 x 10 periods on five records: 500 runs, each a point of every rule's
+    // series, drawn translucent (three opaque series of 500 points hid one another).
+    let many = draw("many", &template.replace("n = 8 }", "n = 10 }"));
     assert!(many.contains("T2 / T1 (fundamental periods), log scale"));
     assert!(!many.contains("record, 1 to"));
+    let translucent = many.matches("opacity=\"0.35\"").count();
+    assert!(translucent >= 3 * 500, "{translucent} translucent marks");
 }
