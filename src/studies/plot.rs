@@ -46,6 +46,9 @@ const MARKERS: usize = 4;
 /// each other, and a series drawn last would hide those before it).
 const DENSE: usize = 400;
 
+/// Samples along each segment of a line that the legend must not cover.
+const LINE_SAMPLES: usize = 16;
+
 /// Lines of more points than this are smooth curves: no markers on their points.
 const SMOOTH: usize = 40;
 
@@ -366,20 +369,36 @@ fn draw<DB: DrawingBackend>(
     let (x0, x1) = range(all.iter().map(|q| q.0));
     let (y0, y1) = range(all.iter().map(|q| q.1));
     let named: Vec<&Series> = p.series.iter().filter(|s| !s.name.is_empty()).collect();
-    // The legend box as a share of the plot area (about 535 x 380 px in a 640 x 480 panel):
-    // 7 px a character at the legend's 12 px font, 40 px of marker and margins; 20 px a line.
+    // The legend box as a share of the plot area (the panel less about 105 x 100 px of axis
+    // labels, caption and margins: 535 x 380 px in a 640 x 480 panel): 7 px a character at
+    // the legend's 12 px font, 40 px of marker and margins; 20 px a line.
     let longest = named
         .iter()
         .map(|s| s.name.chars().count())
         .max()
         .unwrap_or(0);
+    let (panel_w, panel_h) = area.dim_in_pixel();
+    let plot_w = (panel_w as f64 - 105.0 * scale).max(1.0);
+    let plot_h = (panel_h as f64 - 100.0 * scale).max(1.0);
     let (w, h) = (
-        (longest as f64 * 7.0 + 40.0) / 535.0,
-        (named.len() as f64 * 20.0 + 20.0) / 380.0,
+        (longest as f64 * 7.0 + 40.0) * scale / plot_w,
+        (named.len() as f64 * 20.0 + 20.0) * scale / plot_h,
     );
+    // What the legend must not cover: every point, and the lines between the points of a line
+    // series (sampled along each segment).
+    let mut occupied = all.clone();
+    for s in p.series.iter().filter(|s| !s.scatter) {
+        for pair in pts(s).windows(2) {
+            let ((ax, ay), (bx, by)) = (pair[0], pair[1]);
+            occupied.extend((1..LINE_SAMPLES).map(|k| {
+                let f = k as f64 / LINE_SAMPLES as f64;
+                (ax + f * (bx - ax), ay + f * (by - ay))
+            }));
+        }
+    }
     let data_top = y1;
     let (corner, y1) = if named.len() > 1 {
-        legend_place(&all, (x0, x1), (y0, y1), w, h)
+        legend_place(&occupied, (x0, x1), (y0, y1), w, h)
     } else {
         (SeriesLabelPosition::UpperLeft, y1)
     };

@@ -16,8 +16,9 @@ fn elements(svg: &str) -> Vec<&str> {
     svg.split('<').filter(|e| !e.starts_with('/')).collect()
 }
 
-/// Where a drawn mark sits: a circle's centre or every vertex of a polygon or a coloured
-/// polyline (the mesh and the axes are grey or black polylines of width 1).
+/// Where a drawn mark sits: a circle's centre, every vertex of a polygon, or every vertex of a
+/// coloured polyline and points along its segments (the mesh and the axes are grey or black
+/// polylines of width 1).
 fn vertices(e: &str) -> Vec<(f64, f64)> {
     let num = |s: String| s.parse::<f64>().unwrap();
     if e.starts_with("circle") {
@@ -25,7 +26,7 @@ fn vertices(e: &str) -> Vec<(f64, f64)> {
     }
     let data_line = e.starts_with("polyline") && attr(e, "stroke-width").is_some_and(|w| w != "1");
     if e.starts_with("polygon") || data_line {
-        return attr(e, "points")
+        let corners: Vec<(f64, f64)> = attr(e, "points")
             .unwrap()
             .split_whitespace()
             .map(|p| {
@@ -33,6 +34,20 @@ fn vertices(e: &str) -> Vec<(f64, f64)> {
                 (num(x.into()), num(y.into()))
             })
             .collect();
+        if !data_line {
+            return corners;
+        }
+        let mut along = corners.clone();
+        for w in corners.windows(2) {
+            along.extend((1..8).map(|k| {
+                let f = k as f64 / 8.0;
+                (
+                    w[0].0 + f * (w[1].0 - w[0].0),
+                    w[0].1 + f * (w[1].1 - w[0].1),
+                )
+            }));
+        }
+        return along;
     }
     Vec::new()
 }
@@ -164,6 +179,24 @@ fn legends_cover_no_point_and_styles_are_distinct() {
     assert!(svg.contains("where t2_s=0.4"), "the filter in the caption");
     assert!(svg.contains("width=\"1000\" height=\"600\""));
     check(&w, 3, 0);
+    // A small panel: the legend's box is a larger share of it, and no line may pass under it
+    // (the box was sized for 640x480 and a line crossed it).
+    let small = dir.path().join("small.svg");
+    ok(&pound(&[
+        "plot",
+        &s(&results),
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--by",
+        "formula",
+        "--size",
+        "400x320",
+        "-o",
+        &s(&small),
+    ]));
+    check(&small, 3, 0);
     ok(&pound(&[
         "plot",
         &s(&results),
