@@ -384,20 +384,20 @@ fn draw<DB: DrawingBackend>(
         (longest as f64 * 7.0 + 40.0) * scale / plot_w,
         (named.len() as f64 * 20.0 + 20.0) * scale / plot_h,
     );
-    // What the legend must not cover: every point, and the lines between the points of a line
-    // series (sampled along each segment).
-    let mut occupied = all.clone();
-    for s in p.series.iter().filter(|s| !s.scatter) {
-        for pair in pts(s).windows(2) {
-            let ((ax, ay), (bx, by)) = (pair[0], pair[1]);
-            occupied.extend((1..LINE_SAMPLES).map(|k| {
-                let f = k as f64 / LINE_SAMPLES as f64;
-                (ax + f * (bx - ax), ay + f * (by - ay))
-            }));
-        }
-    }
     let data_top = y1;
     let (corner, y1) = if named.len() > 1 {
+        // What the legend must not cover: every point, and the lines between the points of a
+        // line series (sampled along each segment).
+        let mut occupied = all.clone();
+        for s in p.series.iter().filter(|s| !s.scatter) {
+            for pair in pts(s).windows(2) {
+                let ((ax, ay), (bx, by)) = (pair[0], pair[1]);
+                occupied.extend((1..LINE_SAMPLES).map(|k| {
+                    let f = k as f64 / LINE_SAMPLES as f64;
+                    (ax + f * (bx - ax), ay + f * (by - ay))
+                }));
+            }
+        }
         legend_place(&occupied, (x0, x1), (y0, y1), w, h)
     } else {
         (SeriesLabelPosition::UpperLeft, y1)
