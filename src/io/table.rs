@@ -246,50 +246,39 @@ fn split_unit(column: &str) -> (&str, Option<&'static str>) {
     (column, None)
 }
 
-/// A column's name in words: a row's `b2_peak_drift_ratio` is "peak drift ratio, building 2",
-/// `gap_1_2` "gap 1-2", `level_b1f3_b2f3_peak_force` "peak force, level b1f3-b2f3".
-fn words(stem: &str) -> String {
-    let numbered = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
-    if let Some((k, rest)) = stem.strip_prefix('b').and_then(|r| r.split_once('_')) {
-        if numbered(k) {
-            return format!("{}, building {k}", rest.replace('_', " "));
+/// A column's short name and unit (None for counts, ratios and text), from the one table of
+/// column meanings ([`crate::plan::meaning`]) that `pound columns` and the docs print. A column
+/// no sweep writes (another tool's CSV) is named by its words and the unit its suffix spells.
+fn named(column: &str) -> (String, Option<&'static str>) {
+    match crate::plan::meaning::meaning(column) {
+        Some(m) => (m.label, (m.unit != "-").then_some(m.unit)),
+        None => {
+            let (stem, unit) = split_unit(column);
+            (stem.replace('_', " "), unit)
         }
     }
-    if let Some((a, b)) = stem.strip_prefix("gap_").and_then(|r| r.split_once('_')) {
-        if numbered(a) && numbered(b) {
-            return format!("gap {a}-{b}");
-        }
-    }
-    if let Some(rest) = stem.strip_prefix("level_") {
-        let parts: Vec<&str> = rest.splitn(3, '_').collect();
-        if let [l, r, what] = parts[..] {
-            return format!("{}, level {l}-{r}", what.replace('_', " "));
-        }
-    }
-    stem.replace('_', " ")
 }
 
-/// An axis label from a column name: words, and the unit suffix as a unit in parentheses
-/// (`gap_m` -> `gap (m)`, `peak_force_n` -> `peak force (N)`, `b2_peak_drift_ratio` ->
-/// `peak drift ratio, building 2`).
+/// An axis label: the column's short name and its unit in parentheses (`gap_m` -> `gap (m)`,
+/// `pga_g` -> `PGA (g)`, `b2_peak_drift_ratio` -> `peak drift ratio, building 2`).
 pub fn label(column: &str) -> String {
-    match split_unit(column) {
-        (stem, Some(unit)) => format!("{} ({unit})", words(stem)),
-        (stem, None) => words(stem),
+    match named(column) {
+        (name, Some(unit)) => format!("{name} ({unit})"),
+        (name, None) => name,
     }
 }
 
-/// A column's name in words, without its unit (for titles: the axes carry the units).
+/// A column's short name, without its unit (for titles: the axes carry the units).
 pub fn name(column: &str) -> String {
-    words(split_unit(column).0)
+    named(column).0
 }
 
-/// A legend entry for `column = value`, in words with the unit after the value
-/// (`b1_t1_s`, `0.25` -> `t1, building 1 = 0.25 s`).
+/// A legend entry for `column = value`, with the unit after the value (`b1_t1_s`, `0.25` ->
+/// `period T1, building 1 = 0.25 s`).
 pub fn value_label(column: &str, value: &str) -> String {
-    match split_unit(column) {
-        (stem, Some(unit)) => format!("{} = {value} {unit}", words(stem)),
-        (stem, None) => format!("{} = {value}", words(stem)),
+    match named(column) {
+        (name, Some(unit)) => format!("{name} = {value} {unit}"),
+        (name, None) => format!("{name} = {value}"),
     }
 }
 
@@ -309,7 +298,7 @@ pub fn quantity(column: &str, v: f64) -> String {
             false => s,
         }
     };
-    let unit = split_unit(column).1;
+    let unit = named(column).1;
     let large = |base: &str| -> String {
         match v.abs() {
             a if a >= 1e6 => format!("{} M{base}", short(v / 1e6)),
@@ -358,7 +347,7 @@ mod tests {
         assert_eq!(label("gap_m"), "gap (m)");
         assert_eq!(label("peak_force_n"), "peak force (N)");
         assert_eq!(label("impact_velocity_m_s"), "impact velocity (m/s)");
-        assert_eq!(label("beta_n_per_m1_5"), "beta (N/m^1.5)");
+        assert_eq!(label("beta_n_per_m1_5"), "contact stiffness beta (N/m^1.5)");
         assert_eq!(label("impacts"), "impacts");
         let f = Filter::parse_all(&["t2_s=0.9".into(), "law!=hertz".into()]).unwrap();
         assert_eq!(caption(&f), "where t2_s=0.9, law!=hertz");
@@ -367,13 +356,42 @@ mod tests {
         assert_eq!(label("b2_peak_drift_ratio"), "peak drift ratio, building 2");
         assert_eq!(
             label("b1_peak_accel_m_s2"),
-            "peak accel, building 1 (m/s^2)"
+            "peak floor acceleration, building 1 (m/s^2)"
         );
         assert_eq!(
             label("level_b1f3_b2f3_peak_force_n"),
             "peak force, level b1f3-b2f3 (N)"
         );
-        assert_eq!(value_label("b1_t1_s", "0.25"), "t1, building 1 = 0.25 s");
-        assert_eq!(value_label("law", "hertz"), "law = hertz");
+        assert_eq!(
+            value_label("b1_t1_s", "0.25"),
+            "period T1, building 1 = 0.25 s"
+        );
+        assert_eq!(value_label("law", "hertz"), "contact law = hertz");
+        assert_eq!(label("pga_g"), "PGA (g)");
+        // A column no sweep writes: its words, and the unit its suffix spells.
+        assert_eq!(label("sd_drift_m"), "sd drift (m)");
+        assert_eq!(quantity("sd_force_n", 2e3), "2 kN");
+    }
+
+    /// Every label, name and unit a plot prints for a sweep's column is the one table's
+    /// ([`crate::plan::meaning`]): a pair's columns and a row's, building, storey, gap and level.
+    #[test]
+    fn labels_come_from_the_table_of_meanings() {
+        let row = [
+            "b2_peak_roof_m",
+            "b3_peak_accel_m_s2",
+            "b1_s2_hysteretic_energy_j",
+            "gap_1_2_m",
+            "level_b1f3_b2f2_impact_velocity_m_s",
+        ];
+        let header = crate::plan::columns::HEADER;
+        for c in header.iter().copied().chain(row) {
+            let m = crate::plan::meaning::meaning(c).unwrap();
+            assert_eq!(name(c), m.label, "{c}");
+            match m.unit {
+                "-" => assert_eq!(label(c), m.label, "{c}"),
+                u => assert_eq!(label(c), format!("{} ({u})", m.label), "{c}"),
+            }
+        }
     }
 }

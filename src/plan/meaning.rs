@@ -1,203 +1,235 @@
-//! What every output column holds, and in which unit: one table for `pound columns`, the docs
-//! and plot labels. A pair's columns are named outright; a row's per-building (`b2_...`),
+//! What every output column holds, in which unit, and its short name: one table for `pound
+//! columns`, the docs and every plot's axis labels, legends and titles. A pair's columns are named outright; a row's per-building (`b2_...`),
 //! per-gap (`gap_1_2_m`) and per-level (`level_b1f3_b2f3_...`) columns by pattern.
 
-/// A column's meaning and unit (`-` for counts, ratios and text).
+/// A column's meaning, unit (`-` for counts, ratios and text) and short name (`label`: an axis
+/// label without its unit, a legend entry's name, a title's words).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Meaning {
     pub unit: &'static str,
+    pub label: String,
     pub text: String,
 }
 
-/// The columns of one run that do not depend on the scene, with unit and meaning.
-const FIXED: [(&str, &str, &str); 36] = [
-    ("run", "-", "run number"),
-    ("law", "-", "contact law"),
+/// The columns of one run that do not depend on the scene: name, unit, short name, meaning.
+const FIXED: [(&str, &str, &str, &str); 36] = [
+    ("run", "-", "run", "run number"),
+    ("law", "-", "contact law", "contact law"),
     (
         "formula",
         "-",
+        "restitution formula",
         "restitution formula (empty where the law takes none)",
     ),
     (
         "e",
         "-",
+        "coefficient of restitution",
         "coefficient of restitution (empty for elastic laws)",
     ),
     (
         "impact_damping",
         "-",
+        "impact damping",
         "the damping used: zeta, or a in chi = a / v0 (Hunt-Crossley laws)",
     ),
-    ("k_n_per_m", "N/m", "contact stiffness of a linear law"),
+    (
+        "k_n_per_m",
+        "N/m",
+        "contact stiffness k",
+        "contact stiffness of a linear law",
+    ),
     (
         "beta_n_per_m1_5",
         "N/m^1.5",
+        "contact stiffness beta",
         "contact stiffness of a Hertz-type law",
     ),
-    ("record", "-", "record label"),
+    ("record", "-", "record", "record label"),
     (
         "target_pga_g",
         "g",
+        "target PGA",
         "target PGA the record was scaled to (empty for other targets)",
     ),
     (
         "target_sa_g",
         "g",
+        "target Sa(T)",
         "target Sa(T) the record was scaled to (empty for other targets)",
     ),
     (
         "sa_period_s",
         "s",
+        "period of Sa(T)",
         "the period T of target_sa_g (the run's own where it follows a building)",
     ),
     (
         "target_sa_avg_g",
         "g",
+        "target Sa_avg",
         "target Sa_avg the record was scaled to (empty for other targets)",
     ),
     (
         "sa_avg_from_s",
         "s",
+        "shortest period of Sa_avg",
         "the shortest period of target_sa_avg_g",
     ),
-    ("sa_avg_to_s", "s", "the longest period of target_sa_avg_g"),
-    ("scale_factor", "-", "factor applied to the record"),
-    ("pga_g", "g", "PGA of the scaled record"),
-    ("m1_kg", "kg", "mass of building 1"),
-    ("t1_s", "s", "period of building 1"),
-    ("xi1", "-", "damping ratio of building 1"),
-    ("m2_kg", "kg", "mass of building 2"),
-    ("t2_s", "s", "period of building 2"),
-    ("xi2", "-", "damping ratio of building 2"),
-    ("gap_m", "m", "gap between the buildings"),
+    (
+        "sa_avg_to_s",
+        "s",
+        "longest period of Sa_avg",
+        "the longest period of target_sa_avg_g",
+    ),
+    (
+        "scale_factor",
+        "-",
+        "scale factor",
+        "factor applied to the record",
+    ),
+    ("pga_g", "g", "PGA", "PGA of the scaled record"),
+    ("m1_kg", "kg", "mass, building 1", "mass of building 1"),
+    ("t1_s", "s", "period, building 1", "period of building 1"),
+    (
+        "xi1",
+        "-",
+        "damping ratio, building 1",
+        "damping ratio of building 1",
+    ),
+    ("m2_kg", "kg", "mass, building 2", "mass of building 2"),
+    ("t2_s", "s", "period, building 2", "period of building 2"),
+    (
+        "xi2",
+        "-",
+        "damping ratio, building 2",
+        "damping ratio of building 2",
+    ),
+    ("gap_m", "m", "gap", "gap between the buildings"),
     (
         "sample",
         "-",
+        "sample",
         "the sample that set the sampled parameters (empty without [sample])",
     ),
-    ("status", "-", "ok, non_finite or step_limit"),
+    ("status", "-", "status", "ok, non_finite or step_limit"),
     (
         "impacts",
         "-",
+        "impacts",
         "number of impacts (summed over the contact levels)",
     ),
-    ("peak_force_n", "N", "largest pounding force"),
-    ("peak_penetration_m", "m", "largest penetration"),
+    ("peak_force_n", "N", "peak force", "largest pounding force"),
+    (
+        "peak_penetration_m",
+        "m",
+        "peak penetration",
+        "largest penetration",
+    ),
     (
         "peak_u1_m",
         "m",
+        "peak displacement, building 1",
         "largest displacement of building 1 relative to the ground",
     ),
     (
         "peak_u2_m",
         "m",
+        "peak displacement, building 2",
         "largest displacement of building 2 relative to the ground",
     ),
     (
         "impact_velocity_m_s",
         "m/s",
+        "impact velocity",
         "approach speed v0 of the impact with the largest force",
     ),
     (
         "first_impact_s",
         "s",
+        "first impact",
         "onset of the first impact (empty if none)",
     ),
-    ("contact_time_s", "s", "total time in contact"),
+    (
+        "contact_time_s",
+        "s",
+        "contact time",
+        "total time in contact",
+    ),
     (
         "dissipated_energy_j",
         "J",
+        "dissipated energy",
         "net work of the contact force on the relative motion",
     ),
     (
         "substeps",
         "-",
+        "substeps",
         "integration work beyond the exact free steps (RK4 substeps or trial steps)",
     ),
     (
         "input_energy_j",
         "J",
+        "input energy",
         "input work of the ground motion (with --energy or the reference scheme)",
     ),
 ];
 
 /// The energy balance's last two columns.
-const ENERGY: [(&str, &str, &str); 2] = [
+const ENERGY: [(&str, &str, &str, &str); 2] = [
     (
         "damping_energy_j",
         "J",
+        "damping energy",
         "structural damping work (with --energy or the reference scheme)",
     ),
     (
         "energy_residual",
         "-",
+        "energy residual",
         "(input - kinetic - strain - damping - contact work) / largest input",
     ),
 ];
 
-/// Per building `k`: suffix, unit, meaning.
-const PER_BUILDING: [(&str, &str, &str); 15] = [
-    ("storeys", "-", "storeys of building {k}"),
-    (
-        "mass_kg",
-        "kg",
-        "floor mass of building {k} (empty where floor masses are given)",
-    ),
-    ("t1_s", "s", "fundamental period of building {k}"),
-    ("xi", "-", "damping ratio of building {k}"),
-    (
-        "peak_roof_m",
-        "m",
-        "largest roof displacement of building {k} relative to the ground",
-    ),
-    (
-        "peak_drift_ratio",
-        "-",
-        "largest interstorey drift ratio of building {k}",
-    ),
-    ("drift_storey", "-", "the storey of that drift (from 1)"),
-    (
-        "peak_accel_m_s2",
-        "m/s^2",
-        "largest absolute floor acceleration of building {k}",
-    ),
-    (
-        "accel_floor",
-        "-",
-        "the floor of that acceleration (from 1)",
-    ),
-    (
-        "residual_drift_ratio",
-        "-",
-        "largest residual interstorey drift ratio of building {k} at rest after the motion (yielding storeys; empty where the run did not settle)",
-    ),
-    ("residual_storey", "-", "the storey of that residual drift (from 1)"),
-    (
-        "peak_ductility",
-        "-",
-        "largest storey ductility demand of building {k}: peak drift / yield drift",
-    ),
-    ("ductility_storey", "-", "the storey of that ductility (from 1)"),
-    (
-        "hysteretic_energy_j",
-        "J",
-        "hysteretic energy of building {k}'s storeys: their work less the elastic energy they hold at the end",
-    ),
-    (
-        "yielded_storeys",
-        "-",
-        "storeys of building {k} that yielded",
-    ),
+/// Per building `k`: suffix, unit, short name, meaning.
+const PER_BUILDING: [(&str, &str, &str, &str); 15] = [
+    ("storeys", "-", "storeys, building {k}", "storeys of building {k}"),
+    ("mass_kg", "kg", "floor mass, building {k}", "floor mass of building {k} (empty where floor masses are given)"),
+    ("t1_s", "s", "period T1, building {k}", "fundamental period of building {k}"),
+    ("xi", "-", "damping ratio, building {k}", "damping ratio of building {k}"),
+    ("peak_roof_m", "m", "peak roof displacement, building {k}", "largest roof displacement of building {k} relative to the ground"),
+    ("peak_drift_ratio", "-", "peak drift ratio, building {k}", "largest interstorey drift ratio of building {k}"),
+    ("drift_storey", "-", "storey of peak drift, building {k}", "the storey of that drift (from 1)"),
+    ("peak_accel_m_s2", "m/s^2", "peak floor acceleration, building {k}", "largest absolute floor acceleration of building {k}"),
+    ("accel_floor", "-", "floor of peak acceleration, building {k}", "the floor of that acceleration (from 1)"),
+    ("residual_drift_ratio", "-", "residual drift ratio, building {k}", "largest residual interstorey drift ratio of building {k} at rest after the motion (yielding storeys; empty where the run did not settle)"),
+    ("residual_storey", "-", "storey of residual drift, building {k}", "the storey of that residual drift (from 1)"),
+    ("peak_ductility", "-", "peak ductility, building {k}", "largest storey ductility demand of building {k}: peak drift / yield drift"),
+    ("ductility_storey", "-", "storey of peak ductility, building {k}", "the storey of that ductility (from 1)"),
+    ("hysteretic_energy_j", "J", "hysteretic energy, building {k}", "hysteretic energy of building {k}'s storeys: their work less the elastic energy they hold at the end"),
+    ("yielded_storeys", "-", "yielded storeys, building {k}", "storeys of building {k} that yielded"),
 ];
 
-/// Per contact level: suffix, unit, meaning.
-const PER_LEVEL: [(&str, &str, &str); 4] = [
-    ("impacts", "-", "impacts at {level}"),
-    ("peak_force_n", "N", "largest force at {level}"),
-    ("peak_penetration_m", "m", "largest penetration at {level}"),
+/// Per contact level: suffix, unit, short name, meaning.
+const PER_LEVEL: [(&str, &str, &str, &str); 4] = [
+    ("impacts", "-", "impacts, {level}", "impacts at {level}"),
+    (
+        "peak_force_n",
+        "N",
+        "peak force, {level}",
+        "largest force at {level}",
+    ),
+    (
+        "peak_penetration_m",
+        "m",
+        "peak penetration, {level}",
+        "largest penetration at {level}",
+    ),
     (
         "impact_velocity_m_s",
         "m/s",
+        "impact velocity, {level}",
         "approach speed of the largest impact at {level}",
     ),
 ];
@@ -210,8 +242,9 @@ fn number(s: &str) -> Option<usize> {
 
 /// What `column` holds, or None for a name no sweep writes.
 pub fn meaning(column: &str) -> Option<Meaning> {
-    let of = |(_, unit, text): &(&str, &'static str, &str)| Meaning {
+    let of = |(_, unit, label, text): &(&str, &'static str, &str, &str)| Meaning {
         unit,
+        label: label.to_string(),
         text: text.to_string(),
     };
     if let Some(m) = FIXED.iter().chain(&ENERGY).find(|m| m.0 == column) {
@@ -226,6 +259,7 @@ pub fn meaning(column: &str) -> Option<Meaning> {
             if let (Some(a), Some(b)) = (number(a), number(b)) {
                 return Some(Meaning {
                     unit: "m",
+                    label: format!("gap {a}-{b}"),
                     text: format!("gap between buildings {a} and {b}"),
                 });
             }
@@ -250,7 +284,8 @@ pub fn meaning(column: &str) -> Option<Meaning> {
                 );
                 return Some(Meaning {
                     unit: m.1,
-                    text: m.2.replace("{level}", &level),
+                    label: m.2.replace("{level}", &format!("level {left}-{right}")),
+                    text: m.3.replace("{level}", &level),
                 });
             }
         }
@@ -259,17 +294,20 @@ pub fn meaning(column: &str) -> Option<Meaning> {
     if let Some((k, rest)) = column.strip_prefix('b').and_then(|r| r.split_once("_s")) {
         if let Some((j, suffix)) = rest.split_once('_') {
             let text = match suffix {
-                "residual_drift_ratio" => Some(("-", "residual drift ratio of storey {j} of building {k} at rest after the motion, signed (empty where the run did not settle)")),
-                "peak_ductility" => Some(("-", "ductility demand of storey {j} of building {k}: its peak drift / its yield drift")),
-                "hysteretic_energy_j" => Some(("J", "hysteretic energy of storey {j} of building {k}")),
+                "residual_drift_ratio" => Some(("-", "residual drift ratio, building {k} storey {j}", "residual drift ratio of storey {j} of building {k} at rest after the motion, signed (empty where the run did not settle)")),
+                "peak_ductility" => Some(("-", "ductility, building {k} storey {j}", "ductility demand of storey {j} of building {k}: its peak drift / its yield drift")),
+                "hysteretic_energy_j" => Some(("J", "hysteretic energy, building {k} storey {j}", "hysteretic energy of storey {j} of building {k}")),
                 _ => None,
             };
-            if let (Some(k), Some(j), Some((unit, text))) = (number(k), number(j), text) {
+            if let (Some(k), Some(j), Some((unit, label, text))) = (number(k), number(j), text) {
+                let fill = |t: &str| {
+                    t.replace("{j}", &j.to_string())
+                        .replace("{k}", &k.to_string())
+                };
                 return Some(Meaning {
                     unit,
-                    text: text
-                        .replace("{j}", &j.to_string())
-                        .replace("{k}", &k.to_string()),
+                    label: fill(label),
+                    text: fill(text),
                 });
             }
         }
@@ -279,20 +317,24 @@ pub fn meaning(column: &str) -> Option<Meaning> {
         if let (Some(k), Some(m)) = (number(k), PER_BUILDING.iter().find(|m| m.0 == suffix)) {
             return Some(Meaning {
                 unit: m.1,
-                text: m.2.replace("{k}", &k.to_string()),
+                label: m.2.replace("{k}", &k.to_string()),
+                text: m.3.replace("{k}", &k.to_string()),
             });
         }
     }
     None
 }
 
-/// A markdown table of `columns`: name, unit, meaning.
+/// A markdown table of `columns`: name, unit, meaning, and the name plots give it.
 pub fn table<S: AsRef<str>>(columns: &[S]) -> String {
-    let mut s = String::from("| column | unit | meaning |\n|---|---|---|\n");
+    let mut s = String::from("| column | unit | meaning | in plots |\n|---|---|---|---|\n");
     for c in columns {
         let c = c.as_ref();
         let m = meaning(c).expect("every written column has a meaning");
-        s.push_str(&format!("| `{c}` | {} | {} |\n", m.unit, m.text));
+        s.push_str(&format!(
+            "| `{c}` | {} | {} | {} |\n",
+            m.unit, m.text, m.label
+        ));
     }
     s
 }

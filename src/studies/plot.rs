@@ -95,6 +95,35 @@ fn engineering(label: &str, biggest: f64, log: bool) -> (String, f64) {
     }
 }
 
+/// A title's lines and font size for a panel `width` px wide: one line at 18 px where it fits;
+/// else one line at the largest size down to 14 px at which it does; else its words wrapped
+/// into lines at 14 px (a word longer than the panel stands on a line of its own). `measure`
+/// gives a text's width at a size (at the panel's own scale, as `scale`).
+fn fit_title(
+    title: &str,
+    width: f64,
+    scale: f64,
+    measure: impl Fn(&str, f64) -> f64,
+) -> (Vec<String>, f64) {
+    for size in [18.0, 17.0, 16.0, 15.0, 14.0] {
+        if measure(title, size * scale) <= width {
+            return (vec![title.to_string()], size * scale);
+        }
+    }
+    let size = 14.0 * scale;
+    let mut lines: Vec<String> = Vec::new();
+    for word in title.split_whitespace() {
+        match lines.last_mut() {
+            Some(line) if measure(&format!("{line} {word}"), size) <= width => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    (lines, size)
+}
+
 /// The legend's corners, in the order they are tried.
 const CORNERS: [SeriesLabelPosition; 4] = [
     SeriesLabelPosition::UpperLeft,
@@ -378,8 +407,24 @@ fn draw<DB: DrawingBackend>(
         .max()
         .unwrap_or(0);
     let (panel_w, panel_h) = area.dim_in_pixel();
+    // A title too wide for the panel is set smaller, or wrapped: plotters would clip it.
+    let measure = |text: &str, size: f64| {
+        area.estimate_text_size(text, &("sans-serif", size).into_text_style(area))
+            .map_or(f64::INFINITY, |(w, _)| w as f64)
+    };
+    let (title, title_size) = fit_title(
+        &p.title,
+        panel_w as f64 - 2.0 * px(10) as f64,
+        scale,
+        measure,
+    );
+    let title_style = ("sans-serif", title_size).into_text_style(area);
+    let line_h = area
+        .estimate_text_size("Ag", &title_style)
+        .map_or(0, |(_, h)| h) as f64;
     let plot_w = (panel_w as f64 - 105.0 * scale).max(1.0);
-    let plot_h = (panel_h as f64 - 100.0 * scale).max(1.0);
+    let plot_h =
+        (panel_h as f64 - 100.0 * scale - (title.len() as f64 - 1.0) * line_h * 1.4).max(1.0);
     let (w, h) = (
         (longest as f64 * 7.0 + 40.0) * scale / plot_w,
         (named.len() as f64 * 20.0 + 20.0) * scale / plot_h,
@@ -442,9 +487,25 @@ fn draw<DB: DrawingBackend>(
             tick(*v)
         }
     };
-    let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, ("sans-serif", 18.0 * scale))
-        .margin(px(10))
+    // One line goes through plotters' caption; wrapped lines are set one under the other in
+    // the panel's margin, and the chart is built below them.
+    let below_title;
+    let mut builder = match &title[..] {
+        [line] => {
+            let mut b = ChartBuilder::on(area);
+            b.caption(line, title_style.clone()).margin(px(10));
+            b
+        }
+        lines => {
+            let mut rest = area.margin(px(10), px(10), px(10), px(10));
+            for line in lines {
+                rest = rest.titled(line, title_style.clone()).map_err(|x| e(&x))?;
+            }
+            below_title = rest;
+            ChartBuilder::on(&below_title)
+        }
+    };
+    let mut chart = builder
         .x_label_area_size(px(40))
         .y_label_area_size(px(75))
         .build_cartesian_2d(x0..x1, y0..y1)
@@ -547,6 +608,21 @@ mod tests {
                 "1e6"
             ]
         );
+    }
+
+    /// A title is set at 18 px where it fits, smaller down to 14 px, then wrapped at 14 px by
+    /// words (measured here at 0.5 px a character per px of size).
+    #[test]
+    fn titles_shrink_then_wrap() {
+        let measure = |t: &str, size: f64| t.chars().count() as f64 * size * 0.5;
+        let fit = |t: &str, w: f64| fit_title(t, w, 1.0, measure);
+        assert_eq!(fit("abcd", 36.0), (vec!["abcd".to_string()], 18.0));
+        assert_eq!(fit("abcd", 30.0), (vec!["abcd".to_string()], 15.0));
+        let (lines, size) = fit("aa bb cc dd", 40.0);
+        assert_eq!((lines.join("|"), size), ("aa bb|cc dd".to_string(), 14.0));
+        // A word wider than the panel stands alone.
+        let (lines, _) = fit("a verylongword b", 40.0);
+        assert_eq!(lines, ["a", "verylongword", "b"]);
     }
 
     #[test]

@@ -282,7 +282,7 @@ fn legends_cover_no_point_and_styles_are_distinct() {
     ]));
     let t = std::fs::read_to_string(&titled).unwrap();
     assert!(
-        t.contains("Fig. 7") && !t.contains("against pga"),
+        t.contains("Fig. 7") && !t.contains("against PGA"),
         "title replaced"
     );
     assert!(
@@ -317,7 +317,7 @@ fn legends_cover_no_point_and_styles_are_distinct() {
     for said in [
         "1 MN: observed",
         "3 MN: fit",
-        "P(peak force &gt; threshold) against pga",
+        "P(peak force &gt; threshold) against PGA",
     ] {
         assert!(svg.contains(said), "{said}");
     }
@@ -407,4 +407,60 @@ fn a_gap_study_of_one_pair_is_drawn_against_the_record() {
     assert!(!many.contains("record, 1 to"));
     let translucent = many.matches("opacity=\"0.35\"").count();
     assert!(translucent >= 3 * 500, "{translucent} translucent marks");
+}
+
+/// The title's lines: text set larger than the axes' (whose text is 12 px, 9.68 in the SVG's
+/// points), and their size.
+fn title_lines(svg: &str) -> Vec<(String, f64)> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|e| {
+            let size: f64 = attr(e, "font-size")?.parse().ok()?;
+            let text = e[e.find('>')? + 1..e.find('<')?].trim().to_string();
+            (size > 10.5).then_some((text, size))
+        })
+        .collect()
+}
+
+/// A title too long for its panel is wrapped (plotters set it on one line and clipped it at
+/// both sides): every word is kept, in order, and on a wide panel the same title is one line
+/// at the full size.
+#[test]
+fn a_long_title_is_wrapped_on_a_narrow_panel() {
+    let dir = tempdir();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let results = dir.path().join("q.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/quickstart.toml",
+        "-o",
+        &s(&results),
+    ]));
+    let title = "Peak pounding force against the separation gap, the largest over every other parameter of the sweep";
+    let draw = |size: &str| {
+        let plot = dir.path().join(format!("{size}.svg"));
+        ok(&pound(&[
+            "plot",
+            &s(&results),
+            "--x",
+            "gap_m",
+            "--y",
+            "peak_force_n",
+            "--title",
+            title,
+            "--size",
+            size,
+            "-o",
+            &s(&plot),
+        ]));
+        title_lines(&std::fs::read_to_string(&plot).unwrap())
+    };
+    let wide = draw("1400x500");
+    assert_eq!(wide.len(), 1, "{wide:?}");
+    assert_eq!(wide[0].0, title);
+    let narrow = draw("400x320");
+    assert!(narrow.len() >= 2, "{narrow:?}");
+    let joined: Vec<&str> = narrow.iter().map(|l| l.0.as_str()).collect();
+    assert_eq!(joined.join(" "), title);
+    assert!(narrow.iter().all(|l| l.1 < wide[0].1), "{narrow:?} smaller");
 }

@@ -131,10 +131,10 @@ fn plots_from_a_small_sweep() {
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
     for name in [
-        "law = hertz",
-        "law = nonlinear_viscoelastic",
-        "pga (g)",
-        "peak force against pga",
+        "contact law = hertz",
+        "contact law = nonlinear_viscoelastic",
+        "PGA (g)",
+        "peak force against PGA",
     ] {
         assert!(text.contains(name), "{name} not in the SVG");
     }
@@ -374,8 +374,8 @@ fn plotted_values_are_the_chosen_aggregate_at_each_x() {
     };
     let expect = |a0: f64, a1: f64| {
         vec![
-            ("law = a".to_string(), vec![(0.0, a0), (0.01, a1)]),
-            ("law = b".to_string(), vec![(0.0, 5.0), (0.01, 7.0)]),
+            ("contact law = a".to_string(), vec![(0.0, a0), (0.01, a1)]),
+            ("contact law = b".to_string(), vec![(0.0, 5.0), (0.01, 7.0)]),
         ]
     };
     assert_eq!(at(Aggregate::Max), expect(9.0, 6.0));
