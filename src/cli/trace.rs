@@ -15,12 +15,14 @@ pub struct Args {
     run: u64,
     /// The time history at every record step and located event. A pair: displacements,
     /// velocities, absolute floor accelerations, penetration, contact force, contact mode. A
-    /// row: every floor's displacement, and each level's penetration, force and mode.
+    /// row: every floor's displacement, each level's penetration, force and mode, and each
+    /// yielding storey's drift and plastic drift ratios, shear and hysteretic energy.
     /// (default: trace.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Displacements (a row's roofs) and contact force (per level) against time, force against
-    /// penetration (.svg or .png).
+    /// penetration; where storeys yield, each yielding building's hysteresis loop and
+    /// hysteretic energy (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
     #[command(flatten)]

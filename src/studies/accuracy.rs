@@ -218,6 +218,25 @@ pub fn csv(points: &[Point]) -> String {
     s
 }
 
+/// The settings among `settings`, each once, in increasing order.
+fn distinct_settings(settings: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut s: Vec<f64> = settings.filter(|s| !s.is_nan()).collect();
+    s.sort_by(f64::total_cmp);
+    s.dedup();
+    s
+}
+
+/// A setting's marks: a scatter series named for it (`16 substeps per contact`), so that a
+/// point on any line reads as its setting.
+fn setting_marks(setting: f64, points: Vec<(f64, f64)>) -> Series {
+    Series {
+        name: format!("{setting} substeps per contact"),
+        points,
+        scatter: true,
+        style: None,
+    }
+}
+
 /// Work-precision panels: runs/s against the median and the 99th percentile of the peak-force
 /// error, one line per path through its settings, and each setting's points marked and named
 /// in the legend (`16 substeps per contact`), so a point reads as its setting on every path.
@@ -229,13 +248,12 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
         .collect();
     paths.sort();
     paths.dedup();
-    let mut settings: Vec<f64> = points
-        .iter()
-        .map(|p| p.substeps_per_contact)
-        .filter(|s| !s.is_nan())
-        .collect();
-    settings.sort_by(f64::total_cmp);
-    settings.dedup();
+    let settings = distinct_settings(
+        points
+            .iter()
+            .filter(|p| p.path != "reference")
+            .map(|p| p.substeps_per_contact),
+    );
     let panel = |title: &str, err: fn(&Errors) -> f64| {
         let at = |p: &Point| (err(&p.errors), p.runs_per_second);
         let lines = paths.iter().map(|path| Series {
@@ -244,15 +262,15 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
             scatter: false,
             style: None,
         });
-        let marks = settings.iter().map(|&s| Series {
-            name: format!("{s} substeps per contact"),
-            points: points
-                .iter()
-                .filter(|p| p.path != "reference" && p.substeps_per_contact == s)
-                .map(at)
-                .collect(),
-            scatter: true,
-            style: None,
+        let marks = settings.iter().map(|&s| {
+            setting_marks(
+                s,
+                points
+                    .iter()
+                    .filter(|p| p.path != "reference" && p.substeps_per_contact == s)
+                    .map(at)
+                    .collect(),
+            )
         });
         Panel {
             title: title.into(),
@@ -492,8 +510,9 @@ pub fn row_study(
 }
 
 /// The multi-storey work-precision plot: runs/s against the median (left) and p99 (right)
-/// relative error of each quantity, one series per quantity over the fast scheme's settings
-/// (errors of 0, which a log axis cannot show, are left out).
+/// relative error of each quantity, one line per quantity over the fast scheme's settings and
+/// each setting's points marked and named, as the pairs' plot does (errors of 0, which a log
+/// axis cannot show, are left out).
 pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
     type Pick = fn(&RowPoint) -> [f64; 2];
     let quantities: [(&str, Pick); 4] = [
@@ -517,27 +536,48 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
     } else {
         &[]
     };
-    let panel = |title: &str, at: usize| Panel {
-        title: title.into(),
-        x_label: "relative error".into(),
-        y_label: "runs/s".into(),
-        log_x: true,
-        log_y: true,
-        series: quantities
+    let settings = distinct_settings(
+        points
             .iter()
-            .chain(extra)
-            .map(|(name, pick)| Series {
-                name: name.to_string(),
-                points: points
-                    .iter()
-                    .filter(|p| p.path != "reference")
-                    .map(|p| (pick(p)[at], p.runs_per_second))
+            .filter(|p| p.path != "reference")
+            .map(|p| p.substeps_per_contact),
+    );
+    let panel = |title: &str, at: usize| {
+        // Each quantity's point of `p`.
+        let of = |p: &RowPoint, pick: &Pick| (pick(p)[at], p.runs_per_second);
+        let fast = || points.iter().filter(|p| p.path != "reference");
+        let lines = quantities.iter().chain(extra).map(|(name, pick)| Series {
+            name: name.to_string(),
+            points: fast()
+                .map(|p| of(p, pick))
+                .filter(|&(e, _)| e > 0.0)
+                .collect(),
+            scatter: false,
+            style: None,
+        });
+        let marks = settings.iter().map(|&s| {
+            setting_marks(
+                s,
+                fast()
+                    .filter(|p| p.substeps_per_contact == s)
+                    .flat_map(|p| {
+                        quantities
+                            .iter()
+                            .chain(extra)
+                            .map(move |(_, pick)| of(p, pick))
+                    })
                     .filter(|&(e, _)| e > 0.0)
                     .collect(),
-                scatter: false,
-                style: None,
-            })
-            .collect(),
+            )
+        });
+        Panel {
+            title: title.into(),
+            x_label: "relative error".into(),
+            y_label: "runs/s".into(),
+            log_x: true,
+            log_y: true,
+            series: lines.chain(marks).collect(),
+        }
     };
     vec![panel("median error", 0), panel("99th percentile error", 1)]
 }

@@ -4,11 +4,11 @@
 //!
 //! The CPU fast scheme may settle a pair's free stretches from a response shared between runs;
 //! the trace integrates the run alone, which gives the same output (`solver::simulate_shared`).
-//! A row's trace moves every building in every substep, where the sweep lets buildings that
-//! no contact can reach stand still and steps them exactly: the same output to rounding
-//! (`solver::row::simulate_row_observed`).
+//! A row's trace runs as the sweep does, buildings that no contact can reach standing still;
+//! such a building is sampled at its exact motion without changing the run, so the output is
+//! the sweep's to the last digit (`solver::row::simulate_row_observed`).
 
-use crate::physics::solver::row::{simulate_row_observed, RowModel, RowSample};
+use crate::physics::solver::row::{simulate_row_observed, RowModel, RowSample, StoreySample};
 use crate::physics::solver::{simulate_observed, Mode, Sample};
 use crate::plan::row::RowPlan;
 use crate::plan::{PairPlan, Plan, RunSpec};
@@ -148,9 +148,23 @@ fn mode_name(m: Mode) -> &'static str {
     }
 }
 
+/// A yielding storey's trace columns, after its `b2_s1_` prefix.
+pub const STOREY_COLUMNS: [&str; 4] = [
+    "drift_ratio",
+    "plastic_drift_ratio",
+    "shear_n",
+    "hysteretic_energy_j",
+];
+
+/// A yielding storey's column prefix (`b2_s1`, both from 1).
+fn storey_prefix(s: &StoreySample) -> String {
+    format!("b{}_s{}", s.building + 1, s.storey + 1)
+}
+
 /// A row trace's columns: the time, each building's floor displacements (`b1_f1_u_m`, floors
-/// from 1 at the lowest), then each level's penetration, force and mode.
-pub fn row_header(levels: &[String], floors: &[usize]) -> Vec<String> {
+/// from 1 at the lowest), each level's penetration, force and mode, then each yielding
+/// storey's drift and plastic drift ratios, shear and hysteretic energy (`b1_s1_shear_n`).
+pub fn row_header(levels: &[String], floors: &[usize], storeys: &[StoreySample]) -> Vec<String> {
     let mut h = vec!["t_s".to_string()];
     for (b, &n) in floors.iter().enumerate() {
         h.extend((1..=n).map(|f| format!("b{}_f{f}_u_m", b + 1)));
@@ -159,6 +173,10 @@ pub fn row_header(levels: &[String], floors: &[usize]) -> Vec<String> {
         for c in ["penetration_m", "force_n", "mode"] {
             h.push(format!("{l}_{c}"));
         }
+    }
+    for s in storeys {
+        let prefix = storey_prefix(s);
+        h.extend(STOREY_COLUMNS.iter().map(|c| format!("{prefix}_{c}")));
     }
     h
 }
@@ -169,7 +187,8 @@ fn row_csv(levels: &[String], samples: &[RowSample]) -> String {
         .first()
         .map(|s| s.floors.iter().map(Vec::len).collect())
         .unwrap_or_default();
-    let mut s = row_header(levels, &floors).join(",");
+    let storeys = samples.first().map_or(&[][..], |s| &s.storeys[..]);
+    let mut s = row_header(levels, &floors, storeys).join(",");
     s.push('\n');
     for x in samples {
         let mut cells = vec![num(x.t)];
@@ -178,6 +197,17 @@ fn row_csv(levels: &[String], samples: &[RowSample]) -> String {
             cells.push(num(x.penetrations[l]));
             cells.push(num(x.forces[l]));
             cells.push(mode_name(x.modes[l]).into());
+        }
+        for st in &x.storeys {
+            cells.extend(
+                [
+                    st.drift_ratio,
+                    st.plastic_drift_ratio,
+                    st.shear_n,
+                    st.hysteretic_energy_j,
+                ]
+                .map(num),
+            );
         }
         s.push_str(&cells.join(","));
         s.push('\n');
@@ -213,7 +243,8 @@ fn level_label(prefix: &str) -> String {
 type LevelPoint = dyn Fn(&RowSample, usize) -> Option<(f64, f64)>;
 
 /// Each building's roof displacement and each level's force against time; each level's force
-/// against its penetration.
+/// against its penetration; where storeys yield, each yielding building's hysteresis loop (its
+/// storey that dissipates most) and its hysteretic energy against time.
 fn row_panels(index: u64, levels: &[String], samples: &[RowSample]) -> Vec<Panel> {
     let buildings = samples.first().map_or(0, |s| s.floors.len());
     let roofs = (0..buildings)
@@ -238,7 +269,7 @@ fn row_panels(index: u64, levels: &[String], samples: &[RowSample]) -> Vec<Panel
             .filter(|s| s.points.iter().any(|p| p.1 > 0.0))
             .collect()
     };
-    vec![
+    let mut panels = vec![
         Panel {
             title: format!("Run {index}: roof displacements"),
             x_label: "t (s)".into(),
@@ -262,7 +293,79 @@ fn row_panels(index: u64, levels: &[String], samples: &[RowSample]) -> Vec<Panel
             }),
             ..Panel::default()
         },
-    ]
+    ];
+    let (Some(first), Some(last)) = (samples.first(), samples.last()) else {
+        return panels;
+    };
+    // The yielding buildings, each with its storeys' indices in the samples.
+    let mut yielding: Vec<(usize, Vec<usize>)> = Vec::new();
+    for (i, st) in first.storeys.iter().enumerate() {
+        match yielding.last_mut() {
+            Some((b, storeys)) if *b == st.building => storeys.push(i),
+            _ => yielding.push((st.building, vec![i])),
+        }
+    }
+    if yielding.is_empty() {
+        return panels;
+    }
+    let loops = yielding
+        .iter()
+        .map(|(b, storeys)| {
+            let most = *storeys
+                .iter()
+                .max_by(|&&i, &&j| {
+                    let e = |k: usize| last.storeys[k].hysteretic_energy_j;
+                    e(i).total_cmp(&e(j))
+                })
+                .expect("a yielding building has storeys");
+            line(
+                &format!(
+                    "building {} storey {}",
+                    b + 1,
+                    first.storeys[most].storey + 1
+                ),
+                samples
+                    .iter()
+                    .map(|s| (s.storeys[most].drift_ratio, s.storeys[most].shear_n))
+                    .collect(),
+            )
+        })
+        .collect();
+    let energies = yielding
+        .iter()
+        .map(|(b, storeys)| {
+            line(
+                &format!("building {}", b + 1),
+                samples
+                    .iter()
+                    .map(|s| {
+                        (
+                            s.t,
+                            storeys
+                                .iter()
+                                .map(|&i| s.storeys[i].hysteretic_energy_j)
+                                .sum(),
+                        )
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    panels.push(Panel {
+        title: "Storey shear against drift (the storey that dissipates most)".into(),
+        x_label: "storey drift ratio".into(),
+        y_label: "storey shear (N)".into(),
+        series: loops,
+        ..Panel::default()
+    });
+    panels.push(Panel {
+        title: "Hysteretic energy of the storeys".into(),
+        x_label: "t (s)".into(),
+        y_label: "hysteretic energy (J)".into(),
+        series: energies,
+        ..Panel::default()
+    });
+    panels
 }
 
 /// The trace's columns.

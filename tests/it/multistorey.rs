@@ -709,16 +709,21 @@ fn accuracy_of_a_row_config() {
         "--plot",
         svg.to_str().unwrap(),
     ]));
-    // The work-precision plot: a series per quantity in each panel.
+    // The work-precision plot: a series per quantity in each panel, and each setting marked
+    // and named.
     let drawn = std::fs::read_to_string(&svg).unwrap();
     for name in [
         "peak force",
         "drift ratio",
         "floor acceleration",
         "99th percentile error",
+        "\n8 substeps per contact\n",
+        "\n64 substeps per contact\n",
     ] {
         assert!(drawn.contains(name), "{name} missing from the plot");
     }
+    // The reference is not a setting of the fast scheme.
+    assert!(!drawn.contains("\n0 substeps per contact\n"));
     let rows: Vec<Vec<String>> = csv::Reader::from_path(&out)
         .unwrap()
         .records()

@@ -196,3 +196,105 @@ fn a_row_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
     }
     assert!(checked_levels >= 4, "{checked_levels} levels that pound");
 }
+
+/// A yielding row's trace carries each yielding storey's drift, plastic drift, shear and
+/// hysteretic energy, and they end where the sweep's row says: the storeys' hysteretic energies
+/// add up to the building's, the largest plastic drift at the end is the residual drift (where
+/// the run settled), no sampled drift passes the peak drift, and every sample's shear is the
+/// storey's elastic force on its elastic drift `d - p` (one stiffness for every sample), with
+/// its back drift within the yield band. The plot draws the hysteresis loop and the energy.
+#[test]
+fn a_yielding_row_trace_ends_at_its_sweep_rows_storey_outputs() {
+    let dir = tempdir();
+    let cfg = std::path::Path::new("configs/inelastic-row.toml");
+    let text = sweep(dir.path(), cfg);
+    let lines: Vec<&str> = text.lines().collect();
+    let head: Vec<&str> = lines[0].split(',').collect();
+    let cell = |line: &str, name: &str| -> String {
+        let c = head.iter().position(|c| *c == name).unwrap();
+        line.split(',').nth(c).unwrap().to_string()
+    };
+    let mut yielded = 0;
+    for (run, &line) in lines[1..].iter().enumerate() {
+        let (said, trace) = trace(dir.path(), cfg, run);
+        assert_eq!(
+            said.lines().nth(1),
+            Some(line),
+            "run {run}: the sweep's row"
+        );
+        let mut rows = trace.lines();
+        let th: Vec<&str> = rows.next().unwrap().split(',').collect();
+        let samples: Vec<Vec<f64>> = rows
+            .map(|r| {
+                r.split(',')
+                    .map(|c| c.parse().unwrap_or(f64::NAN))
+                    .collect()
+            })
+            .collect();
+        let at = |name: &str| {
+            th.iter()
+                .position(|c| *c == name)
+                .unwrap_or_else(|| panic!("{name} in {th:?}"))
+        };
+        // Building 1 yields (six storeys); building 2 is elastic and has no storey columns.
+        assert!(!th.iter().any(|c| c.starts_with("b2_s")), "{th:?}");
+        let last = samples.last().unwrap();
+        let storey = |j: usize, what: &str| at(&format!("b1_s{j}_{what}"));
+        let energy: f64 = (1..=6)
+            .map(|j| last[storey(j, "hysteretic_energy_j")])
+            .sum();
+        let said_energy: f64 = cell(line, "b1_hysteretic_energy_j").parse().unwrap();
+        assert!(
+            (energy - said_energy).abs() <= 1e-12 * said_energy.abs().max(1.0),
+            "run {run}: {energy} against {said_energy}"
+        );
+        if said_energy > 0.0 {
+            yielded += 1;
+        }
+        let residual = (1..=6)
+            .map(|j| last[storey(j, "plastic_drift_ratio")].abs())
+            .fold(0.0, f64::max);
+        if let Ok(said) = cell(line, "b1_residual_drift_ratio").parse::<f64>() {
+            assert!(
+                (residual - said).abs() <= 1e-12 * said.max(1e-3),
+                "run {run}: residual {residual} against {said}"
+            );
+        }
+        let peak: f64 = cell(line, "b1_peak_drift_ratio").parse().unwrap();
+        for j in 1..=6 {
+            let (d, p, f) = (
+                storey(j, "drift_ratio"),
+                storey(j, "plastic_drift_ratio"),
+                storey(j, "shear_n"),
+            );
+            let sampled = samples.iter().map(|s| s[d].abs()).fold(0.0, f64::max);
+            assert!(sampled <= peak * (1.0 + 1e-12), "run {run} storey {j}");
+            // One stiffness per storey: shear / (d - p) is the same at every sample.
+            let k: Vec<f64> = samples
+                .iter()
+                .filter(|s| (s[d] - s[p]).abs() > 1e-4)
+                .map(|s| s[f] / (s[d] - s[p]))
+                .collect();
+            assert!(
+                !k.is_empty(),
+                "run {run} storey {j}: no elastic drift sampled"
+            );
+            let (lo, hi) = k
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+            assert!(
+                lo > 0.0 && hi / lo < 1.0 + 1e-9,
+                "run {run} storey {j}: {lo} to {hi}"
+            );
+            // Within the band: the back drift `d - p / (1 - b)` at most the yield drift ratio.
+            let band = samples
+                .iter()
+                .map(|s| (s[d] - s[p] / (1.0 - 0.03)).abs())
+                .fold(0.0, f64::max);
+            assert!(band <= 0.005 * (1.0 + 1e-6), "run {run} storey {j}: {band}");
+        }
+        let svg = std::fs::read_to_string(dir.path().join(format!("trace-{run}.svg"))).unwrap();
+        assert!(svg.contains("Storey shear against drift") && svg.contains("Hysteretic energy"));
+    }
+    assert!(yielded >= 3, "{yielded} runs yielded");
+}

@@ -879,6 +879,22 @@ pub struct RowSample {
     pub penetrations: Vec<f64>,
     pub forces: Vec<f64>,
     pub modes: Vec<Mode>,
+    /// Each yielding storey, building by building (none in an elastic row).
+    pub storeys: Vec<StoreySample>,
+}
+
+/// A yielding storey at a sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StoreySample {
+    /// Its building and storey, from 0 (storey 0 joins the ground and the lowest floor).
+    pub building: usize,
+    pub storey: usize,
+    /// Drift and plastic drift over the storey's height; its shear `k (d - p)`, N; the work
+    /// its plastic drift has absorbed, `int f dp`, J (its hysteretic energy so far).
+    pub drift_ratio: f64,
+    pub plastic_drift_ratio: f64,
+    pub shear_n: f64,
+    pub hysteretic_energy_j: f64,
 }
 
 /// What observes a row's run.
@@ -1545,6 +1561,30 @@ impl<'m> RowRun<'m> {
                 })
                 .collect(),
             modes: self.levels.iter().map(|ls| ls.mode).collect(),
+            // A still building's plastic drifts stay as they are until it moves again.
+            storeys: m
+                .storeys
+                .iter()
+                .enumerate()
+                .map(|(s, sm)| {
+                    let u = &floors[sm.building];
+                    let below = if sm.storey == 0 {
+                        0.0
+                    } else {
+                        u[sm.storey - 1]
+                    };
+                    let drift = u[sm.storey] - below;
+                    let p = self.z[m.plastic_slot(s)];
+                    StoreySample {
+                        building: sm.building,
+                        storey: sm.storey,
+                        drift_ratio: drift / sm.height,
+                        plastic_drift_ratio: p / sm.height,
+                        shear_n: sm.k * (drift - p),
+                        hysteretic_energy_j: self.z[m.plastic_slot(s) + m.storeys.len()],
+                    }
+                })
+                .collect(),
             floors,
         };
         if let Some(obs) = self.observer.as_mut() {
