@@ -1,6 +1,7 @@
 //! What every output column holds, in which unit, and its short name: one table for `pound
-//! columns`, the docs and every plot's axis labels, legends and titles. A pair's columns are named outright; a row's per-building (`b2_...`),
-//! per-gap (`gap_1_2_m`) and per-level (`level_b1f3_b2f3_...`) columns by pattern.
+//! columns`, the docs and every plot's axis labels, legends and titles. A pair's columns are
+//! named outright; a row's per-building (`b2_...`), per-gap (`gap_1_2_m`) and per-level
+//! (`level_b1f3_b2f3_...`) columns by pattern.
 
 /// A column's meaning, unit (`-` for counts, ratios and text) and short name (`label`: an axis
 /// label without its unit, a legend entry's name, a title's words).
