@@ -260,7 +260,8 @@ fn named(column: &str) -> (String, Option<&'static str>) {
 }
 
 /// An axis label: the column's short name and its unit in parentheses (`gap_m` -> `gap (m)`,
-/// `pga_g` -> `PGA (g)`, `b2_peak_drift_ratio` -> `peak drift ratio, building 2`).
+/// `pga_g` -> `PGA (g)`, `b2_peak_drift_ratio` -> `peak drift ratio, building 2 (m/m)`, which
+/// a plot's linear axis shows in %).
 pub fn label(column: &str) -> String {
     match named(column) {
         (name, Some(unit)) => format!("{name} ({unit})"),
@@ -309,6 +310,7 @@ pub fn quantity(column: &str, v: f64) -> String {
     match unit {
         Some(u @ ("N" | "J" | "N/m")) => large(u),
         Some("m") if v != 0.0 && v.abs() < 1.0 => format!("{} mm", short(v * 1e3)),
+        Some("m/m") => format!("{} %", short(v * 1e2)),
         Some(u) => format!("{} {u}", short(v)),
         None => short(v),
     }
@@ -327,7 +329,9 @@ mod tests {
         assert_eq!(quantity("gap_1_2_m", 0.05), "50 mm");
         assert_eq!(quantity("peak_u1_m", 1.25), "1.25 m");
         assert_eq!(quantity("pga_g", 0.3), "0.3 g");
-        assert_eq!(quantity("b2_peak_drift_ratio", 0.005), "0.005");
+        assert_eq!(quantity("b2_peak_drift_ratio", 0.005), "0.5 %");
+        assert_eq!(quantity("b2_s3_residual_drift_ratio", 0.0125), "1.25 %");
+        assert_eq!(quantity("b2_peak_ductility", 2.5), "2.5");
         assert_eq!(quantity("impacts", 0.0), "0");
     }
 
@@ -353,7 +357,10 @@ mod tests {
         assert_eq!(caption(&f), "where t2_s=0.9, law!=hertz");
         assert_eq!(caption(&[]), "");
         assert_eq!(label("gap_1_2_m"), "gap 1-2 (m)");
-        assert_eq!(label("b2_peak_drift_ratio"), "peak drift ratio, building 2");
+        assert_eq!(
+            label("b2_peak_drift_ratio"),
+            "peak drift ratio, building 2 (m/m)"
+        );
         assert_eq!(
             label("b1_peak_accel_m_s2"),
             "peak floor acceleration, building 1 (m/s^2)"

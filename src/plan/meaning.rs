@@ -3,7 +3,8 @@
 //! named outright; a row's per-building (`b2_...`), per-gap (`gap_1_2_m`) and per-level
 //! (`level_b1f3_b2f3_...`) columns by pattern.
 
-/// A column's meaning, unit (`-` for counts, ratios and text) and short name (`label`: an axis
+/// A column's meaning, unit (`-` for counts, ratios and text; `m/m` for drift ratios, which
+/// plots and legends show in %) and short name (`label`: an axis
 /// label without its unit, a legend entry's name, a title's words).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Meaning {
@@ -200,11 +201,11 @@ const PER_BUILDING: [(&str, &str, &str, &str); 15] = [
     ("t1_s", "s", "period T1, building {k}", "fundamental period of building {k}"),
     ("xi", "-", "damping ratio, building {k}", "damping ratio of building {k}"),
     ("peak_roof_m", "m", "peak roof displacement, building {k}", "largest roof displacement of building {k} relative to the ground"),
-    ("peak_drift_ratio", "-", "peak drift ratio, building {k}", "largest interstorey drift ratio of building {k}"),
+    ("peak_drift_ratio", "m/m", "peak drift ratio, building {k}", "largest interstorey drift ratio of building {k}"),
     ("drift_storey", "-", "storey of peak drift, building {k}", "the storey of that drift (from 1)"),
     ("peak_accel_m_s2", "m/s^2", "peak floor acceleration, building {k}", "largest absolute floor acceleration of building {k}"),
     ("accel_floor", "-", "floor of peak acceleration, building {k}", "the floor of that acceleration (from 1)"),
-    ("residual_drift_ratio", "-", "residual drift ratio, building {k}", "largest residual interstorey drift ratio of building {k} at rest after the motion (yielding storeys; empty where the run did not settle)"),
+    ("residual_drift_ratio", "m/m", "residual drift ratio, building {k}", "largest residual interstorey drift ratio of building {k} at rest after the motion (yielding storeys; empty where the run did not settle)"),
     ("residual_storey", "-", "storey of residual drift, building {k}", "the storey of that residual drift (from 1)"),
     ("peak_ductility", "-", "peak ductility, building {k}", "largest storey ductility demand of building {k}: peak drift / yield drift"),
     ("ductility_storey", "-", "storey of peak ductility, building {k}", "the storey of that ductility (from 1)"),
@@ -295,7 +296,7 @@ pub fn meaning(column: &str) -> Option<Meaning> {
     if let Some((k, rest)) = column.strip_prefix('b').and_then(|r| r.split_once("_s")) {
         if let Some((j, suffix)) = rest.split_once('_') {
             let text = match suffix {
-                "residual_drift_ratio" => Some(("-", "residual drift ratio, building {k} storey {j}", "residual drift ratio of storey {j} of building {k} at rest after the motion, signed (empty where the run did not settle)")),
+                "residual_drift_ratio" => Some(("m/m", "residual drift ratio, building {k} storey {j}", "residual drift ratio of storey {j} of building {k} at rest after the motion, signed (empty where the run did not settle)")),
                 "peak_ductility" => Some(("-", "ductility, building {k} storey {j}", "ductility demand of storey {j} of building {k}: its peak drift / its yield drift")),
                 "hysteretic_energy_j" => Some(("J", "hysteretic energy, building {k} storey {j}", "hysteretic energy of storey {j} of building {k}")),
                 _ => None,
@@ -354,7 +355,7 @@ mod tests {
         assert!(m
             .text
             .contains("floor 3 of building 1 meets floor 2 of building 2"));
-        assert_eq!(meaning("b12_peak_drift_ratio").unwrap().unit, "-");
+        assert_eq!(meaning("b12_peak_drift_ratio").unwrap().unit, "m/m");
         for c in crate::plan::row::BUILDING_OUTPUTS
             .iter()
             .chain(&crate::plan::row::INELASTIC_OUTPUTS)

@@ -58,6 +58,19 @@ pub enum NoFit {
     Separated,
 }
 
+impl NoFit {
+    /// The reason in a few words, for a legend entry (the table and the notice give it whole).
+    pub fn short(&self) -> &'static str {
+        match self {
+            NoFit::NoneExceed => "none exceed",
+            NoFit::AllExceed => "all exceed",
+            NoFit::OneLevel => "one intensity",
+            NoFit::NonPositiveIm => "intensity <= 0",
+            NoFit::Separated => "counts separate perfectly",
+        }
+    }
+}
+
 /// Maximum-likelihood lognormal fragility through `levels`.
 pub fn fit(levels: &[Level]) -> Result<Fit, NoFit> {
     let lv: Vec<&Level> = levels.iter().filter(|l| l.n > 0).collect();
@@ -567,7 +580,7 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
         series.push(Series {
             name: match f {
                 Ok(_) => format!("{name}: observed"),
-                Err(e) => format!("{name}: observed (no fit: {e})"),
+                Err(e) => format!("{name}: observed (no fit: {})", e.short()),
             },
             points: lv
                 .iter()

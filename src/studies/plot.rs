@@ -70,7 +70,8 @@ fn marker<DB: DrawingBackend, C: Clone + 'static>(
 
 /// An axis label in engineering units for values up to `biggest`, and the factor that takes
 /// the values there: `(N)` to kN or MN, `(J)` to kJ or MJ, `(N/m)` to kN/m or MN/m, `(m)` below
-/// a metre to mm. Log axes keep their unit (their ticks are powers of ten).
+/// a metre to mm, a drift ratio `(m/m)` to %. Log axes keep their unit (their ticks are powers
+/// of ten).
 fn engineering(label: &str, biggest: f64, log: bool) -> (String, f64) {
     const LARGE: [(&str, [(&str, f64); 2]); 3] = [
         ("(N)", [("(MN)", 1e6), ("(kN)", 1e3)]),
@@ -88,6 +89,9 @@ fn engineering(label: &str, biggest: f64, log: bool) -> (String, f64) {
                 }
             }
         }
+    }
+    if let Some(stem) = label.strip_suffix("(m/m)") {
+        return (format!("{stem}(%)"), 1e2);
     }
     match label.strip_suffix("(m)") {
         Some(stem) if biggest < 1.0 => (format!("{stem}(mm)"), 1e3),
@@ -650,5 +654,8 @@ mod tests {
             e("beta (N/m^1.5)", 3e9, false),
             ("beta (N/m^1.5)".into(), 1.0)
         );
+        // Drift ratios in %, as engineers read them (a log axis keeps the ratio).
+        assert_eq!(e("drift (m/m)", 0.012, false), ("drift (%)".into(), 1e2));
+        assert_eq!(e("drift (m/m)", 0.012, true), ("drift (m/m)".into(), 1.0));
     }
 }

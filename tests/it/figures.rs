@@ -464,3 +464,59 @@ fn a_long_title_is_wrapped_on_a_narrow_panel() {
     assert_eq!(joined.join(" "), title);
     assert!(narrow.iter().all(|l| l.1 < wide[0].1), "{narrow:?} smaller");
 }
+
+/// A threshold whose curve cannot be fitted says why in a few words in its legend entry (the
+/// table gives the whole reason): the entry fits its legend box, where the whole reason ran
+/// past the box and out of the figure.
+#[test]
+fn a_failed_fit_is_named_briefly_in_the_legend() {
+    let dir = tempdir();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    // Every threshold's counts separate perfectly: none exceed below one intensity, all above.
+    let runs = dir.path().join("sep.csv");
+    std::fs::write(
+        &runs,
+        "run,status,pga_g,peak_force_n\n0,ok,0.1,0\n1,ok,0.1,0\n2,ok,0.2,5e5\n3,ok,0.2,2e6\n\
+         4,ok,0.3,2e6\n5,ok,0.3,3e6\n6,ok,0.4,3e6\n7,ok,0.4,4e6\n",
+    )
+    .unwrap();
+    let svg = dir.path().join("sep.svg");
+    let out = ok(&pound(&[
+        "fragility",
+        &s(&runs),
+        "--edp",
+        "peak_force_n",
+        "--threshold",
+        "0,1e6,3.5e6",
+        "-o",
+        &s(&dir.path().join("f.csv")),
+        "--plot",
+        &s(&svg),
+    ]));
+    assert!(out.contains("the counts separate perfectly (all below one intensity"));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let entries: Vec<&str> = text
+        .lines()
+        .filter(|l| l.contains("observed"))
+        .map(str::trim)
+        .collect();
+    assert_eq!(entries.len(), 3, "{entries:?}");
+    assert!(entries
+        .iter()
+        .all(|e| e.ends_with(": observed (no fit: counts separate perfectly)")));
+    // The legend's box, which plotters sizes to its longest entry, ends inside the plot area
+    // (the area ends 10 px from the 640 px figure's edge): the whole reason's entry filled the
+    // area and its text ran on out of the figure.
+    let els = elements(&text);
+    let legend = els
+        .iter()
+        .find(|e| e.starts_with("rect") && attr(e, "fill").as_deref() == Some("none"))
+        .expect("a legend");
+    let n = |k: &str| -> f64 { attr(legend, k).unwrap().parse().unwrap() };
+    assert!(
+        n("x") + n("width") < 630.0,
+        "legend from {} wide {}",
+        n("x"),
+        n("width")
+    );
+}
