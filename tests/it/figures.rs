@@ -131,18 +131,24 @@ fn check(path: &Path, entries: usize, shared: usize) {
     );
 }
 
+/// `pound sweep configs/quickstart.toml` into `dir`: the results' path.
+fn quickstart(dir: &Path) -> std::path::PathBuf {
+    let results = dir.join("q.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/quickstart.toml",
+        "-o",
+        results.to_str().unwrap(),
+    ]));
+    results
+}
+
 #[test]
 fn legends_cover_no_point_and_styles_are_distinct() {
     let dir = tempdir();
     let s = |p: &Path| p.to_str().unwrap().to_string();
     // Peak force against the gap, one line per period of building 2 (five series).
-    let results = dir.path().join("q.csv");
-    ok(&pound(&[
-        "sweep",
-        "configs/quickstart.toml",
-        "-o",
-        &s(&results),
-    ]));
+    let results = quickstart(dir.path());
     let plot = dir.path().join("q.svg");
     ok(&pound(&[
         "plot",
@@ -429,13 +435,7 @@ fn title_lines(svg: &str) -> Vec<(String, f64)> {
 fn a_long_title_is_wrapped_on_a_narrow_panel() {
     let dir = tempdir();
     let s = |p: &Path| p.to_str().unwrap().to_string();
-    let results = dir.path().join("q.csv");
-    ok(&pound(&[
-        "sweep",
-        "configs/quickstart.toml",
-        "-o",
-        &s(&results),
-    ]));
+    let results = quickstart(dir.path());
     let title = "Peak pounding force against the separation gap, the largest over every other parameter of the sweep";
     let draw = |size: &str| {
         let plot = dir.path().join(format!("{size}.svg"));

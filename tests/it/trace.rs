@@ -61,6 +61,15 @@ fn trace(dir: &std::path::Path, cfg: &std::path::Path, run: usize) -> (String, S
     (said, std::fs::read_to_string(&out).unwrap())
 }
 
+/// The cell of column `name` in a CSV `line` under the header line `head`.
+fn cell<'a>(head: &str, line: &'a str, name: &str) -> &'a str {
+    let c = head
+        .split(',')
+        .position(|c| c == name)
+        .unwrap_or_else(|| panic!("{name} in {head}"));
+    line.split(',').nth(c).unwrap()
+}
+
 #[test]
 fn a_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
     let dir = tempdir();
@@ -69,11 +78,7 @@ fn a_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
     std::fs::write(&cfg, PAIR).unwrap();
     let text = sweep(dir.path(), &cfg);
     let lines: Vec<&str> = text.lines().collect();
-    let head: Vec<&str> = lines[0].split(',').collect();
-    let col = |name: &str| head.iter().position(|c| *c == name).unwrap();
-    let cell = |line: &str, name: &str| -> f64 {
-        line.split(',').nth(col(name)).unwrap().parse().unwrap()
-    };
+    let cell = |line: &str, name: &str| -> f64 { cell(lines[0], line, name).parse().unwrap() };
     // Every run of the sweep that pounds (16 runs, several with many impacts).
     let pounding: Vec<usize> = (1..lines.len())
         .filter(|&i| cell(lines[i], "impacts") > 0.0)
@@ -129,13 +134,9 @@ fn a_row_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
     std::fs::write(&cfg, crate::multistorey::ROW_CONFIG).unwrap();
     let text = sweep(dir.path(), &cfg);
     let lines: Vec<&str> = text.lines().collect();
-    let head: Vec<&str> = lines[0].split(',').collect();
-    let col = |name: &str| head.iter().position(|c| *c == name).unwrap();
-    let cell = |line: &str, name: &str| -> f64 {
-        line.split(',').nth(col(name)).unwrap().parse().unwrap()
-    };
-    let levels: Vec<&str> = head
-        .iter()
+    let cell = |line: &str, name: &str| -> f64 { cell(lines[0], line, name).parse().unwrap() };
+    let levels: Vec<&str> = lines[0]
+        .split(',')
         .filter_map(|c| c.strip_suffix("_peak_force_n"))
         .filter(|c| c.starts_with("level_"))
         .collect();
@@ -209,11 +210,7 @@ fn a_yielding_row_trace_ends_at_its_sweep_rows_storey_outputs() {
     let cfg = std::path::Path::new("configs/inelastic-row.toml");
     let text = sweep(dir.path(), cfg);
     let lines: Vec<&str> = text.lines().collect();
-    let head: Vec<&str> = lines[0].split(',').collect();
-    let cell = |line: &str, name: &str| -> String {
-        let c = head.iter().position(|c| *c == name).unwrap();
-        line.split(',').nth(c).unwrap().to_string()
-    };
+    let cell = |line: &str, name: &str| cell(lines[0], line, name).to_string();
     let mut yielded = 0;
     for (run, &line) in lines[1..].iter().enumerate() {
         let (said, trace) = trace(dir.path(), cfg, run);

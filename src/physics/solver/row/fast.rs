@@ -153,7 +153,15 @@ fn mode_oscillator(m: &RowModel, k: usize) -> Oscillator {
     }
 }
 
-pub(crate) fn run(m: &RowModel, forcing: &Forcing, z0: Vec<f64>, o: &FastOptions) -> RowOutput {
+/// One run of the row from `z0`; `observer`, if any, hears every accepted step and event (the
+/// output is the same with or without one).
+pub(crate) fn run(
+    m: &RowModel,
+    forcing: &Forcing,
+    z0: Vec<f64>,
+    o: &FastOptions,
+    observer: Option<RowObserver<'_>>,
+) -> RowOutput {
     // Contact substeps run in floor coordinates where the damping allows (O(N) each), and only
     // for the buildings that contact may reach.
     let sub = m.substep_model();
@@ -165,29 +173,8 @@ pub(crate) fn run(m: &RowModel, forcing: &Forcing, z0: Vec<f64>, o: &FastOptions
         z0,
         o,
         false,
-        None,
-    )
-    .0
-}
-
-/// [`run`] with `observer` hearing every accepted step and event (the same output).
-pub(crate) fn run_observed(
-    m: &RowModel,
-    forcing: &Forcing,
-    z0: Vec<f64>,
-    o: &FastOptions,
-    observer: RowObserver<'_>,
-) -> RowOutput {
-    let sub = m.substep_model();
-    run_with(
-        m,
-        sub.as_ref(),
-        Standing::Grown,
-        forcing,
-        z0,
-        o,
-        false,
-        Some(observer),
+        // Shortened to the substep model's life (a coercion `Option` does not make itself).
+        observer.map(|o| o as RowObserver<'_>),
     )
     .0
 }

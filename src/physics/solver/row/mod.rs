@@ -1809,10 +1809,7 @@ pub fn simulate_row(
     z0: Vec<f64>,
     scheme: &RowScheme,
 ) -> RowOutput {
-    match scheme {
-        RowScheme::Fast(o) => fast::run(m, forcing, z0, o),
-        RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false, None),
-    }
+    simulate(m, forcing, z0, scheme, None)
 }
 
 /// As [`simulate_row`] (the same output), handing `observer` the row after every accepted step
@@ -1824,8 +1821,18 @@ pub fn simulate_row_observed(
     scheme: &RowScheme,
     observer: RowObserver<'_>,
 ) -> RowOutput {
+    simulate(m, forcing, z0, scheme, Some(observer))
+}
+
+fn simulate<'a>(
+    m: &'a RowModel,
+    forcing: &Forcing,
+    z0: Vec<f64>,
+    scheme: &RowScheme,
+    observer: Option<RowObserver<'a>>,
+) -> RowOutput {
     match scheme {
-        RowScheme::Fast(o) => fast::run_observed(m, forcing, z0, o, observer),
-        RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false, Some(observer)),
+        RowScheme::Fast(o) => fast::run(m, forcing, z0, o, observer),
+        RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false, observer),
     }
 }
