@@ -31,6 +31,11 @@ fn is_hertzian() -> bool {
     return K.law >= LAW_HERTZ;
 }
 
+// LawKind::force_depends_on_phase: damping acts only while the bodies approach.
+fn force_depends_on_phase() -> bool {
+    return K.law == LAW_MODIFIED_LINEAR || K.law == LAW_NONLINEAR_VISCOELASTIC;
+}
+
 fn is_hunt_crossley() -> bool {
     return K.law > LAW_NONLINEAR_VISCOELASTIC;
 }

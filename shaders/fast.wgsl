@@ -142,7 +142,8 @@ fn rk4(mode: u32, v0: real, seg: Seg, tau: real, z: Z, h: real) -> Z {
 
 struct Located { x: real, z: Z }
 
-// Illinois regula falsi with a guard probe; the step is re-taken by rk4 from (tau, z0).
+// events::locate: Illinois regula falsi with a guard probe, then bisections if the bracket is
+// still open; the step is re-taken by rk4 from (tau, z0).
 fn locate(h: real, f0: real, z1: Z, f1: real, tol: real,
           mode: u32, v0: real, seg: Seg, tau: real, z0: Z) -> Located {
     var a: real = 0.0;
@@ -151,10 +152,10 @@ fn locate(h: real, f0: real, z1: Z, f1: real, tol: real,
     var fb = f1;
     var zb = z1;
     var last = 0;
-    for (var it = 0u; it < LOCATE_ITER; it++) {
+    for (var it = 0u; it < LOCATE_ITER + LOCATE_BISECT; it++) {
         if (b - a <= tol) { break; }
         var x = 0.5 * (a + b);
-        if (fb != fa) {
+        if (it < LOCATE_ITER && fb != fa) {
             x = b - fb * (b - a) / (fb - fa);
         }
         if (!(x > a && x < b)) {
@@ -174,7 +175,7 @@ fn locate(h: real, f0: real, z1: Z, f1: real, tol: real,
             last = -1;
             g = x + 0.5 * tol;
         }
-        if (g > a && g < b) {
+        if (it < LOCATE_ITER && g > a && g < b) {
             let zg = rk4(mode, v0, seg, tau, z0, g);
             let fg = event_value(mode, v0, zg);
             if (fg > 0.0) {

@@ -52,6 +52,8 @@ var<private> TXW: array<real, NM>;
 var<private> PART: array<real, NM>;
 var<private> LMODE: array<u32, NLA>;
 var<private> LV0: array<real, NLA>;
+// Each level's event fires in the step being located (RowRun::firing).
+var<private> LFIRE: array<bool, NLA>;
 var<private> LAW: u32;
 var<private> REC_OFF: u32;
 var<private> REC_LEN: u32;
@@ -185,8 +187,18 @@ fn event_value(l: u32, mode: u32, v0: real, z: ptr<function, ZA>) -> real {
     switch mode {
         case MODE_FREE: { return g; }
         case MODE_APPROACH: { return -r; }
-        default: { return -g; }
+        default: {
+            if (force_depends_on_phase()) {
+                return max(-g, r);
+            }
+            return -g;
+        }
     }
+}
+
+// LevelModel::reapproaches: a restitution that closes again.
+fn reapproaches(l: u32, mode: u32, z: ptr<function, ZA>) -> bool {
+    return mode == MODE_RESTITUTION && ddelta(l, z) > 0.0;
 }
 
 // The fourth-derivative bound of one side's floor, mode by mode.
@@ -279,7 +291,7 @@ fn rk4(seg: Seg, tau: real, z: ptr<function, ZA>, h: real, out: ptr<function, ZA
     }
 }
 
-// RowRun::event_max: the largest of the levels' event values.
+// RowRun::event_max: the largest of the levels' and storeys' event values.
 fn event_max(z: ptr<function, ZA>) -> real {
     var m = -BIG;
     for (var l = 0u; l < NL; l++) {
@@ -289,6 +301,31 @@ fn event_max(z: ptr<function, ZA>) -> real {
         m = storey_event_max(z, m);
     }
     return m;
+}
+
+// RowRun::firing_max: the largest event value of the events that fire in the step's trial
+// (LFIRE, SFIRE), the function an event is located on.
+fn firing_max(z: ptr<function, ZA>) -> real {
+    var m = -BIG;
+    for (var l = 0u; l < NL; l++) {
+        if (LFIRE[l]) {
+            m = max(m, event_value(l, LMODE[l], LV0[l], z));
+        }
+    }
+    if (NS > 0u) {
+        m = storey_firing_max(z, m);
+    }
+    return m;
+}
+
+// RowRun::mark_firing: the events whose value is positive in z.
+fn mark_firing(z: ptr<function, ZA>) {
+    for (var l = 0u; l < NL; l++) {
+        LFIRE[l] = event_value(l, LMODE[l], LV0[l], z) > 0.0;
+    }
+    if (NS > 0u) {
+        storey_mark_firing(z);
+    }
 }
 
 // ---- row/mod.rs: RowRun ----
@@ -497,7 +534,7 @@ fn transitions(tau: real, z: ptr<function, ZA>, before: ptr<function, ZA>) {
         let mode = LMODE[l];
         let v0 = LV0[l];
         if (event_value(l, mode, v0, z) <= 0.0) {
-            if (mode == MODE_RESTITUTION && ddelta(l, z) > 0.0) {
+            if (reapproaches(l, mode, z)) {
                 LMODE[l] = MODE_APPROACH;
                 ENDS_VALID = false;
             }
@@ -519,6 +556,9 @@ fn transitions(tau: real, z: ptr<function, ZA>, before: ptr<function, ZA>) {
             LMODE[l] = next;
         } else if (mode == MODE_APPROACH) {
             LMODE[l] = MODE_RESTITUTION;
+        } else if (reapproaches(l, mode, z)) {
+            // Closing again: the same impact goes on.
+            LMODE[l] = MODE_APPROACH;
         } else {
             end_impact(l);
             LMODE[l] = MODE_FREE;
@@ -526,8 +566,9 @@ fn transitions(tau: real, z: ptr<function, ZA>, before: ptr<function, ZA>) {
     }
 }
 
-// events::locate (Illinois regula falsi with a guard probe) on the largest event value; the
-// step is re-taken by rk4 from (tau, z0). Returns the length, the state at it in `zb`.
+// events::locate (Illinois regula falsi with a guard probe, then bisections if the bracket
+// is still open) on the largest value of the events that fire; the step is re-taken by rk4
+// from (tau, z0). Returns the length, the state at it in `zb`.
 fn locate(h: real, f0: real, f1: real, tol: real, seg: Seg, tau: real, z0: ptr<function, ZA>,
           zb: ptr<function, ZA>) -> real {
     var a: real = 0.0;
@@ -536,17 +577,17 @@ fn locate(h: real, f0: real, f1: real, tol: real, seg: Seg, tau: real, z0: ptr<f
     var fb = f1;
     var last = 0;
     var zx: ZA;
-    for (var it = 0u; it < LOCATE_ITER; it++) {
+    for (var it = 0u; it < LOCATE_ITER + LOCATE_BISECT; it++) {
         if (b - a <= tol) { break; }
         var x = 0.5 * (a + b);
-        if (fb != fa) {
+        if (it < LOCATE_ITER && fb != fa) {
             x = b - fb * (b - a) / (fb - fa);
         }
         if (!(x > a && x < b)) {
             x = 0.5 * (a + b);
         }
         rk4(seg, tau, z0, x, &zx);
-        let fx = event_max(&zx);
+        let fx = firing_max(&zx);
         var g: real;
         if (fx > 0.0) {
             b = x; fb = fx; *zb = zx;
@@ -559,9 +600,9 @@ fn locate(h: real, f0: real, f1: real, tol: real, seg: Seg, tau: real, z0: ptr<f
             last = -1;
             g = x + 0.5 * tol;
         }
-        if (g > a && g < b) {
+        if (it < LOCATE_ITER && g > a && g < b) {
             rk4(seg, tau, z0, g, &zx);
-            let fg = event_max(&zx);
+            let fg = firing_max(&zx);
             if (fg > 0.0) {
                 b = g; fb = fg; *zb = zx;
             } else {
@@ -606,7 +647,8 @@ fn accept(tau: real, h_in: real, trial_in: ptr<function, ZA>, seg: Seg, z0: ptr<
         }
     }
     if (f1 > 0.0) {
-        let f0 = event_max(z0);
+        mark_firing(&trial);
+        let f0 = firing_max(z0);
         let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
         *out = trial;
         let x = locate(h, f0, f1, tol, seg, tau, z0, out);
@@ -619,8 +661,9 @@ fn accept(tau: real, h_in: real, trial_in: ptr<function, ZA>, seg: Seg, z0: ptr<
     }
     track(tau, h, z0, &trial, seg_at(seg, tau), seg_at(seg, tau + h));
     *out = trial;
+    // A level whose phase is not an event (the law's force does not depend on it).
     for (var l = 0u; l < NL; l++) {
-        if (LMODE[l] == MODE_RESTITUTION && ddelta(l, out) > 0.0) {
+        if (reapproaches(l, LMODE[l], out)) {
             LMODE[l] = MODE_APPROACH;
             ENDS_VALID = false;
         }

@@ -92,9 +92,10 @@ struct Tally {
 struct Seg { a0: real, a1: real, dt: real }
 
 // Settings of the fast scheme both integrating stages share (fast.wgsl, row.wgsl):
-// fast::MAX_PIECES_PER_SUBSTEP, fast::SUSTAINED, and the event location's tolerance and
-// iterations.
+// fast::MAX_PIECES_PER_SUBSTEP, fast::SUSTAINED, and the event location's tolerance,
+// iterations and bisections after them.
 const MAX_PIECES_PER_SUBSTEP: u32 = 64u;
 const SUSTAINED: real = 2.0;
 const LOCATE_TOL: real = 1e-9;
 const LOCATE_ITER: u32 = 16u;
+const LOCATE_BISECT: u32 = 32u;

@@ -19,6 +19,8 @@ const SM_DOWN: u32 = 2u;
 
 // Each storey's spring state (StoreyMode), and whether the run has settled.
 var<private> SM: array<u32, NSA>;
+// Each storey's event fires in the step being located (RowRun::firing).
+var<private> SFIRE: array<bool, NSA>;
 var<private> SETTLED: u32;
 // The last record step of a run that has not settled (yielding::settle_intervals).
 var<private> END: u32;
@@ -76,6 +78,25 @@ fn storey_event_max(z: ptr<function, ZA>, m_in: real) -> real {
         m = max(m, e);
     }
     return m;
+}
+
+// The storeys' part of RowRun::firing_max, from `m` (the levels').
+fn storey_firing_max(z: ptr<function, ZA>, m_in: real) -> real {
+    var m = m_in;
+    for (var s = 0u; s < NS; s++) {
+        if (SFIRE[s]) {
+            let e = storey_event(s, SM[s], storey_drift(s, z, 0u), storey_drift(s, z, NM), (*z)[PS0 + s]);
+            m = max(m, e);
+        }
+    }
+    return m;
+}
+
+// The storeys' part of RowRun::mark_firing.
+fn storey_mark_firing(z: ptr<function, ZA>) {
+    for (var s = 0u; s < NS; s++) {
+        SFIRE[s] = storey_event(s, SM[s], storey_drift(s, z, 0u), storey_drift(s, z, NM), (*z)[PS0 + s]) > 0.0;
+    }
 }
 
 // row::plastic_rhs: each plastic load on the modal accelerations; while a storey yields, its

@@ -100,6 +100,10 @@ pub fn run(a: Args) -> Result<()> {
     let points = accuracy::study_plan(&plan, ctx.as_ref(), &settings, tol, |l| {
         let _ = super::say_text(&format!("{l}\n"));
     })?;
+    // Every run whose error rose with more substeps, by name: a p99 hides the run that jumps.
+    for line in points.not_converging() {
+        say!("{line}");
+    }
     write_file(&output, points.csv().as_bytes())?;
     if let Some(p) = plot {
         super::save_plot(&p, &points.panels(), 2, &figure)?;
@@ -110,7 +114,7 @@ pub fn run(a: Args) -> Result<()> {
         .into_iter()
         .map(|verdict| Measured { verdict, runs })
         .collect();
-    check_targets(&choices, &measured, &config)
+    check_targets(&choices, &measured, &config, suite)
 }
 
 /// One path at one setting, as `--target-error` judges it, of a study of `runs` runs.
@@ -133,7 +137,7 @@ impl Measured {
                 "no run was compared (of {}, none pounded with the reference's impact count)",
                 self.runs
             ))
-        } else if self.verdict.force_p99.is_nan() || self.verdict.force_p99 > target {
+        } else if self.verdict.p99.is_nan() || self.verdict.p99 > target {
             Some(format!("p99 above {target:e}"))
         } else {
             None
@@ -148,6 +152,7 @@ fn check_targets(
     choices: &[pounding::physics::solver::calibration::Choice],
     measured: &[Measured],
     config: &std::path::Path,
+    suite: pounding::physics::solver::calibration::Suite,
 ) -> Result<()> {
     let mut missed = Vec::new();
     for c in choices {
@@ -157,11 +162,12 @@ fn check_targets(
         }) {
             let short = m.short_of(c.target);
             say!(
-                "--target-error {:e}: {} substeps per contact, {}: p99 peak-force error {:.2e} over {} runs compared, {} failed ({})",
+                "--target-error {:e}: {} substeps per contact, {}: {} {:.2e} over {} runs compared, {} failed ({})",
                 c.target,
                 c.substeps_per_contact,
                 m.verdict.path,
-                m.verdict.force_p99,
+                suite.measure(),
+                m.verdict.p99,
                 m.verdict.compared,
                 m.verdict.failed,
                 match &short {

@@ -490,13 +490,15 @@ pub fn target_error_in(
     }
     let c = for_target_in(suite, target).map_err(|best| {
         anyhow::anyhow!(
-            "--target-error {target:e}: below what the fast scheme is calibrated for on {} (its smallest p99 peak-force error is {best:.1e}); use a larger target, or the reference scheme (--scheme reference)",
-            suite.config()
+            "--target-error {target:e}: below what the fast scheme is calibrated for on {} (its smallest {} is {best:.1e}); use a larger target, or the reference scheme (--scheme reference)",
+            suite.config(),
+            suite.measure()
         )
     })?;
     note!(
-        "--target-error {target:e}: {} RK4 substeps per contact (p99 peak-force error {:.1e} on {}, measured by pound accuracy)",
+        "--target-error {target:e}: {} RK4 substeps per contact ({} {:.1e} on {}, measured by pound accuracy)",
         c.substeps_per_contact,
+        suite.measure(),
         c.calibrated_p99,
         suite.config()
     );

@@ -84,6 +84,15 @@ impl LawKind {
         )
     }
 
+    /// The force differs between approach and restitution (damping acts only while the
+    /// bodies approach): the phase is then part of the motion, and its change is located.
+    pub fn force_depends_on_phase(self) -> bool {
+        matches!(
+            self,
+            LawKind::ModifiedLinear | LawKind::NonlinearViscoelastic
+        )
+    }
+
     /// Uses an impact damping ratio `zeta(e)` from a restitution formula.
     pub fn uses_zeta(self) -> bool {
         matches!(

@@ -93,6 +93,7 @@ impl Plan {
         use crate::physics::solver::calibration::Suite;
         match self {
             Plan::Pair(_) => Suite::Pairs,
+            Plan::Row(_) if self.yields() => Suite::YieldingRows,
             Plan::Row(_) => Suite::Rows,
         }
     }

@@ -347,6 +347,12 @@ pub struct RowPoint {
     /// above): the largest count difference, and the largest relative peak-force error.
     pub count_gap_max: u32,
     pub differing_force_max: f64,
+    /// The runs whose error rose with this setting: above [`SLACK`] times the larger of
+    /// their errors at the two settings before (and the floor, [`rise_floor`]; two, so that
+    /// an error that one setting left small by chance, its parts cancelling, is not taken
+    /// for the trend), each with the error it rose from. A run's error is its worst relative
+    /// error over the quantities compared ([`run_error`]).
+    pub not_converging: Vec<Rise>,
     /// Where storeys yield: median and p99 of the residual drift ratio's error against the
     /// building's peak drift ratio (a residual near 0 has no relative error of its own), then
     /// of the peak ductility's relative error, over the yielding buildings of the runs
@@ -354,16 +360,118 @@ pub struct RowPoint {
     pub yielding: Option<[f64; 4]>,
 }
 
+/// A run whose error rose from one setting to the next (`pound accuracy` names each).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rise {
+    /// The run's number, as in the sweep's `run` column.
+    pub run: u64,
+    pub previous_setting: f64,
+    pub previous_error: f64,
+    pub error: f64,
+}
+
+/// How much a run's error may grow from one setting to the next before it is reported as not
+/// converging: the fast scheme's error falls at order 3 to 4, so a rise of 3x is no wobble
+/// of an error that converges (the CI check, `tests/it/convergence.rs`, holds every run of its
+/// yielding scenes to it).
+pub const SLACK: f64 = 3.0;
+
+/// The error below which settings are not told apart against a reference at tolerance `tol`:
+/// `100 tol`, and no less than 1e-6 (where the peaks of free record steps, interpolated by a
+/// quintic Hermite, the same at every setting, leave the error).
+pub fn rise_floor(tol: f64) -> f64 {
+    (100.0 * tol).max(1e-6)
+}
+
+/// A run's worst relative error against the reference's run: peak force (where it pounds) and
+/// each building's peak roof displacement, drift ratio and, where storeys yield, ductility
+/// and residual drift (against the peak drift). None where it cannot be compared: either run
+/// failed, or their impact counts differ.
+pub fn run_error(
+    t: &crate::physics::row::RowOutput,
+    o: &crate::physics::row::RowOutput,
+) -> Option<f64> {
+    if o.status != Status::Ok || t.status != Status::Ok || t.impacts != o.impacts {
+        return None;
+    }
+    let mut e = if t.impacts > 0 {
+        rel(o.peak_force, t.peak_force)
+    } else {
+        0.0
+    };
+    for (bt, bo) in t.buildings.iter().zip(&o.buildings) {
+        e = e
+            .max(rel(bo.peak_roof, bt.peak_roof))
+            .max(rel(bo.peak_drift_ratio, bt.peak_drift_ratio));
+        if let (Some(yt), Some(yo)) = (bt.inelastic, bo.inelastic) {
+            e = e.max(rel(yo.peak_ductility, yt.peak_ductility));
+            if yt.residual_drift_ratio.is_finite() && yo.residual_drift_ratio.is_finite() {
+                e = e.max(
+                    (yo.residual_drift_ratio - yt.residual_drift_ratio).abs()
+                        / bt.peak_drift_ratio.max(f64::MIN_POSITIVE),
+                );
+            }
+        }
+    }
+    Some(e)
+}
+
+/// The runs whose error `errors` (per run; None where not compared) rose above [`SLACK`] times
+/// the larger of their errors at the last two settings of `before` (each a setting and its
+/// errors) and above `floor`.
+pub fn rises(before: &[(f64, Vec<Option<f64>>)], errors: &[Option<f64>], floor: f64) -> Vec<Rise> {
+    let mut out = Vec::new();
+    for (run, e1) in errors.iter().enumerate() {
+        let Some(e1) = *e1 else { continue };
+        // The larger error of the two settings before, where compared there.
+        let Some((previous_setting, e0)) = (before.iter().rev().take(2))
+            .filter_map(|(s, e)| e.get(run).copied().flatten().map(|e| (*s, e)))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+        else {
+            continue;
+        };
+        if e1 > SLACK * e0.max(floor) {
+            out.push(Rise {
+                run: run as u64,
+                previous_setting,
+                previous_error: e0,
+                error: e1,
+            });
+        }
+    }
+    out
+}
+
 /// The further columns of [`row_markdown`] where storeys yield.
 const YIELDING_COLUMNS: &str =
     " residual drift med | residual drift p99 | ductility med | ductility p99 |";
 
 /// The columns of [`row_markdown`].
-pub const ROW_MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | force med | force p99 | roof med | roof p99 | drift med | drift p99 | accel med | accel p99 | impacts differ | failed | residual med | residual p99 | count gap max | differing force max |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
+pub const ROW_MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | force med | force p99 | roof med | roof p99 | drift med | drift p99 | accel med | accel p99 | impacts differ | failed | residual med | residual p99 | count gap max | differing force max | not converging |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|";
 
 impl RowPoint {
+    /// The p99 that `--target-error` calibrates on rows: the peak force's, and where storeys
+    /// yield the largest of the peak force's, drift's, residual drift's and ductility's
+    /// (`calibration::Suite::YieldingRows`).
+    pub fn calibrated_p99(&self) -> f64 {
+        match self.yielding {
+            Some([_, residual, _, ductility]) => {
+                [self.force[1], self.drift[1], residual, ductility]
+                    .into_iter()
+                    .fold(f64::NEG_INFINITY, |m, x| {
+                        if x.is_nan() || m.is_nan() {
+                            f64::NAN
+                        } else {
+                            m.max(x)
+                        }
+                    })
+            }
+            None => self.force[1],
+        }
+    }
+
     /// The numbers of a table line and a CSV line, in column order after the path.
-    fn numbers(&self) -> [f64; 16] {
+    fn numbers(&self) -> [f64; 17] {
         [
             self.substeps_per_contact,
             self.runs_per_second,
@@ -381,6 +489,7 @@ impl RowPoint {
             self.residual[1],
             self.count_gap_max as f64,
             self.differing_force_max,
+            self.not_converging.len() as f64,
         ]
     }
 }
@@ -392,7 +501,7 @@ pub fn row_markdown(p: &RowPoint) -> String {
         .iter()
         .enumerate()
         .map(|(i, x)| match i {
-            0 | 11 | 14 => format!("{x}"),
+            0 | 11 | 14 | 16 => format!("{x}"),
             1 => format!("{x:.0}"),
             10 => format!("{:.2} %", 100.0 * x),
             _ => figure(*x),
@@ -488,6 +597,7 @@ pub fn row_study(
             residual: med_p99(r),
             count_gap_max: gap_max,
             differing_force_max: differing_force,
+            not_converging: Vec::new(),
             yielding: yields.then(|| {
                 let ([r0, r1], [m0, m1]) = (med_p99(res), med_p99(mu));
                 [r0, r1, m0, m1]
@@ -497,13 +607,22 @@ pub fn row_study(
     let (truth, rate) = solve(Scheme::Reference(ReferenceOptions::with_tol(tol)));
     let mut points = vec![point("reference", 0.0, rate, &truth, &truth)];
     each(&points[0]);
+    // Each run's errors at the two settings before, to find the runs whose error rises.
+    let mut before: Vec<(f64, Vec<Option<f64>>)> = Vec::new();
+    let floor = rise_floor(tol);
     for &s in settings {
         let (out, rate) = solve(Scheme::Fast(FastOptions {
             substeps_per_contact: s,
             energy: true,
             ..FastOptions::default()
         }));
-        points.push(point("cpu-fast-f64", s, rate, &truth, &out));
+        let mut p = point("cpu-fast-f64", s, rate, &truth, &out);
+        let errors: Vec<Option<f64>> = (truth.iter().zip(&out))
+            .map(|(t, o)| run_error(t, o))
+            .collect();
+        p.not_converging = rises(&before, &errors, floor);
+        before.push((s, errors));
+        points.push(p);
         each(points.last().expect("pushed"));
     }
     points
@@ -584,7 +703,7 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
 
 /// The multi-storey study's points as CSV.
 pub fn row_csv(points: &[RowPoint]) -> String {
-    let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99,count_gap_max,differing_force_max");
+    let mut s = String::from("path,substeps_per_contact,runs_per_s,force_median,force_p99,roof_median,roof_p99,drift_median,drift_p99,accel_median,accel_p99,impact_count_differs,failed,residual_median,residual_p99,count_gap_max,differing_force_max,not_converging");
     if points.iter().any(|p| p.yielding.is_some()) {
         s.push_str(",residual_drift_median,residual_drift_p99,ductility_median,ductility_p99");
     }
@@ -607,18 +726,37 @@ pub enum Points {
     Rows(Vec<RowPoint>),
 }
 
-/// One path at one setting as `--target-error` judges it: its p99 relative peak-force error
-/// (NaN over no compared run), the runs that failed here or in the reference, the runs compared.
+/// One path at one setting as `--target-error` judges it: the p99 of what the scene's
+/// calibration measures (NaN over no compared run; [`crate::physics::solver::calibration::Suite::measure`]),
+/// the runs that failed here or in the reference, the runs compared.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Verdict {
     pub path: String,
     pub substeps_per_contact: f64,
-    pub force_p99: f64,
+    pub p99: f64,
     pub failed: u64,
     pub compared: u64,
 }
 
 impl Points {
+    /// Each run whose error rose from one setting to the next, in words (rows).
+    pub fn not_converging(&self) -> Vec<String> {
+        let Points::Rows(points) = self else {
+            return Vec::new();
+        };
+        points
+            .iter()
+            .flat_map(|p| {
+                p.not_converging.iter().map(move |r| {
+                    format!(
+                        "not converging: run {} at {} substeps per contact, error {:.1e} after {:.1e} at {}",
+                        r.run, p.substeps_per_contact, r.error, r.previous_error, r.previous_setting
+                    )
+                })
+            })
+            .collect()
+    }
+
     pub fn csv(&self) -> String {
         match self {
             Points::Pairs(p) => csv(p),
@@ -640,7 +778,7 @@ impl Points {
                 .map(|p| Verdict {
                     path: p.path.clone(),
                     substeps_per_contact: p.substeps_per_contact,
-                    force_p99: p.errors.force_p99,
+                    p99: p.errors.force_p99,
                     failed: p.errors.failed,
                     compared: p.errors.compared,
                 })
@@ -650,7 +788,7 @@ impl Points {
                 .map(|p| Verdict {
                     path: p.path.clone(),
                     substeps_per_contact: p.substeps_per_contact,
-                    force_p99: p.force[1],
+                    p99: p.calibrated_p99(),
                     failed: p.failed,
                     compared: p.compared,
                 })
@@ -710,4 +848,89 @@ pub fn study_plan(
         Plan::Pair(p) => Points::Pairs(study(p, ctx, settings, tol, |p| line(markdown_row(p)))?),
         Plan::Row(r) => Points::Rows(row_study(r, settings, tol, |p| line(row_markdown(p)))),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::row::{BuildingOutput, InelasticOutput, RowOutput};
+
+    #[test]
+    fn a_run_whose_error_rises_is_named_and_a_chance_dip_is_not() {
+        let floor = 1e-6;
+        let before = vec![
+            (8.0, vec![Some(1e-4), Some(1e-4), Some(1e-9), None]),
+            (16.0, vec![Some(1e-5), Some(1e-8), Some(1e-9), Some(1e-5)]),
+        ];
+        // Run 0 jumps (issue 46's run 5: 4.4e-6 at 64, then 7.5e-4); run 1 was small by chance
+        // at 16 and is back on its trend; run 2 rises, but within 3 times the floor; run 3 was
+        // not compared at 8; run 4 has no error before.
+        let now = [
+            Some(1e-3),
+            Some(2e-5),
+            Some(2.9e-6),
+            Some(3.1e-5),
+            Some(1.0),
+        ];
+        let r = rises(&before, &now, floor);
+        assert_eq!(
+            r,
+            vec![
+                Rise {
+                    run: 0,
+                    previous_setting: 8.0,
+                    previous_error: 1e-4,
+                    error: 1e-3
+                },
+                Rise {
+                    run: 3,
+                    previous_setting: 16.0,
+                    previous_error: 1e-5,
+                    error: 3.1e-5
+                },
+            ]
+        );
+        // Only the last two settings count: a large error three settings back does not hide a
+        // rise.
+        let mut longer = before.clone();
+        longer.insert(0, (4.0, vec![Some(1.0); 4]));
+        assert_eq!(rises(&longer, &now, floor), r);
+        assert!(rises(&[], &now, floor).is_empty());
+    }
+
+    #[test]
+    fn a_runs_error_is_its_worst_quantity() {
+        let building = |drift: f64, residual: f64| BuildingOutput {
+            peak_roof: 0.1,
+            peak_drift_ratio: drift,
+            peak_accel: 3.0,
+            inelastic: Some(InelasticOutput {
+                residual_drift_ratio: residual,
+                peak_ductility: drift / 0.005,
+                ..InelasticOutput::default()
+            }),
+            ..BuildingOutput::default()
+        };
+        let run = |force: f64, residual: f64| RowOutput {
+            impacts: 3,
+            peak_force: force,
+            buildings: vec![building(0.02, residual)],
+            ..RowOutput::default()
+        };
+        let truth = run(1e6, 0.004);
+        assert_eq!(run_error(&truth, &truth), Some(0.0));
+        // The residual drift's error is against the peak drift: 2e-6 / 0.02.
+        let e = run_error(&truth, &run(1e6 * (1.0 + 1e-6), 0.004 + 2e-6)).unwrap();
+        assert!((e - 1e-4).abs() < 1e-12, "{e}");
+        // A residual that did not settle on either side is left out, not a NaN error.
+        let unsettled = run(1e6, f64::NAN);
+        assert_eq!(run_error(&unsettled, &unsettled), Some(0.0));
+        // Different impact counts or a failed run: not compared.
+        let mut other = run(1e6, 0.004);
+        other.impacts = 4;
+        assert_eq!(run_error(&truth, &other), None);
+        other.impacts = 3;
+        other.status = Status::StepLimit;
+        assert_eq!(run_error(&truth, &other), None);
+    }
 }

@@ -15,7 +15,11 @@ use pounding::physics::solver::row::{simulate_row, RowModel, RowScheme};
 use pounding::physics::solver::FastOptions;
 
 /// Every model on the test device, each on its own record of `records`.
-fn on_gpu(models: &[RowModel], records: &[Vec<f64>], opts: &GpuOptions) -> Vec<Option<RowOutput>> {
+pub(crate) fn on_gpu(
+    models: &[RowModel],
+    records: &[Vec<f64>],
+    opts: &GpuOptions,
+) -> Vec<Option<RowOutput>> {
     let ctx = ctx().unwrap();
     let refs: Vec<&[f64]> = records.iter().map(|r| &r[..]).collect();
     let recs = GpuRecords::upload(ctx, opts.precision, &refs).unwrap();

@@ -3,6 +3,7 @@
 mod accuracy;
 mod cli;
 mod config;
+mod convergence;
 mod damage;
 mod fast_vs_reference;
 mod fidelity;

@@ -733,12 +733,31 @@ fn accuracy_of_a_row_config() {
     assert_eq!(rows[0][0], "reference");
     // Runs whose impact count differs are reported by their largest count difference and
     // peak-force error (none for the reference against itself).
-    assert_eq!(&rows[0][15..], ["0", "0"]);
+    assert_eq!(&rows[0][15..17], ["0", "0"]);
     for r in &rows[1..] {
         let gap: u32 = r[15].parse().unwrap();
         let force: f64 = r[16].parse().unwrap();
         assert_eq!(gap == 0, force == 0.0 && r[11] == "0", "{table}");
     }
+    // The runs whose error rose with the setting (issue 46): none at the first setting, which
+    // has none before it; every row counts them.
+    let header = csv::Reader::from_path(&out)
+        .unwrap()
+        .headers()
+        .unwrap()
+        .clone();
+    assert_eq!(&header[17], "not_converging");
+    assert_eq!(&rows[0][17], "0");
+    assert_eq!(&rows[1][17], "0");
+    let rose: usize = rows[2][17].parse().unwrap();
+    assert_eq!(
+        rose,
+        table
+            .lines()
+            .filter(|l| l.starts_with("not converging: run"))
+            .count(),
+        "{table}"
+    );
     let p99 = |r: &[String], col: usize| r[col].parse::<f64>().unwrap();
     // Columns: force p99 (4), roof p99 (6), drift p99 (8).
     for col in [4, 6, 8] {

@@ -21,7 +21,7 @@ use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::Propagator;
 use crate::physics::row::{BuildingOutput, LevelOutput, RowOutput, StoreyOutput};
-use crate::physics::solver::fast::LOCATE_ITERATIONS;
+use crate::physics::solver::fast::{LOCATE_BISECTIONS, LOCATE_ITERATIONS};
 use crate::physics::solver::row::yielding::settle_intervals;
 use crate::physics::solver::row::{simulate_row, RowModel, RowScheme};
 use crate::physics::solver::FastOptions;
@@ -387,7 +387,7 @@ impl RowShape {
         let track = 5 * nm + 2 * forces + 2 * sq + nl + nm + nl * (3 * level);
         let track = track + 2 * (storeys + ns * nmax) + ns;
         let transitions = nl * (3 * level) + storeys;
-        let locate = LOCATE_ITERATIONS as u64 * (2 * (rk4 + event_max) + 1);
+        let locate = (2 * LOCATE_ITERATIONS + LOCATE_BISECTIONS) as u64 * (rk4 + event_max + 1);
         let accept = 4 * event_max + nl * (2 * level) + rk4 + locate + track + transitions;
         let accept = accept + storeys;
         let piece = rk4 + accept + zlen;

@@ -1,6 +1,7 @@
 //! Locating the non-smooth instants inside a step: first touch, the turn, separation, and a
 //! touch hidden inside a free step; the mode change each calls for.
 
+use super::fast::LOCATE_BISECTIONS;
 use super::hermite::{cubic_max_bound, hermite_range, CUBIC_SLOPE_WEIGHT};
 use super::tracker::Tracker;
 use super::{ddelta, delta, force, Mode, Segment, State};
@@ -20,8 +21,11 @@ pub(crate) fn event_value(p: &Pair, mode: Mode, v0: f64, z: &State) -> f64 {
 /// Regula falsi (Illinois) for the first instant in `(0, h]` where `f > 0`, given
 /// `f(0) <= 0 < f(h)`. `step(x)` re-takes the step with length `x`. Each estimate is followed
 /// by a guard probe `tol` beyond it (towards the other end), which closes the bracket at once
-/// when the estimate is good and keeps regula falsi from stalling on one side. Returns the length
-/// and state on the far side of the event, so the next mode starts with a consistent sign.
+/// when the estimate is good and keeps regula falsi from stalling on one side. If `max_iter`
+/// such iterations leave the bracket wider than `tol` (a function regula falsi cannot model,
+/// e.g. one that is 0 where the step starts), up to [`LOCATE_BISECTIONS`] bisections close it:
+/// an event is never taken late by more than `tol`. Returns the length and state on the far
+/// side of the event, so the next mode starts with a consistent sign.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn locate<S>(
     h: f64,
@@ -36,11 +40,11 @@ pub(crate) fn locate<S>(
     let (mut a, mut fa) = (0.0, f0.min(0.0));
     let (mut b, mut fb, mut zb) = (h, f1, z1);
     let mut last = 0i8;
-    for _ in 0..max_iter {
+    for it in 0..max_iter + LOCATE_BISECTIONS {
         if b - a <= tol {
             break;
         }
-        let mut x = if fb != fa {
+        let mut x = if it < max_iter && fb != fa {
             b - fb * (b - a) / (fb - fa)
         } else {
             0.5 * (a + b)
@@ -65,7 +69,7 @@ pub(crate) fn locate<S>(
             last = -1;
             x + 0.5 * tol
         };
-        if g > a && g < b {
+        if it < max_iter && g > a && g < b {
             let zg = step(g);
             let fg = eval(&zg);
             if fg > 0.0 {

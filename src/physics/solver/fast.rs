@@ -64,6 +64,10 @@ pub const SUSTAINED: f64 = 2.0;
 pub const LOCATE_TOLERANCE: f64 = 1e-9;
 pub const LOCATE_ITERATIONS: u32 = 16;
 
+/// Bisections after event location's regula falsi iterations (in every scheme), enough to
+/// close any bracket to its tolerance (`LOCATE_BISECT` in the shaders).
+pub const LOCATE_BISECTIONS: u32 = 32;
+
 /// Accepted pieces one substep may be cut into by events before the run ends with
 /// `step_limit` (a guard against a stalled event search; the shader has the same cap).
 pub const MAX_PIECES_PER_SUBSTEP: u32 = 64;
