@@ -76,7 +76,8 @@ pub enum Cmd {
     /// Runs per second of the CPU and GPU paths on the same sweeps, with where time goes.
     Bench(bench::Args),
     /// Speed against error of every path and accuracy setting on a benchmark sweep, against the
-    /// reference solved once.
+    /// reference solved once; on rows, each run whose error rose with the setting is named
+    /// ("not converging").
     Accuracy(accuracy::Args),
     /// Impact damping zeta(e) of every formula, and `exact` per law.
     Formulas(formulas::Args),
