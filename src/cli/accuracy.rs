@@ -63,7 +63,12 @@ pub fn run(a: Args) -> Result<()> {
         .map(|e| super::target_error_in(suite, e))
         .collect::<Result<Vec<_>>>()?;
     let settings = if choices.is_empty() {
-        settings
+        // In increasing order, each once: a run's error is judged against the coarser settings
+        // before it ("not converging").
+        let mut s = settings;
+        s.sort_by(f64::total_cmp);
+        s.dedup();
+        s
     } else {
         // Targets may come in any order and share a setting: each setting runs once.
         let mut s: Vec<f64> = choices.iter().map(|c| c.substeps_per_contact).collect();
@@ -103,7 +108,16 @@ pub fn run(a: Args) -> Result<()> {
         let _ = super::say_text(&format!("{l}\n"));
     })?;
     // Every run whose error rose with more substeps, by name: a p99 hides the run that jumps.
-    for line in points.not_converging() {
+    let rising = points.not_converging();
+    if !rising.is_empty() {
+        say!(
+            "not converging: {} run(s) whose error (a run's worst relative error over peak force, roof, drift, ductility and residual drift) rose above {} times the larger of its errors at the two settings before, and above {:.0e} (100 --tol, at least 1e-6):",
+            rising.len(),
+            accuracy::SLACK,
+            accuracy::rise_floor(tol)
+        );
+    }
+    for line in rising {
         say!("{line}");
     }
     write_file(&output, points.csv().as_bytes())?;

@@ -749,8 +749,8 @@ impl Points {
             .flat_map(|p| {
                 p.not_converging.iter().map(move |r| {
                     format!(
-                        "not converging: run {} at {} substeps per contact, error {:.1e} after {:.1e} at {}",
-                        r.run, p.substeps_per_contact, r.error, r.previous_error, r.previous_setting
+                        "not converging: run {}, error rose from {:.1e} at {} to {:.1e} at {} substeps per contact",
+                        r.run, r.previous_error, r.previous_setting, r.error, p.substeps_per_contact
                     )
                 })
             })

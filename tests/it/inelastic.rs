@@ -477,11 +477,39 @@ fn target_error_on_yielding_rows_reads_their_own_calibration() {
         csv.to_str().unwrap(),
     ]));
     assert!(
-        checked.contains("--target-error 1e-7: 192 substeps per contact, cpu-fast-f64: p99 error")
+        checked.contains(
+            "--target-error 1e-7: 192 substeps per contact, cpu-fast-f64: largest p99 error of peak force, drift, residual drift and ductility"
+        )
             && checked.contains("(met)"),
         "{checked}"
     );
     assert!(!checked.contains("not converging: run"), "{checked}");
+}
+
+/// `pound accuracy` takes its settings in increasing order, each once: a run's error is judged
+/// against the coarser settings before it, so `--settings 64,8,8` (a new user's order) must
+/// not report every run as "not converging" at 8 (it did) nor run 8 twice.
+#[test]
+fn accuracy_settings_are_taken_coarse_to_fine_once_each() {
+    let dir = tempdir();
+    let csv = dir.path().join("accuracy.csv");
+    let out = ok(&pound(&[
+        "accuracy",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/configs/inelastic-row.toml"),
+        "--backend",
+        "cpu",
+        "--settings",
+        "64,8,8",
+        "-o",
+        csv.to_str().unwrap(),
+    ]));
+    let settings: Vec<String> = table(&csv)
+        .iter()
+        .filter(|r| r["path"] == "cpu-fast-f64")
+        .map(|r| r["substeps_per_contact"].clone())
+        .collect();
+    assert_eq!(settings, ["8", "64"], "{out}");
+    assert!(!out.contains("not converging:"), "{out}");
 }
 
 /// A yield drift ratio given as a range is an axis (every storey the value of the run), and a

@@ -124,7 +124,7 @@ impl Suite {
         match self {
             Suite::Pairs | Suite::Rows => "p99 peak-force error",
             Suite::YieldingRows => {
-                "p99 error (the largest of peak force, drift, residual drift and ductility)"
+                "largest p99 error of peak force, drift, residual drift and ductility"
             }
         }
     }
