@@ -195,11 +195,13 @@ const ENERGY: [(&str, &str, &str, &str); 2] = [
 ];
 
 /// Per building `k`: suffix, unit, short name, meaning.
-const PER_BUILDING: [(&str, &str, &str, &str); 15] = [
+const PER_BUILDING: [(&str, &str, &str, &str); 17] = [
     ("storeys", "-", "storeys, building {k}", "storeys of building {k}"),
     ("mass_kg", "kg", "floor mass, building {k}", "floor mass of building {k} (empty where floor masses are given)"),
     ("t1_s", "s", "period T1, building {k}", "fundamental period of building {k}"),
     ("xi", "-", "damping ratio, building {k}", "damping ratio of building {k}"),
+    ("yield_drift_ratio", "m/m", "yield drift ratio, building {k}", "yield drift ratio of every storey of building {k} (swept or sampled)"),
+    ("yield_base_shear_coefficient", "-", "base shear strength, building {k}", "base shear strength of building {k} over its weight (swept or sampled)"),
     ("peak_roof_m", "m", "peak roof displacement, building {k}", "largest roof displacement of building {k} relative to the ground"),
     ("peak_drift_ratio", "m/m", "peak drift ratio, building {k}", "largest interstorey drift ratio of building {k}"),
     ("drift_storey", "-", "storey of peak drift, building {k}", "the storey of that drift (from 1)"),

@@ -1102,3 +1102,4 @@ fn scene() -> &'static Scene {
 }
 
 mod round2;
+mod round3;

@@ -1,0 +1,140 @@
+//! Hostile pass, round 3 (issue 47): the newer commands keep the promises the older ones keep.
+//! One test per class, named after it.
+
+use crate::support::{ok, pound, tempdir};
+use pounding::plan::config::load_text;
+use std::path::Path;
+
+/// `base` (TOML lines) with `extra`'s lines after it, less the base's lines whose key `extra`
+/// gives or drops (a line `-key`).
+fn with(base: &[&str], extra: &str) -> String {
+    let key = |line: &str| line.split('=').next().unwrap_or("").trim().to_string();
+    let given = |line: &str| {
+        extra
+            .lines()
+            .any(|l| key(l) == key(line) || l.strip_prefix('-') == Some(key(line).as_str()))
+    };
+    let mut lines: Vec<&str> = base.iter().copied().filter(|l| !given(l)).collect();
+    lines.extend(extra.lines().filter(|l| !l.starts_with('-')));
+    lines.join("\n")
+}
+
+/// A row of two 2-storey buildings with `b0`, `b1` added to (or replacing keys of) each
+/// building's keys, `contact` to the contact's, and `tail` at the end.
+fn row_config(b0: &str, b1: &str, contact: &str, tail: &str) -> String {
+    let building = |period: &'static str| {
+        [
+            "storeys = 2",
+            "storey_height_m = 3.0",
+            "mass_kg = 3.0e5",
+            period,
+            "damping_ratio = 0.05",
+        ]
+    };
+    format!(
+        "[[building]]\n{}\n\n[[building]]\n{}\n\n[contact]\n{}\n\n[[record]]\nsynthetic = {{ seed = 1, duration_s = 1.0, dt_s = 0.01, pga_g = 0.3 }}\n{tail}\n",
+        with(&building("period_s = 0.4"), b0),
+        with(&building("period_s = 0.3"), b1),
+        with(&["law = \"linear\"", "k_n_per_m = 1e9", "gap_m = 0.01"], contact),
+    )
+}
+
+/// Class 2, a panic: every column that any plan can write has a meaning (`pound columns` and
+/// the plots read them from the one table), over plans generated with every kind of grid axis
+/// and every `[sample]` key of a row, strengths swept and sampled among them. It panicked on
+/// a swept or sampled strength (`b1_yield_base_shear_coefficient`).
+#[test]
+fn every_column_of_every_plan_has_a_meaning() {
+    // Each building's strength as a value, a list, a range; each other key as a list.
+    let strengths = [
+        "yield_drift_ratio = 0.004",
+        "yield_drift_ratio = [0.003, 0.005]",
+        "yield_drift_ratio = { from = 0.003, to = 0.006, n = 2 }",
+        "yield_base_shear_coefficient = 0.15",
+        "yield_base_shear_coefficient = [0.1, 0.2]",
+    ];
+    let building_axes = [
+        "period_s = [0.3, 0.5]",
+        "mass_kg = [2e5, 3e5]",
+        "damping_ratio = [0.02, 0.05]",
+        "gap_right_m = [0.0, 0.01]",
+    ];
+    let contact_axes = [
+        "gap_m = [0.0, 0.01]",
+        "e = [0.5, 0.8]\nformula = \"anagnostopoulos\"",
+        "k_n_per_m = [1e9, 2e9]",
+    ];
+    let mut configs = Vec::new();
+    for s in strengths {
+        for a in building_axes {
+            configs.push(row_config(
+                &format!("{s}\n{a}"),
+                "yield_drift_ratio = 0.004",
+                "",
+                "",
+            ));
+        }
+        configs.push(row_config(s, s, "", "[intensity]\npga_g = [0.2, 0.4]"));
+    }
+    for c in contact_axes {
+        configs.push(row_config("yield_drift_ratio = 0.004", "", c, ""));
+    }
+    // Every `[sample]` key of a row of two.
+    let sampled = [
+        ("building[0].mass_kg", 2e5, 3e5),
+        ("building[1].period_s", 0.2, 0.4),
+        ("building[0].damping_ratio", 0.02, 0.05),
+        ("building[0].gap_right_m", 0.0, 0.02),
+        ("contact.k_n_per_m", 1e9, 2e9),
+        ("building[0].yield_drift_ratio", 0.003, 0.006),
+        ("building[1].yield_base_shear_coefficient", 0.1, 0.2),
+    ];
+    for (key, min, max) in sampled {
+        // The sampled key leaves the grid.
+        let name = key.rsplit('.').next().unwrap();
+        let (mut b0, mut b1, mut contact) = (
+            "yield_drift_ratio = 0.004".to_string(),
+            "yield_drift_ratio = 0.004".to_string(),
+            String::new(),
+        );
+        if key.contains("base_shear") {
+            b1 = format!("-yield_drift_ratio\n-{name}");
+        } else if key.starts_with("building[0]") {
+            b0 = format!("{b0}\n-{name}");
+        } else if key.starts_with("building[1]") {
+            b1 = format!("{b1}\n-{name}");
+        } else {
+            contact = format!("-{name}");
+        }
+        if key.contains("yield_drift_ratio") {
+            b0 = format!("-{name}");
+        }
+        let tail = format!(
+            "[sample]\nn = 3\nseed = 1\n[[sample.axis]]\nkey = \"{key}\"\ndist = \"uniform\"\nmin = {min}\nmax = {max}\n"
+        );
+        configs.push(row_config(&b0, &b1, &contact, &tail));
+    }
+    let mut checked = 0;
+    for text in &configs {
+        let plan =
+            load_text(text, Path::new("generated.toml")).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        for column in plan.header() {
+            assert!(
+                pounding::plan::meaning::meaning(&column).is_some(),
+                "column {column} has no meaning\n{text}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 0 && configs.len() >= 30, "{checked} columns");
+    // And through the command, where it panicked.
+    let dir = tempdir();
+    let cfg = dir.path().join("swept.toml");
+    let swept = configs
+        .iter()
+        .find(|c| c.contains("yield_base_shear_coefficient = [0.1, 0.2]"))
+        .unwrap();
+    std::fs::write(&cfg, swept).unwrap();
+    let table = ok(&pound(&["columns", cfg.to_str().unwrap()]));
+    assert!(table.contains("b1_yield_base_shear_coefficient"), "{table}");
+}
