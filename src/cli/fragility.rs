@@ -9,7 +9,7 @@ use pounding::studies::fragility::{
     bootstrap, crossings, csv, default_im, fit, panel, Band, FragilitySpec, Grouped,
 };
 use pounding::studies::plot::Series;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Bootstrap replicates at most (each refits every threshold).
 const MAX_BOOTSTRAP: usize = 100_000;
@@ -61,8 +61,19 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<()> {
     let output = super::default_output(a.output.clone(), "fragility.csv");
+    // A damage-state file is an input like the results (a built-in set's name is no file).
+    let states_file = a
+        .damage_states
+        .as_deref()
+        .map(Path::new)
+        .filter(|p| p.is_file());
+    let other: Vec<(&str, &Path)> = states_file
+        .map(|p| ("the damage-state file", p))
+        .into_iter()
+        .collect();
     check_study_outputs(
         &a.results,
+        &other,
         &[
             ("-o", Some(&output), Holds::Csv),
             ("--plot", a.plot.as_deref(), Holds::Plot),

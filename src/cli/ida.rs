@@ -40,6 +40,7 @@ pub fn run(a: Args) -> Result<()> {
     let output = super::default_output(a.output.clone(), "ida.csv");
     check_study_outputs(
         &a.results,
+        &[],
         &[
             ("-o", Some(&output), Holds::Csv),
             ("--plot", a.plot.as_deref(), Holds::Plot),

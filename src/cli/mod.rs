@@ -217,8 +217,10 @@ pub fn check_extension(what: &str, path: &Path, holds: Holds) -> Result<()> {
         return Ok(());
     };
     let plots = ["svg", "png"];
+    // `toml`: configs and damage-state files, never an output of these.
     let named = [
         "csv", "parquet", "svg", "png", "pdf", "jpg", "jpeg", "eps", "ps", "json", "xlsx", "tsv",
+        "toml",
     ];
     let fits = match holds {
         Holds::Plot => plots.contains(&ext.as_str()),
@@ -392,14 +394,18 @@ pub fn config_inputs<'a>(
     ins
 }
 
-/// Check the outputs of a study of a results file (`plot`, `fragility`) against the file and
-/// its sidecar, then warn when the results are not vouched for by that sidecar.
-pub fn check_study_outputs(results: &Path, outputs: &[(&str, Option<&Path>, Holds)]) -> Result<()> {
+/// Check the outputs of a study of a results file (`plot`, `fragility`) against the file, its
+/// sidecar and the study's `other` inputs (a damage-state file), then warn when the results are
+/// not vouched for by that sidecar.
+pub fn check_study_outputs(
+    results: &Path,
+    other: &[(&str, &Path)],
+    outputs: &[(&str, Option<&Path>, Holds)],
+) -> Result<()> {
     let sidecar = pounding::io::provenance::meta_path(results);
-    check_outputs(
-        &[("the results", results), ("the results' sidecar", &sidecar)],
-        outputs,
-    )?;
+    let mut inputs = vec![("the results", results), ("the results' sidecar", &sidecar)];
+    inputs.extend_from_slice(other);
+    check_outputs(&inputs, outputs)?;
     if let Some(w) = pounding::io::journal::provenance_warning(results) {
         note!("warning: {w}");
     }

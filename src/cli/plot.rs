@@ -52,7 +52,7 @@ enum AggArg {
 
 pub fn run(a: Args) -> Result<()> {
     let output = super::default_output(a.output.clone(), "plot.svg");
-    check_study_outputs(&a.results, &[("-o", Some(&output), Holds::Plot)])?;
+    check_study_outputs(&a.results, &[], &[("-o", Some(&output), Holds::Plot)])?;
     let table = Table::read(&a.results)?;
     let spec = PlotSpec {
         x: a.x,

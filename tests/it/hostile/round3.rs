@@ -138,3 +138,64 @@ fn every_column_of_every_plan_has_a_meaning() {
     let table = ok(&pound(&["columns", cfg.to_str().unwrap()]));
     assert!(table.contains("b1_yield_base_shear_coefficient"), "{table}");
 }
+
+/// Class 1, an input destroyed: a damage-state file, as the results and the config are, is
+/// refused as an output, also through a symbolic link (`fragility -o states.toml` wrote its CSV
+/// over the file, rc 0), and an output whose extension names another format (`-o x.toml` for
+/// CSV) is refused as `.svg` for CSV is; the file is left as it was.
+#[test]
+fn an_input_is_never_an_output() {
+    let dir = tempdir();
+    let d = dir.path();
+    let runs = d.join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/configs/inelastic-row.toml"),
+        "--backend",
+        "cpu",
+        "-o",
+        runs.to_str().unwrap(),
+    ]));
+    let states = d.join("states.toml");
+    let text = "name = \"t\"\nsource = \"drawn\"\n[[state]]\nname = \"light\"\nlimit = 0.004\n[[state]]\nname = \"heavy\"\nlimit = 0.02\n";
+    std::fs::write(&states, text).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&states, d.join("link.csv")).unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let fragility = |limits: &[&str], output: &str| {
+        let mut args = vec![
+            "fragility".to_string(),
+            s(&runs),
+            "--edp".into(),
+            "b1_peak_drift_ratio".into(),
+        ];
+        args.extend(limits.iter().map(|x| x.to_string()));
+        args.extend(["-o".to_string(), s(&d.join(output))]);
+        let refs: Vec<&str> = args.iter().map(String::as_str).collect();
+        pound(&refs)
+    };
+    let mut cases = vec![
+        (
+            fragility(&["--damage-states", &s(&states)], "states.toml"),
+            "damage-state file",
+        ),
+        (
+            fragility(&["--threshold", "0.01"], "x.toml"),
+            "a .toml name",
+        ),
+    ];
+    #[cfg(unix)]
+    cases.push((
+        fragility(&["--damage-states", &s(&states)], "link.csv"),
+        "damage-state file",
+    ));
+    for (o, needle) in cases {
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "rc 0: {err}");
+        assert!(err.contains(needle), "expected `{needle}` in: {err}");
+    }
+    assert_eq!(std::fs::read_to_string(&states).unwrap(), text);
+    assert!(!d.join("x.toml").exists());
+    // The same file as a damage-state set is read, and a CSV next to it is written.
+    ok(&fragility(&["--damage-states", &s(&states)], "states.csv"));
+}
