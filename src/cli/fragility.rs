@@ -91,6 +91,12 @@ pub fn run(a: Args) -> Result<()> {
         .map(DamageStates::get)
         .transpose()
         .map_err(|e| anyhow!(e))?;
+    if let Some(why) = states.as_ref().and_then(|d| {
+        let unit = pounding::plan::meaning::meaning(&a.edp).map(|m| m.unit);
+        d.unit_mismatch(&a.edp, unit)
+    }) {
+        bail!(why);
+    }
     let (thresholds, names): (Vec<f64>, Vec<String>) = match &states {
         Some(d) => (d.limits(), d.states.iter().map(|s| s.0.clone()).collect()),
         None => (

@@ -20,6 +20,9 @@ pub struct DamageStates {
     pub source: String,
     /// Ascending: (state, limit). Exceedance of a state is `EDP > limit`.
     pub states: Vec<(String, f64)>,
+    /// The limits' unit, as the table of meanings writes units (`m/m` for drift ratios); None
+    /// where a file gives none.
+    pub unit: Option<String>,
 }
 
 const HAZUS: &str = "HAZUS-MH MR5 Technical Manual (FEMA 2010), Table 5.9";
@@ -38,6 +41,7 @@ const BUILT_IN: [(&str, &str, [f64; 4]); 4] = [
 struct RawStates {
     name: Option<String>,
     source: Option<String>,
+    unit: Option<String>,
     #[serde(rename = "state")]
     states: Vec<RawState>,
 }
@@ -67,6 +71,7 @@ impl DamageStates {
                     .zip(limits)
                     .map(|(s, l)| (s.to_string(), *l))
                     .collect(),
+                unit: Some("m/m".into()),
             });
         }
         let path = Path::new(given);
@@ -102,11 +107,29 @@ impl DamageStates {
             name: raw.name.unwrap_or_else(|| given.to_string()),
             source: raw.source.unwrap_or_else(|| given.to_string()),
             states: raw.states.into_iter().map(|s| (s.name, s.limit)).collect(),
+            unit: raw.unit,
         })
     }
 
     pub fn limits(&self) -> Vec<f64> {
         self.states.iter().map(|s| s.1).collect()
+    }
+
+    /// Why these limits cannot be read on column `edp` whose unit is `unit` (from the table of
+    /// meanings): their unit is another. None where they can, or where either unit is unknown.
+    pub fn unit_mismatch(&self, edp: &str, unit: Option<&str>) -> Option<String> {
+        let (mine, theirs) = (self.unit.as_deref()?, unit?);
+        (mine != theirs).then(|| {
+            let example = if mine == "m/m" {
+                " (a drift ratio column such as b1_peak_drift_ratio)"
+            } else {
+                ""
+            };
+            format!(
+                "--damage-states {}: its limits are in {mine}, but --edp {edp} is in {theirs}: give an EDP in {mine}{example}, or limits in {theirs} (a damage-state file with unit = \"{theirs}\")",
+                self.name
+            )
+        })
     }
 }
 

@@ -199,3 +199,60 @@ fn an_input_is_never_an_output() {
     // The same file as a damage-state set is read, and a CSV next to it is written.
     ok(&fragility(&["--damage-states", &s(&states)], "states.csv"));
 }
+
+/// Class 3, units ignored: damage-state limits in one unit are refused on a column in another,
+/// both named (`--edp peak_force_n --damage-states hazus-c1l-high` read drift-ratio limits as
+/// newtons, rc 0, four identical curves); a file may give its limits' unit, and then reads on
+/// a column in that unit.
+#[test]
+fn limits_and_columns_agree_on_units() {
+    let dir = tempdir();
+    let d = dir.path();
+    let runs = d.join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/configs/inelastic-row.toml"),
+        "--backend",
+        "cpu",
+        "-o",
+        runs.to_str().unwrap(),
+    ]));
+    let forces = d.join("forces.toml");
+    std::fs::write(
+        &forces,
+        "unit = \"N\"\n[[state]]\nname = \"light\"\nlimit = 1e6\n[[state]]\nname = \"heavy\"\nlimit = 3e6\n",
+    )
+    .unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let run = |edp: &str, states: &str, out: &str| {
+        pound(&[
+            "fragility",
+            &s(&runs),
+            "--edp",
+            edp,
+            "--damage-states",
+            states,
+            "-o",
+            &s(&d.join(out)),
+        ])
+    };
+    for (o, needles) in [
+        (
+            run("peak_force_n", "hazus-c1l-high", "a.csv"),
+            ["in m/m", "peak_force_n is in N"],
+        ),
+        (
+            run("b1_peak_drift_ratio", &s(&forces), "b.csv"),
+            ["in N", "b1_peak_drift_ratio is in m/m"],
+        ),
+    ] {
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "rc 0: {err}");
+        for n in needles {
+            assert!(err.contains(n), "expected `{n}` in: {err}");
+        }
+    }
+    assert!(!d.join("a.csv").exists() && !d.join("b.csv").exists());
+    ok(&run("peak_force_n", &s(&forces), "c.csv"));
+    ok(&run("b1_peak_drift_ratio", "hazus-c1l-high", "d.csv"));
+}
