@@ -62,20 +62,15 @@ pub fn run(a: Args) -> Result<()> {
         .into_iter()
         .map(|e| super::target_error_in(suite, e))
         .collect::<Result<Vec<_>>>()?;
-    let settings = if choices.is_empty() {
-        // In increasing order, each once: a run's error is judged against the coarser settings
-        // before it ("not converging").
-        let mut s = settings;
-        s.sort_by(f64::total_cmp);
-        s.dedup();
-        s
+    let mut settings = if choices.is_empty() {
+        settings
     } else {
-        // Targets may come in any order and share a setting: each setting runs once.
-        let mut s: Vec<f64> = choices.iter().map(|c| c.substeps_per_contact).collect();
-        s.sort_by(f64::total_cmp);
-        s.dedup();
-        s
+        choices.iter().map(|c| c.substeps_per_contact).collect()
     };
+    // In increasing order, each once: a run's error is judged against the coarser settings
+    // before it ("not converging"), and targets may come in any order and share a setting.
+    settings.sort_by(f64::total_cmp);
+    settings.dedup();
     let most = MAX_SUBSTEPS_PER_CONTACT;
     if let Some(bad) = settings.iter().find(|s| !(**s >= 1.0 && **s <= most)) {
         bail!(

@@ -455,16 +455,14 @@ impl RowPoint {
     /// (`calibration::Suite::YieldingRows`).
     pub fn calibrated_p99(&self) -> f64 {
         match self.yielding {
+            // NaN (a statistic over no run) wins: no evidence is not a small error.
             Some([_, residual, _, ductility]) => {
-                [self.force[1], self.drift[1], residual, ductility]
-                    .into_iter()
-                    .fold(f64::NEG_INFINITY, |m, x| {
-                        if x.is_nan() || m.is_nan() {
-                            f64::NAN
-                        } else {
-                            m.max(x)
-                        }
-                    })
+                let p99s = [self.force[1], self.drift[1], residual, ductility];
+                if p99s.iter().any(|x| x.is_nan()) {
+                    f64::NAN
+                } else {
+                    p99s.into_iter().fold(f64::NEG_INFINITY, f64::max)
+                }
             }
             None => self.force[1],
         }
@@ -727,8 +725,9 @@ pub enum Points {
 }
 
 /// One path at one setting as `--target-error` judges it: the p99 of what the scene's
-/// calibration measures (NaN over no compared run; [`crate::physics::solver::calibration::Suite::measure`]),
-/// the runs that failed here or in the reference, the runs compared.
+/// calibration measures (NaN over no compared run;
+/// [`crate::physics::solver::calibration::Suite::measure`]), the runs that failed here or in
+/// the reference, the runs compared.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Verdict {
     pub path: String,

@@ -1,9 +1,10 @@
 //! Convergence of the fast scheme on yielding scenes (issue 46), run by run: against the row
 //! reference at a tight tolerance, every run's error must fall as the substeps per contact grow
-//! from 8 to 512 (never above `SLACK` times the larger of its errors at the two settings
-//! before, above the `FLOOR` where the reference and the peaks' interpolation leave it: the
-//! rule `pound accuracy` reports "not converging" by), be within `AT_128` at 128, reach the
-//! floor at 512, and count the reference's impacts from the default (16) on.
+//! from 8 to 512 (never above `studies::accuracy::SLACK` (3) times the larger of its errors at
+//! the two settings before, above the `FLOOR` where the reference and the peaks' interpolation
+//! leave it: the rule `pound accuracy` reports "not converging" by, `studies::accuracy::rises`),
+//! be within `AT_128` at 128, reach the floor at 512, and count the reference's impacts from
+//! the default (16) on.
 //!
 //! A run's error is its worst relative error over what a yielding study reads: the peak
 //! force, and each building's peak roof displacement, drift ratio and ductility, residual
@@ -28,11 +29,10 @@ use pounding::physics::solver::row::fast::simulate_whole_row;
 use pounding::physics::solver::row::{simulate_row, RowModel, RowScheme};
 use pounding::physics::solver::{FastOptions, ReferenceOptions};
 use pounding::record::{read_record, ReadOptions};
+use pounding::studies::accuracy::rises;
 
 /// The settings tried, substeps per contact.
 const SETTINGS: [f64; 7] = [8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0];
-/// The most a run's error may rise from the settings before (above the floor).
-const SLACK: f64 = pounding::studies::accuracy::SLACK;
 /// The error below which settings are not told apart: the reference (tolerance 1e-10) and the
 /// peaks of free record steps (a quintic Hermite over each, the same at every setting) agree
 /// with the exact motion to about 1e-7 here.
@@ -341,18 +341,15 @@ fn judge(
         }
         let line: Vec<String> = errs.iter().map(|(s, e)| format!("{s}: {e:.1e}")).collect();
         eprintln!("{path}, {}: {}", scene.name, line.join(", "));
-        // Against the larger error of the two settings before (`pound accuracy`'s rule).
+        // `pound accuracy`'s rule, over the settings this run was compared at.
+        let before: Vec<(f64, Vec<Option<f64>>)> =
+            errs.iter().map(|&(s, e)| (s, vec![Some(e)])).collect();
         for k in 1..errs.len() {
             let (s1, e1) = errs[k];
-            let (s0, e0) = errs[k.saturating_sub(2)..k]
-                .iter()
-                .cloned()
-                .max_by(|a, b| a.1.total_cmp(&b.1))
-                .expect("a setting before");
-            if e1 > SLACK * e0.max(FLOOR) {
+            for r in rises(&before[..k], &[Some(e1)], FLOOR) {
                 bad.push(format!(
-                    "{path}, {}: not converging, error {e1:.2e} at {s1} after {e0:.2e} at {s0}",
-                    scene.name
+                    "{path}, {}: not converging, error {e1:.2e} at {s1} after {:.2e} at {}",
+                    scene.name, r.previous_error, r.previous_setting
                 ));
             }
         }

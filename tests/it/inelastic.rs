@@ -413,10 +413,9 @@ fn opensees_cross_check() {
     );
 }
 
-/// `pound accuracy` on a yielding row adds the residual drift's and the ductility's errors to
-/// the rows' table and CSV; at the default setting both are small against the reference.
-#[test]
-fn accuracy_measures_residual_drift_and_ductility() {
+/// `pound accuracy --backend cpu --settings SETTINGS` of the shipped yielding row: its table
+/// (stdout) and its CSV's rows.
+fn accuracy_of_the_yielding_row(settings: &str) -> (String, Vec<HashMap<String, String>>) {
     let dir = tempdir();
     let csv = dir.path().join("accuracy.csv");
     let out = ok(&pound(&[
@@ -425,12 +424,19 @@ fn accuracy_measures_residual_drift_and_ductility() {
         "--backend",
         "cpu",
         "--settings",
-        "64",
+        settings,
         "-o",
         csv.to_str().unwrap(),
     ]));
+    (out, table(&csv))
+}
+
+/// `pound accuracy` on a yielding row adds the residual drift's and the ductility's errors to
+/// the rows' table and CSV; at the default setting both are small against the reference.
+#[test]
+fn accuracy_measures_residual_drift_and_ductility() {
+    let (out, rows) = accuracy_of_the_yielding_row("64");
     assert!(out.contains("residual drift p99 | ductility med"), "{out}");
-    let rows = table(&csv);
     let fast = rows.iter().find(|r| r["path"] == "cpu-fast-f64").unwrap();
     for col in ["residual_drift_p99", "ductility_p99"] {
         let x = num(fast, col);
@@ -440,8 +446,9 @@ fn accuracy_measures_residual_drift_and_ductility() {
 
 /// `--target-error` on a yielding row reads the yielding suites' calibration (issue 46: 1e-7
 /// took 192 substeps from the elastic rows' table, which gave the shipped pair's run 5 a peak
-/// force 2.7e-3 off where the table promised 8.7e-8), and `pound accuracy --target-error` checks the choice on the yielding
-/// quantities: the largest of the p99 errors of peak force, drift, residual drift and ductility.
+/// force 2.7e-3 off where the table promised 8.7e-8), and `pound accuracy --target-error`
+/// checks the choice on the yielding quantities: the largest of the p99 errors of peak force,
+/// drift, residual drift and ductility.
 #[test]
 fn target_error_on_yielding_rows_reads_their_own_calibration() {
     let dir = tempdir();
@@ -491,19 +498,8 @@ fn target_error_on_yielding_rows_reads_their_own_calibration() {
 /// not report every run as "not converging" at 8 (it did) nor run 8 twice.
 #[test]
 fn accuracy_settings_are_taken_coarse_to_fine_once_each() {
-    let dir = tempdir();
-    let csv = dir.path().join("accuracy.csv");
-    let out = ok(&pound(&[
-        "accuracy",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/configs/inelastic-row.toml"),
-        "--backend",
-        "cpu",
-        "--settings",
-        "64,8,8",
-        "-o",
-        csv.to_str().unwrap(),
-    ]));
-    let settings: Vec<String> = table(&csv)
+    let (out, rows) = accuracy_of_the_yielding_row("64,8,8");
+    let settings: Vec<String> = rows
         .iter()
         .filter(|r| r["path"] == "cpu-fast-f64")
         .map(|r| r["substeps_per_contact"].clone())

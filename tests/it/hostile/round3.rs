@@ -139,15 +139,9 @@ fn every_column_of_every_plan_has_a_meaning() {
     assert!(table.contains("b1_yield_base_shear_coefficient"), "{table}");
 }
 
-/// Class 1, an input destroyed: a damage-state file, as the results and the config are, is
-/// refused as an output, also through a symbolic link (`fragility -o states.toml` wrote its CSV
-/// over the file, rc 0), and an output whose extension names another format (`-o x.toml` for
-/// CSV) is refused as `.svg` for CSV is; the file is left as it was.
-#[test]
-fn an_input_is_never_an_output() {
-    let dir = tempdir();
-    let d = dir.path();
-    let runs = d.join("runs.csv");
+/// The shipped yielding row's sweep (6 runs, CPU) into `dir`/runs.csv: results to study.
+fn yielding_runs(dir: &Path) -> std::path::PathBuf {
+    let runs = dir.join("runs.csv");
     ok(&pound(&[
         "sweep",
         concat!(env!("CARGO_MANIFEST_DIR"), "/configs/inelastic-row.toml"),
@@ -156,6 +150,18 @@ fn an_input_is_never_an_output() {
         "-o",
         runs.to_str().unwrap(),
     ]));
+    runs
+}
+
+/// Class 1, an input destroyed: a damage-state file, as the results and the config are, is
+/// refused as an output, also through a symbolic link (`fragility -o states.toml` wrote its CSV
+/// over the file, rc 0), and an output whose extension names another format (`-o x.toml` for
+/// CSV) is refused as `.svg` for CSV is; the file is left as it was.
+#[test]
+fn an_input_is_never_an_output() {
+    let dir = tempdir();
+    let d = dir.path();
+    let runs = yielding_runs(d);
     let states = d.join("states.toml");
     let text = "name = \"t\"\nsource = \"drawn\"\n[[state]]\nname = \"light\"\nlimit = 0.004\n[[state]]\nname = \"heavy\"\nlimit = 0.02\n";
     std::fs::write(&states, text).unwrap();
@@ -208,15 +214,7 @@ fn an_input_is_never_an_output() {
 fn limits_and_columns_agree_on_units() {
     let dir = tempdir();
     let d = dir.path();
-    let runs = d.join("runs.csv");
-    ok(&pound(&[
-        "sweep",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/configs/inelastic-row.toml"),
-        "--backend",
-        "cpu",
-        "-o",
-        runs.to_str().unwrap(),
-    ]));
+    let runs = yielding_runs(d);
     let forces = d.join("forces.toml");
     std::fs::write(
         &forces,
