@@ -254,3 +254,8 @@ fn limits_and_columns_agree_on_units() {
     ok(&run("peak_force_n", &s(&forces), "c.csv"));
     ok(&run("b1_peak_drift_ratio", "hazus-c1l-high", "d.csv"));
 }
+
+// The remaining classes, one file per area (each file's tests named after their class).
+mod figures; // classes 4, 5, 14 and the long title of 9: what a figure shows
+mod inputs; // classes 7, 8, 11 and the config and record parts of 9: what a config and a record take
+mod studies; // classes 10, 13 and the fragility parts of 8 and 9: what a fit says
