@@ -24,12 +24,14 @@ pub struct Args {
     plot: Option<PathBuf>,
     #[command(flatten)]
     figure: super::FigureArgs,
-    /// The probability of pounding at each gap, per pair and intensity, with the fitted curve
-    /// (CSV).
+    /// The share of runs that pound at each gap counted, per pair and intensity, with the
+    /// fitted probability there (CSV).
     #[arg(long)]
     curve: Option<PathBuf>,
-    /// Gaps (m) at which to count the probability of pounding: start:stop:step or a,b,c
-    /// (default: the config's gap axis, or 21 round values up to the largest required gap).
+    /// Gaps (m) at which to count the share of runs that pound, for `--curve` and the figure:
+    /// start:stop:step or a,b,c (default: the config's gap axis, or 21 round values up to the
+    /// largest required gap). The lognormal is fitted to the runs' required gaps, whatever
+    /// the gaps counted.
     #[arg(long)]
     gaps: Option<String>,
     /// Worker threads (default: all cores).
@@ -116,17 +118,20 @@ pub fn run(a: Args) -> Result<()> {
             study.pounding(p, &at)
         })
         .collect();
-    say!("\n| pair | intensity | median required gap (fit) | beta | gap for P(pounding) = 10 % | 5 % | 1 % |\n|---|---|---:|---:|---:|---:|---:|");
+    say!("\n| pair | intensity | runs | floors close | median required gap (fit) | beta | gap for P(pounding) = 10 % | 5 % | 1 % |\n|---|---|---:|---:|---:|---:|---:|---:|---:|");
     for c in curves.iter().flatten() {
         let g = |p: f64| {
             c.gap_for(p)
                 .map_or("".into(), |g| format!("{:.2} mm", g * 1e3))
         };
+        let (runs, _, _) = c.points.first().copied().unwrap_or_default();
         match &c.fit {
             Ok(f) => say!(
-                "| {} | {} | {:.2} mm | {:.3} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {:.2} mm | {:.3} | {} | {} | {} |",
                 study.pair_name(c.pair),
                 study.intensity_label(c.intensity),
+                f.runs,
+                f.closing,
                 f.median * 1e3,
                 f.beta,
                 g(0.10),
@@ -134,10 +139,9 @@ pub fn run(a: Args) -> Result<()> {
                 g(0.01)
             ),
             Err(e) => say!(
-                "| {} | {} | no fit: {} | | | | |",
+                "| {} | {} | {runs} | | no fit: {e} | | | | |",
                 study.pair_name(c.pair),
                 study.intensity_label(c.intensity),
-                no_fit(e)
             ),
         }
     }
@@ -149,24 +153,6 @@ pub fn run(a: Args) -> Result<()> {
         super::save_plot(p, &study.panels(&curves), 3, &a.figure)?;
     }
     Ok(())
-}
-
-/// Why no lognormal could be fitted, in the words of a gap study (the fit's "exceeding" is a
-/// run needing no more than the gap).
-fn no_fit(e: &pounding::studies::fragility::NoFit) -> String {
-    use pounding::studies::fragility::NoFit;
-    match e {
-        NoFit::NoneExceed => {
-            "every run pounds at every gap counted above 0 (--gaps reaches further)".into()
-        }
-        NoFit::AllExceed => {
-            "no run pounds at any gap counted above 0 (--gaps can start lower)".into()
-        }
-        NoFit::Separated => {
-            "the required gaps all lie between two neighbouring gaps counted (finer --gaps resolve them)".into()
-        }
-        other => other.to_string(),
-    }
 }
 
 /// `--gaps`: start:stop:step, a list a,b,c, or one value; each >= 0 m.
@@ -188,7 +174,7 @@ fn curve_csv(study: &GapStudy, curves: &[Vec<PoundingCurve>]) -> String {
     for c in curves.iter().flatten() {
         for &(g, n, k) in &c.points {
             let fitted = match &c.fit {
-                Ok(f) if g > 0.0 => format!("{}", 1.0 - f.probability(g)),
+                Ok(f) => format!("{}", f.pounding(g)),
                 _ => String::new(),
             };
             s.push_str(&format!(

@@ -2,8 +2,9 @@
 //! axes (buildings x records x intensities x samples), the gap each adjacent pair needs, exactly
 //! from the time histories ([`crate::physics::solver::separation`]), against what the code rules
 //! say from the same peak displacements ([`crate::physics::separation`]); a summary per rule;
-//! and the probability of pounding against the gap, with a lognormal fit (the fragility fit of
-//! [`crate::studies::fragility`], the gap in the place of the intensity).
+//! and the probability of pounding against the gap, with a lognormal fitted by maximum likelihood
+//! to the runs' required gaps themselves (each is known exactly; the gaps it is counted at are
+//! for display and do not move the fit).
 //!
 //! Elastic responses are linear in the record's scale, so one response per record and building
 //! values serves every intensity. Where storeys yield they are not: every run is its own
@@ -18,8 +19,8 @@ use crate::physics::solver::separation::{
 use crate::plan::columns::{contact_and_motion, num, CONTACT_AND_MOTION};
 use crate::plan::intensity::TARGET_COLUMNS;
 use crate::plan::row::level_name;
+use crate::plan::sample::phi;
 use crate::plan::{Motions, Plan};
-use crate::studies::fragility::{fit, Fit, Level, NoFit};
 use crate::studies::plot::{Panel, Series};
 use rayon::prelude::*;
 
@@ -554,7 +555,7 @@ impl<'a> GapStudy<'a> {
     }
 
     /// Per intensity, the share of runs of pair `a` that pound at each of `gaps` (their
-    /// required gap exceeds it), and the lognormal fit of the required gap.
+    /// required gap exceeds it), and the lognormal fitted to the runs' required gaps.
     pub fn pounding(&self, a: usize, gaps: &[f64]) -> Vec<PoundingCurve> {
         let required: Vec<(usize, f64)> = (0..self.len())
             .filter_map(|m| {
@@ -576,21 +577,11 @@ impl<'a> GapStudy<'a> {
                         (g, mine.len() as u64, pound)
                     })
                     .collect();
-                // P(required <= g) rises with g like a fragility with g as the intensity.
-                let levels: Vec<Level> = points
-                    .iter()
-                    .filter(|(g, _, _)| *g > 0.0)
-                    .map(|&(g, n, pound)| Level {
-                        im: g,
-                        n,
-                        exceed: n - pound,
-                    })
-                    .collect();
                 PoundingCurve {
                     pair: a,
                     intensity: i,
                     points,
-                    fit: fit(&levels),
+                    fit: GapFit::of(&mine),
                 }
             })
             .collect()
@@ -747,7 +738,7 @@ impl<'a> GapStudy<'a> {
                         points: (1..=100)
                             .map(|i| {
                                 let g = top * i as f64 / 100.0;
-                                (g * 1e3, 1.0 - f.probability(g))
+                                (g * 1e3, f.pounding(g))
                             })
                             .collect(),
                         scatter: false,
@@ -789,17 +780,109 @@ pub struct RuleSummary {
 pub struct PoundingCurve {
     pub pair: usize,
     pub intensity: usize,
-    /// `(gap, runs, runs that pound)`.
+    /// `(gap, runs, runs that pound)`, at the gaps counted (for display).
     pub points: Vec<(f64, u64, u64)>,
-    /// The lognormal fit of `P(required gap <= gap)`: `P(pounding) = 1 - fit.probability`.
-    pub fit: Result<Fit, NoFit>,
+    /// The lognormal fitted to the runs' required gaps.
+    pub fit: Result<GapFit, NoGapFit>,
 }
 
 impl PoundingCurve {
     /// The gap at which the fitted probability of pounding is `p`.
     pub fn gap_for(&self, p: f64) -> Option<f64> {
-        let f = self.fit.as_ref().ok()?;
-        Some(f.median * (f.beta * crate::plan::sample::phi_inv(1.0 - p)).exp())
+        self.fit.as_ref().ok()?.gap_for(p)
+    }
+}
+
+/// The probability of pounding against the gap, fitted to the runs' required gaps: a share
+/// `closing / runs` of the runs whose floors close at all, and among those a lognormal
+/// required gap, `P(pounding | gap g) = closing / runs * (1 - Phi(ln(g / median) / beta))`.
+///
+/// Every run's required gap is known exactly, so the lognormal is fitted to those values by
+/// maximum likelihood (`ln median` their mean logarithm, `beta` the root-mean-square spread
+/// of the logarithms about it), not to counts at the gaps a grid happens to hold: counts at a
+/// coarse grid move the median by as much as the grid's spacing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GapFit {
+    /// m: the median of the closing runs' required gaps.
+    pub median: f64,
+    pub beta: f64,
+    /// Standard errors of `ln median` (`beta / sqrt(n)`) and of `beta` (`beta / sqrt(2 n)`).
+    pub se_ln_median: f64,
+    pub se_beta: f64,
+    /// Runs counted, and of those, runs whose floors close (required gap > 0).
+    pub runs: u64,
+    pub closing: u64,
+}
+
+/// Why no lognormal could be fitted to the required gaps.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum NoGapFit {
+    #[error("no run at this intensity")]
+    NoRuns,
+    #[error("the floors close in no run: no gap is needed")]
+    NoneClose,
+    #[error("the floors close in only one run: a lognormal needs two")]
+    OneCloses,
+    #[error("every run whose floors close needs the same gap: the dispersion is 0")]
+    AllEqual,
+}
+
+impl GapFit {
+    /// The maximum-likelihood lognormal of the positive values of `required` (m), with the
+    /// share of runs whose floors close.
+    pub fn of(required: &[f64]) -> Result<GapFit, NoGapFit> {
+        let logs: Vec<f64> = required
+            .iter()
+            .filter(|&&r| r > 0.0)
+            .map(|r| r.ln())
+            .collect();
+        let n = logs.len();
+        match (required.len(), n) {
+            (0, _) => return Err(NoGapFit::NoRuns),
+            (_, 0) => return Err(NoGapFit::NoneClose),
+            (_, 1) => return Err(NoGapFit::OneCloses),
+            _ => {}
+        }
+        let mean = logs.iter().sum::<f64>() / n as f64;
+        let beta = (logs.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n as f64).sqrt();
+        // Equal values give a spread of rounding noise, not a dispersion.
+        if beta.is_nan() || beta <= 1e-12 {
+            return Err(NoGapFit::AllEqual);
+        }
+        Ok(GapFit {
+            median: mean.exp(),
+            beta,
+            se_ln_median: beta / (n as f64).sqrt(),
+            se_beta: beta / (2.0 * n as f64).sqrt(),
+            runs: required.len() as u64,
+            closing: n as u64,
+        })
+    }
+
+    /// The share of runs whose floors close.
+    pub fn closing_share(&self) -> f64 {
+        self.closing as f64 / self.runs as f64
+    }
+
+    /// The fitted probability of pounding at a gap of `g` m.
+    pub fn pounding(&self, g: f64) -> f64 {
+        if g <= 0.0 {
+            return self.closing_share();
+        }
+        self.closing_share() * (1.0 - phi((g / self.median).ln() / self.beta))
+    }
+
+    /// The gap at which the fitted probability of pounding is `p` (0 where the runs whose
+    /// floors close are fewer than that share: no gap is needed for it).
+    pub fn gap_for(&self, p: f64) -> Option<f64> {
+        if !(p > 0.0 && p < 1.0) {
+            return None;
+        }
+        let q = p / self.closing_share();
+        if q >= 1.0 {
+            return Some(0.0);
+        }
+        Some(self.median * (self.beta * crate::plan::sample::phi_inv(1.0 - q)).exp())
     }
 }
 
@@ -854,11 +937,33 @@ mod tests {
             "{:?}",
             pounding.series.iter().map(|s| &s.name).collect::<Vec<_>>()
         );
-        curves[0][1].fit = Err(crate::studies::fragility::NoFit::NoneExceed);
+        curves[0][1].fit = Err(NoGapFit::NoneClose);
         let panels = study.panels(&curves);
         let last = panels.last().unwrap();
         assert_eq!(last.series.len(), 3);
         assert!(last.series[2].name.ends_with("(no lognormal fit)"));
+    }
+
+    /// The fit of the required gaps: the lognormal's maximum-likelihood parameters, the runs
+    /// whose floors never close as a share apart, and `gap_for` the inverse of `pounding`.
+    #[test]
+    fn the_gap_fit_is_the_required_gaps_lognormal() {
+        let f = GapFit::of(&[0.0, 0.01, 0.04, 0.0]).unwrap();
+        assert_eq!((f.runs, f.closing), (4, 2));
+        assert!((f.median - 0.02).abs() < 1e-15);
+        assert!((f.beta - 2f64.ln()).abs() < 1e-15);
+        assert_eq!(f.pounding(0.0), 0.5);
+        assert!((f.pounding(0.02) - 0.25).abs() < 1e-7);
+        for p in [0.01, 0.1, 0.4] {
+            let g = f.gap_for(p).unwrap();
+            assert!((f.pounding(g) - p).abs() < 1e-7, "{p}: {g}");
+        }
+        // No gap is needed for a probability the closing runs cannot reach.
+        assert_eq!(f.gap_for(0.6), Some(0.0));
+        assert_eq!(GapFit::of(&[]), Err(NoGapFit::NoRuns));
+        assert_eq!(GapFit::of(&[0.0, 0.0]), Err(NoGapFit::NoneClose));
+        assert_eq!(GapFit::of(&[0.0, 0.03]), Err(NoGapFit::OneCloses));
+        assert_eq!(GapFit::of(&[0.03, 0.03]), Err(NoGapFit::AllEqual));
     }
 
     #[test]
