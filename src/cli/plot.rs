@@ -69,13 +69,10 @@ pub fn run(a: Args) -> Result<()> {
         log_x: a.log_x,
         log_y: a.log_y,
     };
-    let (mut p, failed) = panel(&table, &spec)?;
+    let (mut p, left_out) = panel(&table, &spec)?;
     a.figure.apply(std::slice::from_mut(&mut p));
-    if failed > 0 {
-        note!(
-            "{}: {failed} rows left out: runs whose status is not ok, or values that are not finite",
-            a.results.display()
-        );
+    for line in left_out.lines() {
+        note!("{}: {line}", a.results.display());
     }
     // A log axis cannot show a value <= 0: such points are left out, with a count.
     let off_log = p

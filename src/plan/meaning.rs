@@ -244,6 +244,19 @@ fn number(s: &str) -> Option<usize> {
         .flatten()
 }
 
+impl Meaning {
+    /// Why a cell of this column may be empty, in the table's words (`where the run did not
+    /// settle`, `if none`), or None where the meaning gives no reason.
+    pub fn when_empty(&self) -> Option<&str> {
+        // The reason is a parenthetical clause: `(empty ...)` or `(...; empty ...)`.
+        let at = ["(empty ", "; empty "]
+            .iter()
+            .find_map(|k| self.text.find(k).map(|i| i + k.len()))?;
+        let end = self.text[at..].find([')', ';'])? + at;
+        Some(&self.text[at..end])
+    }
+}
+
 /// What `column` holds, or None for a name no sweep writes.
 pub fn meaning(column: &str) -> Option<Meaning> {
     let of = |(_, unit, label, text): &(&str, &'static str, &str, &str)| Meaning {

@@ -74,31 +74,92 @@ fn sorted_groups(names: Vec<String>) -> Vec<String> {
     v
 }
 
-/// The panel for `spec` over `table`, and the number of failed runs left out. Rows with an
-/// empty x or y (a run that did not pound has no first impact) are left out, and so are runs
-/// whose `status` is not `ok` (their values are whatever a diverged run held) and non-finite
-/// values.
-pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableError> {
+/// The rows a plot left out, by reason (none is left out silently).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LeftOut {
+    /// Runs whose `status` is not `ok`: their values are whatever a diverged run held.
+    pub failed: usize,
+    /// Rows with a value that is not finite.
+    pub not_finite: usize,
+    /// Per plotted column, rows where it is empty (a run that did not pound has no first
+    /// impact; a run that did not settle, no residual drift).
+    pub empty: Vec<(String, usize)>,
+    /// Series (`--by` values) of which every row was left out, so none is drawn.
+    pub vanished: Vec<String>,
+}
+
+impl LeftOut {
+    /// One line per reason, each with its count, in the table of meanings' words.
+    pub fn lines(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.failed > 0 {
+            out.push(format!(
+                "{} rows left out: runs whose status is not ok",
+                self.failed
+            ));
+        }
+        if self.not_finite > 0 {
+            out.push(format!(
+                "{} rows left out: values that are not finite",
+                self.not_finite
+            ));
+        }
+        for (column, n) in self.empty.iter().filter(|(_, n)| *n > 0) {
+            let why = crate::plan::meaning::meaning(column)
+                .and_then(|m| m.when_empty().map(str::to_string))
+                .map_or(String::new(), |w| format!(" ({w})"));
+            out.push(format!("{n} rows left out: {column} is empty{why}"));
+        }
+        for g in &self.vanished {
+            out.push(format!(
+                "no series drawn for {g}: every one of its rows was left out"
+            ));
+        }
+        out
+    }
+}
+
+/// The panel for `spec` over `table`, and the rows left out (counted by reason): runs whose
+/// `status` is not `ok` (their values are whatever a diverged run held), rows with an empty x
+/// or y (a run that did not pound has no first impact) and non-finite values.
+pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, LeftOut), TableError> {
     let (cx, cy) = (table.col(&spec.x)?, table.col(&spec.y)?);
     let cby = spec.by.as_deref().map(|b| table.col(b)).transpose()?;
     let cstatus = table.col("status").ok();
     let rows = table.select(&spec.filters)?;
     let mut groups: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
-    let mut failed = 0;
+    let mut left = LeftOut::default();
+    let (mut empty_x, mut empty_y) = (0, 0);
+    // Every series a kept row belongs to, drawn or not.
+    let mut seen: Vec<String> = Vec::new();
     for i in rows {
+        let g = cby.map_or(String::new(), |c| table.rows[i][c].clone());
+        if !seen.contains(&g) {
+            seen.push(g.clone());
+        }
         if cstatus.is_some_and(|c| table.rows[i][c] != "ok") {
-            failed += 1;
+            left.failed += 1;
             continue;
         }
-        let (Some(x), Some(y)) = (table.num(i, cx)?, table.num(i, cy)?) else {
+        let (x, y) = (table.num(i, cx)?, table.num(i, cy)?);
+        let (Some(x), Some(y)) = (x, y) else {
+            empty_x += usize::from(x.is_none());
+            empty_y += usize::from(x.is_some() && y.is_none());
             continue;
         };
         if !(x.is_finite() && y.is_finite()) {
-            failed += 1;
+            left.not_finite += 1;
             continue;
         }
-        let g = cby.map_or(String::new(), |c| table.rows[i][c].clone());
         groups.entry(g).or_default().push((x, y));
+    }
+    left.empty = vec![(spec.x.clone(), empty_x), (spec.y.clone(), empty_y)];
+    if let Some(b) = &spec.by {
+        left.vanished = sorted_groups(seen)
+            .into_iter()
+            .filter(|g| !groups.contains_key(g))
+            .map(|g| value_label(b, &g))
+            .collect();
     }
     let names = sorted_groups(groups.keys().cloned().collect());
     let series = names
@@ -147,6 +208,6 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableErro
             log_y: spec.log_y,
             series,
         },
-        failed,
+        left,
     ))
 }

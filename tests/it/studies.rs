@@ -366,7 +366,7 @@ fn plotted_values_are_the_chosen_aggregate_at_each_x() {
             log_y: false,
         };
         let (p, failed) = panel(&table, &spec).unwrap();
-        assert_eq!(failed, 1, "the step_limit run is left out");
+        assert_eq!(failed.failed, 1, "the step_limit run is left out");
         p.series
             .iter()
             .map(|s| (s.name.clone(), s.points.clone()))

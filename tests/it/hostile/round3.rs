@@ -305,6 +305,69 @@ fn a_gap_fit_does_not_depend_on_the_grid() {
     assert_eq!(cells[6], format!("{beta:.3}"), "{default}");
 }
 
+/// Class 6, silent drops: `pound plot` says how many rows it left out and why, by reason in
+/// the table of meanings' words (a residual drift is empty where the run did not settle), and
+/// names a series of which every row was left out. It left out empty values without a word, so
+/// a whole series vanished.
+#[test]
+fn every_row_left_out_is_counted() {
+    let dir = tempdir();
+    let results = dir.path().join("runs.csv");
+    std::fs::write(
+        &results,
+        "run,record,pga_g,b1_residual_drift_ratio,b1_first_impact_s,status\n\
+         0,quiet,0.2,0.001,,ok\n\
+         1,quiet,0.4,0.002,,ok\n\
+         2,strong,0.2,,1.5,ok\n\
+         3,strong,0.4,,1.2,ok\n\
+         4,quiet,0.6,0.003,,step_limit\n\
+         5,quiet,,0.004,,ok\n\
+         6,quiet,0.8,inf,,ok\n",
+    )
+    .unwrap();
+    let plot = dir.path().join("p.svg");
+    let out = pound(&[
+        "plot",
+        results.to_str().unwrap(),
+        "--x",
+        "pga_g",
+        "--y",
+        "b1_residual_drift_ratio",
+        "--by",
+        "record",
+        "-o",
+        plot.to_str().unwrap(),
+    ]);
+    ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    for said in [
+        "1 rows left out: runs whose status is not ok",
+        "1 rows left out: values that are not finite",
+        "1 rows left out: pga_g is empty",
+        "2 rows left out: b1_residual_drift_ratio is empty (where the run did not settle)",
+        "no series drawn for record = strong: every one of its rows was left out",
+    ] {
+        assert!(err.contains(said), "missing `{said}` in:\n{err}");
+    }
+    // The first impact is empty where the run did not pound.
+    let out = pound(&[
+        "plot",
+        results.to_str().unwrap(),
+        "--x",
+        "pga_g",
+        "--y",
+        "b1_first_impact_s",
+        "-o",
+        plot.to_str().unwrap(),
+    ]);
+    ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("3 rows left out: b1_first_impact_s is empty"),
+        "{err}"
+    );
+}
+
 // The remaining classes, one file per area (each file's tests named after their class).
 mod figures; // classes 4, 5, 14 and the long title of 9: what a figure shows
 mod inputs; // classes 7, 8, 11 and the config and record parts of 9: what a config and a record take
