@@ -105,8 +105,9 @@ pub enum Cmd {
     Restitution(restitution::Args),
     /// Force against penetration through one isolated impact (the seed's Fig. 5), per e.
     Hysteresis(hysteresis::Args),
-    /// One run of a sweep, whole: its time history at every record step and located event
-    /// (CSV, plot) and its row as the sweep writes it (pairs).
+    /// One run of a sweep, whole (pairs and rows, yielding storeys included): its time
+    /// history at every record step and located event (CSV, plot) and its row as the sweep
+    /// writes it.
     Trace(trace::Args),
     /// Print a commented starting config that runs as is: `pound init pair > my.toml`.
     Init(start::InitArgs),
