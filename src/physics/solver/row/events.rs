@@ -1,0 +1,253 @@
+//! A row run's events: each level's contact mode and each yielding storey's spring state
+//! ending, located within a step, and the transitions they call for; the acceptance of a step.
+
+use super::yielding::StoreyMode;
+use super::RowRun;
+use crate::physics::solver::events::{hidden_rise, locate, touch};
+use crate::physics::solver::{Mode, Segment};
+
+impl<'m> RowRun<'m> {
+    /// Each event's value in state `z`, levels then storeys (positive once that level's contact
+    /// mode or storey's spring state must end); `-inf` where it is not checked (a level whose
+    /// buildings do not both move, a storey of a building standing still).
+    pub(super) fn event_values<'a>(
+        &'a self,
+        z: &'a [f64],
+    ) -> impl Iterator<Item = f64> + use<'a, 'm> {
+        let n = self.m.n;
+        let levels = (self.m.levels.iter().zip(&self.levels).zip(&self.level_on)).map(
+            move |((lm, ls), &on)| {
+                if on {
+                    lm.event_value(n, ls.mode, ls.v0, z)
+                } else {
+                    f64::NEG_INFINITY
+                }
+            },
+        );
+        let storeys = (self.m.storeys.iter().zip(&self.storey_modes).enumerate()).map(
+            move |(s, (sm, &mode))| {
+                if self.active[sm.building] {
+                    let p = z[self.m.plastic_slot(s)];
+                    sm.event_value(mode, sm.drift(z, 0), sm.drift(z, n), p)
+                } else {
+                    f64::NEG_INFINITY
+                }
+            },
+        );
+        levels.chain(storeys)
+    }
+
+    /// The largest event value of the checked levels and storeys (positive once any level's
+    /// contact mode or storey's spring state must end).
+    pub(super) fn event_max(&self, z: &[f64]) -> f64 {
+        self.event_values(z).fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The largest event value in `z` of the events that fire in a step's trial end (marked by
+    /// [`RowRun::mark_firing`]): the function an event is located on. The others are left out
+    /// because one of them can sit at 0 where a step starts (a storey that has just unloaded
+    /// stays on its band edge, a level that has just separated) and leave it there while the
+    /// event that fires grows from far below: regula falsi on their maximum then creeps from
+    /// that end and stalls, and the event is taken late, by up to the whole step.
+    pub(super) fn firing_max(&self, z: &[f64]) -> f64 {
+        (self.event_values(z).zip(&self.firing))
+            .filter(|(_, &f)| f)
+            .fold(f64::NEG_INFINITY, |m, (v, _)| m.max(v))
+    }
+
+    /// Mark the events whose value is positive in `z` as the ones that fire.
+    pub(super) fn mark_firing(&mut self, z: &[f64]) {
+        let mut firing = std::mem::take(&mut self.firing);
+        firing.clear();
+        firing.extend(self.event_values(z).map(|v| v > 0.0));
+        self.firing = firing;
+    }
+
+    /// The earliest fraction of a step `z0 -> z1` (length `h`) at which an elastic storey's
+    /// back drift could rise past its band between the ends (both inside it).
+    pub(super) fn hidden_yield(&self, z0: &[f64], z1: &[f64], h: f64) -> Option<f64> {
+        let n = self.m.n;
+        let mut first: Option<f64> = None;
+        for (s, (sm, &mode)) in self.m.storeys.iter().zip(&self.storey_modes).enumerate() {
+            if mode != StoreyMode::Elastic || !self.active[sm.building] {
+                continue;
+            }
+            let p = self.m.plastic_slot(s);
+            let e0 = sm.edges(sm.drift(z0, 0), sm.drift(z0, n), z0[p]);
+            let e1 = sm.edges(sm.drift(z1, 0), sm.drift(z1, n), z1[p]);
+            for (a, b) in e0.iter().zip(&e1) {
+                if let Some(x) = hidden_rise(a.0, a.1, b.0, b.1, h) {
+                    first = Some(first.map_or(x, |f| f.min(x)));
+                }
+            }
+        }
+        first
+    }
+
+    /// The storeys' spring changes that the events at the run's state call for: yield onset
+    /// on a bounding line when moving outwards, unloading when the drift velocity reverses. A
+    /// storey that reached its bounding line already turning back (a grazing touch, located
+    /// just past its turning point) takes the return map instead: its plastic drift moves by
+    /// the overshoot, `(1 - b)` times it, as OpenSees' `Steel01` would, so it is on its band
+    /// again and stays elastic (with the work of that flow).
+    pub(super) fn storey_transitions(&mut self) {
+        let m = self.m;
+        let (n, ns) = (m.n, m.storeys.len());
+        for (s, sm) in m.storeys.iter().enumerate() {
+            if !self.active[sm.building] {
+                continue;
+            }
+            let slot = m.plastic_slot(s);
+            let z = &mut self.z;
+            let (d, r, p) = (sm.drift(z, 0), sm.drift(z, n), z[slot]);
+            let mode = self.storey_modes[s];
+            if sm.event_value(mode, d, r, p) <= 0.0 {
+                continue;
+            }
+            // The plastic load's rate at the last piece's end was the old state's.
+            self.ends_valid = false;
+            self.storey_modes[s] = match mode {
+                StoreyMode::Elastic => {
+                    let sign = sm.back_drift(d, p).signum();
+                    self.storeys[s].yielded = true;
+                    if sign * r > 0.0 {
+                        StoreyMode::Yielding(sign)
+                    } else {
+                        let p_new = (1.0 - sm.b) * (d - sign * sm.d_y);
+                        let f_mid = sm.k * (d - 0.5 * (p + p_new));
+                        z[slot + ns] += f_mid * (p_new - p);
+                        z[slot] = p_new;
+                        StoreyMode::Elastic
+                    }
+                }
+                StoreyMode::Yielding(_) => StoreyMode::Elastic,
+            };
+        }
+    }
+
+    /// Apply the mode changes that the events at state `z` (time `t`) call for; `before` is
+    /// the state at the start of the step in which they were located. A level whose event
+    /// value is not positive only goes back to approach if its restitution closes again (a
+    /// law whose phase is not an event).
+    pub(super) fn transitions(&mut self, t: f64, z: &[f64], before: &[f64]) {
+        let n = self.m.n;
+        let on = self.level_on.iter();
+        for ((lm, ls), _) in self
+            .m
+            .levels
+            .iter()
+            .zip(self.levels.iter_mut())
+            .zip(on)
+            .filter(|(_, &on)| on)
+        {
+            if lm.event_value(n, ls.mode, ls.v0, z) <= 0.0 {
+                if lm.reapproaches(n, ls.mode, z) {
+                    ls.mode = Mode::Approach;
+                    self.ends_valid = false;
+                }
+                continue;
+            }
+            // The forces at the end of the last piece were those of the old mode.
+            self.ends_valid = false;
+            ls.mode = match ls.mode {
+                Mode::Free => {
+                    let (v0, next) = touch(lm.delta(before), lm.ddelta(n, z), ls.v0);
+                    let f = lm.force(n, next, v0, z);
+                    ls.onset(t, v0, f);
+                    next
+                }
+                Mode::Approach => Mode::Restitution,
+                // Closing again: the same impact goes on.
+                Mode::Restitution if lm.reapproaches(n, Mode::Restitution, z) => Mode::Approach,
+                Mode::Restitution => {
+                    ls.end_impact();
+                    Mode::Free
+                }
+            };
+        }
+    }
+
+    /// Accept `trial`, the step `t -> t + h` over `seg` in the current modes; `step(x)` re-takes
+    /// it with length `x`. As the pair's `Integration::accept`: a touch hidden inside the step
+    /// (at a free level) and any event are located, the step then ends there. Returns the
+    /// length advanced.
+    #[allow(clippy::too_many_arguments)]
+    pub fn accept(
+        &mut self,
+        seg: &Segment,
+        t: f64,
+        h: f64,
+        trial: Vec<f64>,
+        tol_rel: f64,
+        max_iter: u32,
+        mut step: impl FnMut(f64) -> Vec<f64>,
+    ) -> f64 {
+        let n = self.m.n;
+        let z0 = std::mem::take(&mut self.z);
+        let (mut trial, mut h) = (trial, h);
+        let mut f1 = self.event_max(&trial);
+        if f1 <= 0.0 {
+            let hidden = self
+                .levels_in(Mode::Free)
+                .filter_map(|(lm, _)| {
+                    hidden_rise(
+                        lm.delta(&z0),
+                        lm.ddelta(n, &z0),
+                        lm.delta(&trial),
+                        lm.ddelta(n, &trial),
+                        h,
+                    )
+                })
+                .fold(None, |acc: Option<f64>, s| {
+                    Some(acc.map_or(s, |a| a.min(s)))
+                });
+            let hidden = match (hidden, self.hidden_yield(&z0, &trial, h)) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            };
+            if let Some(s) = hidden {
+                let zs = step(s * h);
+                let fs = self.event_max(&zs);
+                if fs > 0.0 {
+                    (trial, f1, h) = (zs, fs, s * h);
+                }
+            }
+        }
+        let ag = |x: f64| seg.at(x);
+        let advanced = if f1 > 0.0 {
+            self.mark_firing(&trial);
+            let f0 = self.firing_max(&z0);
+            let tol = (tol_rel * h).max(4.0 * f64::EPSILON * t.abs());
+            let (x, zb) = locate(
+                h,
+                f0,
+                trial,
+                f1,
+                tol,
+                max_iter,
+                &mut step,
+                |s: &Vec<f64>| self.firing_max(s),
+            );
+            self.track(t, x, &z0, &zb, (ag(t), ag(t + x)));
+            self.transitions(t + x, &zb, &z0);
+            self.z = zb;
+            if !self.m.storeys.is_empty() {
+                self.storey_transitions();
+            }
+            x
+        } else {
+            self.track(t, h, &z0, &trial, (ag(t), ag(t + h)));
+            self.z = trial;
+            // A level whose phase is not an event (the law's force does not depend on it).
+            for (lm, ls) in self.m.levels.iter().zip(self.levels.iter_mut()) {
+                if lm.reapproaches(n, ls.mode, &self.z) {
+                    ls.mode = Mode::Approach;
+                    self.ends_valid = false;
+                }
+            }
+            h
+        };
+        self.emit(seg, t + advanced);
+        advanced
+    }
+}

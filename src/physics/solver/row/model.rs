@@ -1,0 +1,409 @@
+//! The row as the integrators see it: each building's modes (and floor form), the contact levels
+//! in modal terms, the yielding storeys, and what the schemes ask of the whole model (the state
+//! at rest, floors from modes, free-step bounds).
+
+use super::yielding::StoreyModel;
+use crate::physics::contact::Contact;
+use crate::physics::row::Row;
+use crate::physics::shear::Modes;
+use crate::physics::solver::events::fourth_derivative_bound;
+use crate::physics::solver::Segment;
+
+/// One building of the row, as the integrators see it.
+#[derive(Debug, Clone)]
+pub(crate) struct BuildingModel {
+    /// Index of its first mode in `q`.
+    pub off: usize,
+    pub modes: Modes,
+    /// Storey heights, m.
+    pub heights: Vec<f64>,
+    pub masses: Vec<f64>,
+    /// `sqrt` of the total mass: modal coordinates of a 1 m motion are this large.
+    pub scale: f64,
+    /// Its floor-coordinate form (Rayleigh damping only: `C` is then tridiagonal like `K`).
+    pub floor_form: Option<FloorForm>,
+    /// Per mode, its largest `|phi|` over the floors: a bound on any floor's share of it.
+    pub shape_max: Vec<f64>,
+    /// Its slice of the state holds floor displacements and velocities instead of modes
+    /// (in the fast scheme's contact substeps, [`RowModel::substep_model`]).
+    pub in_floors: bool,
+    /// Index of its storey 0 in [`RowModel::storeys`] where its storeys yield.
+    pub first_storey: Option<usize>,
+}
+
+/// Buildings of this many storeys or more take their contact substeps in floor coordinates.
+/// Below it the modes cost no more and the change of coordinates is overhead (`pound bench
+/// --storeys 1,3,6,12,20`: 0.9x at one storey, even at three, 1.1x at six; BENCHMARKS.md).
+pub(crate) const FLOOR_SUBSTEPS_FROM: usize = 4;
+
+/// A shear building in floor coordinates: `M u'' + C u' + K u = -M 1 ag + F` with tridiagonal
+/// `K` and `C = a0 M + a1 K`, so its right-hand side costs `O(N)`.
+#[derive(Debug, Clone)]
+pub(crate) struct FloorForm {
+    /// Storey stiffnesses, N/m: `k[j]` joins floor `j - 1` (the ground for `j = 0`) and `j`.
+    pub k: Vec<f64>,
+    pub a0: f64,
+    pub a1: f64,
+    pub inv_m: Vec<f64>,
+}
+
+impl FloorForm {
+    /// `out[j] = (K x)_j / m_j`.
+    #[inline]
+    #[allow(clippy::needless_range_loop)] // floor j of `out`, `k`, `inv_m` and `x`
+    pub(super) fn k_over_m(&self, x: impl Fn(usize) -> f64, out: &mut [f64]) {
+        let nb = self.k.len();
+        let storey = |j: usize| self.k[j] * (x(j) - if j == 0 { 0.0 } else { x(j - 1) });
+        let mut s = storey(0);
+        for j in 0..nb {
+            let above = if j + 1 < nb { storey(j + 1) } else { 0.0 };
+            out[j] = (s - above) * self.inv_m[j];
+            s = above;
+        }
+    }
+}
+
+impl BuildingModel {
+    pub fn n(&self) -> usize {
+        self.modes.count()
+    }
+}
+
+/// One contact level, as the integrators see it.
+#[derive(Debug, Clone)]
+pub(crate) struct LevelModel {
+    /// Offset and length of the left and right buildings' modes in `q`.
+    pub a: (usize, usize),
+    pub b: (usize, usize),
+    /// Buildings and floors (from 0) of the level.
+    pub buildings: (usize, usize),
+    pub floors: (usize, usize),
+    /// Mode-shape rows of the two floors: `u_left = phi_a . q[a]`.
+    pub phi_a: Vec<f64>,
+    pub phi_b: Vec<f64>,
+    /// How the level's force enters the two buildings' accelerations: the mode-shape rows
+    /// again (`phi^T F`), or `1 / m` of the floor in floor coordinates.
+    pub psi_a: Vec<f64>,
+    pub psi_b: Vec<f64>,
+    pub gap: f64,
+    pub contact: Contact,
+}
+
+/// A row resolved for integration: modes of every building and the levels in modal terms.
+#[derive(Debug, Clone)]
+pub struct RowModel {
+    /// Total modes.
+    pub(crate) n: usize,
+    /// Per mode: `w^2`, `2 xi w` and the participation `L`.
+    pub(crate) w2: Vec<f64>,
+    pub(crate) two_xi_w: Vec<f64>,
+    pub(crate) part: Vec<f64>,
+    pub(crate) buildings: Vec<BuildingModel>,
+    pub(crate) levels: Vec<LevelModel>,
+    /// The yielding storeys, building by building (none in an elastic row).
+    pub(crate) storeys: Vec<StoreyModel>,
+}
+
+impl RowModel {
+    pub fn new(row: &Row) -> RowModel {
+        let mut buildings = Vec::new();
+        let mut storeys = Vec::new();
+        let mut off = 0;
+        let (mut w2, mut two_xi_w, mut part) = (vec![], vec![], vec![]);
+        for (k, b) in row.buildings.iter().enumerate() {
+            let modes = b.modes();
+            for i in 0..modes.count() {
+                w2.push(modes.omega[i] * modes.omega[i]);
+                two_xi_w.push(2.0 * modes.xi[i] * modes.omega[i]);
+                part.push(modes.participation[i]);
+            }
+            let n = modes.count();
+            let floor_form = b.rayleigh(&modes.omega).map(|(a0, a1)| FloorForm {
+                k: b.stiffness.clone(),
+                a0,
+                a1,
+                inv_m: b.masses.iter().map(|m| 1.0 / m).collect(),
+            });
+            let shape_max = (0..n)
+                .map(|i| {
+                    modes
+                        .shape
+                        .iter()
+                        .fold(0.0, |a: f64, row| a.max(row[i].abs()))
+                })
+                .collect();
+            let first_storey = b.yielding.as_ref().map(|y| {
+                let first = storeys.len();
+                for j in 0..n {
+                    let modal_row: Vec<f64> = (0..n)
+                        .map(|i| {
+                            modes.shape[j][i] - if j == 0 { 0.0 } else { modes.shape[j - 1][i] }
+                        })
+                        .collect();
+                    storeys.push(StoreyModel {
+                        building: k,
+                        storey: j,
+                        k: b.stiffness[j],
+                        d_y: y.force[j] / b.stiffness[j],
+                        b: y.post_yield[j],
+                        height: b.heights[j],
+                        off,
+                        row: modal_row.clone(),
+                        psi: modal_row.clone(),
+                        modal_row,
+                    });
+                }
+                first
+            });
+            buildings.push(BuildingModel {
+                off,
+                shape_max,
+                first_storey,
+                modes,
+                heights: b.heights.clone(),
+                masses: b.masses.clone(),
+                scale: b.masses.iter().sum::<f64>().sqrt(),
+                floor_form,
+                in_floors: false,
+            });
+            off += n;
+        }
+        let levels = row
+            .levels
+            .iter()
+            .map(|l| {
+                let (ba, bb) = (&buildings[l.left], &buildings[l.left + 1]);
+                let (fa, fb) = (l.floor_left - 1, l.floor_right - 1);
+                LevelModel {
+                    a: (ba.off, ba.n()),
+                    b: (bb.off, bb.n()),
+                    buildings: (l.left, l.left + 1),
+                    floors: (fa, fb),
+                    phi_a: ba.modes.shape[fa].clone(),
+                    phi_b: bb.modes.shape[fb].clone(),
+                    psi_a: ba.modes.shape[fa].clone(),
+                    psi_b: bb.modes.shape[fb].clone(),
+                    gap: row.gaps[l.left],
+                    contact: l.contact,
+                }
+            })
+            .collect();
+        RowModel {
+            n: off,
+            w2,
+            two_xi_w,
+            part,
+            buildings,
+            levels,
+            storeys,
+        }
+    }
+
+    /// The model of the fast scheme's contact substeps: every building of
+    /// [`FLOOR_SUBSTEPS_FROM`] storeys or more with Rayleigh damping in floor coordinates
+    /// (each level then reads and pushes one floor of it, `O(1)`), the others in modes. RK4 is affine-invariant, so its steps in either coordinates are the
+    /// same motion to rounding; the floor form costs `O(N)` per right-hand side where the
+    /// modes cost `O(N)` per level.
+    /// None when no building would change coordinates.
+    pub(crate) fn substep_model(&self) -> Option<RowModel> {
+        let floors = |b: &BuildingModel| b.floor_form.is_some() && b.n() >= FLOOR_SUBSTEPS_FROM;
+        if !self.buildings.iter().any(floors) {
+            return None;
+        }
+        let mut m = self.clone();
+        for b in m.buildings.iter_mut() {
+            b.in_floors = floors(b);
+        }
+        for l in m.levels.iter_mut() {
+            let (ba, bb) = (&m.buildings[l.buildings.0], &m.buildings[l.buildings.1]);
+            if ba.in_floors {
+                l.a = (ba.off + l.floors.0, 1);
+                l.phi_a = vec![1.0];
+                l.psi_a = vec![1.0 / ba.masses[l.floors.0]];
+            }
+            if bb.in_floors {
+                l.b = (bb.off + l.floors.1, 1);
+                l.phi_b = vec![1.0];
+                l.psi_b = vec![1.0 / bb.masses[l.floors.1]];
+            }
+        }
+        m.storeys_to_coordinates();
+        Some(m)
+    }
+
+    /// Express `z`, a state of `modal` (this model's modal twin), in this model's
+    /// coordinates: `u = Phi q` for the buildings in floors.
+    #[cfg(test)]
+    pub(crate) fn modes_to_substeps(&self, z: &mut [f64]) {
+        for k in 0..self.buildings.len() {
+            self.building_to_substeps(k, z);
+        }
+    }
+
+    /// Back to modes: `q = Phi^T M u` for the buildings in floors.
+    #[cfg(test)]
+    pub(crate) fn substeps_to_modes(&self, z: &mut [f64]) {
+        for k in 0..self.buildings.len() {
+            self.building_to_modes(k, z);
+        }
+    }
+
+    /// [`RowModel::modes_to_substeps`] for building `k` alone.
+    pub(crate) fn building_to_substeps(&self, k: usize, z: &mut [f64]) {
+        let (n, b) = (self.n, &self.buildings[k]);
+        if b.in_floors {
+            let (o, nb) = (b.off, b.n());
+            let u = b.modes.to_floors(&z[o..o + nb]);
+            let v = b.modes.to_floors(&z[n + o..n + o + nb]);
+            z[o..o + nb].copy_from_slice(&u);
+            z[n + o..n + o + nb].copy_from_slice(&v);
+        }
+    }
+
+    /// [`RowModel::substeps_to_modes`] for building `k` alone.
+    pub(crate) fn building_to_modes(&self, k: usize, z: &mut [f64]) {
+        let (n, b) = (self.n, &self.buildings[k]);
+        if b.in_floors {
+            let (o, nb) = (b.off, b.n());
+            let q = b.modes.to_modes(&b.masses, &z[o..o + nb]);
+            let qd = b.modes.to_modes(&b.masses, &z[n + o..n + o + nb]);
+            z[o..o + nb].copy_from_slice(&q);
+            z[n + o..n + o + nb].copy_from_slice(&qd);
+        }
+    }
+
+    /// Each building's largest modal rate, `w + 2 xi w` (1/s).
+    pub(crate) fn building_rates(&self) -> Vec<f64> {
+        self.buildings
+            .iter()
+            .map(|b| {
+                (b.off..b.off + b.n())
+                    .map(|i| self.mode_rate(i))
+                    .fold(0.0, f64::max)
+            })
+            .collect()
+    }
+
+    /// Length of the state vector.
+    pub(crate) fn len(&self) -> usize {
+        2 * self.n + self.levels.len() + 2 + 2 * self.storeys.len()
+    }
+
+    /// The state at rest.
+    pub fn at_rest(&self) -> Vec<f64> {
+        vec![0.0; self.len()]
+    }
+
+    /// The state with floor displacements `u[b]` and velocities `v[b]` of every building `b`
+    /// (relative to the ground).
+    pub fn state_of_floors(&self, u: &[Vec<f64>], v: &[Vec<f64>]) -> Vec<f64> {
+        let mut z = self.at_rest();
+        for (k, b) in self.buildings.iter().enumerate() {
+            let q = b.modes.to_modes(&b.masses, &u[k]);
+            let qd = b.modes.to_modes(&b.masses, &v[k]);
+            z[b.off..b.off + b.n()].copy_from_slice(&q);
+            z[self.n + b.off..self.n + b.off + b.n()].copy_from_slice(&qd);
+        }
+        z
+    }
+
+    /// Floor displacements of building `b` in state `z` (in this model's coordinates: its
+    /// modes, or its floors in a substep model).
+    pub fn floors(&self, b: usize, z: &[f64]) -> Vec<f64> {
+        let bm = &self.buildings[b];
+        let own = &z[bm.off..bm.off + bm.n()];
+        if bm.in_floors {
+            own.to_vec()
+        } else {
+            bm.modes.to_floors(own)
+        }
+    }
+
+    /// The largest rate of any mode (1/s): `w + 2 xi w`, as [`crate::physics::model::Oscillator::rate`].
+    pub(crate) fn structural_rate(&self) -> f64 {
+        (0..self.n).map(|i| self.mode_rate(i)).fold(0.0, f64::max)
+    }
+
+    /// Mode `i`'s rate, `w + 2 xi w` (1/s).
+    fn mode_rate(&self, i: usize) -> f64 {
+        self.w2[i].sqrt() + self.two_xi_w[i]
+    }
+
+    /// Kinetic plus strain energy (what the springs hold), J, in modal state `z`.
+    pub(crate) fn mechanical_energy(&self, z: &[f64]) -> f64 {
+        let n = self.n;
+        let modal: f64 = (0..n)
+            .map(|i| 0.5 * (z[n + i] * z[n + i] + self.w2[i] * z[i] * z[i]))
+            .sum();
+        if self.storeys.is_empty() {
+            modal
+        } else {
+            modal + self.plastic_strain_correction(z)
+        }
+    }
+}
+
+#[inline]
+pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+impl RowModel {
+    /// Each building's bound on the `|u''''|` of any of its floors over a free step, from each
+    /// mode's bound on `|q''''|` (`bounds`): `sum_i max_j |phi_ji| bound_i`, `O(N)` per
+    /// building where each level's own bound costs `O(N)` per level.
+    pub(crate) fn coarse_floor_bounds(&self, bounds: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(self.buildings.iter().map(|b| {
+            b.shape_max
+                .iter()
+                .zip(&bounds[b.off..b.off + b.n()])
+                .map(|(p, q)| p * q)
+                .sum::<f64>()
+        }));
+    }
+
+    /// Each mode's bound on `|q''''|` over a free step from `z0` to `z1` in `seg`
+    /// ([`fourth_derivative_bound`] of the mode's oscillator under its share of the ground
+    /// motion), into `out`.
+    pub(crate) fn fourth_derivative_bounds(
+        &self,
+        seg: &Segment,
+        z0: &[f64],
+        z1: &[f64],
+        out: &mut Vec<f64>,
+    ) {
+        let n = self.n;
+        // About the static response to the plastic loads: the motion the propagator steps.
+        let mut shift = [Vec::new(), Vec::new()];
+        if !self.storeys.is_empty() {
+            for (s, z) in shift.iter_mut().zip([z0, z1]) {
+                s.resize(n, 0.0);
+                self.static_offsets(z, s);
+            }
+        }
+        let at = |s: &Vec<f64>, k: usize| s.get(k).copied().unwrap_or(0.0);
+        out.clear();
+        out.extend((0..n).map(|k| {
+            let osc = crate::physics::model::Oscillator {
+                m: 1.0,
+                k: self.w2[k],
+                c: self.two_xi_w[k],
+            };
+            let s = Segment {
+                a0: seg.a0 * self.part[k],
+                a1: seg.a1 * self.part[k],
+                ..*seg
+            };
+            let q = if shift[0].is_empty() {
+                z0[k].abs().max(z1[k].abs())
+            } else {
+                (z0[k] - at(&shift[0], k))
+                    .abs()
+                    .max((z1[k] - at(&shift[1], k)).abs())
+            };
+            let qd = z0[n + k].abs().max(z1[n + k].abs());
+            fourth_derivative_bound(&osc, q, qd, &s)
+        }));
+    }
+}

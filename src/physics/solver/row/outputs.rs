@@ -1,0 +1,388 @@
+//! What a row run reports: its time history to an observer ([`RowSample`]), the peaks tracked
+//! between samples (floors, levels, closings), and the run's output at its end.
+
+use super::{step_still, BuildingModel, RowRun};
+use crate::physics::model::{EnergyBalance, Status};
+use crate::physics::row::{RowOutput, StoreyOutput};
+use crate::physics::solver::hermite::{
+    cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak,
+};
+use crate::physics::solver::tracker::raise_force_peak;
+use crate::physics::solver::{Mode, Segment};
+
+/// A point of a row's time history handed to an observer after every accepted step and
+/// event (as the pair's [`super::Sample`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RowSample {
+    pub t: f64,
+    /// Each building's floor displacements relative to the ground, m (lowest floor first).
+    pub floors: Vec<Vec<f64>>,
+    /// Each level's penetration (0 where apart), m, contact force, N, and contact mode.
+    pub penetrations: Vec<f64>,
+    pub forces: Vec<f64>,
+    pub modes: Vec<Mode>,
+    /// Each yielding storey, building by building (none in an elastic row).
+    pub storeys: Vec<StoreySample>,
+}
+
+/// A yielding storey at a sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StoreySample {
+    /// Its building and storey, from 0 (storey 0 joins the ground and the lowest floor).
+    pub building: usize,
+    pub storey: usize,
+    /// Drift and plastic drift over the storey's height; its shear `k (d - p)`, N; the work
+    /// its plastic drift has absorbed, `int f dp`, J (its hysteretic energy so far).
+    pub drift_ratio: f64,
+    pub plastic_drift_ratio: f64,
+    pub shear_n: f64,
+    pub hysteretic_energy_j: f64,
+}
+
+/// What observes a row's run.
+pub type RowObserver<'o> = &'o mut dyn FnMut(&RowSample);
+
+impl<'m> RowRun<'m> {
+    /// Set the contact forces on each building's floors in state `z` into `floors[.][end]`.
+    pub(super) fn set_floor_forces(&mut self, z: &[f64], end: usize) {
+        let n = self.m.n;
+        for f in self.floors.iter_mut() {
+            f[end].force.fill(0.0);
+        }
+        for (lm, ls) in self.m.levels.iter().zip(&self.levels) {
+            if ls.mode == Mode::Free {
+                continue;
+            }
+            let fl = lm.force(n, ls.mode, ls.v0, z);
+            self.floors[lm.buildings.0][end].force[lm.floors.0] -= fl;
+            self.floors[lm.buildings.1][end].force[lm.floors.1] += fl;
+        }
+    }
+
+    /// Raise the buildings' peaks over the piece `z0 -> z1` of length `h` (ground acceleration
+    /// `ag0`, `ag1` at its ends). A building no contact acts on takes its displacement and
+    /// drift peaks from the quintic Hermite (both ends' accelerations are exact) and its floor
+    /// accelerations' from the cubic Hermite with their rates; one in contact takes the cubic
+    /// Hermite of displacements and drifts, and its accelerations at the piece's ends (a
+    /// contact force's spike is not smooth enough for the cubic).
+    pub(super) fn track_buildings(&mut self, z0: &[f64], z1: &[f64], ag: (f64, f64), h: f64) {
+        let m = self.m;
+        if self.ends_ready {
+            self.ends_ready = false;
+        } else {
+            self.floor_ends(z0, z1, ag);
+        }
+        self.touched.fill(false);
+        for (lm, ls) in m.levels.iter().zip(&self.levels) {
+            if ls.mode != Mode::Free {
+                self.touched[lm.buildings.0] = true;
+                self.touched[lm.buildings.1] = true;
+            }
+        }
+        for (k, bm) in m.buildings.iter().enumerate() {
+            if self.active[k] {
+                self.raise_building(k, bm, h, !self.touched[k]);
+            }
+        }
+    }
+
+    /// The moving buildings' floor kinematics at both ends of the piece `z0 -> z1` into
+    /// `floors[.][0]` and `[1]` (the start's from the last piece's end while still valid).
+    #[inline(always)]
+    pub(super) fn floor_ends(&mut self, z0: &[f64], z1: &[f64], ag: (f64, f64)) {
+        let m = self.m;
+        if self.ends_valid {
+            for (f, _) in self.floors.iter_mut().zip(&self.active).filter(|(_, &a)| a) {
+                f.swap(0, 1);
+            }
+        } else {
+            self.set_floor_forces(z0, 0);
+            for (k, bm) in m.buildings.iter().enumerate() {
+                if self.active[k] {
+                    self.floors[k][0].fill(m, (k, bm), z0, ag.0, &self.storey_modes);
+                }
+            }
+        }
+        self.set_floor_forces(z1, 1);
+        for (k, bm) in m.buildings.iter().enumerate() {
+            if self.active[k] {
+                self.floors[k][1].fill(m, (k, bm), z1, ag.1, &self.storey_modes);
+            }
+        }
+    }
+
+    /// The floors' kinematics at both ends of a free record step `z0 -> z1` (ground
+    /// acceleration `ag` at its ends), computed before the step is taken so that the levels'
+    /// checks read them ([`RowRun::level_ends`]): [`RowRun::free_step`] then tracks the peaks
+    /// from them, and [`RowRun::drop_free_ends`] puts the floors back when the step is redone in
+    /// substeps instead.
+    pub fn prepare_free_ends(&mut self, z0: &[f64], z1: &[f64], ag: (f64, f64)) {
+        self.valid_before = self.ends_valid;
+        self.floor_ends(z0, z1, ag);
+        self.ends_ready = true;
+    }
+
+    /// Undo [`RowRun::prepare_free_ends`]: the start's kinematics are the last piece's end
+    /// again.
+    pub fn drop_free_ends(&mut self) {
+        if self.ends_ready {
+            for f in self.floors.iter_mut() {
+                f.swap(0, 1);
+            }
+            self.ends_valid = self.valid_before;
+            self.ends_ready = false;
+        }
+    }
+
+    /// Level `l`'s penetration and its rate at the start and end of the prepared free step,
+    /// `[delta0, delta0', delta1, delta1']`, from the floors (the same products as
+    /// [`LevelModel::delta`] from the modes).
+    pub fn level_ends(&self, l: usize) -> [f64; 4] {
+        let lm = &self.m.levels[l];
+        let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+        let [a0, a1] = &self.floors[a];
+        let [b0, b1] = &self.floors[b];
+        [
+            a0.u[fa] - b0.u[fb] - lm.gap,
+            a0.v[fa] - b0.v[fb],
+            a1.u[fa] - b1.u[fb] - lm.gap,
+            a1.v[fa] - b1.v[fb],
+        ]
+    }
+
+    /// Raise building `k`'s peaks over a piece of length `h` between its floor kinematics
+    /// `floors[k]`: `free` when no contact acts on it.
+    #[inline(always)]
+    pub(super) fn raise_building(&mut self, k: usize, bm: &BuildingModel, h: f64, free: bool) {
+        {
+            let [s0, s1] = &self.floors[k];
+            let out = &mut self.buildings[k];
+            let nb = bm.n();
+            let raise = |peak: f64, y: [f64; 2], d: [f64; 2], a: [f64; 2]| -> f64 {
+                if free {
+                    raise_quintic_peak(peak, y, d, a, h)
+                } else {
+                    raise_cubic_peak(peak, y[0], d[0], y[1], d[1], h)
+                }
+            };
+            let top = nb - 1;
+            out.peak_roof = raise(
+                out.peak_roof,
+                [s0.u[top], s1.u[top]],
+                [s0.v[top], s1.v[top]],
+                [s0.a_rel[top], s1.a_rel[top]],
+            );
+            for j in 0..nb {
+                let below = |x: &[f64]| if j == 0 { 0.0 } else { x[j - 1] };
+                let inv_h = 1.0 / bm.heights[j];
+                let y = [
+                    (s0.u[j] - below(&s0.u)) * inv_h,
+                    (s1.u[j] - below(&s1.u)) * inv_h,
+                ];
+                let d = [
+                    (s0.v[j] - below(&s0.v)) * inv_h,
+                    (s1.v[j] - below(&s1.v)) * inv_h,
+                ];
+                // The ground's floor 0 moves with the frame: its relative acceleration is 0.
+                let a = [
+                    (s0.a_rel[j] - below(&s0.a_rel)) * inv_h,
+                    (s1.a_rel[j] - below(&s1.a_rel)) * inv_h,
+                ];
+                let p = raise(out.peak_drift_ratio, y, d, a);
+                if p > out.peak_drift_ratio {
+                    out.peak_drift_ratio = p;
+                    out.drift_storey = j as u32 + 1;
+                }
+                if let Some(first) = bm.first_storey {
+                    let st = &mut self.storeys[first + j];
+                    st.peak_drift_ratio = raise(st.peak_drift_ratio, y, d, a);
+                }
+                let p = if free {
+                    raise_cubic_peak(
+                        out.peak_accel,
+                        s0.a_abs[j],
+                        s0.jerk[j],
+                        s1.a_abs[j],
+                        s1.jerk[j],
+                        h,
+                    )
+                } else {
+                    out.peak_accel.max(s0.a_abs[j].abs()).max(s1.a_abs[j].abs())
+                };
+                if p > out.peak_accel {
+                    out.peak_accel = p;
+                    out.accel_floor = j as u32 + 1;
+                }
+            }
+        }
+    }
+
+    /// Account for a piece `t0 -> t0 + h` from `z0` to `z1` in the current modes.
+    pub(super) fn track(&mut self, t0: f64, h: f64, z0: &[f64], z1: &[f64], ag: (f64, f64)) {
+        let m = self.m;
+        let n = m.n;
+        self.track_buildings(z0, z1, ag, h);
+        self.raise_closings(t0, h);
+        self.ends_valid = true;
+        let nl = m.levels.len();
+        self.e_peak = self.e_peak.max(self.e_initial + z1[2 * n + nl]);
+        for (l, (lm, ls)) in m.levels.iter().zip(self.levels.iter_mut()).enumerate() {
+            if ls.mode == Mode::Free {
+                continue;
+            }
+            let o = &mut ls.out;
+            o.contact_time += h;
+            let (y0, d0, y1, d1) = (
+                lm.delta(z0),
+                lm.ddelta(n, z0),
+                lm.delta(z1),
+                lm.ddelta(n, z1),
+            );
+            if cubic_max_bound(y0, d0, y1, d1, h) > o.peak_penetration {
+                o.peak_penetration = o.peak_penetration.max(hermite_range(y0, d0, y1, d1, h).1);
+            }
+            o.dissipated_energy = z1[2 * n + l];
+            // The force's rates from the floors' accelerations at both ends (with the contact
+            // forces of these modes: the ends are recomputed where a mode changes).
+            let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+            let accel = |e: usize| self.floors[a][e].a_rel[fa] - self.floors[b][e].a_rel[fb];
+            let approaching = ls.mode == Mode::Approach;
+            let f = lm.force(n, ls.mode, ls.v0, z1);
+            let r1 = lm.contact.force_rate(y1, d1, accel(1), ls.v0, approaching);
+            ls.imp_peak = raise_force_peak(ls.imp_peak, f, r1, h, || {
+                let f0 = lm.force(n, ls.mode, ls.v0, z0);
+                (
+                    f0,
+                    lm.contact.force_rate(y0, d0, accel(0), ls.v0, approaching),
+                )
+            });
+        }
+    }
+
+    /// Hand the observer, if any, the row at time `t` inside the record step `seg`: the moving
+    /// buildings from the state (in the current model), those standing still stepped exactly
+    /// from the step's start to `t` (as [`RowRun::activate`] would, without changing the run).
+    pub fn emit(&mut self, seg: &Segment, t: f64) {
+        if self.observer.is_none() {
+            return;
+        }
+        let (m, modal, n) = (self.m, self.modal, self.m.n);
+        let floors: Vec<Vec<f64>> = (0..m.buildings.len())
+            .map(|k| {
+                if self.active[k] {
+                    m.floors(k, &self.z)
+                } else {
+                    let mut z = self.z.clone();
+                    if t > seg.t0 {
+                        step_still(modal, k, seg, t, &self.z, &mut z, false);
+                    }
+                    modal.floors(k, &z)
+                }
+            })
+            .collect();
+        let sample = RowSample {
+            t,
+            penetrations: m
+                .levels
+                .iter()
+                .map(|lm| {
+                    let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+                    (floors[a][fa] - floors[b][fb] - lm.gap).max(0.0)
+                })
+                .collect(),
+            forces: (m.levels.iter().zip(&self.levels).zip(&self.level_on))
+                .map(|((lm, ls), &on)| {
+                    if on {
+                        lm.force(n, ls.mode, ls.v0, &self.z)
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+            modes: self.levels.iter().map(|ls| ls.mode).collect(),
+            // A still building's plastic drifts stay as they are until it moves again.
+            storeys: m
+                .storeys
+                .iter()
+                .enumerate()
+                .map(|(s, sm)| {
+                    let u = &floors[sm.building];
+                    let below = if sm.storey == 0 {
+                        0.0
+                    } else {
+                        u[sm.storey - 1]
+                    };
+                    let drift = u[sm.storey] - below;
+                    let p = self.z[m.plastic_slot(s)];
+                    StoreySample {
+                        building: sm.building,
+                        storey: sm.storey,
+                        drift_ratio: drift / sm.height,
+                        plastic_drift_ratio: p / sm.height,
+                        shear_n: sm.k * (drift - p),
+                        hysteretic_energy_j: self.z[m.plastic_slot(s) + m.storeys.len()],
+                    }
+                })
+                .collect(),
+            floors,
+        };
+        if let Some(obs) = self.observer.as_mut() {
+            obs(&sample);
+        }
+    }
+
+    /// End the run with `status`, after `substeps` steps of integration work.
+    pub fn finish(mut self, status: Status, substeps: u64) -> RowOutput {
+        self.leave_substeps();
+        let m = self.m;
+        let n = m.n;
+        let nl = m.levels.len();
+        let ns = m.storeys.len();
+        let hysteretic: f64 = (0..ns).map(|s| self.z[m.plastic_slot(s) + ns]).sum();
+        let energy = self.energy.then(|| {
+            let contact: f64 = (0..nl).map(|l| self.z[2 * n + l]).sum::<f64>() + hysteretic;
+            EnergyBalance::close(
+                self.e_initial,
+                self.z[2 * n + nl],
+                self.z[2 * n + nl + 1],
+                contact,
+                m.mechanical_energy(&self.z),
+                self.e_peak,
+            )
+        });
+        for ls in self.levels.iter_mut() {
+            if ls.mode != Mode::Free {
+                ls.end_impact();
+            }
+        }
+        // Each storey's outputs, which each yielding building gathers.
+        let storeys: Vec<StoreyOutput> = m
+            .storeys
+            .iter()
+            .zip(&self.storeys)
+            .enumerate()
+            .map(|(s, (sm, st))| StoreyOutput {
+                residual_drift_ratio: self.z[m.plastic_slot(s)] / sm.height,
+                peak_ductility: st.peak_drift_ratio * sm.height / sm.d_y,
+                hysteretic_energy: self.z[m.plastic_slot(s) + ns],
+                yielded: st.yielded,
+            })
+            .collect();
+        let mut out = RowOutput {
+            status,
+            levels: self.levels.iter().map(|l| l.out).collect(),
+            buildings: self.buildings,
+            substeps,
+            free_steps: self.free_steps,
+            energy,
+            storeys,
+            closings: self.closings.unwrap_or_default(),
+            ..RowOutput::default()
+        };
+        if ns > 0 {
+            out.gather_storeys(&m.storey_spans(), self.settled && status == Status::Ok);
+        }
+        out.gather();
+        out
+    }
+}

@@ -1,0 +1,335 @@
+//! One run of a row being integrated ([`RowRun`]), shared by both schemes: its state, the
+//! buildings that move and those that stand still (stepped exactly), the fast scheme's substep
+//! model, and free record steps.
+
+use super::yielding::StoreyMode;
+use super::{Floors, LevelModel, LevelState, RowModel, RowObserver, StoreyState};
+use crate::physics::row::{BuildingOutput, LevelClosing};
+use crate::physics::solver::hermite::{quintic_max_bound, quintic_range, raise_quintic_peak};
+use crate::physics::solver::{Mode, Segment};
+
+/// Building `k` of `modal`, standing still since `seg.t0` (its modes at `z0`, the row's modal
+/// state then), stepped exactly to `t` into `z`: `Propagator` over `t - seg.t0` about the static
+/// response to its plastic loads (constant while it stands still), with the input and damping
+/// work where `energy`.
+pub(super) fn step_still(
+    modal: &RowModel,
+    k: usize,
+    seg: &Segment,
+    t: f64,
+    z0: &[f64],
+    z: &mut [f64],
+    energy: bool,
+) {
+    let b = &modal.buildings[k];
+    let (n, nl) = (modal.n, modal.levels.len());
+    let h = t - seg.t0;
+    let qs = b.first_storey.map(|_| {
+        let mut qs = vec![0.0; n];
+        modal.static_offsets(z0, &mut qs);
+        qs
+    });
+    let shift = |i: usize| qs.as_ref().map_or(0.0, |q| q[i]);
+    for i in b.off..b.off + b.n() {
+        let osc = crate::physics::model::Oscillator {
+            m: 1.0,
+            k: modal.w2[i],
+            c: modal.two_xi_w[i],
+        };
+        let (a0, a1) = (modal.part[i] * seg.a0, modal.part[i] * seg.at(t));
+        let p = crate::physics::propagator::Propagator::new(&osc, h);
+        let q0 = z0[i] - shift(i);
+        let (q1, v1) = p.step(q0, z0[n + i], a0, a1);
+        (z[i], z[n + i]) = (q1 + shift(i), v1);
+        if energy {
+            let f = crate::physics::propagator::EnergyForms::new(&osc, h);
+            let (vv, agv) = f.integrals(q0, z0[n + i], a0, a1);
+            z[2 * n + nl] -= agv;
+            z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
+        }
+    }
+}
+
+/// One run of a row being integrated, shared by both schemes (as the pair's `Integration`).
+pub(crate) struct RowRun<'m> {
+    /// The model the state is in: `modal`, or its substep model between
+    /// [`RowRun::enter_substeps`] and [`RowRun::leave_substeps`].
+    pub m: &'m RowModel,
+    pub(super) modal: &'m RowModel,
+    pub z: Vec<f64>,
+    pub levels: Vec<LevelState>,
+    pub buildings: Vec<BuildingOutput>,
+    pub free_steps: u64,
+    /// Report the energy balance.
+    pub energy: bool,
+    pub(super) e_initial: f64,
+    pub(super) e_peak: f64,
+    /// Each building's floor kinematics at the start and end of the last tracked piece;
+    /// `ends_valid`: the ends describe `z` in the levels' current modes, so the next piece
+    /// starts from them instead of computing them again.
+    pub(super) floors: Vec<[Floors; 2]>,
+    pub(super) ends_valid: bool,
+    /// The floors hold a prepared free step's ends ([`RowRun::prepare_free_ends`]), and
+    /// `ends_valid` before it.
+    pub(super) ends_ready: bool,
+    pub(super) valid_before: bool,
+    pub(super) touched: Vec<bool>,
+    /// The buildings that move in the current substeps (all, outside the fast scheme's
+    /// contact steps), and the levels between two of them: only those are integrated, checked
+    /// for events and tracked ([`RowRun::set_active`]).
+    pub active: Vec<bool>,
+    pub(super) level_on: Vec<bool>,
+    /// Each yielding storey's spring state, and its record.
+    pub storey_modes: Vec<StoreyMode>,
+    pub(super) storeys: Vec<StoreyState>,
+    /// No storey can yield again after the run's end (set by the scheme,
+    /// [`RowModel::settled`]): the plastic drifts are the residual drifts.
+    pub settled: bool,
+    /// Per event (levels, then storeys), whether it fires in the step being located.
+    pub(super) firing: Vec<bool>,
+    /// Per level, its floors' closing and peaks, where asked for ([`RowRun::track_closings`]).
+    pub(super) closings: Option<Vec<LevelClosing>>,
+    /// Hears every accepted step and event ([`RowRun::emit`]).
+    pub observer: Option<RowObserver<'m>>,
+}
+
+impl<'m> RowRun<'m> {
+    /// Start at `t0` from state `z` (levels already overlapping start in contact).
+    pub fn start(m: &'m RowModel, z: Vec<f64>, t0: f64) -> Self {
+        let mut run = RowRun {
+            m,
+            modal: m,
+            levels: vec![LevelState::default(); m.levels.len()],
+            buildings: vec![BuildingOutput::default(); m.buildings.len()],
+            free_steps: 0,
+            energy: true,
+            e_initial: m.mechanical_energy(&z),
+            e_peak: 0.0,
+            floors: m
+                .buildings
+                .iter()
+                .map(|b| [Floors::new(b.n()), Floors::new(b.n())])
+                .collect(),
+            ends_valid: false,
+            ends_ready: false,
+            valid_before: false,
+            touched: vec![false; m.buildings.len()],
+            active: vec![true; m.buildings.len()],
+            level_on: vec![true; m.levels.len()],
+            storey_modes: vec![StoreyMode::Elastic; m.storeys.len()],
+            storeys: vec![StoreyState::default(); m.storeys.len()],
+            settled: false,
+            firing: Vec::with_capacity(m.levels.len() + m.storeys.len()),
+            closings: None,
+            observer: None,
+            z,
+        };
+        let z = run.z.clone();
+        run.transitions(t0, &z, &z);
+        if !m.storeys.is_empty() {
+            run.storey_transitions();
+        }
+        run
+    }
+
+    /// Track each level's closing and its floors' peaks from here on (into
+    /// [`RowOutput::closings`]). Every piece must move both buildings of every level: no
+    /// building may stand still.
+    pub fn track_closings(&mut self) {
+        self.closings = Some(vec![LevelClosing::default(); self.m.levels.len()]);
+    }
+
+    /// Raise each level's closing and its floors' peaks over a piece `t0 -> t0 + h` between
+    /// the floors' kinematics at its ends (no contact acts: the quintic Hermite, as the
+    /// buildings' peaks).
+    pub(super) fn raise_closings(&mut self, t0: f64, h: f64) {
+        let Some(closings) = self.closings.as_mut() else {
+            return;
+        };
+        for (c, lm) in closings.iter_mut().zip(&self.m.levels) {
+            let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+            let ([a0, a1], [b0, b1]) = (&self.floors[a], &self.floors[b]);
+            let y = [a0.u[fa] - b0.u[fb], a1.u[fa] - b1.u[fb]];
+            let d = [a0.v[fa] - b0.v[fb], a1.v[fa] - b1.v[fb]];
+            let acc = [a0.a_rel[fa] - b0.a_rel[fb], a1.a_rel[fa] - b1.a_rel[fb]];
+            if quintic_max_bound(y, d, acc, h) > c.closing {
+                let (hi, s) = quintic_range(y, d, acc, h)[1];
+                if hi > c.closing {
+                    (c.closing, c.time) = (hi, Some(t0 + s * h));
+                }
+            }
+            c.peak_left = raise_quintic_peak(
+                c.peak_left,
+                [a0.u[fa], a1.u[fa]],
+                [a0.v[fa], a1.v[fa]],
+                [a0.a_rel[fa], a1.a_rel[fa]],
+                h,
+            );
+            c.peak_right = raise_quintic_peak(
+                c.peak_right,
+                [b0.u[fb], b1.u[fb]],
+                [b0.v[fb], b1.v[fb]],
+                [b0.a_rel[fb], b1.a_rel[fb]],
+                h,
+            );
+        }
+    }
+
+    /// Take the state into `sub` (the modal model's [`RowModel::substep_model`]) for a record
+    /// step of substeps.
+    /// The floors' kinematics at the last piece's end stay valid: they are the same motion
+    /// in either coordinates.
+    /// Only the active buildings change coordinates: the others keep their modal state at the
+    /// step's start until they are activated or stepped exactly.
+    pub fn enter_substeps(&mut self, sub: &'m RowModel) {
+        for k in 0..sub.buildings.len() {
+            if self.active[k] {
+                sub.building_to_substeps(k, &mut self.z);
+            }
+        }
+        self.m = sub;
+    }
+
+    /// Back to the modal model after the substeps.
+    pub fn leave_substeps(&mut self) {
+        if !std::ptr::eq(self.m, self.modal) {
+            for k in 0..self.m.buildings.len() {
+                if self.active[k] {
+                    self.m.building_to_modes(k, &mut self.z);
+                }
+            }
+            self.m = self.modal;
+        }
+    }
+
+    /// Let only the `active` buildings move in the substeps to come (and the levels between
+    /// two of them be checked).
+    pub fn set_active(&mut self, active: &[bool]) {
+        self.active.copy_from_slice(active);
+        self.refresh_levels_on();
+    }
+
+    /// A level is checked when both its buildings move.
+    pub(super) fn refresh_levels_on(&mut self) {
+        for (on, lm) in self.level_on.iter_mut().zip(&self.m.levels) {
+            *on = self.active[lm.buildings.0] && self.active[lm.buildings.1];
+        }
+    }
+
+    /// Whether level `l` is checked: both its buildings move.
+    pub fn level_on(&self, l: usize) -> bool {
+        self.level_on[l]
+    }
+
+    /// Every building moves again (after a record step with some standing still).
+    pub fn all_active(&mut self) {
+        self.active.fill(true);
+        self.level_on.fill(true);
+    }
+
+    /// A building that stood still since `seg.t0` joins the substeps at `t`: its modes are
+    /// stepped exactly from the step's start (`Propagator` over `t - seg.t0`, with the input and
+    /// damping work), its peaks tracked over that free piece, and its state moved into the
+    /// substeps' coordinates.
+    pub fn activate(&mut self, k: usize, seg: &Segment, t: f64) {
+        let modal = self.modal;
+        let h = t - seg.t0;
+        let z0 = self.z.clone();
+        if h > 0.0 {
+            step_still(modal, k, seg, t, &z0, &mut self.z, self.energy);
+            let z1 = self.z.clone();
+            self.track_still(k, &z0, &z1, (seg.a0, seg.at(t)), h);
+        }
+        self.active[k] = true;
+        self.refresh_levels_on();
+        if !std::ptr::eq(self.m, modal) {
+            self.m.building_to_substeps(k, &mut self.z);
+        }
+    }
+
+    /// End a record step over `seg` for the buildings that stood still through it: their
+    /// exact free step `z1` (modal, the whole row's), with `work` (each mode's input and
+    /// damping work over the step, when the energy is kept), and their peaks over it. Call in
+    /// modal coordinates ([`RowRun::leave_substeps`]).
+    pub fn finish_still(&mut self, seg: &Segment, z0: &[f64], z1: &[f64], work: &[(f64, f64)]) {
+        let modal = self.modal;
+        let (n, nl) = (modal.n, modal.levels.len());
+        for k in 0..modal.buildings.len() {
+            if self.active[k] {
+                continue;
+            }
+            let b = &modal.buildings[k];
+            for i in b.off..b.off + b.n() {
+                self.z[i] = z1[i];
+                self.z[n + i] = z1[n + i];
+                if let Some(&(agv, vv)) = work.get(i) {
+                    self.z[2 * n + nl] -= agv;
+                    self.z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
+                }
+            }
+            self.track_still(k, z0, z1, (seg.a0, seg.a1), seg.dt);
+        }
+        self.e_peak = self.e_peak.max(self.e_initial + self.z[2 * n + nl]);
+        self.all_active();
+    }
+
+    /// Raise building `k`'s peaks over a free piece of length `h` from `z0` to `z1` (modal
+    /// states; no contact acts on it), leaving its floor kinematics at `z1` as the piece's end.
+    pub(super) fn track_still(&mut self, k: usize, z0: &[f64], z1: &[f64], ag: (f64, f64), h: f64) {
+        let modal = self.modal;
+        let bm = &modal.buildings[k];
+        for (end, z, a) in [(0, z0, ag.0), (1, z1, ag.1)] {
+            let f = &mut self.floors[k][end];
+            f.force.fill(0.0);
+            f.fill(modal, (k, bm), z, a, &self.storey_modes);
+        }
+        self.raise_building(k, bm, h, true);
+    }
+
+    /// Each level's mode and impact speed, into `out`.
+    pub fn level_modes(&self, out: &mut Vec<(Mode, f64)>) {
+        out.clear();
+        out.extend(self.levels.iter().map(|l| (l.mode, l.v0)));
+    }
+
+    /// The checked levels ([`RowRun::level_on`]) in contact mode `mode`.
+    pub(super) fn levels_in(&self, mode: Mode) -> impl Iterator<Item = (&LevelModel, &LevelState)> {
+        self.m
+            .levels
+            .iter()
+            .zip(&self.levels)
+            .zip(&self.level_on)
+            .filter(move |((_, ls), &on)| on && ls.mode == mode)
+            .map(|(l, _)| l)
+    }
+
+    /// The shortest [`Contact::onset_cut`] at `t` of the checked levels that approach.
+    pub fn onset_cut(&self, t: f64, per_contact: f64, tol: f64) -> f64 {
+        self.levels_in(Mode::Approach)
+            .map(|(lm, ls)| {
+                lm.contact
+                    .onset_cut(t - ls.t_onset, ls.v0, per_contact, tol)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    pub fn any_contact(&self) -> bool {
+        self.levels.iter().any(|l| l.mode != Mode::Free)
+    }
+
+    /// Is some storey on a bounding line?
+    pub fn any_yielding(&self) -> bool {
+        self.storey_modes
+            .iter()
+            .any(|m| matches!(m, StoreyMode::Yielding(_)))
+    }
+
+    /// A free record step over `seg` to `z1`, with no possible contact (checked by the caller).
+    pub fn free_step(&mut self, seg: &Segment, z1: Vec<f64>) {
+        let z0 = std::mem::take(&mut self.z);
+        self.track(seg.t0, seg.dt, &z0, &z1, (seg.a0, seg.a1));
+        self.free_steps += 1;
+        self.z = z1;
+        self.emit(seg, seg.t1());
+    }
+}
