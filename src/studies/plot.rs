@@ -292,11 +292,46 @@ pub fn save_at(
         size.1.clamp(*PANEL_SIZES.start(), *PANEL_SIZES.end()),
     );
     if png {
-        let scale = dpi.clamp(*DPIS.start(), *DPIS.end()) as f64 / BASE_DPI as f64;
+        let dpi = dpi.clamp(*DPIS.start(), *DPIS.end());
+        let scale = dpi as f64 / BASE_DPI as f64;
+        check_pixels(panels.len(), cols, size, dpi).map_err(|message| PlotError {
+            path: path.into(),
+            message,
+        })?;
         self::png(path, panels, cols, size, scale)
     } else {
         svg(path, panels, cols, size)
     }
+}
+
+/// The pixels of a PNG of `n` panels, `cols` a row, each `size` at `dpi`, within
+/// [`crate::plan::limits::MAX_FIGURE_PIXELS`]: checked before the image is allocated. Err: the
+/// product, the bound and what gets under it.
+pub fn check_pixels(n: usize, cols: usize, size: (u32, u32), dpi: u32) -> Result<(), String> {
+    use crate::plan::limits::{MAX_FIGURE_PIXELS, WHY_FIGURE_PIXELS};
+    let cols = cols.clamp(1, n.max(1));
+    let rows = n.div_ceil(cols).max(1);
+    let scaled = |v: u32| (v as f64 * dpi as f64 / BASE_DPI as f64).round() as u64;
+    let (w, h) = (scaled(size.0) * cols as u64, scaled(size.1) * rows as u64);
+    if w * h <= MAX_FIGURE_PIXELS {
+        return Ok(());
+    }
+    // The largest dpi at which this figure fits, for the message.
+    let fits = (BASE_DPI as f64
+        * (MAX_FIGURE_PIXELS as f64 / (size.0 as f64 * cols as f64 * size.1 as f64 * rows as f64))
+            .sqrt())
+    .floor();
+    Err(format!(
+        "{n} panel(s), {cols} a row, of {}x{} px (--size) at {dpi} dpi (--dpi) make a {w}x{h} PNG, {:.0} megapixels: over the bound of {} megapixels a figure ({WHY_FIGURE_PIXELS}). Lower --size or --dpi (at this size, {} dpi or less), or draw an SVG",
+        size.0,
+        size.1,
+        (w * h) as f64 / 1e6,
+        MAX_FIGURE_PIXELS / 1_000_000,
+        match fits as u32 {
+            d if d >= *DPIS.start() => format!("{d}"),
+            _ => "no resolution fits; a smaller --size".to_string(),
+        }
+    ))
 }
 
 fn grid(panels: &[Panel], cols: usize, size: (u32, u32)) -> (usize, usize, (u32, u32)) {
@@ -627,6 +662,17 @@ mod tests {
         // A word wider than the panel stands alone.
         let (lines, _) = fit("a verylongword b", 40.0);
         assert_eq!(lines, ["a", "verylongword", "b"]);
+    }
+
+    #[test]
+    fn pixels_are_bounded_before_drawing() {
+        assert!(check_pixels(6, 3, (640, 480), 300).is_ok());
+        let e = check_pixels(6, 3, (4000, 4000), 600).unwrap_err();
+        assert!(
+            e.contains("75000x50000") && e.contains("100 megapixels"),
+            "{e}"
+        );
+        assert!(check_pixels(1, 1, (4000, 4000), 96).is_ok());
     }
 
     #[test]
