@@ -70,7 +70,7 @@ pub fn run(a: Args) -> Result<()> {
         log_y: a.log_y,
     };
     let (mut p, failed) = panel(&table, &spec)?;
-    a.figure.apply(std::slice::from_mut(&mut p));
+    a.figure.apply(std::slice::from_mut(&mut p))?;
     if failed > 0 {
         note!(
             "{}: {failed} rows left out: runs whose status is not ok, or values that are not finite",

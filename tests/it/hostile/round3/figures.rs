@@ -1,11 +1,66 @@
 //! Hostile pass, round 3 (issue 47), classes 4, 5, 14 and the long title of 9: a figure's labels,
 //! ticks, axes and titles say what it shows, and what it costs is bounded before it is drawn.
 
-use crate::support::{pound, tempdir};
+use crate::support::{ok, pound, tempdir};
 use std::path::Path;
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
+}
+
+/// An SVG's texts in document order, each with its element's attributes.
+fn texts(svg: &str) -> Vec<(String, String)> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let (attrs, rest) = t.split_once('>')?;
+            let body = rest.split('<').next()?.trim().replace("&gt;", ">");
+            Some((attrs.to_string(), body))
+        })
+        .collect()
+}
+
+/// The y tick labels (right-aligned numbers) of the panel whose title starts with `title`:
+/// those after its title, up to the first text after them that is not a number.
+fn y_ticks(svg: &str, title: &str) -> Vec<f64> {
+    let all = texts(svg);
+    let from = all
+        .iter()
+        .position(|(_, t)| t.starts_with(title))
+        .unwrap_or_else(|| panic!("no panel `{title}`"));
+    let mut ticks = Vec::new();
+    for (attrs, t) in &all[from + 1..] {
+        match t.parse::<f64>() {
+            Ok(v) if attrs.contains("text-anchor=\"end\"") => ticks.push(v),
+            Ok(_) => {}
+            Err(_) if ticks.is_empty() => {}
+            Err(_) => break,
+        }
+    }
+    ticks
+}
+
+/// Every number printed in a figure: none is a float step's residue of 0 (`-2.78e-17`).
+fn no_residue_of_zero(svg: &str, what: &str) {
+    for (_, t) in texts(svg) {
+        if let Ok(v) = t.parse::<f64>() {
+            assert!(v == 0.0 || v.abs() > 1e-9, "{what}: a tick `{t}`");
+        }
+    }
+}
+
+fn column(csv: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    let at = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == name)
+        .unwrap();
+    lines
+        .filter_map(|l| l.split(',').nth(at)?.parse().ok())
+        .collect()
 }
 
 fn refused(out: &std::process::Output, said: &[&str]) {
@@ -14,6 +69,96 @@ fn refused(out: &std::process::Output, said: &[&str]) {
     for s in said {
         assert!(err.contains(s), "`{s}` in: {err}");
     }
+}
+
+/// Class 4, labels that contradict the data: a label's unit scales the data to it (`Force
+/// (kN)` on forces in N divides them by 1000) or is refused, naming the flag and the quantity's
+/// unit; on a figure of several panels a label goes only to the panels whose quantity it fits;
+/// a tick at 0 reads 0 (it read `-2.78e-17` on a roof's displacement).
+#[test]
+fn labels_agree_with_the_data() {
+    let dir = tempdir();
+    let csv = dir.path().join("x.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/inelastic-row.toml",
+        "-o",
+        s(&csv),
+    ]));
+    let forces = column(&csv, "peak_force_n");
+    let (lo, hi) = forces
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(l, h), &f| (l.min(f), h.max(f)));
+    let plot = |label: &str, out: &Path| {
+        pound(&[
+            "plot",
+            s(&csv),
+            "--x",
+            "pga_g",
+            "--y",
+            "peak_force_n",
+            "--y-label",
+            label,
+            "-o",
+            s(out),
+        ])
+    };
+    let kn = dir.path().join("kn.svg");
+    ok(&plot("Force (kN)", &kn));
+    let svg = std::fs::read_to_string(&kn).unwrap();
+    let ticks = y_ticks(&svg, "peak force against");
+    assert!(!ticks.is_empty());
+    for t in &ticks {
+        assert!(
+            (lo / 1e3 * 0.8..=hi / 1e3 * 1.2).contains(t),
+            "a tick {t} kN for forces of {lo} to {hi} N: {ticks:?}"
+        );
+    }
+    refused(
+        &plot("Force (s)", &dir.path().join("s.svg")),
+        &["--y-label", "Force (s)", "N"],
+    );
+    assert!(!dir.path().join("s.svg").exists());
+    // A trace's panels: displacements, forces (contact and storey shear), energy.
+    let tcsv = dir.path().join("t.csv");
+    let trace = |extra: &[&str], out: &Path| {
+        let mut args = vec![
+            "trace",
+            "configs/inelastic-row.toml",
+            "--run",
+            "5",
+            "-o",
+            s(&tcsv),
+        ];
+        args.extend(["--plot", s(out)]);
+        args.extend(extra);
+        pound(&args)
+    };
+    let t = dir.path().join("t.svg");
+    ok(&trace(&[], &t));
+    let plain = std::fs::read_to_string(&t).unwrap();
+    no_residue_of_zero(&plain, "a trace");
+    ok(&trace(&["--y-label", "force (kN)"], &t));
+    let svg = std::fs::read_to_string(&t).unwrap();
+    let labels: Vec<String> = texts(&svg).into_iter().map(|(_, t)| t).collect();
+    assert_eq!(
+        labels.iter().filter(|l| *l == "force (kN)").count(),
+        3,
+        "the force panels: {labels:?}"
+    );
+    assert!(labels.iter().any(|l| l.starts_with("displacement (")));
+    assert!(labels.iter().any(|l| l.starts_with("hysteretic energy (")));
+    // The storey shear, some 5 MN, in kN.
+    let shear = y_ticks(&svg, "Storey shear");
+    assert!(shear.iter().any(|v| v.abs() >= 1000.0), "{shear:?}");
+    refused(
+        &trace(&["--y-label", "force (s)"], &dir.path().join("u.svg")),
+        &["--y-label", "force (s)", "(m)", "(N)", "(J)"],
+    );
+    refused(
+        &trace(&["--y-label", "response"], &dir.path().join("u.svg")),
+        &["--y-label", "response", "unit"],
+    );
 }
 
 /// Class 5, resources: a figure's pixels are bounded before it is drawn. Six panels of
