@@ -3,7 +3,7 @@
 //! 16, 50 and 84 % fractiles of the demand at each intensity level (collapse-free: every run
 //! has a finite demand, so fractiles of the demand given the intensity are well defined).
 
-use crate::io::table::{label, order_key, Filter, Table, TableError};
+use crate::io::table::{label, name, order_key, Filter, Table, TableError};
 use crate::studies::fragility::{demand_rows, quantile, LeftOut};
 use crate::studies::plot::{Panel, Series};
 use std::collections::{BTreeMap, HashMap};
@@ -195,8 +195,8 @@ impl Ida {
         Panel {
             title: format!(
                 "IDA: {} against {} ({} curves{})",
-                spec.edp,
-                spec.im,
+                name(&spec.edp),
+                name(&spec.im),
                 self.curves.len(),
                 if named { "" } else { " in grey" }
             ),
@@ -205,6 +205,7 @@ impl Ida {
             log_x: false,
             log_y: false,
             series,
+            y_span: None,
         }
     }
 }

@@ -289,17 +289,16 @@ const CORNERS: [SeriesLabelPosition; 4] = [
     SeriesLabelPosition::LowerLeft,
 ];
 
-/// Where the legend goes, and how far the y range must grow upwards for it: the first corner
-/// whose box (estimated from the entries' text, as fractions `w`, `h` of the plot area) covers
-/// no point; else the top left, with the y range raised by the box's height so that it covers
-/// none there either.
+/// Where the legend goes: the first corner whose box (estimated from the entries' text, as
+/// fractions `w`, `h` of the plot area) covers no point; None where each would, and the legend
+/// goes beside the plot (raising the y range to make room would run a probability axis to 2).
 fn legend_place(
     points: &[(f64, f64)],
     x: (f64, f64),
     y: (f64, f64),
     w: f64,
     h: f64,
-) -> (SeriesLabelPosition, f64) {
+) -> Option<SeriesLabelPosition> {
     let inside = |(fx0, fx1): (f64, f64), (fy0, fy1): (f64, f64)| {
         points.iter().any(|&(px, py)| {
             let (u, v) = ((px - x.0) / (x.1 - x.0), (py - y.0) / (y.1 - y.0));
@@ -314,14 +313,10 @@ fn legend_place(
         };
         let fy = if i < 2 { (1.0 - h, 1.0) } else { (0.0, h) };
         if !inside(fx, fy) {
-            return (c, y.1);
+            return Some(c);
         }
     }
-    let h = h.min(0.9);
-    (
-        SeriesLabelPosition::UpperLeft,
-        y.1 + (y.1 - y.0) * h / (1.0 - h),
-    )
+    None
 }
 
 /// One chart.
@@ -333,6 +328,9 @@ pub struct Panel {
     pub log_x: bool,
     pub log_y: bool,
     pub series: Vec<Series>,
+    /// Values the y axis shows whatever the data (a probability's 0 and 1, so that its axis
+    /// does not start at 0.82); None: the data's range.
+    pub y_span: Option<(f64, f64)>,
 }
 
 /// The label of the power of ten `10^k`: `0.01` to `1000` plainly, else `1e-5`, `1e6`.
@@ -598,7 +596,8 @@ fn draw<DB: DrawingBackend>(
     };
     let all: Vec<(f64, f64)> = p.series.iter().flat_map(pts).collect();
     let (x0, x1) = range(all.iter().map(|q| q.0));
-    let (y0, y1) = range(all.iter().map(|q| q.1));
+    let span = p.y_span.iter().flat_map(|&(a, b)| [ty(a), ty(b)]);
+    let (y0, y1) = range(all.iter().map(|q| q.1).chain(span));
     let named: Vec<&Series> = p.series.iter().filter(|s| !s.name.is_empty()).collect();
     // The legend box as a share of the plot area (the panel less about 105 x 100 px of axis
     // labels, caption and margins: 535 x 380 px in a 640 x 480 panel): 7 px a character at
@@ -614,7 +613,7 @@ fn draw<DB: DrawingBackend>(
         area.estimate_text_size(text, &("sans-serif", size).into_text_style(area))
             .map_or(f64::INFINITY, |(w, _)| w as f64)
     };
-    let (title, title_size) = fit_title(
+    let (mut title, title_size) = fit_title(
         &p.title,
         panel_w as f64 - 2.0 * px(10) as f64,
         scale,
@@ -624,6 +623,20 @@ fn draw<DB: DrawingBackend>(
     let line_h = area
         .estimate_text_size("Ag", &title_style)
         .map_or(0, |(_, h)| h) as f64;
+    // A title of more lines than fit a third of the panel is cut after them, its last line
+    // ending in an ellipsis: the plot keeps the rest of the panel (it was drawn over the title).
+    let most = (panel_h as f64 / 3.0 / (line_h * 1.4)).floor().max(1.0) as usize;
+    if title.len() > most {
+        title.truncate(most);
+        let last = title.last_mut().expect("a line");
+        while measure(&format!("{last} …"), title_size) > panel_w as f64 - 2.0 * px(10) as f64 {
+            match last.rfind(' ') {
+                Some(k) => last.truncate(k),
+                None => break,
+            }
+        }
+        last.push_str(" …");
+    }
     let plot_w = (panel_w as f64 - 105.0 * scale).max(1.0);
     let plot_h =
         (panel_h as f64 - 100.0 * scale - (title.len() as f64 - 1.0) * line_h * 1.4).max(1.0);
@@ -631,8 +644,7 @@ fn draw<DB: DrawingBackend>(
         (longest as f64 * 7.0 + 40.0) * scale / plot_w,
         (named.len() as f64 * 20.0 + 20.0) * scale / plot_h,
     );
-    let data_top = y1;
-    let (corner, y1) = if named.len() > 1 {
+    let corner = if named.len() > 1 {
         // What the legend must not cover: every point, and the lines between the points of a
         // line series (sampled along each segment).
         let mut occupied = all.clone();
@@ -647,11 +659,23 @@ fn draw<DB: DrawingBackend>(
         }
         legend_place(&occupied, (x0, x1), (y0, y1), w, h)
     } else {
-        (SeriesLabelPosition::UpperLeft, y1)
+        None
     };
-    // Where the range was raised to make room for the legend, the room above the data carries
-    // no tick labels: a probability axis is not labelled past 1.
-    let above_data = |v: f64| v > data_top + (data_top - y0).abs() * 1e-9;
+    // A legend that would cover data in every corner goes beside the plot, in a margin kept
+    // for it: to the right where it takes at most 40 % of the panel's width, else below.
+    let legend_font = 12.0 * scale;
+    let outside = (named.len() > 1 && corner.is_none()).then(|| {
+        let widest = named
+            .iter()
+            .map(|s| measure(&s.name, legend_font))
+            .fold(0.0, f64::max);
+        let size = (
+            (widest + 40.0 * scale).ceil() as i32,
+            ((named.len() as f64 * 20.0 + 10.0) * scale).ceil() as i32,
+        );
+        let right = size.0 as f64 + px(20) as f64 <= 0.4 * panel_w as f64;
+        (right, size)
+    });
     let label = |l: &str, log: bool| {
         if log {
             format!("{l}, log scale")
@@ -687,9 +711,7 @@ fn draw<DB: DrawingBackend>(
         }
     };
     let fmt_y = |v: &f64| {
-        if above_data(*v) {
-            String::new()
-        } else if p.log_y {
+        if p.log_y {
             log_tick(*v)
         } else {
             linear_tick(*v, y0, y1)
@@ -713,6 +735,11 @@ fn draw<DB: DrawingBackend>(
             ChartBuilder::on(&below_title)
         }
     };
+    match outside {
+        Some((true, (w, _))) => builder.margin_right(w as u32 + px(20)),
+        Some((false, (_, h))) => builder.margin_bottom(h as u32 + px(20)),
+        None => &mut builder,
+    };
     let mut chart = builder
         .x_label_area_size(px(40))
         .y_label_area_size(px(75))
@@ -735,6 +762,7 @@ fn draw<DB: DrawingBackend>(
     mesh.draw().map_err(|x| e(&x))?;
     // Style slots in order of first appearance: a curve and its points share one.
     let mut slots: Vec<usize> = Vec::new();
+    let mut entries: Vec<(&str, usize, RGBAColor)> = Vec::new();
     for (i, s) in p.series.iter().enumerate() {
         let slot = {
             let key = s.style.unwrap_or(usize::MAX - i);
@@ -747,6 +775,9 @@ fn draw<DB: DrawingBackend>(
             }
         };
         let color = PALETTE[slot % PALETTE.len()].to_rgba();
+        if !s.name.is_empty() {
+            entries.push((&s.name, slot, color));
+        }
         let data = pts(s);
         if s.name.is_empty() {
             // Unnamed: a background line (one of many), thin and grey, with no legend entry.
@@ -785,7 +816,38 @@ fn draw<DB: DrawingBackend>(
                 .map_err(|x| e(&x))?;
         }
     }
-    if named.len() > 1 {
+    if let Some((right, (w, h))) = outside {
+        let (xs, ys) = chart.plotting_area().get_pixel_range();
+        let (bx, by) = area.get_base_pixel();
+        let (x, y) = if right {
+            (panel_w as i32 - px(10) as i32 - w, ys.start - by)
+        } else {
+            (xs.start - bx, panel_h as i32 - px(10) as i32 - h)
+        };
+        let corners = [(x, y), (x + w, y + h)];
+        area.draw(&Rectangle::new(corners, WHITE.mix(0.85).filled()))
+            .map_err(|x| e(&x))?;
+        area.draw(&Rectangle::new(corners, BLACK.stroke_width(px(1))))
+            .map_err(|x| e(&x))?;
+        let font = ("sans-serif", legend_font).into_text_style(area).pos(
+            plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Left,
+                plotters::style::text_anchor::VPos::Center,
+            ),
+        );
+        for (k, (name, slot, color)) in entries.iter().enumerate() {
+            let at = y + ((k as f64 * 20.0 + 15.0) * scale).round() as i32;
+            area.draw(&marker::<DB, (i32, i32)>(
+                *slot,
+                (x + px(14) as i32, at),
+                *color,
+                scale,
+            ))
+            .map_err(|x| e(&x))?;
+            area.draw(&Text::new(*name, (x + px(28) as i32, at), font.clone()))
+                .map_err(|x| e(&x))?;
+        }
+    } else if let Some(corner) = corner {
         let mut legend = chart.configure_series_labels();
         legend
             .position(corner)

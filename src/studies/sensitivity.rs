@@ -146,6 +146,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, usize), TableErro
             log_x: spec.log_x,
             log_y: spec.log_y,
             series,
+            y_span: None,
         },
         failed,
     ))

@@ -184,3 +184,166 @@ fn a_figure_costs_a_bounded_number_of_pixels() {
     refused(&out, &["pixels", "--size", "--dpi"]);
     assert!(!png.exists());
 }
+
+/// Class 14 and the long title of 9, figures that misreport: a probability axis runs from 0 to
+/// 1 (not to 2 to make room for a legend, which goes beside the plot; not from 0.82 up); titles
+/// name columns in words, as the axes do; a title too long for its panel never covers the plot.
+#[test]
+fn figures_report_what_they_show() {
+    let dir = tempdir();
+    // Fragility curves fill the plot: their legend cannot sit inside it.
+    let runs = dir.path().join("fr.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/fragility-example.toml",
+        "-o",
+        s(&runs),
+    ]));
+    let f = dir.path().join("f.svg");
+    ok(&pound(&[
+        "fragility",
+        s(&runs),
+        "--edp",
+        "peak_force_n",
+        "--threshold",
+        "0,1e6,3e6",
+        "-o",
+        s(&dir.path().join("f.csv")),
+        "--plot",
+        s(&f),
+    ]));
+    let svg = std::fs::read_to_string(&f).unwrap();
+    // The plot area's top is where its grid lines end; tick 1 sits at it, not half way down.
+    let top = svg
+        .split("<line")
+        .skip(1)
+        .filter(|l| l.contains("opacity"))
+        .flat_map(|l| {
+            ["y1", "y2"].map(|k| {
+                let at = l.find(&format!(" {k}=\"")).unwrap() + 5;
+                l[at..].split('"').next().unwrap().parse::<f64>().unwrap()
+            })
+        })
+        .fold(f64::INFINITY, f64::min);
+    let at = |v: &str| {
+        texts(&svg)
+            .into_iter()
+            .find(|(a, t)| t == v && a.contains("text-anchor=\"end\""))
+            .map(|(a, _)| {
+                let i = a.find(" y=\"").unwrap() + 4;
+                a[i..].split('"').next().unwrap().parse::<f64>().unwrap()
+            })
+            .unwrap_or_else(|| panic!("a tick {v}"))
+    };
+    let (zero, one) = (at("0"), at("1"));
+    assert!(
+        one - top < 0.1 * (zero - one),
+        "the axis runs past 1: top {top}, tick 1 at {one}, tick 0 at {zero}"
+    );
+    no_residue_of_zero(&svg, "fragility");
+    // The probability of pounding where every gap pounds often: from 0, not from 0.82.
+    let g = dir.path().join("g.svg");
+    ok(&pound(&[
+        "gap",
+        "configs/gap-example.toml",
+        "-o",
+        s(&dir.path().join("g.csv")),
+        "--plot",
+        s(&g),
+        "--gaps",
+        "0.01,0.02,0.04",
+    ]));
+    let svg = std::fs::read_to_string(&g).unwrap();
+    let p = y_ticks(&svg, "Probability of pounding");
+    assert!(p.contains(&0.0) && p.contains(&1.0), "{p:?}");
+    no_residue_of_zero(&svg, "gap");
+    // Titles in words: pound ida's, and pound plot's --where caption.
+    let csv = dir.path().join("x.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/inelastic-row.toml",
+        "-o",
+        s(&csv),
+    ]));
+    let i = dir.path().join("i.svg");
+    ok(&pound(&[
+        "ida",
+        s(&csv),
+        "--edp",
+        "b1_peak_drift_ratio",
+        "--where",
+        "gap_1_2_m=0.01",
+        "-o",
+        s(&dir.path().join("i.csv")),
+        "--plot",
+        s(&i),
+    ]));
+    let svg = std::fs::read_to_string(&i).unwrap();
+    let title = &texts(&svg)[0].1;
+    assert!(
+        title.contains("peak drift ratio, building 1") && !title.contains('_'),
+        "{title}"
+    );
+    let w = dir.path().join("w.svg");
+    ok(&pound(&[
+        "plot",
+        s(&csv),
+        "--x",
+        "pga_g",
+        "--y",
+        "peak_force_n",
+        "--where",
+        "gap_1_2_m=0.01",
+        "-o",
+        s(&w),
+    ]));
+    let svg = std::fs::read_to_string(&w).unwrap();
+    let title = &texts(&svg)[0].1;
+    assert!(
+        title.contains("gap 1-2 = 0.01 m") && !title.contains('_'),
+        "{title}"
+    );
+    // A title of 400 words on a small panel: its lines end above the plot area.
+    let long: Vec<String> = (0..400).map(|k| format!("word{k}")).collect();
+    let l = dir.path().join("l.svg");
+    ok(&pound(&[
+        "plot",
+        s(&csv),
+        "--x",
+        "pga_g",
+        "--y",
+        "peak_force_n",
+        "--title",
+        &long.join(" "),
+        "--size",
+        "320x320",
+        "-o",
+        s(&l),
+    ]));
+    let svg = std::fs::read_to_string(&l).unwrap();
+    let grid_top = svg
+        .split("<line")
+        .skip(1)
+        .filter(|l| l.contains("opacity"))
+        .flat_map(|l| {
+            ["y1", "y2"].map(|k| {
+                let at = l.find(&format!(" {k}=\"")).unwrap() + 5;
+                l[at..].split('"').next().unwrap().parse::<f64>().unwrap()
+            })
+        })
+        .fold(f64::INFINITY, f64::min);
+    let lowest_title = texts(&svg)
+        .into_iter()
+        .filter(|(_, t)| t.starts_with("word") || t.ends_with('…'))
+        .map(|(a, _)| {
+            let i = a.find(" y=\"").unwrap() + 4;
+            a[i..].split('"').next().unwrap().parse::<f64>().unwrap()
+        })
+        .fold(0.0f64, f64::max);
+    // A line's `y` is its top; its text is about 11 px high.
+    assert!(
+        lowest_title + 11.0 < grid_top,
+        "a title line at {lowest_title}, the plot from {grid_top}"
+    );
+    assert!(grid_top < 200.0, "the plot keeps most of its panel");
+}
