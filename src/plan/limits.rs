@@ -67,7 +67,7 @@ pub const MAX_CURVE_GAPS: usize = 10_000;
 /// before a pixel is drawn. An SVG has no pixels and is not bound.
 pub const MAX_FIGURE_PIXELS: u64 = 100_000_000;
 pub const WHY_FIGURE_PIXELS: &str =
-    "a PNG is drawn whole in memory, 3 bytes a pixel: 100 megapixels is 300 MB, and past any print (a six-panel figure at 300 dpi is about 18)";
+    "a PNG is drawn whole in memory at 3 bytes a pixel, so 100 megapixels is 300 MB; six 640x480 panels at 300 dpi, for print, are 18";
 
 /// Runs of one `pound bench` size.
 pub const MAX_BENCH_RUNS: u64 = 1_000_000_000;

@@ -281,7 +281,9 @@ fn figures_report_what_they_show() {
     let svg = std::fs::read_to_string(&i).unwrap();
     let title = &texts(&svg)[0].1;
     assert!(
-        title.contains("peak drift ratio, building 1") && !title.contains('_'),
+        title.contains("peak drift ratio, building 1")
+            && title.contains("where gap 1-2 = 0.01 m")
+            && !title.contains('_'),
         "{title}"
     );
     let w = dir.path().join("w.svg");
