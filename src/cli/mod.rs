@@ -291,11 +291,17 @@ pub struct FigureArgs {
     /// Each panel's size in pixels, WIDTHxHEIGHT (each 320 to 4000; default 640x480).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Every panel's x-axis label (default: the quantity in words, with its unit). A unit in
-    /// parentheses, (N), (J), (N/m) or (m), is turned into kN, MN, mm... as the default's is.
+    /// The x-axis label (default: the quantity in words, with its unit). A unit in parentheses
+    /// at its end is the axis's: a multiple of the quantity's unit scales the values to it
+    /// (kN, MN for N; kJ, MJ for J; kN/m, MN/m for N/m; mm, cm for m; % for m/m; ms for s),
+    /// and a base unit, (N), (J), (N/m), (m) or (m/m), is turned into kN, mm, %... as the
+    /// default's is; a unit of another quantity is refused. Of several panels, a label with a
+    /// unit goes to those whose quantity is in that unit (`--y-label "force (kN)"` on a trace
+    /// relabels the force panels, not the displacements); one without goes to all where all
+    /// hold quantities in one unit, and is refused where they do not.
     #[arg(long)]
     pub x_label: Option<String>,
-    /// Every panel's y-axis label, as `--x-label`.
+    /// The y-axis label, as `--x-label`.
     #[arg(long)]
     pub y_label: Option<String>,
     /// A PNG's resolution in dots per inch, 48 to 600 (default 96): `--size` is at 96 dpi, so
@@ -316,7 +322,7 @@ impl FigureArgs {
     ) -> Result<()> {
         use pounding::studies::plot;
         let mut panels = panels.to_vec();
-        self.apply(&mut panels);
+        self.apply(&mut panels)?;
         let size = self.size.unwrap_or(plot::PANEL);
         plot::save_at(
             path,
@@ -330,14 +336,17 @@ impl FigureArgs {
 }
 
 impl FigureArgs {
-    /// Give `panels` the title and axis labels asked for.
-    pub fn apply(&self, panels: &mut [pounding::studies::plot::Panel]) {
-        for p in panels.iter_mut() {
-            if let Some(x) = &self.x_label {
-                p.x_label = x.clone();
-            }
-            if let Some(y) = &self.y_label {
-                p.y_label = y.clone();
+    /// Give `panels` the title and axis labels asked for, each axis's values in its label's
+    /// unit ([`pounding::studies::plot::relabel`]); Err: a label that contradicts the data. A
+    /// second call changes nothing more (the panels are in the labels' units by then).
+    pub fn apply(&self, panels: &mut [pounding::studies::plot::Panel]) -> Result<()> {
+        use pounding::studies::plot::{relabel, Axis};
+        for (flag, asked, axis) in [
+            ("--x-label", &self.x_label, Axis::X),
+            ("--y-label", &self.y_label, Axis::Y),
+        ] {
+            if let Some(l) = asked {
+                relabel(panels, axis, l).map_err(|why| anyhow::anyhow!("{flag} `{l}`: {why}"))?;
             }
         }
         match (&self.title, panels) {
@@ -345,6 +354,7 @@ impl FigureArgs {
             (Some(t), [first, ..]) => first.title = format!("{t}: {}", first.title),
             _ => {}
         }
+        Ok(())
     }
 }
 

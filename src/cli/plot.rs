@@ -70,7 +70,7 @@ pub fn run(a: Args) -> Result<()> {
         log_y: a.log_y,
     };
     let (mut p, left_out) = panel(&table, &spec)?;
-    a.figure.apply(std::slice::from_mut(&mut p));
+    a.figure.apply(std::slice::from_mut(&mut p))?;
     for line in left_out.lines() {
         note!("{}: {line}", a.results.display());
     }

@@ -204,6 +204,7 @@ fn spectrum(
                 scatter: false,
                 style: None,
             }],
+            y_span: None,
         };
         super::save_plot(p, &[panel], 1, figure)?;
     }

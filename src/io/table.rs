@@ -139,13 +139,28 @@ impl std::fmt::Display for Filter {
     }
 }
 
-/// The filters as a caption: `where a=1, b<2`; empty for none.
+/// The filters as a caption, in the words and units the axes use (`t2_s=0.9`, `law!=hertz` ->
+/// `where period, building 2 = 0.9 s and contact law != hertz`); empty for none.
 pub fn caption(filters: &[Filter]) -> String {
     if filters.is_empty() {
         return String::new();
     }
-    let all: Vec<String> = filters.iter().map(|f| f.to_string()).collect();
-    format!("where {}", all.join(", "))
+    let all: Vec<String> = filters
+        .iter()
+        .map(|f| {
+            let (name, unit) = named(&f.column);
+            let op = f.to_string();
+            let op = op[f.column.len()..]
+                .strip_suffix(f.value.as_str())
+                .unwrap_or("=");
+            // A unit after a number; a text value (a law, a record) stands alone.
+            match unit {
+                Some(u) if f.value.parse::<f64>().is_ok() => format!("{name} {op} {} {u}", f.value),
+                _ => format!("{name} {op} {}", f.value),
+            }
+        })
+        .collect();
+    format!("where {}", all.join(" and "))
 }
 
 /// `column OP value` with OP one of `=`, `!=`, `<`, `<=`, `>`, `>=`. `=` and `!=` compare numbers
@@ -354,7 +369,10 @@ mod tests {
         assert_eq!(label("beta_n_per_m1_5"), "contact stiffness beta (N/m^1.5)");
         assert_eq!(label("impacts"), "impacts");
         let f = Filter::parse_all(&["t2_s=0.9".into(), "law!=hertz".into()]).unwrap();
-        assert_eq!(caption(&f), "where t2_s=0.9, law!=hertz");
+        assert_eq!(
+            caption(&f),
+            "where period, building 2 = 0.9 s and contact law != hertz"
+        );
         assert_eq!(caption(&[]), "");
         assert_eq!(label("gap_1_2_m"), "gap 1-2 (m)");
         assert_eq!(

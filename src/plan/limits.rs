@@ -61,6 +61,14 @@ pub const MAX_E_VALUES: usize = 10_000;
 /// Gaps of `pound gap --gaps` (each is a row of the probability table, per pair and intensity).
 pub const MAX_CURVE_GAPS: usize = 10_000;
 
+/// Pixels of one PNG figure: its panels, `--size` and `--dpi` together (each within its own
+/// bounds, [`crate::studies::plot::PANEL_SIZES`] and [`crate::studies::plot::DPIS`], six
+/// panels of 4000x4000 px at 600 dpi asked for 3.75 gigapixels, 11 GB, and aborted). Checked
+/// before a pixel is drawn. An SVG has no pixels and is not bound.
+pub const MAX_FIGURE_PIXELS: u64 = 100_000_000;
+pub const WHY_FIGURE_PIXELS: &str =
+    "a PNG is drawn whole in memory at 3 bytes a pixel, so 100 megapixels is 300 MB; six 640x480 panels at 300 dpi, for print, are 18";
+
 /// Runs of one `pound bench` size.
 pub const MAX_BENCH_RUNS: u64 = 1_000_000_000;
 

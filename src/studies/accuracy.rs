@@ -279,6 +279,7 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
             log_x: true,
             log_y: true,
             series: lines.chain(marks).collect(),
+            y_span: None,
         }
     };
     vec![
@@ -694,6 +695,7 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
             log_x: true,
             log_y: true,
             series: lines.chain(marks).collect(),
+            y_span: None,
         }
     };
     vec![panel("median error", 0), panel("99th percentile error", 1)]

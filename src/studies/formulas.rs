@@ -74,6 +74,7 @@ pub fn zeta_panels(es: &[f64]) -> Result<Vec<Panel>, RestitutionError> {
         log_x: false,
         log_y,
         series: series.clone(),
+        y_span: None,
     };
     Ok(vec![panel(false), panel(true)])
 }

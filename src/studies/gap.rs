@@ -751,6 +751,7 @@ impl<'a> GapStudy<'a> {
                 x_label: "gap (mm)".into(),
                 y_label: "P(required gap > gap)".into(),
                 series,
+                y_span: Some((0.0, 1.0)),
                 ..Panel::default()
             });
         }

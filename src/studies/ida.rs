@@ -3,7 +3,7 @@
 //! 16, 50 and 84 % fractiles of the demand at each intensity level (collapse-free: every run
 //! has a finite demand, so fractiles of the demand given the intensity are well defined).
 
-use crate::io::table::{label, order_key, Filter, Table, TableError};
+use crate::io::table::{caption, label, name, order_key, Filter, Table, TableError};
 use crate::studies::fragility::{demand_rows, quantile, LeftOut};
 use crate::studies::plot::{Panel, Series};
 use std::collections::{BTreeMap, HashMap};
@@ -193,18 +193,24 @@ impl Ida {
             });
         }
         Panel {
+            // The rows kept, as pound plot's and pound fragility's titles say them.
             title: format!(
-                "IDA: {} against {} ({} curves{})",
-                spec.edp,
-                spec.im,
+                "IDA: {} against {} ({} curves{}){}",
+                name(&spec.edp),
+                name(&spec.im),
                 self.curves.len(),
-                if named { "" } else { " in grey" }
+                if named { "" } else { " in grey" },
+                match caption(&spec.filters) {
+                    c if c.is_empty() => c,
+                    c => format!("; {c}"),
+                }
             ),
             x_label: label(&spec.edp),
             y_label: label(&spec.im),
             log_x: false,
             log_y: false,
             series,
+            y_span: None,
         }
     }
 }

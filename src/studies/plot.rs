@@ -99,6 +99,159 @@ fn engineering(label: &str, biggest: f64, log: bool) -> (String, f64) {
     }
 }
 
+/// The units a label may name that are multiples of one another, each with its family (the
+/// unit the rest are multiples of) and its size in that unit.
+const SCALED_UNITS: [(&str, &str, f64); 16] = [
+    ("N", "N", 1.0),
+    ("kN", "N", 1e3),
+    ("MN", "N", 1e6),
+    ("J", "J", 1.0),
+    ("kJ", "J", 1e3),
+    ("MJ", "J", 1e6),
+    ("N/m", "N/m", 1.0),
+    ("kN/m", "N/m", 1e3),
+    ("MN/m", "N/m", 1e6),
+    ("m", "m", 1.0),
+    ("cm", "m", 1e-2),
+    ("mm", "m", 1e-3),
+    ("m/m", "m/m", 1.0),
+    ("%", "m/m", 1e-2),
+    ("s", "s", 1.0),
+    ("ms", "s", 1e-3),
+];
+
+/// Units a label may name that are taken as they are (no other unit is a multiple of them).
+const OTHER_UNITS: [&str; 5] = ["g", "kg", "m/s", "m/s^2", "N/m^1.5"];
+
+/// The unit in parentheses that ends `label`, where it is one of the units above (`peak force
+/// (N)` -> `N`); None for none, or for words in parentheses (`T2 / T1 (fundamental periods)`).
+pub fn unit_of(label: &str) -> Option<&str> {
+    let inner = label.trim_end().strip_suffix(')')?;
+    let unit = inner[inner.rfind('(')? + 1..].trim();
+    let known = SCALED_UNITS.iter().any(|u| u.0 == unit) || OTHER_UNITS.contains(&unit);
+    known.then_some(unit)
+}
+
+/// The factor that takes values of the quantity labelled `quantity` to the unit the label
+/// `asked` names (`peak force (N)`, `Force (kN)` -> 1e-3); 1 where `asked` names no unit. Err:
+/// why they disagree (a unit of another quantity, a unit on a quantity that has none, or a
+/// unit this does not know).
+pub fn rescale(quantity: &str, asked: &str) -> Result<f64, String> {
+    let words = |l: &str| {
+        l.trim_end()
+            .strip_suffix(')')
+            .and_then(|i| i.rfind('(').map(|k| i[k + 1..].trim().to_string()))
+    };
+    let family = |u: &str| SCALED_UNITS.iter().find(|s| s.0 == u).map(|s| (s.1, s.2));
+    let alike = |q: &str| -> String {
+        match family(q) {
+            Some((f, _)) => SCALED_UNITS
+                .iter()
+                .filter(|s| s.1 == f)
+                .map(|s| s.0)
+                .collect::<Vec<_>>()
+                .join(", "),
+            None => q.to_string(),
+        }
+    };
+    match (unit_of(quantity), unit_of(asked), words(asked)) {
+        (None, Some(a), _) => Err(format!(
+            "({a}) is a unit, but the axis holds {quantity}, which has none"
+        )),
+        (None, None, _) | (Some(_), None, None) => Ok(1.0),
+        (Some(q), None, Some(w)) => Err(format!(
+            "`{w}` is not a unit the figure knows; the axis holds {quantity}: write its unit as {}",
+            alike(q)
+        )),
+        (Some(q), Some(a), _) if q == a => Ok(1.0),
+        (Some(q), Some(a), _) => match (family(q), family(a)) {
+            (Some((fq, sq)), Some((fa, sa))) if fq == fa => Ok(sq / sa),
+            _ => Err(format!(
+                "({a}) is not a unit of {quantity}: write its unit as {}",
+                alike(q)
+            )),
+        },
+    }
+}
+
+/// Which axis a label is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Axis {
+    X,
+    Y,
+}
+
+/// Give `panels` the axis label `asked`, each panel's values on that axis scaled to the unit
+/// it names (`Force (kN)` on forces in N divides them by 1000). One panel takes it, or the
+/// reason it does not fit. Of several, a label that names a unit goes to the panels whose
+/// quantity is in that unit or a multiple of it (others keep theirs); one that names none goes
+/// to every panel where all show quantities in one unit. Err: why no panel takes it.
+pub fn relabel(panels: &mut [Panel], axis: Axis, asked: &str) -> Result<(), String> {
+    let current = |p: &Panel| match axis {
+        Axis::X => p.x_label.clone(),
+        Axis::Y => p.y_label.clone(),
+    };
+    let set = |p: &mut Panel, f: f64| {
+        for s in &mut p.series {
+            for q in &mut s.points {
+                match axis {
+                    Axis::X => q.0 *= f,
+                    Axis::Y => q.1 *= f,
+                }
+            }
+        }
+        match axis {
+            Axis::X => p.x_label = asked.to_string(),
+            Axis::Y => p.y_label = asked.to_string(),
+        }
+    };
+    if let [only] = panels {
+        let f = rescale(&current(only), asked)?;
+        set(only, f);
+        return Ok(());
+    }
+    // The panels' quantities, each once, for the messages.
+    let mut held: Vec<String> = Vec::new();
+    for p in panels.iter() {
+        let l = current(p);
+        let u = unit_of(&l).map_or_else(|| format!("`{l}`"), |u| format!("({u})"));
+        if !held.contains(&u) {
+            held.push(u);
+        }
+    }
+    let fits: Vec<Option<f64>> = panels
+        .iter()
+        .map(|p| {
+            let l = current(p);
+            match (unit_of(asked), unit_of(&l)) {
+                (Some(_), Some(_)) => rescale(&l, asked).ok(),
+                (Some(_), None) => None,
+                // No unit asked: every panel, where they hold one kind of quantity.
+                (None, _) if held.len() == 1 => rescale(&l, asked).ok(),
+                (None, _) => None,
+            }
+        })
+        .collect();
+    if fits.iter().all(Option::is_none) {
+        return Err(match unit_of(asked) {
+            Some(_) => format!(
+                "its unit fits none of the panels, whose axes hold {}",
+                held.join(", ")
+            ),
+            None => format!(
+                "it names no unit, and the panels' axes hold {}: end it with a unit in parentheses, e.g. `{asked} (N)`, and it goes to the panels in that unit",
+                held.join(", ")
+            ),
+        });
+    }
+    for (p, f) in panels.iter_mut().zip(fits) {
+        if let Some(f) = f {
+            set(p, f);
+        }
+    }
+    Ok(())
+}
+
 /// A title's lines and font size for a panel `width` px wide: one line at 18 px where it fits;
 /// else one line at the largest size down to 14 px at which it does; else its words wrapped
 /// into lines at 14 px (a word longer than the panel stands on a line of its own). `measure`
@@ -136,17 +289,16 @@ const CORNERS: [SeriesLabelPosition; 4] = [
     SeriesLabelPosition::LowerLeft,
 ];
 
-/// Where the legend goes, and how far the y range must grow upwards for it: the first corner
-/// whose box (estimated from the entries' text, as fractions `w`, `h` of the plot area) covers
-/// no point; else the top left, with the y range raised by the box's height so that it covers
-/// none there either.
+/// Where the legend goes: the first corner whose box (estimated from the entries' text, as
+/// fractions `w`, `h` of the plot area) covers no point; None where each would, and the legend
+/// goes beside the plot (raising the y range to make room would run a probability axis to 2).
 fn legend_place(
     points: &[(f64, f64)],
     x: (f64, f64),
     y: (f64, f64),
     w: f64,
     h: f64,
-) -> (SeriesLabelPosition, f64) {
+) -> Option<SeriesLabelPosition> {
     let inside = |(fx0, fx1): (f64, f64), (fy0, fy1): (f64, f64)| {
         points.iter().any(|&(px, py)| {
             let (u, v) = ((px - x.0) / (x.1 - x.0), (py - y.0) / (y.1 - y.0));
@@ -161,14 +313,10 @@ fn legend_place(
         };
         let fy = if i < 2 { (1.0 - h, 1.0) } else { (0.0, h) };
         if !inside(fx, fy) {
-            return (c, y.1);
+            return Some(c);
         }
     }
-    let h = h.min(0.9);
-    (
-        SeriesLabelPosition::UpperLeft,
-        y.1 + (y.1 - y.0) * h / (1.0 - h),
-    )
+    None
 }
 
 /// One chart.
@@ -180,6 +328,9 @@ pub struct Panel {
     pub log_x: bool,
     pub log_y: bool,
     pub series: Vec<Series>,
+    /// Values the y axis shows whatever the data (a probability's 0 and 1, so that its axis
+    /// does not start at 0.82); None: the data's range.
+    pub y_span: Option<(f64, f64)>,
 }
 
 /// The label of the power of ten `10^k`: `0.01` to `1000` plainly, else `1e-5`, `1e6`.
@@ -208,6 +359,16 @@ fn tick(v: f64) -> String {
             Some((m, x)) => format!("{}e{x}", m.trim_end_matches('0').trim_end_matches('.')),
             None => s,
         }
+    }
+}
+
+/// A linear axis's tick label for `v` on an axis from `lo` to `hi`: a tick at 0 reached by
+/// float steps (-2.78e-17, 1.73e-18) reads 0, as any within a billionth of the span does.
+fn linear_tick(v: f64, lo: f64, hi: f64) -> String {
+    if v.abs() <= (hi - lo).abs() * 1e-9 {
+        "0".to_string()
+    } else {
+        tick(v)
     }
 }
 
@@ -292,11 +453,46 @@ pub fn save_at(
         size.1.clamp(*PANEL_SIZES.start(), *PANEL_SIZES.end()),
     );
     if png {
-        let scale = dpi.clamp(*DPIS.start(), *DPIS.end()) as f64 / BASE_DPI as f64;
+        let dpi = dpi.clamp(*DPIS.start(), *DPIS.end());
+        let scale = dpi as f64 / BASE_DPI as f64;
+        check_pixels(panels.len(), cols, size, dpi).map_err(|message| PlotError {
+            path: path.into(),
+            message,
+        })?;
         self::png(path, panels, cols, size, scale)
     } else {
         svg(path, panels, cols, size)
     }
+}
+
+/// The pixels of a PNG of `n` panels, `cols` a row, each `size` at `dpi`, within
+/// [`crate::plan::limits::MAX_FIGURE_PIXELS`]: checked before the image is allocated. Err: the
+/// product, the bound and what gets under it.
+pub fn check_pixels(n: usize, cols: usize, size: (u32, u32), dpi: u32) -> Result<(), String> {
+    use crate::plan::limits::{MAX_FIGURE_PIXELS, WHY_FIGURE_PIXELS};
+    let cols = cols.clamp(1, n.max(1));
+    let rows = n.div_ceil(cols).max(1);
+    let scaled = |v: u32| (v as f64 * dpi as f64 / BASE_DPI as f64).round() as u64;
+    let (w, h) = (scaled(size.0) * cols as u64, scaled(size.1) * rows as u64);
+    if w * h <= MAX_FIGURE_PIXELS {
+        return Ok(());
+    }
+    // The largest dpi at which this figure fits, for the message.
+    let fits = (BASE_DPI as f64
+        * (MAX_FIGURE_PIXELS as f64 / (size.0 as f64 * cols as f64 * size.1 as f64 * rows as f64))
+            .sqrt())
+    .floor();
+    Err(format!(
+        "{n} panel(s), {cols} a row, of {}x{} px (--size) at {dpi} dpi (--dpi) make a {w}x{h} PNG, {:.0} megapixels: over the bound of {} megapixels a figure ({WHY_FIGURE_PIXELS}). Lower --size or --dpi (at this size, {} dpi or less), or draw an SVG",
+        size.0,
+        size.1,
+        (w * h) as f64 / 1e6,
+        MAX_FIGURE_PIXELS / 1_000_000,
+        match fits as u32 {
+            d if d >= *DPIS.start() => format!("{d}"),
+            _ => "no resolution fits; a smaller --size".to_string(),
+        }
+    ))
 }
 
 fn grid(panels: &[Panel], cols: usize, size: (u32, u32)) -> (usize, usize, (u32, u32)) {
@@ -400,7 +596,8 @@ fn draw<DB: DrawingBackend>(
     };
     let all: Vec<(f64, f64)> = p.series.iter().flat_map(pts).collect();
     let (x0, x1) = range(all.iter().map(|q| q.0));
-    let (y0, y1) = range(all.iter().map(|q| q.1));
+    let span = p.y_span.iter().flat_map(|&(a, b)| [ty(a), ty(b)]);
+    let (y0, y1) = range(all.iter().map(|q| q.1).chain(span));
     let named: Vec<&Series> = p.series.iter().filter(|s| !s.name.is_empty()).collect();
     // The legend box as a share of the plot area (the panel less about 105 x 100 px of axis
     // labels, caption and margins: 535 x 380 px in a 640 x 480 panel): 7 px a character at
@@ -416,7 +613,7 @@ fn draw<DB: DrawingBackend>(
         area.estimate_text_size(text, &("sans-serif", size).into_text_style(area))
             .map_or(f64::INFINITY, |(w, _)| w as f64)
     };
-    let (title, title_size) = fit_title(
+    let (mut title, title_size) = fit_title(
         &p.title,
         panel_w as f64 - 2.0 * px(10) as f64,
         scale,
@@ -426,6 +623,20 @@ fn draw<DB: DrawingBackend>(
     let line_h = area
         .estimate_text_size("Ag", &title_style)
         .map_or(0, |(_, h)| h) as f64;
+    // A title of more lines than fit a third of the panel is cut after them, its last line
+    // ending in an ellipsis: the plot keeps the rest of the panel (it was drawn over the title).
+    let most = (panel_h as f64 / 3.0 / (line_h * 1.4)).floor().max(1.0) as usize;
+    if title.len() > most {
+        title.truncate(most);
+        let last = title.last_mut().expect("a line");
+        while measure(&format!("{last} …"), title_size) > panel_w as f64 - 2.0 * px(10) as f64 {
+            match last.rfind(' ') {
+                Some(k) => last.truncate(k),
+                None => break,
+            }
+        }
+        last.push_str(" …");
+    }
     let plot_w = (panel_w as f64 - 105.0 * scale).max(1.0);
     let plot_h =
         (panel_h as f64 - 100.0 * scale - (title.len() as f64 - 1.0) * line_h * 1.4).max(1.0);
@@ -433,8 +644,7 @@ fn draw<DB: DrawingBackend>(
         (longest as f64 * 7.0 + 40.0) * scale / plot_w,
         (named.len() as f64 * 20.0 + 20.0) * scale / plot_h,
     );
-    let data_top = y1;
-    let (corner, y1) = if named.len() > 1 {
+    let corner = if named.len() > 1 {
         // What the legend must not cover: every point, and the lines between the points of a
         // line series (sampled along each segment).
         let mut occupied = all.clone();
@@ -449,11 +659,23 @@ fn draw<DB: DrawingBackend>(
         }
         legend_place(&occupied, (x0, x1), (y0, y1), w, h)
     } else {
-        (SeriesLabelPosition::UpperLeft, y1)
+        None
     };
-    // Where the range was raised to make room for the legend, the room above the data carries
-    // no tick labels: a probability axis is not labelled past 1.
-    let above_data = |v: f64| v > data_top + (data_top - y0).abs() * 1e-9;
+    // A legend that would cover data in every corner goes beside the plot, in a margin kept
+    // for it: to the right where it takes at most 40 % of the panel's width, else below.
+    let legend_font = 12.0 * scale;
+    let outside = (named.len() > 1 && corner.is_none()).then(|| {
+        let widest = named
+            .iter()
+            .map(|s| measure(&s.name, legend_font))
+            .fold(0.0, f64::max);
+        let size = (
+            (widest + 40.0 * scale).ceil() as i32,
+            ((named.len() as f64 * 20.0 + 10.0) * scale).ceil() as i32,
+        );
+        let right = size.0 as f64 + px(20) as f64 <= 0.4 * panel_w as f64;
+        (right, size)
+    });
     let label = |l: &str, log: bool| {
         if log {
             format!("{l}, log scale")
@@ -481,14 +703,18 @@ fn draw<DB: DrawingBackend>(
             tick((x / unit).round() * unit)
         }
     };
-    let fmt_x = |v: &f64| if p.log_x { log_tick(*v) } else { tick(*v) };
-    let fmt_y = |v: &f64| {
-        if above_data(*v) {
-            String::new()
-        } else if p.log_y {
+    let fmt_x = |v: &f64| {
+        if p.log_x {
             log_tick(*v)
         } else {
-            tick(*v)
+            linear_tick(*v, x0, x1)
+        }
+    };
+    let fmt_y = |v: &f64| {
+        if p.log_y {
+            log_tick(*v)
+        } else {
+            linear_tick(*v, y0, y1)
         }
     };
     // One line goes through plotters' caption; wrapped lines are set one under the other in
@@ -508,6 +734,11 @@ fn draw<DB: DrawingBackend>(
             below_title = rest;
             ChartBuilder::on(&below_title)
         }
+    };
+    match outside {
+        Some((true, (w, _))) => builder.margin_right(w as u32 + px(20)),
+        Some((false, (_, h))) => builder.margin_bottom(h as u32 + px(20)),
+        None => &mut builder,
     };
     let mut chart = builder
         .x_label_area_size(px(40))
@@ -531,6 +762,7 @@ fn draw<DB: DrawingBackend>(
     mesh.draw().map_err(|x| e(&x))?;
     // Style slots in order of first appearance: a curve and its points share one.
     let mut slots: Vec<usize> = Vec::new();
+    let mut entries: Vec<(&str, usize, RGBAColor)> = Vec::new();
     for (i, s) in p.series.iter().enumerate() {
         let slot = {
             let key = s.style.unwrap_or(usize::MAX - i);
@@ -543,6 +775,9 @@ fn draw<DB: DrawingBackend>(
             }
         };
         let color = PALETTE[slot % PALETTE.len()].to_rgba();
+        if !s.name.is_empty() {
+            entries.push((&s.name, slot, color));
+        }
         let data = pts(s);
         if s.name.is_empty() {
             // Unnamed: a background line (one of many), thin and grey, with no legend entry.
@@ -581,7 +816,38 @@ fn draw<DB: DrawingBackend>(
                 .map_err(|x| e(&x))?;
         }
     }
-    if named.len() > 1 {
+    if let Some((right, (w, h))) = outside {
+        let (xs, ys) = chart.plotting_area().get_pixel_range();
+        let (bx, by) = area.get_base_pixel();
+        let (x, y) = if right {
+            (panel_w as i32 - px(10) as i32 - w, ys.start - by)
+        } else {
+            (xs.start - bx, panel_h as i32 - px(10) as i32 - h)
+        };
+        let corners = [(x, y), (x + w, y + h)];
+        area.draw(&Rectangle::new(corners, WHITE.mix(0.85).filled()))
+            .map_err(|x| e(&x))?;
+        area.draw(&Rectangle::new(corners, BLACK.stroke_width(px(1))))
+            .map_err(|x| e(&x))?;
+        let font = ("sans-serif", legend_font).into_text_style(area).pos(
+            plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Left,
+                plotters::style::text_anchor::VPos::Center,
+            ),
+        );
+        for (k, (name, slot, color)) in entries.iter().enumerate() {
+            let at = y + ((k as f64 * 20.0 + 15.0) * scale).round() as i32;
+            area.draw(&marker::<DB, (i32, i32)>(
+                *slot,
+                (x + px(14) as i32, at),
+                *color,
+                scale,
+            ))
+            .map_err(|x| e(&x))?;
+            area.draw(&Text::new(*name, (x + px(28) as i32, at), font.clone()))
+                .map_err(|x| e(&x))?;
+        }
+    } else if let Some(corner) = corner {
         let mut legend = chart.configure_series_labels();
         legend
             .position(corner)
@@ -627,6 +893,69 @@ mod tests {
         // A word wider than the panel stands alone.
         let (lines, _) = fit("a verylongword b", 40.0);
         assert_eq!(lines, ["a", "verylongword", "b"]);
+    }
+
+    #[test]
+    fn a_tick_at_zero_reads_zero() {
+        assert_eq!(linear_tick(-2.78e-17, -0.2, 0.06), "0");
+        assert_eq!(linear_tick(1.73e-18, -0.04, 1.04), "0");
+        assert_eq!(linear_tick(1e-6, 0.0, 1e-4), "1e-6");
+        assert_eq!(linear_tick(0.05, -0.2, 0.06), "0.05");
+    }
+
+    #[test]
+    fn labels_scale_the_data_to_their_unit_or_are_refused() {
+        assert_eq!(rescale("peak force (N)", "Force (kN)"), Ok(1e-3));
+        assert_eq!(rescale("peak force (N)", "Force (MN)"), Ok(1e-6));
+        assert_eq!(rescale("gap (mm)", "gap (m)"), Ok(1e-3));
+        assert_eq!(rescale("drift (m/m)", "drift (%)"), Ok(1e2));
+        assert_eq!(
+            rescale("PGA (g)", "Peak ground acceleration, PGA (g)"),
+            Ok(1.0)
+        );
+        assert_eq!(rescale("peak force (N)", "Peak force"), Ok(1.0));
+        assert_eq!(rescale("impacts", "Number (of impacts)"), Ok(1.0));
+        let no = |q: &str, a: &str| rescale(q, a).unwrap_err();
+        assert!(no("peak force (N)", "Force (s)").contains("N, kN, MN"));
+        assert!(no("peak force (N)", "Force (kip)").contains("`kip`"));
+        assert!(no("probability of exceedance", "P (N)").contains("has none"));
+        assert_eq!(unit_of("T2 / T1 (fundamental periods)"), None);
+        // Several panels: a unit picks the panels it fits; none, all of one unit.
+        let panel = |y: &str| Panel {
+            y_label: y.into(),
+            series: vec![Series {
+                name: String::new(),
+                points: vec![(1.0, 2000.0)],
+                scatter: false,
+                style: None,
+            }],
+            ..Panel::default()
+        };
+        let mut ps = vec![panel("displacement (m)"), panel("contact force (N)")];
+        relabel(&mut ps, Axis::Y, "force (kN)").unwrap();
+        assert_eq!(ps[0].y_label, "displacement (m)");
+        assert_eq!(ps[0].series[0].points, [(1.0, 2000.0)]);
+        assert_eq!(ps[1].y_label, "force (kN)");
+        assert_eq!(ps[1].series[0].points, [(1.0, 2.0)]);
+        // Again: the panel is in kN by now.
+        relabel(&mut ps, Axis::Y, "force (kN)").unwrap();
+        assert_eq!(ps[1].series[0].points, [(1.0, 2.0)]);
+        assert!(relabel(&mut ps, Axis::Y, "force (s)").is_err());
+        assert!(relabel(&mut ps, Axis::Y, "response").is_err());
+        let mut same = vec![panel("force (N)"), panel("shear (N)")];
+        relabel(&mut same, Axis::Y, "Force").unwrap();
+        assert_eq!(same[1].y_label, "Force");
+    }
+
+    #[test]
+    fn pixels_are_bounded_before_drawing() {
+        assert!(check_pixels(6, 3, (640, 480), 300).is_ok());
+        let e = check_pixels(6, 3, (4000, 4000), 600).unwrap_err();
+        assert!(
+            e.contains("75000x50000") && e.contains("100 megapixels"),
+            "{e}"
+        );
+        assert!(check_pixels(1, 1, (4000, 4000), 96).is_ok());
     }
 
     #[test]

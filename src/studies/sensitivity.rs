@@ -207,6 +207,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, LeftOut), TableEr
             log_x: spec.log_x,
             log_y: spec.log_y,
             series,
+            y_span: None,
         },
         left,
     ))

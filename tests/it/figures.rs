@@ -182,7 +182,10 @@ fn legends_cover_no_point_and_styles_are_distinct() {
         &s(&w),
     ]));
     let svg = std::fs::read_to_string(&w).unwrap();
-    assert!(svg.contains("where t2_s=0.4"), "the filter in the caption");
+    assert!(
+        svg.contains("where period, building 2 = 0.4 s"),
+        "the filter in the caption, in words"
+    );
     assert!(svg.contains("width=\"1000\" height=\"600\""));
     check(&w, 3, 0);
     // A small panel: the legend's box is a larger share of it, and no line may pass under it
@@ -254,8 +257,8 @@ fn legends_cover_no_point_and_styles_are_distinct() {
     let glyphs = read(&svg).glyphs;
     assert_eq!(glyphs.len(), 6, "{glyphs:?}");
     check(&f, 6, 3);
-    // The legend sits above the curves, in room the range was raised for: that room carries
-    // no tick labels, so the probability axis is labelled up to 1 and no further.
+    // The curves leave no corner free: the legend sits beside the plot, and the probability
+    // axis is labelled up to 1 and no further.
     let ticks: Vec<f64> = svg
         .split("<text")
         .filter(|t| t.contains("text-anchor=\"end\""))
