@@ -31,6 +31,29 @@ pub mod plan;
 pub mod record;
 pub mod studies;
 
+/// A number as a message or a record command shows it: as typed (shortest round trip) for
+/// ordinary magnitudes, in exponent form beyond (`1e300`, not three hundred digits). At crate
+/// root so the records, below the plans, show numbers as the plans do.
+pub fn show(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// `x` to `places` decimals where that reads (a table's fixed columns), in exponent form with
+/// as many beyond, as [`show`] draws the line: bounded however large or small `x` is.
+pub fn show_places(x: f64, places: usize) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
+        format!("{x:.places$}")
+    } else {
+        format!("{x:.places$e}")
+    }
+}
+
 /// Print a line to standard error. A failed write (stderr closed, or on a full device) is
 /// ignored, never a panic: diagnostics must not turn a good run into a crash.
 pub fn note(line: impl std::fmt::Display) {

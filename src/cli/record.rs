@@ -21,6 +21,10 @@ pub struct FileArgs {
     /// Lines to skip before parsing.
     #[arg(long, default_value_t = 0)]
     skip_lines: usize,
+    /// Read only the samples from START to END s, on the record's clock: a config's
+    /// `window_s = [START, END]`, so the numbers are those a sweep scales to.
+    #[arg(long, value_name = "START:END")]
+    window: Option<String>,
 }
 
 impl FileArgs {
@@ -34,7 +38,8 @@ impl FileArgs {
             ),
             None => None,
         };
-        Ok(read_record(
+        let window = self.window.as_deref().map(parse_window).transpose()?;
+        let rec = read_record(
             &self.file,
             &ReadOptions {
                 format,
@@ -42,7 +47,26 @@ impl FileArgs {
                 dt: self.dt,
                 skip_lines: self.skip_lines,
             },
-        )?)
+        )?;
+        match (window, &self.window) {
+            (Some(w), Some(text)) => rec
+                .windowed(w)
+                .map_err(|m| anyhow::anyhow!("--window {text}: {m}")),
+            _ => Ok(rec),
+        }
+    }
+}
+
+/// `--window START:END` (s), the command line's `window_s = [START, END]`.
+fn parse_window(text: &str) -> Result<[f64; 2]> {
+    match text
+        .split(':')
+        .map(|x| x.trim().parse::<f64>().ok())
+        .collect::<Option<Vec<_>>>()
+        .as_deref()
+    {
+        Some(&[start, end]) if start.is_finite() && end.is_finite() => Ok([start, end]),
+        _ => bail!("--window `{text}`: expected START:END in s (e.g. 0:15), as a config's window_s = [START, END]"),
     }
 }
 
@@ -137,7 +161,10 @@ pub fn run(cmd: Cmd) -> Result<()> {
             let output = super::default_output(output, "spectrum.csv");
             let periods = parse_periods(&periods)?;
             if !(0.0..1.0).contains(&damping) {
-                bail!("--damping {damping}: expected 0 <= damping < 1");
+                bail!(
+                    "--damping {}: expected 0 <= damping < 1",
+                    pounding::show(damping)
+                );
             }
             super::check_outputs(
                 &[("the record", record.file.as_path())],
@@ -171,7 +198,15 @@ fn spectrum(
     for &(t, sd) in &rows {
         let w = 2.0 * std::f64::consts::PI / t;
         let sa = w * w * sd;
-        csv.push_str(&format!("{t},{},{sa},{sd}\n", sa / G));
+        // Shortest round trip, in exponent form beyond ordinary magnitudes (never 300 digits).
+        let show = pounding::show;
+        csv.push_str(&format!(
+            "{},{},{},{}\n",
+            show(t),
+            show(sa / G),
+            show(sa),
+            show(sd)
+        ));
         points.push((t, sa / G));
     }
     let (pgv, pgd) = intensity::pgv_pgd(rec);
@@ -179,21 +214,26 @@ fn spectrum(
         .iter()
         .cloned()
         .fold((0.0, 0.0), |b, p| if p.1 > b.1 { p } else { b });
+    let places = pounding::show_places;
     say!(
-        "{}: PGA {:.4} g, PGV {:.4} m/s, PGD {:.4} m (from rest, no baseline correction); Sa peaks at {:.4} g at T = {:.3} s ({} periods, {} % damping)",
+        "{}: PGA {} g, PGV {} m/s, PGD {} m (from rest, no baseline correction); Sa peaks at {} g at T = {} s ({} periods, {} % damping)",
         rec.name,
-        rec.pga().value / G,
-        pgv,
-        pgd,
-        peak.1,
-        peak.0,
+        places(rec.pga().value / G, 4),
+        places(pgv, 4),
+        places(pgd, 4),
+        places(peak.1, 4),
+        places(peak.0, 3),
         periods.len(),
-        100.0 * damping
+        pounding::show(100.0 * damping)
     );
     super::write_file(output, csv.as_bytes())?;
     if let Some(p) = plot {
         let panel = pounding::studies::plot::Panel {
-            title: format!("{}: {} % damped spectrum", rec.name, 100.0 * damping),
+            title: format!(
+                "{}: {} % damped spectrum",
+                rec.name,
+                pounding::show(100.0 * damping)
+            ),
             x_label: "period T (s)".into(),
             y_label: "Sa (g)".into(),
             log_x: true,
@@ -215,32 +255,40 @@ fn info(record: &FileArgs) -> Result<()> {
     let file = &record.file;
     let rec = record.read()?;
     let pga = rec.pga();
+    // Bounded however large or small the record's numbers are.
+    let (show, places) = (pounding::show, pounding::show_places);
     say!("file      {}", file.display());
+    if let Some(w) = &record.window {
+        say!("window    {w} s (the samples a config's window_s reads)");
+    }
     say!("npts      {}", rec.npts());
-    say!("dt        {} s", rec.dt);
-    say!("t0        {} s", rec.t0);
-    say!("duration  {:.3} s", rec.duration());
+    say!("dt        {} s", show(rec.dt));
+    say!("t0        {} s", show(rec.t0));
+    say!("duration  {} s", places(rec.duration(), 3));
     say!(
-        "pga       {:.4} g  ({:.4} m/s^2, {:.1} cm/s^2)",
-        pga.value / G,
-        pga.value,
-        pga.value * 100.0
+        "pga       {} g  ({} m/s^2, {} cm/s^2)",
+        places(pga.value / G, 4),
+        places(pga.value, 4),
+        places(pga.value * 100.0, 1)
     );
     say!(
-        "pga at    t = {:.3} s (sample {}, value {:+.4} g)",
-        pga.time,
+        "pga at    t = {} s (sample {}, value {} g)",
+        places(pga.time, 3),
         pga.index,
-        rec.accel[pga.index] / G
+        places(rec.accel[pga.index] / G, 4)
     );
     let (pgv, pgd) = intensity::pgv_pgd(&rec);
-    say!("pgv       {pgv:.4} m/s  (from rest, no baseline correction)");
-    say!("pgd       {pgd:.4} m");
+    say!(
+        "pgv       {} m/s  (from rest, no baseline correction)",
+        places(pgv, 4)
+    );
+    say!("pgd       {} m", places(pgd, 4));
     let sa: Vec<String> = [0.2, 0.5, 1.0, 2.0]
         .iter()
         .map(|&t| {
             format!(
-                "{t} s {:.4} g",
-                intensity::sa(&rec, t, intensity::DEFAULT_DAMPING) / G
+                "{t} s {} g",
+                places(intensity::sa(&rec, t, intensity::DEFAULT_DAMPING) / G, 4)
             )
         })
         .collect();
@@ -248,9 +296,9 @@ fn info(record: &FileArgs) -> Result<()> {
     let limit = pounding::plan::limits::WARN_PGA_G;
     if pga.value / G > limit {
         note!(
-            "warning: {}: a PGA of {:.3} g is above {limit} g, where no recorded earthquake reaches: are the values in {} (--units)?",
+            "warning: {}: a PGA of {} g is above {limit} g, where no recorded earthquake reaches: are the values in {} (--units)?",
             file.display(),
-            pga.value / G,
+            places(pga.value / G, 3),
             if pga.value / G > 100.0 { "cm/s2" } else { "m/s2 or cm/s2" }
         );
     }

@@ -249,6 +249,9 @@ pub enum AggregateError {
     NonFiniteThreshold { given: String },
     #[error("--exceed: at most {MAX_EXCEED} thresholds, {0} given")]
     TooManyExceed(usize),
+    /// One name for two columns of the summary.
+    #[error("{flag}: `{given}` is given twice (a summary's columns each have their own name)")]
+    Twice { flag: &'static str, given: String },
 }
 
 /// A swept-parameter column, as a key (floats by their bits; an absent value is `u64::MAX`).
@@ -451,6 +454,16 @@ impl Aggregator {
         if exceed.len() > MAX_EXCEED {
             return Err(AggregateError::TooManyExceed(exceed.len()));
         }
+        if let Some((b, _, _)) = by
+            .iter()
+            .enumerate()
+            .find_map(|(i, b)| by[..i].iter().any(|x| x.1 == b.1).then_some(b))
+        {
+            return Err(AggregateError::Twice {
+                flag: "--aggregate",
+                given: b.clone(),
+            });
+        }
         let parsed: Vec<(String, usize, f64)> = exceed
             .iter()
             .map(|e| {
@@ -479,6 +492,17 @@ impl Aggregator {
                 Ok((c.trim().to_string(), i, t))
             })
             .collect::<Result<_, _>>()?;
+        // One column and threshold, however spelled (`1e6`, `1000000`), is one column.
+        if let Some(k) = (0..parsed.len()).find(|&k| {
+            parsed[..k]
+                .iter()
+                .any(|p| (p.1, p.2) == (parsed[k].1, parsed[k].2))
+        }) {
+            return Err(AggregateError::Twice {
+                flag: "--exceed",
+                given: exceed[k].clone(),
+            });
+        }
         Ok(Aggregator {
             by,
             outputs,

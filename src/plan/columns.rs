@@ -66,14 +66,10 @@ pub const SUMMARISED: [&str; 8] = {
     names
 };
 
-/// Shortest round-trip text; scientific notation outside [1e-4, 1e15) so tiny values stay short.
+/// Shortest round-trip text; scientific notation outside [1e-4, 1e15) so tiny values stay short
+/// ([`crate::show`], the one form of a number every output and message writes).
 pub(crate) fn num(x: f64) -> String {
-    let a = x.abs();
-    if a != 0.0 && !(1e-4..1e15).contains(&a) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
+    crate::show(x)
 }
 
 /// The columns of the contact and the ground motion: the first [`CONTACT_AND_MOTION`] of

@@ -265,13 +265,138 @@ impl Axis {
     }
 }
 
+/// What a TOML error says, in the config's words: serde names Rust types (`f64`, `usize`,
+/// `struct RawRun`) where the user wrote a number, a whole number or a table. The one place a
+/// config's TOML error is made, for pairs and rows alike.
+pub(crate) fn toml_error(path: &Path, e: toml::de::Error) -> ConfigError {
+    let mut m = e.to_string();
+    for (rust, words) in [
+        ("expected f64", "expected a number"),
+        ("expected usize", "expected a whole number >= 0"),
+        ("expected u64", "expected a whole number >= 0"),
+        ("expected u32", "expected a whole number >= 0"),
+        ("expected i64", "expected a whole number"),
+        ("expected a sequence", "expected a list"),
+    ] {
+        m = m.replace(rust, words);
+    }
+    // serde writes a float it refuses in full (`1e300` as 301 digits): as a message shows it.
+    let mut from = 0;
+    while let Some(i) = m[from..].find("floating point `").map(|i| from + i + 16) {
+        let end = m[i..].find('`').map_or(m.len(), |j| i + j);
+        let shown = m[i..end]
+            .parse::<f64>()
+            .map_or_else(|_| m[i..end].to_string(), crate::plan::limits::show);
+        m.replace_range(i..end, &shown);
+        from = i + shown.len();
+    }
+    while let Some(i) = m.find("expected struct ") {
+        let name = i + "expected struct ".len();
+        let end = m[name..]
+            .find(|c: char| !c.is_alphanumeric())
+            .map_or(m.len(), |j| name + j);
+        m.replace_range(i..end, "expected a table");
+    }
+    ConfigError::Toml {
+        path: path.into(),
+        message: m,
+    }
+}
+
+/// A value of a key that takes several forms, read by a visitor that names them all when the
+/// value takes none (serde's untagged enums say only "did not match any variant"): numbers,
+/// strings, lists and tables each go to `number`, `text`, `list` or `table`, those not given
+/// (`None`) refused with `forms`.
+macro_rules! forms {
+    ($ty:ty, $forms:expr, {
+        number: $num:expr, text: $text:expr, list: $list:expr, table: $table:expr $(,)?
+    }) => {
+        impl<'de> ::serde::Deserialize<'de> for $ty {
+            fn deserialize<D: ::serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+                struct V;
+                impl<'de> ::serde::de::Visitor<'de> for V {
+                    type Value = $ty;
+                    fn expecting(&self, f: &mut ::std::fmt::Formatter) -> ::std::fmt::Result {
+                        f.write_str($forms)
+                    }
+                    fn visit_f64<E: ::serde::de::Error>(self, v: f64) -> Result<$ty, E> {
+                        let number: Option<fn(f64) -> $ty> = $num;
+                        number.map(|n| n(v)).ok_or_else(|| {
+                            E::invalid_type(::serde::de::Unexpected::Float(v), &self)
+                        })
+                    }
+                    fn visit_i64<E: ::serde::de::Error>(self, v: i64) -> Result<$ty, E> {
+                        let number: Option<fn(f64) -> $ty> = $num;
+                        number.map(|n| n(v as f64)).ok_or_else(|| {
+                            E::invalid_type(::serde::de::Unexpected::Signed(v), &self)
+                        })
+                    }
+                    fn visit_u64<E: ::serde::de::Error>(self, v: u64) -> Result<$ty, E> {
+                        self.visit_i64(v.min(i64::MAX as u64) as i64)
+                    }
+                    fn visit_str<E: ::serde::de::Error>(self, v: &str) -> Result<$ty, E> {
+                        let text: Option<fn(String) -> $ty> = $text;
+                        text.map(|t| t(v.to_string()))
+                            .ok_or_else(|| E::invalid_type(::serde::de::Unexpected::Str(v), &self))
+                    }
+                    fn visit_seq<A: ::serde::de::SeqAccess<'de>>(
+                        self,
+                        seq: A,
+                    ) -> Result<$ty, A::Error> {
+                        let list: Option<fn(A) -> Result<$ty, A::Error>> = $list;
+                        match list {
+                            Some(l) => l(seq),
+                            None => Err(::serde::de::Error::invalid_type(
+                                ::serde::de::Unexpected::Seq,
+                                &self,
+                            )),
+                        }
+                    }
+                    fn visit_map<A: ::serde::de::MapAccess<'de>>(
+                        self,
+                        map: A,
+                    ) -> Result<$ty, A::Error> {
+                        let table: Option<fn(A) -> Result<$ty, A::Error>> = $table;
+                        match table {
+                            Some(t) => t(map),
+                            None => Err(::serde::de::Error::invalid_type(
+                                ::serde::de::Unexpected::Map,
+                                &self,
+                            )),
+                        }
+                    }
+                }
+                d.deserialize_any(V)
+            }
+        }
+    };
+}
+pub(crate) use forms;
+
+/// The elements of a list, each read as `T`.
+pub(crate) fn elements<'de, T: Deserialize<'de>, A: SeqAccess<'de>>(
+    mut seq: A,
+) -> Result<Vec<T>, A::Error> {
+    let mut v = Vec::new();
+    while let Some(x) = seq.next_element::<T>()? {
+        v.push(x);
+    }
+    Ok(v)
+}
+
 /// One string or a list of strings.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Names {
     One(String),
     List(Vec<String>),
 }
+
+forms!(Names, "a name, or a list of names", {
+    number: None,
+    text: Some(Names::One),
+    list: Some(|s| elements(s).map(Names::List)),
+    table: None,
+});
 
 impl Names {
     fn list(&self) -> Vec<String> {
@@ -395,19 +520,40 @@ pub struct RawIntensity {
     pub sa_period_s: Option<RawPeriod>,
     /// Targets of `Sa_avg` (g) over `sa_avg_periods_s` (from, to), `sa_avg_n` periods.
     pub sa_avg_g: Option<Axis>,
-    pub sa_avg_periods_s: Option<Vec<RawPeriod>>,
+    pub sa_avg_periods_s: Option<RawPeriods>,
     pub sa_avg_n: Option<usize>,
     /// Damping ratio of the spectral targets' oscillator (default 5 %).
     pub sa_damping: Option<f64>,
 }
 
 /// A period as written: seconds, or `"building1"`, `"0.2*building1"`, `"building[0]"`.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone)]
 pub enum RawPeriod {
     Seconds(f64),
     Named(String),
 }
+
+/// The forms of a period, for [`RawPeriod`]'s messages and `sa_avg_periods_s`'s.
+const PERIOD_FORMS: &str =
+    "a period in s, or a building's: \"building1\", \"building[0]\" or a multiple, \"0.2*building1\"";
+
+forms!(RawPeriod, PERIOD_FORMS, {
+    number: Some(RawPeriod::Seconds),
+    text: Some(RawPeriod::Named),
+    list: None,
+    table: None,
+});
+
+/// `sa_avg_periods_s`: a list of periods (two, from and to: [`RawIntensity`] counts them).
+#[derive(Debug, Clone)]
+pub struct RawPeriods(pub Vec<RawPeriod>);
+
+forms!(RawPeriods, "a list of two periods [from, to], each in s or a building's (\"0.2*building1\")", {
+    number: None,
+    text: None,
+    list: Some(|s| elements(s).map(RawPeriods)),
+    table: None,
+});
 
 /// The periods `sa_avg_n` may ask for: Eads et al. (2015) use 10.
 const MAX_SA_AVG_N: usize = 100;
@@ -525,7 +671,7 @@ impl RawIntensity {
             }
             _ => {
                 let k = "intensity.sa_avg_periods_s";
-                let p = match self.sa_avg_periods_s.as_deref() {
+                let p = match self.sa_avg_periods_s.as_ref().map(|p| &p.0[..]) {
                     Some([a, b]) => [period(&format!("{k}[0]"), a)?, period(&format!("{k}[1]"), b)?],
                     Some(v) => {
                         return Err(invalid(
@@ -731,10 +877,7 @@ pub fn parse(
     base: &Path,
     records: &Path,
 ) -> Result<PairPlan, ConfigError> {
-    let raw: RawConfig = toml::from_str(text).map_err(|e| ConfigError::Toml {
-        path: path.into(),
-        message: e.to_string(),
-    })?;
+    let raw: RawConfig = toml::from_str(text).map_err(|e| toml_error(path, e))?;
     parse_raw(&raw, path, base, records)
 }
 
@@ -843,7 +986,8 @@ fn parse_scheme(
                     return Err(invalid(
                         "run.substeps_per_contact",
                         format!(
-                            "{n}: expected 1 to {} ({})",
+                            "{}: expected 1 to {} ({})",
+                            crate::plan::limits::show(n),
                             crate::plan::limits::MAX_SUBSTEPS_PER_CONTACT,
                             crate::plan::limits::WHY_SUBSTEPS
                         ),
@@ -877,12 +1021,20 @@ fn parse_laws(
 ) -> Result<(Vec<LawKind>, Vec<Formula>), ConfigError> {
     let mut laws = Vec::new();
     for (i, k) in contact.law.list().iter().enumerate() {
-        laws.push(LawKind::from_key(k).ok_or_else(|| {
+        let law = LawKind::from_key(k).ok_or_else(|| {
             invalid(
                 &format!("contact.law[{i}]"),
                 format!("unknown law `{k}`: expected one of {}", LawKind::keys()),
             )
-        })?);
+        })?;
+        // Twice would write two runs of one label for every other value.
+        if let Some(j) = laws.iter().position(|l| *l == law) {
+            return Err(invalid(
+                &format!("contact.law[{i}]"),
+                format!("`{k}` is given twice (also contact.law[{j}])"),
+            ));
+        }
+        laws.push(law);
     }
     let mut formulas = Vec::new();
     for (i, k) in contact
@@ -893,12 +1045,19 @@ fn parse_laws(
         .iter()
         .enumerate()
     {
-        formulas.push(Formula::from_key(k).ok_or_else(|| {
+        let formula = Formula::from_key(k).ok_or_else(|| {
             invalid(
                 &format!("contact.formula[{i}]"),
                 format!("unknown formula `{k}`: expected one of {}", Formula::keys()),
             )
-        })?);
+        })?;
+        if let Some(j) = formulas.iter().position(|f| *f == formula) {
+            return Err(invalid(
+                &format!("contact.formula[{i}]"),
+                format!("`{k}` is given twice (also contact.formula[{j}])"),
+            ));
+        }
+        formulas.push(formula);
     }
     Ok((laws, formulas))
 }
@@ -948,6 +1107,17 @@ fn contact_spec(
                 error,
             },
         })?;
+        // A label names a record's runs in every output: two records of one label could not be
+        // told apart (a name given twice, two windows of one file, one seed twice).
+        if let Some(j) = recs.iter().position(|r: &Arc<Record>| r.name == rec.name) {
+            return Err(invalid(
+                &key,
+                format!(
+                    "is labelled `{}`, as record[{j}] is: give each a distinct name = \"...\"",
+                    rec.name
+                ),
+            ));
+        }
         recs.push(Arc::new(rec));
     }
     Ok(ContactSpec {
@@ -1285,13 +1455,12 @@ fn load_record(r: &RawRecord, base: &Path, records: &Path) -> Result<Record, Loa
         };
         read_record(&file, &opts).map_err(LoadError::Record)?
     };
-    if let Some([start, end]) = r.window_s {
-        rec = rec.window(start, end).ok_or_else(|| {
+    if let Some(w) = r.window_s {
+        rec = rec.windowed(w).map_err(|m| {
             LoadError::Invalid(format!(
-                "window_s = [{start}, {end}]: expected start < end holding at least two samples of the record ({} s to {} s, dt {} s)",
-                rec.t0,
-                rec.t0 + (rec.npts().max(1) - 1) as f64 * rec.dt,
-                rec.dt
+                "window_s = [{}, {}]: {m}",
+                crate::plan::limits::show(w[0]),
+                crate::plan::limits::show(w[1])
             ))
         })?;
     }

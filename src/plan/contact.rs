@@ -197,17 +197,28 @@ impl ContactPlan {
             )?;
         }
         let mut pgas = Vec::with_capacity(spec.records.len());
+        // A target scales the part of a record that is simulated (its window): of zeros, it
+        // has none of the measure the target names.
+        let target = spec.intensities.iter().find_map(|i| match i {
+            Intensity::Scale(_) => None,
+            Intensity::PgaG(_) => Some(("PGA", i.key())),
+            Intensity::Spectral { im, .. } if im.average => Some(("Sa_avg", i.key())),
+            Intensity::Spectral { .. } => Some(("Sa", i.key())),
+        });
         for (r, rec) in spec.records.iter().enumerate() {
-            let scaled = spec
-                .intensities
-                .iter()
-                .any(|i| !matches!(i, Intensity::Scale(_)));
-            if scaled {
-                // A record of zeros has no PGA or Sa to scale to.
-                rec.scale_to_pga(1.0)
-                    .map_err(|e| err(format!("record[{r}]"), e.to_string()))?;
+            let pga = rec.pga().value;
+            if let (Some((measure, key)), true) = (target, pga <= 0.0) {
+                return Err(err(
+                    format!("record[{r}]"),
+                    format!(
+                        "{}: all zeros from {} s to {} s (the part simulated): no {measure} to scale to {key}",
+                        rec.name,
+                        crate::plan::limits::show(rec.t0),
+                        crate::plan::limits::show(rec.t0 + (rec.npts() - 1) as f64 * rec.dt),
+                    ),
+                ));
             }
-            pgas.push(rec.pga().value);
+            pgas.push(pga);
         }
         // Damping per (law, formula, e): printed formulas are cheap, `exact` root-finds once here.
         let mut damping = HashMap::new();

@@ -253,37 +253,70 @@ impl Intensity {
     }
 }
 
-/// The shortest and longest of `periods` (what [`check_periods`] needs of each building).
+/// The shortest and longest of `periods`.
 pub fn span(periods: impl Iterator<Item = f64>) -> (f64, f64) {
     periods.fold((f64::INFINITY, 0.0), |(lo, hi), t| (lo.min(t), hi.max(t)))
 }
 
-/// Check a spectral target's periods against every value the buildings' periods take: `lo` and
-/// `hi` hold, per building, its shortest and longest fundamental period in the sweep (each
-/// period read grows with the building's, so the extremes bound them all).
+/// Check a spectral target's periods against every value the buildings' periods take:
+/// `periods[b]` holds every fundamental period building `b` takes in the sweep (its axis and
+/// its samples). Each period read grows with the building's, so the extremes bound them all;
+/// and an `Sa_avg` is refused where its two ends are one period in a run, as it is where they
+/// are written alike (`["0.5*building[0]", 0.5]` with building[0] at 1 s read one period).
 pub fn check_periods(
     intensities: &[Intensity],
-    lo: &[f64],
-    hi: &[f64],
+    periods: &[Vec<f64>],
 ) -> Result<(), (String, String)> {
     let Some(im) = intensities.iter().find_map(|i| i.spectral()) else {
         return Ok(());
     };
+    let key = || im.periods_key().to_string();
     for b in im.buildings() {
-        if b >= lo.len() {
+        if b >= periods.len() {
             return Err((
-                im.periods_key().into(),
+                key(),
                 format!(
                     "follows building{} (building[{b}]), but the scene has {} buildings",
                     b + 1,
-                    lo.len()
+                    periods.len()
                 ),
             ));
         }
     }
-    for periods in [lo, hi] {
-        SpectralIm::check_range(im.range(periods))
-            .map_err(|m| (im.periods_key().to_string(), m))?;
+    let (lo, hi): (Vec<f64>, Vec<f64>) = periods.iter().map(|p| span(p.iter().copied())).unzip();
+    for ends in [&lo, &hi] {
+        SpectralIm::check_range(im.range(ends)).map_err(|m| (key(), m))?;
+    }
+    // Ends on one building (at two factors) are never one period; on two, or a building and
+    // seconds, they are where the values they take meet.
+    if im.average && !(im.from.building().is_some() && im.from.building() == im.to.building()) {
+        let values = |p: PeriodRef| -> Vec<(f64, f64)> {
+            match p {
+                PeriodRef::Seconds(t) => vec![(t, f64::NAN)],
+                PeriodRef::Building { building, factor } => {
+                    periods[building].iter().map(|&t| (factor * t, t)).collect()
+                }
+            }
+        };
+        let mut to = values(im.to);
+        to.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (t, own) in values(im.from) {
+            if let Ok(j) = to.binary_search_by(|x| x.0.total_cmp(&t)) {
+                let at = |p: PeriodRef, own: f64| match p.building() {
+                    Some(b) => format!(" (building[{b}] at {} s)", crate::plan::limits::show(own)),
+                    None => String::new(),
+                };
+                return Err((
+                    key(),
+                    format!(
+                        "from{} and to{} are the same period, {} s: give a range in every run (or sa_g for one period)",
+                        at(im.from, own),
+                        at(im.to, to[j].1),
+                        crate::plan::limits::show(t)
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
 }

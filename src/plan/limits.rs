@@ -91,13 +91,5 @@ pub fn above_height(rows: &[(crate::plan::RunSpec, crate::physics::model::RunOut
 /// The runs of a grid axis or range (`{ from, to, n }`).
 pub const MAX_AXIS_POINTS: usize = 10_000_000;
 
-/// A number as a message shows it: as typed for ordinary magnitudes, in exponent form beyond
-/// (`1e300`, not three hundred digits).
-pub fn show(x: f64) -> String {
-    let a = x.abs();
-    if a == 0.0 || !a.is_finite() || (1e-4..1e15).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
-}
+/// A number as a message shows it ([`crate::show`], beside the records that show numbers too).
+pub use crate::show;

@@ -554,19 +554,23 @@ impl PairPlan {
                 }
             }
         }
-        let extremes = |b: &BuildingAxes, axis: SampledAxis| {
-            let sampled = spec.samples.iter().flat_map(|s| {
-                let j = s.axes.iter().position(|a| *a == axis);
-                j.into_iter()
-                    .flat_map(move |j| s.points.iter().map(move |p| p[j]))
-            });
-            intensity::span(b.period.iter().copied().chain(sampled))
+        // Every period each building takes: its samples where sampled (its axis then holds a
+        // placeholder), else its axis.
+        let periods = |b: &BuildingAxes, axis: SampledAxis| -> Vec<f64> {
+            spec.samples
+                .iter()
+                .find_map(|s| {
+                    let j = s.axes.iter().position(|a| *a == axis)?;
+                    Some(s.points.iter().map(|p| p[j]).collect())
+                })
+                .unwrap_or_else(|| b.period.clone())
         };
-        let (lo1, hi1) = extremes(&spec.building1, SampledAxis::Period1);
-        let (lo2, hi2) = extremes(&spec.building2, SampledAxis::Period2);
+        let taken = [
+            periods(&spec.building1, SampledAxis::Period1),
+            periods(&spec.building2, SampledAxis::Period2),
+        ];
         let contact = ContactPlan::new(spec.contact)?;
-        intensity::check_periods(&contact.spec.intensities, &[lo1, lo2], &[hi1, hi2])
-            .map_err(|(k, m)| err(k, m))?;
+        intensity::check_periods(&contact.spec.intensities, &taken).map_err(|(k, m)| err(k, m))?;
         let c = &contact.spec;
         let counts = AxisCounts {
             formulas: c.formulas.len(),

@@ -33,12 +33,18 @@ const YIELD_SHEAR: Check = (
 );
 
 /// One value for every storey, or one per storey (bottom to top).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum PerStorey {
     One(f64),
     Each(Vec<f64>),
 }
+
+config::forms!(PerStorey, "a number (every storey) or a list of numbers (one per storey, bottom to top)", {
+    number: Some(PerStorey::One),
+    text: None,
+    list: Some(|s| config::elements(s).map(PerStorey::Each)),
+    table: None,
+});
 
 /// The column prefix of a contact level: `level_b1f3_b2f3` for floor 3 of building 1 (`left`
 /// = 0, buildings from 0 here) against floor 3 of building 2 (floors from 1).
@@ -85,13 +91,22 @@ pub struct RawShearBuilding {
 
 /// `yield_drift_ratio` as written: one value for every storey, one per storey, or a range
 /// table (`{ from, to, n }`): an axis of values each for every storey.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum YieldDrift {
     One(f64),
     Each(Vec<f64>),
     Axis(crate::plan::config::RangeSpec),
 }
+
+config::forms!(YieldDrift, "a drift ratio (every storey), a list of them (one per storey, bottom to top), or a range table { from, to, n } / { from, to, step } (an axis of values each for every storey)", {
+    number: Some(YieldDrift::One),
+    text: None,
+    list: Some(|s| config::elements(s).map(YieldDrift::Each)),
+    table: Some(|m| {
+        crate::plan::config::RangeSpec::deserialize(serde::de::value::MapAccessDeserializer::new(m))
+            .map(YieldDrift::Axis)
+    }),
+});
 
 /// How strong a yielding building's storeys are.
 #[derive(Debug, Clone, PartialEq)]
@@ -869,10 +884,7 @@ pub fn parse_row(
     base: &Path,
     records: &Path,
 ) -> Result<RowPlan, ConfigError> {
-    let raw: RawRowConfig = toml::from_str(text).map_err(|e| ConfigError::Toml {
-        path: path.into(),
-        message: e.to_string(),
-    })?;
+    let raw: RawRowConfig = toml::from_str(text).map_err(|e| config::toml_error(path, e))?;
     let invalid = |key: &str, message: String| ConfigError::Invalid {
         path: path.into(),
         key: key.into(),
@@ -1055,19 +1067,22 @@ pub fn parse_row(
                 .into(),
         ));
     }
-    // Each building's shortest and longest period, over its axis and its samples.
-    let (mut lo, mut hi) = (Vec::new(), Vec::new());
-    for (b, a) in buildings.iter().enumerate() {
-        let sampled = samples.iter().flat_map(|s| {
-            let j = s.axes.iter().position(|x| *x == RowSampled::Period(b));
-            j.into_iter()
-                .flat_map(move |j| s.points.iter().map(move |p| p[j]))
-        });
-        let (l, h) = crate::plan::intensity::span(a.period.iter().copied().chain(sampled));
-        lo.push(l);
-        hi.push(h);
-    }
-    crate::plan::intensity::check_periods(&contact.spec.intensities, &lo, &hi)
+    // Every period each building takes: its samples where sampled (its axis then holds a
+    // placeholder), else its axis.
+    let taken: Vec<Vec<f64>> = buildings
+        .iter()
+        .enumerate()
+        .map(|(b, a)| {
+            samples
+                .iter()
+                .find_map(|s| {
+                    let j = s.axes.iter().position(|x| *x == RowSampled::Period(b))?;
+                    Some(s.points.iter().map(|p| p[j]).collect())
+                })
+                .unwrap_or_else(|| a.period.clone())
+        })
+        .collect();
+    crate::plan::intensity::check_periods(&contact.spec.intensities, &taken)
         .map_err(|(k, m)| invalid(&k, m))?;
     let mut dims = vec![samples.as_ref().map_or(1, |s| s.points.len())];
     dims.extend(

@@ -138,7 +138,8 @@ pub(crate) fn refused_draw(
         .find(|&(_, v)| !ok(v))
         .map(|(i, v)| {
             format!(
-                "sample {i} drew {v}: expected {expected}; truncate the distribution with min/max"
+                "sample {i} drew {}: expected {expected}; truncate the distribution with min/max",
+                crate::plan::limits::show(v)
             )
         })
 }

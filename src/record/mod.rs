@@ -73,17 +73,33 @@ impl Record {
     /// holds fewer than two samples.
     pub fn window(&self, start: f64, end: f64) -> Option<Record> {
         let tol = 1e-9 * self.dt;
-        let first = ((start - self.t0 - tol) / self.dt).ceil().max(0.0) as usize;
-        let last =
-            (((end - self.t0 + tol) / self.dt).floor() as usize).min(self.npts().checked_sub(1)?);
-        if end < start || last < first + 1 {
+        // Sample indices in f64 first: a window far past the record (1e300 s) is no index.
+        let first = ((start - self.t0 - tol) / self.dt).ceil().max(0.0);
+        let last = ((end - self.t0 + tol) / self.dt)
+            .floor()
+            .min(self.npts().checked_sub(1)? as f64);
+        if !(end >= start && last >= first + 1.0) {
             return None;
         }
+        let (first, last) = (first as usize, last as usize);
         Some(Record {
             name: self.name.clone(),
             dt: self.dt,
             t0: self.t0 + first as f64 * self.dt,
             accel: self.accel[first..=last].to_vec(),
+        })
+    }
+
+    /// [`Record::window`], or why not: the one reading of a window, for a config's `window_s`
+    /// and the record commands' `--window` alike (each names its own spelling before it).
+    pub fn windowed(&self, [start, end]: [f64; 2]) -> Result<Record, String> {
+        self.window(start, end).ok_or_else(|| {
+            format!(
+                "expected start < end holding at least two samples of the record ({} s to {} s, dt {} s)",
+                crate::show(self.t0),
+                crate::show(self.t0 + (self.npts().max(1) - 1) as f64 * self.dt),
+                crate::show(self.dt)
+            )
         })
     }
 

@@ -150,7 +150,10 @@ pub fn parse_record(
     };
     if let Some(dt) = opts.dt {
         if !(dt.is_finite() && dt > 0.0) {
-            return Err(ctx.invalid(format!("dt must be a positive number of seconds, got {dt}")));
+            return Err(ctx.invalid(format!(
+                "dt must be a positive number of seconds, got {}",
+                crate::show(dt)
+            )));
         }
     }
     let format = match opts.format {
@@ -171,7 +174,11 @@ pub fn parse_record(
     };
     if let (Some(given), Format::At2 | Format::TwoColumn) = (opts.dt, format) {
         if (given - dt).abs() > 1e-6 * dt {
-            return Err(ctx.invalid(format!("the file says dt = {dt} s but {given} s was given")));
+            return Err(ctx.invalid(format!(
+                "the file says dt = {} s but {} s was given",
+                crate::show(dt),
+                crate::show(given)
+            )));
         }
     }
     if values.len() < 2 {
@@ -369,7 +376,7 @@ fn parse_at2(lines: &[(usize, &str)], ctx: &Ctx) -> Result<Parsed, RecordError> 
         {
             return Err(ctx.parse(
                 n,
-                format!("the header gives NPTS = {npts} and DT = {dt}: expected a whole number of points >= 1 and a sample interval > 0 s"),
+                format!("the header gives NPTS = {npts} and DT = {}: expected a whole number of points >= 1 and a sample interval > 0 s", crate::show(dt)),
             ));
         }
         let last = lines
@@ -508,7 +515,7 @@ fn parse_two_column(lines: &[(usize, &str)], ctx: &Ctx) -> Result<Parsed, Record
         if (d - step).abs() > 1e-3 * step + 2e-6 {
             return Err(ctx.parse(
                 rows[i],
-                format!("time {} breaks the uniform step dt = {step} s (previous time {}); only uniformly sampled records are supported", times[i], times[i - 1]),
+                format!("time {} breaks the uniform step dt = {} s (previous time {}); only uniformly sampled records are supported", crate::show(times[i]), crate::show(step), crate::show(times[i - 1])),
             ));
         }
     }

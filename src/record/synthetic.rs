@@ -84,22 +84,23 @@ pub fn synthetic(spec: &SyntheticSpec) -> Result<Record, RecordError> {
     ] {
         if !(v.is_finite() && v > 0.0) {
             return Err(bad(format!(
-                "synthetic.{key} must be a positive number, got {v}"
+                "synthetic.{key} must be a positive number, got {}",
+                crate::show(v)
             )));
         }
     }
     if spec.fg_hz > 0.5 / spec.dt {
         return Err(bad(format!(
             "synthetic.fg_hz = {} is above the Nyquist frequency of dt_s = {} ({} Hz)",
-            spec.fg_hz,
-            spec.dt,
-            0.5 / spec.dt
+            crate::show(spec.fg_hz),
+            crate::show(spec.dt),
+            crate::show(0.5 / spec.dt)
         )));
     }
     if spec.zeta_g > 2.0 {
         return Err(bad(format!(
             "synthetic.zeta_g = {}: expected at most 2 (a ground filter damped far past critical passes almost nothing)",
-            spec.zeta_g
+            crate::show(spec.zeta_g)
         )));
     }
     let n = (spec.duration / spec.dt).round() as usize;
