@@ -233,9 +233,22 @@ pub fn run(a: Args) -> Result<()> {
             poor.join(", ")
         );
     }
-    for (i, j, im) in crossings(&fits, lo, hi) {
+    // The severer of two thresholds is the larger, in whatever order --threshold gave them.
+    let mut order: Vec<usize> = (0..fits.len()).collect();
+    order.sort_by(|&x, &y| spec.thresholds[x].total_cmp(&spec.thresholds[y]));
+    let ascending: Vec<_> = order.iter().map(|&k| fits[k].clone()).collect();
+    for (i, j, from, to) in crossings(&ascending, lo, hi) {
+        let (i, j) = (order[i], order[j]);
+        // The wrong order is one interval of the levels' range (two lognormal curves meet once
+        // at most): name it, and where the curves are in order.
+        let outside = match (from > lo, to < hi) {
+            (false, false) => "no level run is free of it: read them with care".to_string(),
+            (false, true) => format!("read them only above {to:.4}"),
+            (true, false) => format!("read them only below {from:.4}"),
+            (true, true) => "read them only outside it".to_string(),
+        };
         note!(
-            "notice: the fitted curves of {} and {} cross: from {} = {im:.4} the more severe ({}) is the more probable, which no run can be (every run above {} is above {}); the curves are kept as fitted, read them only below that intensity or fit with more runs",
+            "notice: the fitted curves of {} and {} are out of order from {} = {from:.4} to {to:.4}: there the more severe ({}) is the more probable, which no run can be (every run above {} is above {}); the curves are kept as fitted: {outside}, or fit with more runs",
             names[i], names[j], spec.im, names[j], spec.thresholds[j], spec.thresholds[i]
         );
     }

@@ -504,24 +504,37 @@ pub fn bootstrap(
 }
 
 /// Where fitted curves of ascending thresholds disagree with their order, within the
-/// intensities `lo..=hi`: for each pair `(i, j)`, `i < j`, the lowest intensity (of 200 spaced
-/// evenly) at which the curve of the higher threshold `j` lies above the curve of `i`. Counts
-/// cannot do that (a run above `j` is above `i`); fitted curves of different betas can.
-pub fn crossings(fits: &[Result<Fit, NoFit>], lo: f64, hi: f64) -> Vec<(usize, usize, f64)> {
-    let n = 200;
-    let ims: Vec<f64> = (0..=n)
-        .map(|k| lo + (hi - lo) * k as f64 / n as f64)
-        .filter(|&im| im > 0.0)
-        .collect();
+/// intensities `lo..=hi`: for each pair `(i, j)`, `i < j`, the interval `(from, to)` where the
+/// curve of the higher threshold `j` lies above the curve of `i`. Counts cannot do that (a run
+/// above `j` is above `i`); fitted curves of different betas can. Two lognormal curves differ in
+/// sign as `ln IM (1 / beta_j - 1 / beta_i) + ln m_i / beta_i - ln m_j / beta_j`, linear in
+/// `ln IM`: they meet at one intensity at most, so the wrong order is one interval, on the side
+/// of the meeting point where the flatter curve is the higher (of equal betas, everywhere where
+/// `m_j < m_i`).
+pub fn crossings(fits: &[Result<Fit, NoFit>], lo: f64, hi: f64) -> Vec<(usize, usize, f64, f64)> {
     let mut out = Vec::new();
     for (i, a) in fits.iter().enumerate() {
         for (j, b) in fits.iter().enumerate().skip(i + 1) {
             let (Ok(a), Ok(b)) = (a, b) else { continue };
-            if let Some(&im) = ims
-                .iter()
-                .find(|&&im| b.probability(im) > a.probability(im) + 1e-12)
-            {
-                out.push((i, j, im));
+            // `b` above `a` where `slope ln IM + offset > 0`.
+            let slope = 1.0 / b.beta - 1.0 / a.beta;
+            let offset = a.median.ln() / a.beta - b.median.ln() / b.beta;
+            let (from, to) = if slope.abs() < 1e-12 * (1.0 / a.beta + 1.0 / b.beta) {
+                if offset > 0.0 {
+                    (lo, hi)
+                } else {
+                    continue;
+                }
+            } else {
+                let meet = (-offset / slope).exp();
+                if slope > 0.0 {
+                    (meet.max(lo), hi)
+                } else {
+                    (lo, meet.min(hi))
+                }
+            };
+            if from < to {
+                out.push((i, j, from, to));
             }
         }
     }
@@ -686,14 +699,31 @@ mod tests {
         };
         assert!(crossings(&[curve(0.5, 0.4), curve(0.8, 0.4)], 0.05, 3.0).is_empty());
         // ln(im) where they meet: (b2 ln m1 - b1 ln m2) / (b2 - b1), below which the flatter
-        // (higher threshold) curve lies above the steeper one.
-        let c = crossings(&[curve(0.5, 0.2), curve(0.6, 0.8)], 0.05, 3.0);
+        // (higher threshold) curve lies above the steeper one: the interval runs from the
+        // lowest level to there, and the curves are in order on either side of its ends.
+        let (a, b) = (curve(0.5, 0.2), curve(0.6, 0.8));
+        let meet = ((0.8 * 0.5f64.ln() - 0.2 * 0.6f64.ln()) / (0.8 - 0.2)).exp();
+        let c = crossings(&[a.clone(), b.clone()], 0.05, 3.0);
         assert_eq!(c.len(), 1);
-        let (i, j, im) = c[0];
-        assert_eq!((i, j), (0, 1));
-        assert!(im < 0.5, "{im}");
+        let (i, j, from, to) = c[0];
+        assert_eq!((i, j, from), (0, 1, 0.05));
+        assert!((to / meet - 1.0).abs() < 1e-12, "{to} {meet}");
+        let (a, b) = (a.unwrap(), b.unwrap());
+        assert!(b.probability(0.99 * to) > a.probability(0.99 * to));
+        assert!(b.probability(1.01 * to) < a.probability(1.01 * to));
+        // The steeper higher curve is above from the meeting point up; not at all when it
+        // meets beyond the levels.
+        let c = crossings(&[curve(0.6, 0.8), curve(0.5, 0.2)], 0.05, 3.0);
+        assert_eq!(c.len(), 1);
         assert!(
-            curve(0.6, 0.8).unwrap().probability(im) > curve(0.5, 0.2).unwrap().probability(im)
+            (c[0].2 / meet - 1.0).abs() < 1e-12 && c[0].3 == 3.0,
+            "{c:?}"
+        );
+        assert!(crossings(&[curve(0.6, 0.8), curve(0.5, 0.2)], 0.05, 0.9 * meet).is_empty());
+        // Equal betas, medians out of order: wrong everywhere.
+        assert_eq!(
+            crossings(&[curve(0.8, 0.4), curve(0.5, 0.4)], 0.05, 3.0),
+            vec![(0, 1, 0.05, 3.0)]
         );
     }
 
