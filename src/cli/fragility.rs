@@ -6,13 +6,18 @@ use anyhow::{anyhow, bail, Result};
 use pounding::io::table::{Filter, Table};
 use pounding::studies::damage_states::DamageStates;
 use pounding::studies::fragility::{
-    bootstrap, crossings, csv, default_im, fit, panel, Band, FragilitySpec, Grouped,
+    bootstrap, crossings, csv, default_im, fit, number, panel, Band, FragilitySpec, Grouped,
+    Undecided,
 };
 use pounding::studies::plot::Series;
 use std::path::{Path, PathBuf};
 
 /// Bootstrap replicates at most (each refits every threshold).
 const MAX_BOOTSTRAP: usize = 100_000;
+
+/// Bootstrap replicates at least: a 5 % and a 95 % percentile need some replicates beyond each
+/// (5 at 100), or the "90 %" band is the smallest and largest of a few draws.
+const MIN_BOOTSTRAP: usize = 100;
 
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("limits").required(true).args(["threshold", "damage_states"])))]
@@ -36,15 +41,16 @@ pub struct Args {
     #[arg(long, value_name = "SET")]
     damage_states: Option<String>,
     /// Bootstrap replicates over the groups of `--by` (records), for 90 % bands of each
-    /// fitted median, beta and curve (0: none).
+    /// fitted median, beta and curve (0: none; else at least 100).
     #[arg(long, default_value_t = 0)]
     bootstrap: usize,
-    /// Seed of the bootstrap draws.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// The column whose groups the bootstrap draws with replacement.
-    #[arg(long, default_value = "record")]
-    by: String,
+    /// Seed of the bootstrap draws (with --bootstrap; default 1).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// The column whose groups the bootstrap draws with replacement (with --bootstrap; default
+    /// record).
+    #[arg(long)]
+    by: Option<String>,
     /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
     #[arg(long = "where", value_name = "FILTER")]
     filters: Vec<String>,
@@ -85,6 +91,20 @@ pub fn run(a: Args) -> Result<()> {
             a.bootstrap
         );
     }
+    if a.bootstrap > 0 && a.bootstrap < MIN_BOOTSTRAP {
+        bail!(
+            "--bootstrap {}: expected 0 (no bands) or at least {MIN_BOOTSTRAP} replicates: the 90 % band is the 5 and 95 % percentiles of the replicates, which fewer cannot place",
+            a.bootstrap
+        );
+    }
+    // Flags of the bootstrap mean nothing without it.
+    for (flag, given) in [("--by", a.by.is_some()), ("--seed", a.seed.is_some())] {
+        if given && a.bootstrap == 0 {
+            bail!("{flag} applies to the bootstrap bands: give --bootstrap N (N >= {MIN_BOOTSTRAP}) with it, or leave {flag} out");
+        }
+    }
+    let by = a.by.clone().unwrap_or_else(|| "record".into());
+    let seed = a.seed.unwrap_or(1);
     let states = a
         .damage_states
         .as_deref()
@@ -101,7 +121,7 @@ pub fn run(a: Args) -> Result<()> {
         Some(d) => (d.limits(), d.states.iter().map(|s| s.0.clone()).collect()),
         None => (
             a.threshold.clone(),
-            a.threshold.iter().map(|t| t.to_string()).collect(),
+            a.threshold.iter().map(|&t| number(t)).collect(),
         ),
     };
     let table = Table::read(&a.results)?;
@@ -111,20 +131,21 @@ pub fn run(a: Args) -> Result<()> {
         thresholds,
         filters: Filter::parse_all(&a.filters)?,
     };
-    let group = (a.bootstrap > 0).then_some(a.by.as_str());
+    let group = (a.bootstrap > 0).then_some(by.as_str());
     let (grouped, skipped) = Grouped::read(&table, &spec, group)?;
     let lv = grouped.pooled(&[1]);
-    let runs: u64 = lv.first().map_or(0, |l| l.iter().map(|x| x.n).sum());
+    let runs = grouped.runs;
     if runs == 0 {
         bail!(
-            "{}: no runs left to count (check --where)",
-            a.results.display()
+            "{}: no run left to count: {}",
+            a.results.display(),
+            why_none(&table, &spec, &a.filters, &skipped)?
         );
     }
     let fits: Vec<_> = lv.iter().map(|l| fit(l)).collect();
     say!(
         "{runs} runs at {} levels of {}{}",
-        lv[0].len(),
+        grouped.ims.len(),
         spec.im,
         if skipped.total() > 0 {
             format!(" ({} rows left out: {skipped})", skipped.total())
@@ -132,11 +153,11 @@ pub fn run(a: Args) -> Result<()> {
             String::new()
         }
     );
-    if lv[0].len() as u64 * 2 > runs && runs >= 10 {
+    if grouped.ims.len() * 2 > runs && runs >= 10 {
         note!(
             "notice: {} takes {} values over {runs} runs: an intensity measure that differs from run to run (levels of one or two runs each) gives shares of little meaning; the level a sweep scales to is a target column (target_pga_g, target_sa_g, target_sa_avg_g)",
             spec.im,
-            lv[0].len()
+            grouped.ims.len()
         );
     }
     if let Some(d) = &states {
@@ -151,17 +172,22 @@ pub fn run(a: Args) -> Result<()> {
             bail!(
                 "--bootstrap: the runs fall in {} group of {}: resampling needs at least two",
                 grouped.groups.len(),
-                a.by
+                by
             );
         }
         say!(
-            "bootstrap: {} replicates over {} groups of {} (seed {}), 90 % bands",
+            "bootstrap: {} replicates over {} groups of {} (seed {}), 90 % bands{}",
             a.bootstrap,
             grouped.groups.len(),
-            a.by,
-            a.seed
+            by,
+            seed,
+            if grouped.unknown > 0 {
+                " (of the fits to the runs decided)"
+            } else {
+                ""
+            }
         );
-        bootstrap(&grouped, a.bootstrap, a.seed, &plot_ims)
+        bootstrap(&grouped, a.bootstrap, seed, &plot_ims)
     } else {
         vec![None; spec.thresholds.len()]
     };
@@ -181,7 +207,7 @@ pub fn run(a: Args) -> Result<()> {
     let mut unfitted = Vec::new();
     for (i, f) in fits.iter().enumerate() {
         let label = match &states {
-            Some(_) => format!("{} ({})", names[i], spec.thresholds[i]),
+            Some(_) => format!("{} ({})", names[i], number(spec.thresholds[i])),
             None => names[i].clone(),
         };
         let band = match (&bands[i], a.bootstrap > 0) {
@@ -233,13 +259,30 @@ pub fn run(a: Args) -> Result<()> {
             poor.join(", ")
         );
     }
-    for (i, j, im) in crossings(&fits, lo, hi) {
+    // The severer of two thresholds is the larger, in whatever order --threshold gave them.
+    let mut order: Vec<usize> = (0..fits.len()).collect();
+    order.sort_by(|&x, &y| spec.thresholds[x].total_cmp(&spec.thresholds[y]));
+    let ascending: Vec<_> = order.iter().map(|&k| fits[k].clone()).collect();
+    for (i, j, from, to) in crossings(&ascending, lo, hi) {
+        let (i, j) = (order[i], order[j]);
+        // The wrong order is one interval of the levels' range (two lognormal curves meet once
+        // at most): name it, and where the curves are in order.
+        let outside = match (from > lo, to < hi) {
+            (false, false) => "no level run is free of it: read them with care".to_string(),
+            (false, true) => format!("read them only above {to:.4}"),
+            (true, false) => format!("read them only below {from:.4}"),
+            (true, true) => "read them only outside it".to_string(),
+        };
         note!(
-            "notice: the fitted curves of {} and {} cross: from {} = {im:.4} the more severe ({}) is the more probable, which no run can be (every run above {} is above {}); the curves are kept as fitted, read them only below that intensity or fit with more runs",
-            names[i], names[j], spec.im, names[j], spec.thresholds[j], spec.thresholds[i]
+            "notice: the fitted curves of {} and {} are out of order from {} = {from:.4} to {to:.4}: there the more severe ({}) is the more probable, which no run can be (every run above {} is above {}); the curves are kept as fitted: {outside}, or fit with more runs",
+            names[i], names[j], spec.im, names[j], number(spec.thresholds[j]), number(spec.thresholds[i])
         );
     }
-    write_file(&output, csv(&spec, &lv).as_bytes())?;
+    if grouped.unknown > 0 {
+        undecided_table(&grouped, &spec, &states.as_ref().map(|_| names.clone()))?;
+    }
+    let state_names = states.as_ref().map(|_| names.as_slice());
+    write_file(&output, csv(&spec, state_names, &grouped).as_bytes())?;
     if let Some(p) = &a.plot {
         let mut pl = panel(&spec, &lv, &fits);
         if states.is_some() {
@@ -276,4 +319,103 @@ fn band_series(b: &Band) -> [Series; 2] {
         scatter: false,
         style: None,
     })
+}
+
+/// Why no run was left to count, naming the cause: `--where` keeping no row, every run failed,
+/// the intensity or the demand column empty in every row (an intensity the sweep was not scaled
+/// to), values not finite.
+fn why_none(
+    table: &Table,
+    spec: &FragilitySpec,
+    filters: &[String],
+    skipped: &pounding::studies::fragility::LeftOut,
+) -> Result<String> {
+    let rows = table.rows.len();
+    let kept = table.select(&spec.filters)?.len();
+    if rows == 0 {
+        return Ok("the file has no rows".into());
+    }
+    if kept == 0 {
+        return Ok(format!(
+            "--where {} keeps none of its {rows} rows",
+            filters.join(" --where ")
+        ));
+    }
+    let mut why = Vec::new();
+    if kept < rows {
+        why.push(format!("--where keeps {kept} of {rows} rows"));
+    }
+    if skipped.failed > 0 {
+        why.push(format!("{} have status not ok", skipped.failed));
+    }
+    let empty_everywhere = |c: &str| {
+        table
+            .col(c)
+            .is_ok_and(|i| table.rows.iter().all(|r| r[i].trim().is_empty()))
+    };
+    if skipped.empty_im > 0 {
+        let mut w = format!("{} have no value of --im {}", skipped.empty_im, spec.im);
+        if empty_everywhere(&spec.im) {
+            w.push_str(&format!(
+                " (empty in every row: not an intensity this sweep was scaled to; it has {})",
+                default_im(table)
+            ));
+        }
+        why.push(w);
+    }
+    if skipped.empty_edp > 0 {
+        let mut w = format!("{} have no value of --edp {}", skipped.empty_edp, spec.edp);
+        if empty_everywhere(&spec.edp) {
+            w.push_str(" (empty in every row)");
+        }
+        why.push(w);
+    }
+    if skipped.non_finite > 0 {
+        why.push(format!(
+            "{} have a value not finite (NaN or infinite)",
+            skipped.non_finite
+        ));
+    }
+    Ok(format!("of {kept} rows, {}", why.join(", ")))
+}
+
+/// The runs with no value of the demand (a residual drift where the run did not settle): how
+/// many each threshold decides by the bounding column, how many stay undecided, and the fit
+/// with those counted as none exceeding and as all exceeding, which bound the fit to the runs
+/// decided.
+fn undecided_table(
+    grouped: &Grouped,
+    spec: &FragilitySpec,
+    states: &Option<Vec<String>>,
+) -> Result<()> {
+    let decided = match &grouped.bound {
+        Some(b) => format!("; {b} decides those at or below a threshold as not exceeding it (a residual drift never exceeds the peak drift)"),
+        None => ", and no column of this file bounds it: each is undecided".into(),
+    };
+    say!(
+        "\n{} runs have no value of {} (the run did not settle){decided}. The fits above are to the runs decided; the undecided, counted as none exceeding and as all exceeding, bound them:",
+        grouped.unknown,
+        spec.edp
+    );
+    say!("\n| {} > | decided by the bound | undecided | median if none exceed | beta | median if all exceed | beta |\n|---:|---:|---:|---:|---:|---:|---:|", spec.edp);
+    let none = grouped.pooled_counting(&[1], Undecided::NotExceeding);
+    let all = grouped.pooled_counting(&[1], Undecided::Exceeding);
+    let show = |lv: &[pounding::studies::fragility::Level]| match fit(lv) {
+        Ok(f) => format!("{:.4} | {:.4}", f.median, f.beta),
+        Err(e) => format!("no fit: {e} |"),
+    };
+    for (t, &limit) in spec.thresholds.iter().enumerate() {
+        let label = match states {
+            Some(n) => format!("{} ({})", n[t], number(limit)),
+            None => number(limit),
+        };
+        let undecided: u64 = grouped.undecided_at(t).iter().sum();
+        say!(
+            "| {label} | {} | {undecided} | {} | {} |",
+            grouped.bounded[t],
+            show(&none[t]),
+            show(&all[t])
+        );
+    }
+    Ok(())
 }

@@ -78,9 +78,13 @@ pub fn run(a: Args) -> Result<()> {
             String::new()
         }
     );
+    // Failed runs are left out of the fractiles: over the others they are collapse-free, and the
+    // table says so where any failed.
+    let failed: usize = ida.failed.iter().sum();
+    let over = if failed > 0 { " (collapse-free)" } else { "" };
     let head: Vec<String> = FRACTILES
         .iter()
-        .map(|f| format!("{} {f} %", spec.edp))
+        .map(|f| format!("{} {f} %{over}", spec.edp))
         .collect();
     say!(
         "\n| {} | curves | {} |\n|---:|---:|---:|---:|---:|",
@@ -89,6 +93,10 @@ pub fn run(a: Args) -> Result<()> {
     );
     for (l, im) in ida.ims.iter().enumerate() {
         let f = ida.fractiles[l];
+        if ida.counts[l] == 0 {
+            say!("| {im} | 0 | no run with a value | | |");
+            continue;
+        }
         say!(
             "| {im} | {} | {:.4e} | {:.4e} | {:.4e} |",
             ida.counts[l],
@@ -97,18 +105,45 @@ pub fn run(a: Args) -> Result<()> {
             f[2]
         );
     }
+    // Where curves are missing at a level, say why: no run there, or a run left out.
     let short: Vec<String> = ida
         .ims
         .iter()
-        .zip(&ida.counts)
-        .filter(|(_, &n)| n < ida.curves.len())
-        .map(|(im, n)| format!("{im} ({n} of {})", ida.curves.len()))
+        .enumerate()
+        .filter(|(l, _)| ida.counts[*l] < ida.curves.len())
+        .map(|(l, im)| {
+            let (n, f, e) = (ida.counts[l], ida.failed[l], ida.no_value[l]);
+            let mut why = Vec::new();
+            if f > 0 {
+                why.push(format!("{f} failed (status not ok)"));
+            }
+            if e > 0 {
+                why.push(format!(
+                    "{e} with no value of {} (a run that did not settle)",
+                    spec.edp
+                ));
+            }
+            let absent = ida.curves.len().saturating_sub(n + f + e);
+            if absent > 0 {
+                why.push(format!("{absent} with no run"));
+            }
+            format!(
+                "{im}: {n} of {} curves ({})",
+                ida.curves.len(),
+                why.join(", ")
+            )
+        })
         .collect();
     if !short.is_empty() {
         note!(
-            "notice: some curves have no run at {} = {}: the fractiles there are over the curves that do",
+            "notice: not every curve has a value at each level of {}: {}; the fractiles there are over the runs with a value",
             spec.im,
-            short.join(", ")
+            short.join("; ")
+        );
+    }
+    if failed > 0 {
+        note!(
+            "notice: {failed} failed runs (status not ok: a collapse or a numerical failure) are left out of the fractiles, which are therefore collapse-free: below the fractiles of every run where the failed runs are the most severe"
         );
     }
     write_file(&output, ida.csv(&spec).as_bytes())?;

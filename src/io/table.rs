@@ -307,6 +307,13 @@ pub fn quantity(column: &str, v: f64) -> String {
         if x == 0.0 || !x.is_finite() {
             return format!("{x}");
         }
+        if !(1e-6..1e15).contains(&x.abs()) {
+            // Far from 1, digits would run to hundreds (1e-300): an exponent instead.
+            let e = format!("{x:.3e}");
+            let (m, p) = e.split_once('e').unwrap_or((&e, "0"));
+            let m = m.trim_end_matches('0').trim_end_matches('.');
+            return format!("{m}e{p}");
+        }
         let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
         let s = format!("{x:.digits$}");
         match s.contains('.') {
@@ -348,6 +355,7 @@ mod tests {
         assert_eq!(quantity("b2_s3_residual_drift_ratio", 0.0125), "1.25 %");
         assert_eq!(quantity("b2_peak_ductility", 2.5), "2.5");
         assert_eq!(quantity("impacts", 0.0), "0");
+        assert_eq!(quantity("b1_peak_drift_ratio", 1e-300), "1e-298 %");
     }
 
     #[test]

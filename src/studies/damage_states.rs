@@ -88,6 +88,28 @@ impl DamageStates {
             return Err(format!("{given}: no [[state]]: give at least one"));
         }
         for (i, s) in raw.states.iter().enumerate() {
+            // A name labels a table row, a legend entry and a CSV cell: one line of text,
+            // telling its state apart.
+            if s.name.trim().is_empty() {
+                return Err(format!(
+                    "{given}: state[{i}]: name is empty: give each state a name"
+                ));
+            }
+            if s.name.chars().any(char::is_control) {
+                return Err(format!(
+                    "{given}: state[{i}] name {:?}: expected one line of text (no line break, tab or other control character)",
+                    s.name
+                ));
+            }
+            if let Some(j) = raw.states[..i]
+                .iter()
+                .position(|o| o.name.trim() == s.name.trim())
+            {
+                return Err(format!(
+                    "{given}: state[{i}] name `{}` is also state[{j}]'s: give each state its own name",
+                    s.name
+                ));
+            }
             if !s.limit.is_finite() {
                 return Err(format!(
                     "{given}: state[{i}] ({}): limit {} is not finite",

@@ -44,6 +44,8 @@ impl Fit {
 /// Why no curve could be fitted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum NoFit {
+    #[error("no run with a value to count")]
+    NoRuns,
     #[error("no run exceeds the threshold")]
     NoneExceed,
     #[error("every run exceeds the threshold")]
@@ -62,6 +64,7 @@ impl NoFit {
     /// The reason in a few words, for a legend entry (the table and the notice give it whole).
     pub fn short(&self) -> &'static str {
         match self {
+            NoFit::NoRuns => "no runs",
             NoFit::NoneExceed => "none exceed",
             NoFit::AllExceed => "all exceed",
             NoFit::OneLevel => "one intensity",
@@ -78,6 +81,9 @@ pub fn fit(levels: &[Level]) -> Result<Fit, NoFit> {
         return Err(NoFit::NonPositiveIm);
     }
     let (n, k): (u64, u64) = lv.iter().fold((0, 0), |(n, k), l| (n + l.n, k + l.exceed));
+    if n == 0 {
+        return Err(NoFit::NoRuns);
+    }
     if k == 0 {
         return Err(NoFit::NoneExceed);
     }
@@ -273,15 +279,18 @@ pub struct FragilitySpec {
 pub struct LeftOut {
     /// `status` not `ok`.
     pub failed: usize,
-    /// An empty IM or EDP cell.
-    pub empty: usize,
+    /// An empty IM cell.
+    pub empty_im: usize,
+    /// An empty EDP cell (of a column that may be empty: counted apart by the caller that keeps
+    /// such runs, see [`Demand::Unknown`]).
+    pub empty_edp: usize,
     /// A NaN or infinite IM or EDP: neither exceeding nor not.
     pub non_finite: usize,
 }
 
 impl LeftOut {
     pub fn total(&self) -> usize {
-        self.failed + self.empty + self.non_finite
+        self.failed + self.empty_im + self.empty_edp + self.non_finite
     }
 }
 
@@ -289,7 +298,8 @@ impl std::fmt::Display for LeftOut {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let parts: Vec<String> = [
             (self.failed, "status not ok"),
-            (self.empty, "no value"),
+            (self.empty_im, "no value of the intensity"),
+            (self.empty_edp, "no value of the demand"),
             (self.non_finite, "a value not finite (NaN or infinite)"),
         ]
         .iter()
@@ -300,8 +310,8 @@ impl std::fmt::Display for LeftOut {
     }
 }
 
-/// Counts per threshold and intensity level, and the rows left out (status not `ok`, no IM or
-/// EDP value, or one that is not finite). Thresholds must be finite.
+/// Counts per threshold and intensity level of the runs decided, and the rows left out (status
+/// not `ok`, no IM or EDP value, or one that is not finite). Thresholds must be finite.
 pub fn levels(
     table: &Table,
     spec: &FragilitySpec,
@@ -325,34 +335,84 @@ pub fn default_im(table: &Table) -> String {
         .to_string()
 }
 
+/// The column whose value bounds demand column `edp` from above, for a demand that may be empty
+/// in a run that did not fail: a residual drift (`bK_residual_drift_ratio`, and a storey's signed
+/// `bK_sJ_residual_drift_ratio`) is a storey's plastic drift at rest, which never exceeds the
+/// largest drift the storey reached (plastic drift moves only while the storey yields, and then
+/// lies between zero and the drift: docs/inelastic.md), so building K's
+/// `bK_peak_drift_ratio` bounds it. None for any other column.
+pub fn bounding_column(edp: &str) -> Option<String> {
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    let (k, suffix) = edp.strip_prefix('b')?.split_once('_')?;
+    let storey = |s: &str| {
+        s.strip_prefix('s')
+            .and_then(|r| r.split_once('_'))
+            .is_some_and(|(j, rest)| digits(j) && rest == "residual_drift_ratio")
+    };
+    (digits(k) && (suffix == "residual_drift_ratio" || storey(suffix)))
+        .then(|| format!("b{k}_peak_drift_ratio"))
+}
+
+/// A run's demand.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Demand {
+    Value(f64),
+    /// No value in a run that did not fail, of a column that may be empty there (a residual
+    /// drift where the run did not settle: [`crate::engine::aggregate::may_be_empty`]): not
+    /// known, but at most `bound` where the [`bounding_column`] has a finite value.
+    Unknown {
+        bound: Option<f64>,
+    },
+}
+
 /// The rows of `table` that `filters` keep, whose status is `ok` (where there is a status column)
 /// and whose IM (column `ci`) and EDP (`ce`) are finite numbers: (row, intensity level, EDP).
-/// The level is the IM rounded to 12 significant digits (CSV text round-trips exactly, but
-/// scaled PGAs computed per record may differ in the last bits). `skipped` counts the rest.
+/// An empty EDP of a column that may be empty in a run that did not fail is kept as
+/// [`Demand::Unknown`] (with its bound where the table has the [`bounding_column`]); an empty one
+/// of another column is left out. The level is the IM rounded to 12 significant digits (CSV
+/// text round-trips exactly, but scaled PGAs computed per record may differ in the last bits).
+/// `skipped` counts the rest.
 pub fn demand_rows(
     table: &Table,
     filters: &[Filter],
     ci: usize,
     ce: usize,
     skipped: &mut LeftOut,
-) -> Result<Vec<(usize, f64, f64)>, TableError> {
+) -> Result<Vec<(usize, f64, Demand)>, TableError> {
     let cs = table.col("status").ok();
+    let edp = &table.header[ce];
+    let may_be_empty = crate::engine::aggregate::may_be_empty(edp);
+    let cb = bounding_column(edp).and_then(|b| table.col(&b).ok());
     let mut out = Vec::new();
     for i in table.select(filters)? {
         if cs.is_some_and(|c| table.rows[i][c] != "ok") {
             skipped.failed += 1;
             continue;
         }
-        let (Some(im), Some(edp)) = (table.num(i, ci)?, table.num(i, ce)?) else {
-            skipped.empty += 1;
+        let Some(im) = table.num(i, ci)? else {
+            skipped.empty_im += 1;
             continue;
         };
-        if !(im.is_finite() && edp.is_finite()) {
+        let demand = match table.num(i, ce)? {
+            Some(v) => Demand::Value(v),
+            None if may_be_empty => {
+                let bound = cb.map(|c| table.num(i, c)).transpose()?.flatten();
+                Demand::Unknown {
+                    bound: bound.filter(|b| b.is_finite()),
+                }
+            }
+            None => {
+                skipped.empty_edp += 1;
+                continue;
+            }
+        };
+        let finite = im.is_finite() && !matches!(demand, Demand::Value(v) if !v.is_finite());
+        if !finite {
             skipped.non_finite += 1;
             continue;
         }
         let level = format!("{im:.11e}").parse::<f64>().unwrap_or(im);
-        out.push((i, level, edp));
+        out.push((i, level, demand));
     }
     Ok(out)
 }
@@ -366,8 +426,28 @@ pub struct Grouped {
     pub ims: Vec<f64>,
     /// The groups' names (the group column's text), in order of first appearance.
     pub groups: Vec<String>,
-    /// `counts[group][threshold][level]`: runs and exceedances.
+    /// `counts[group][threshold][level]`: runs decided and exceedances among them.
     pub counts: Vec<Vec<Vec<(u64, u64)>>>,
+    /// `undecided[group][threshold][level]`: runs with no value of the demand that its bound
+    /// does not decide ([`Demand::Unknown`]); empty where there are none.
+    pub undecided: Vec<Vec<Vec<u64>>>,
+    /// Runs read (decided or not), and those among them with no value of the demand.
+    pub runs: usize,
+    pub unknown: usize,
+    /// Per threshold: runs with no value decided by their bound (at or below the threshold).
+    pub bounded: Vec<u64>,
+    /// The column that bounds the demand from above, where the table has it.
+    pub bound: Option<String>,
+}
+
+/// How [`Grouped::pooled_counting`] counts the undecided runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Undecided {
+    /// Left out: the central estimate, on the runs decided.
+    Left,
+    /// All as exceeding, or all as not: the bounds.
+    Exceeding,
+    NotExceeding,
 }
 
 impl Grouped {
@@ -389,37 +469,63 @@ impl Grouped {
         let mut ims: BTreeMap<u64, f64> = BTreeMap::new();
         let mut groups: Vec<String> = Vec::new();
         let mut group_of: std::collections::HashMap<String, usize> = Default::default();
-        let mut runs: Vec<(usize, u64, f64)> = Vec::new();
-        for (i, level, edp) in demand_rows(table, &spec.filters, ci, ce, &mut skipped)? {
+        let mut runs: Vec<(usize, u64, Demand)> = Vec::new();
+        for (i, level, demand) in demand_rows(table, &spec.filters, ci, ce, &mut skipped)? {
             ims.insert(order_key(level), level);
             let name = cg.map_or(String::new(), |c| table.rows[i][c].clone());
             let g = *group_of.entry(name.clone()).or_insert_with(|| {
                 groups.push(name);
                 groups.len() - 1
             });
-            runs.push((g, order_key(level), edp));
+            runs.push((g, order_key(level), demand));
         }
         let at: BTreeMap<u64, usize> = ims.keys().enumerate().map(|(i, k)| (*k, i)).collect();
-        let mut counts =
-            vec![vec![vec![(0u64, 0u64); ims.len()]; spec.thresholds.len()]; groups.len()];
-        for (g, key, edp) in runs {
+        let nt = spec.thresholds.len();
+        let mut counts = vec![vec![vec![(0u64, 0u64); ims.len()]; nt]; groups.len()];
+        let mut undecided = vec![vec![vec![0u64; ims.len()]; nt]; groups.len()];
+        let mut bounded = vec![0u64; nt];
+        let unknown = runs
+            .iter()
+            .filter(|r| matches!(r.2, Demand::Unknown { .. }))
+            .count();
+        for &(g, key, demand) in &runs {
             for (t, &limit) in spec.thresholds.iter().enumerate() {
                 let c = &mut counts[g][t][at[&key]];
-                c.0 += 1;
-                c.1 += u64::from(edp > limit);
+                match demand {
+                    Demand::Value(edp) => {
+                        c.0 += 1;
+                        c.1 += u64::from(edp > limit);
+                    }
+                    // Not above its bound, so not above a limit at or above the bound.
+                    Demand::Unknown { bound: Some(b) } if b <= limit => {
+                        c.0 += 1;
+                        bounded[t] += 1;
+                    }
+                    Demand::Unknown { .. } => undecided[g][t][at[&key]] += 1,
+                }
             }
         }
         let grouped = Grouped {
             ims: ims.into_values().collect(),
             groups,
             counts,
+            undecided: if unknown > 0 { undecided } else { Vec::new() },
+            runs: runs.len(),
+            unknown,
+            bounded,
+            bound: bounding_column(&spec.edp).filter(|b| table.col(b).is_ok()),
         };
         Ok((grouped, skipped))
     }
 
     /// The levels per threshold when group `g` counts `weights[g]` times (a weight of 1 for
-    /// every group, or `[1]` for all: the counts as read).
+    /// every group, or `[1]` for all: the counts as read), of the runs decided.
     pub fn pooled(&self, weights: &[u32]) -> Vec<Vec<Level>> {
+        self.pooled_counting(weights, Undecided::Left)
+    }
+
+    /// [`Grouped::pooled`], with the undecided runs counted as `how` says.
+    pub fn pooled_counting(&self, weights: &[u32], how: Undecided) -> Vec<Vec<Level>> {
         let thresholds = self.counts.first().map_or(0, |c| c.len());
         (0..thresholds)
             .map(|t| {
@@ -430,14 +536,28 @@ impl Grouped {
                         let (mut n, mut exceed) = (0, 0);
                         for (g, c) in self.counts.iter().enumerate() {
                             let w = u64::from(*weights.get(g).unwrap_or(&weights[0]));
+                            let u = self.undecided.get(g).map_or(0, |u| u[t][l]);
                             n += w * c[t][l].0;
                             exceed += w * c[t][l].1;
+                            if how != Undecided::Left {
+                                n += w * u;
+                            }
+                            if how == Undecided::Exceeding {
+                                exceed += w * u;
+                            }
                         }
                         Level { im, n, exceed }
                     })
                     .filter(|l| l.n > 0)
                     .collect()
             })
+            .collect()
+    }
+
+    /// Runs undecided at threshold `t`, at each level (over every group).
+    pub fn undecided_at(&self, t: usize) -> Vec<u64> {
+        (0..self.ims.len())
+            .map(|l| self.undecided.iter().map(|u| u[t][l]).sum())
             .collect()
     }
 }
@@ -504,24 +624,37 @@ pub fn bootstrap(
 }
 
 /// Where fitted curves of ascending thresholds disagree with their order, within the
-/// intensities `lo..=hi`: for each pair `(i, j)`, `i < j`, the lowest intensity (of 200 spaced
-/// evenly) at which the curve of the higher threshold `j` lies above the curve of `i`. Counts
-/// cannot do that (a run above `j` is above `i`); fitted curves of different betas can.
-pub fn crossings(fits: &[Result<Fit, NoFit>], lo: f64, hi: f64) -> Vec<(usize, usize, f64)> {
-    let n = 200;
-    let ims: Vec<f64> = (0..=n)
-        .map(|k| lo + (hi - lo) * k as f64 / n as f64)
-        .filter(|&im| im > 0.0)
-        .collect();
+/// intensities `lo..=hi`: for each pair `(i, j)`, `i < j`, the interval `(from, to)` where the
+/// curve of the higher threshold `j` lies above the curve of `i`. Counts cannot do that (a run
+/// above `j` is above `i`); fitted curves of different betas can. Two lognormal curves differ in
+/// sign as `ln IM (1 / beta_j - 1 / beta_i) + ln m_i / beta_i - ln m_j / beta_j`, linear in
+/// `ln IM`: they meet at one intensity at most, so the wrong order is one interval, on the side
+/// of the meeting point where the flatter curve is the higher (of equal betas, everywhere where
+/// `m_j < m_i`).
+pub fn crossings(fits: &[Result<Fit, NoFit>], lo: f64, hi: f64) -> Vec<(usize, usize, f64, f64)> {
     let mut out = Vec::new();
     for (i, a) in fits.iter().enumerate() {
         for (j, b) in fits.iter().enumerate().skip(i + 1) {
             let (Ok(a), Ok(b)) = (a, b) else { continue };
-            if let Some(&im) = ims
-                .iter()
-                .find(|&&im| b.probability(im) > a.probability(im) + 1e-12)
-            {
-                out.push((i, j, im));
+            // `b` above `a` where `slope ln IM + offset > 0`.
+            let slope = 1.0 / b.beta - 1.0 / a.beta;
+            let offset = a.median.ln() / a.beta - b.median.ln() / b.beta;
+            let (from, to) = if slope.abs() < 1e-12 * (1.0 / a.beta + 1.0 / b.beta) {
+                if offset > 0.0 {
+                    (lo, hi)
+                } else {
+                    continue;
+                }
+            } else {
+                let meet = (-offset / slope).exp();
+                if slope > 0.0 {
+                    (meet.max(lo), hi)
+                } else {
+                    (lo, meet.min(hi))
+                }
+            };
+            if from < to {
+                out.push((i, j, from, to));
             }
         }
     }
@@ -542,21 +675,68 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
     }
 }
 
-/// The counts as CSV: threshold, im, n, exceed, fraction.
-pub fn csv(spec: &FragilitySpec, levels: &[Vec<Level>]) -> String {
-    let mut s = format!("threshold,{},runs,exceed,fraction\n", spec.im);
-    for (t, lv) in spec.thresholds.iter().zip(levels) {
-        for l in lv {
+/// The counts as CSV, a row per threshold and level: the state's name (with `states`), the
+/// threshold, the intensity, the runs decided, those exceeding, their fraction, the runs
+/// undecided (no value, not decided by the bound: [`Demand::Unknown`]) and the fraction's bounds
+/// with those counted as none exceeding and as all exceeding.
+pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -> String {
+    let quote = |s: &str| {
+        if s.contains([',', '"', '\n', '\r']) {
+            format!("\"{}\"", s.replace('"', "\"\""))
+        } else {
+            s.to_string()
+        }
+    };
+    let mut s = String::new();
+    if states.is_some() {
+        s.push_str("state,");
+    }
+    s.push_str(&format!(
+        "threshold,{},runs,exceed,fraction,undecided,fraction_if_none_exceed,fraction_if_all_exceed\n",
+        quote(&spec.im)
+    ));
+    let ratio = |k: u64, n: u64| {
+        if n > 0 {
+            (k as f64 / n as f64).to_string()
+        } else {
+            String::new()
+        }
+    };
+    for (t, &limit) in spec.thresholds.iter().enumerate() {
+        let undecided = grouped.undecided_at(t);
+        for (l, &im) in grouped.ims.iter().enumerate() {
+            let (n, k) = grouped
+                .counts
+                .iter()
+                .fold((0, 0), |(n, k), c| (n + c[t][l].0, k + c[t][l].1));
+            let u = undecided[l];
+            if n + u == 0 {
+                continue;
+            }
+            if let Some(names) = states {
+                s.push_str(&quote(&names[t]));
+                s.push(',');
+            }
             s.push_str(&format!(
-                "{t},{},{},{},{}\n",
-                l.im,
-                l.n,
-                l.exceed,
-                l.exceed as f64 / l.n as f64
+                "{},{im},{n},{k},{},{u},{},{}\n",
+                number(limit),
+                ratio(k, n),
+                ratio(k, n + u),
+                ratio(k + u, n + u)
             ));
         }
     }
     s
+}
+
+/// A number as a person reads it: its shortest round-trip text, in exponent form where the
+/// decimal would be long (a threshold of 1e-300 is not 300 digits).
+pub fn number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs()) {
+        x.to_string()
+    } else {
+        format!("{x:e}")
+    }
 }
 
 /// A threshold's legend entry: `> 1 MN` for `peak_force_n` above 1e6 ([`crate::io::table::quantity`]).
@@ -632,6 +812,11 @@ mod tests {
             ims: ims.to_vec(),
             groups: (0..groups.len()).map(|g| format!("r{g}")).collect(),
             counts: groups.iter().map(|c| vec![c.clone()]).collect(),
+            undecided: Vec::new(),
+            runs: groups.iter().flatten().map(|c| c.0 as usize).sum(),
+            unknown: 0,
+            bounded: vec![0],
+            bound: None,
         }
     }
 
@@ -687,15 +872,84 @@ mod tests {
         };
         assert!(crossings(&[curve(0.5, 0.4), curve(0.8, 0.4)], 0.05, 3.0).is_empty());
         // ln(im) where they meet: (b2 ln m1 - b1 ln m2) / (b2 - b1), below which the flatter
-        // (higher threshold) curve lies above the steeper one.
-        let c = crossings(&[curve(0.5, 0.2), curve(0.6, 0.8)], 0.05, 3.0);
+        // (higher threshold) curve lies above the steeper one: the interval runs from the
+        // lowest level to there, and the curves are in order on either side of its ends.
+        let (a, b) = (curve(0.5, 0.2), curve(0.6, 0.8));
+        let meet = ((0.8 * 0.5f64.ln() - 0.2 * 0.6f64.ln()) / (0.8 - 0.2)).exp();
+        let c = crossings(&[a.clone(), b.clone()], 0.05, 3.0);
         assert_eq!(c.len(), 1);
-        let (i, j, im) = c[0];
-        assert_eq!((i, j), (0, 1));
-        assert!(im < 0.5, "{im}");
+        let (i, j, from, to) = c[0];
+        assert_eq!((i, j, from), (0, 1, 0.05));
+        assert!((to / meet - 1.0).abs() < 1e-12, "{to} {meet}");
+        let (a, b) = (a.unwrap(), b.unwrap());
+        assert!(b.probability(0.99 * to) > a.probability(0.99 * to));
+        assert!(b.probability(1.01 * to) < a.probability(1.01 * to));
+        // The steeper higher curve is above from the meeting point up; not at all when it
+        // meets beyond the levels.
+        let c = crossings(&[curve(0.6, 0.8), curve(0.5, 0.2)], 0.05, 3.0);
+        assert_eq!(c.len(), 1);
         assert!(
-            curve(0.6, 0.8).unwrap().probability(im) > curve(0.5, 0.2).unwrap().probability(im)
+            (c[0].2 / meet - 1.0).abs() < 1e-12 && c[0].3 == 3.0,
+            "{c:?}"
         );
+        assert!(crossings(&[curve(0.6, 0.8), curve(0.5, 0.2)], 0.05, 0.9 * meet).is_empty());
+        // Equal betas, medians out of order: wrong everywhere.
+        assert_eq!(
+            crossings(&[curve(0.8, 0.4), curve(0.5, 0.4)], 0.05, 3.0),
+            vec![(0, 1, 0.05, 3.0)]
+        );
+    }
+
+    /// A residual drift, of a building or a storey, is bounded by its building's peak drift;
+    /// no other column is.
+    #[test]
+    fn residual_drifts_are_bounded_by_the_peak() {
+        for (edp, bound) in [
+            ("b1_residual_drift_ratio", Some("b1_peak_drift_ratio")),
+            ("b12_s3_residual_drift_ratio", Some("b12_peak_drift_ratio")),
+            ("b1_peak_drift_ratio", None),
+            ("b1_residual_storey", None),
+            ("bx_residual_drift_ratio", None),
+            ("b1_s_residual_drift_ratio", None),
+        ] {
+            assert_eq!(bounding_column(edp).as_deref(), bound, "{edp}");
+        }
+        assert_eq!(number(1e-300), "1e-300");
+        assert_eq!(number(0.005), "0.005");
+        assert_eq!(number(2e6), "2000000");
+    }
+
+    /// Runs with no value: decided where the bound is at or below a threshold, else undecided,
+    /// and counted each way for the bounds.
+    #[test]
+    fn runs_with_no_value_are_decided_by_the_bound_or_counted_apart() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.csv");
+        std::fs::write(
+            &p,
+            "status,pga_g,b1_peak_drift_ratio,b1_residual_drift_ratio\nok,0.1,0.002,0.001\nok,0.1,0.004,\nok,0.2,0.02,0.006\nok,0.2,0.03,\nfailed,0.2,,\n",
+        )
+        .unwrap();
+        let table = Table::read(&p).unwrap();
+        let spec = FragilitySpec {
+            im: "pga_g".into(),
+            edp: "b1_residual_drift_ratio".into(),
+            thresholds: vec![0.005],
+            filters: Vec::new(),
+        };
+        let (g, left) = Grouped::read(&table, &spec, None).unwrap();
+        assert_eq!((g.runs, g.unknown, left.failed), (4, 2, 1));
+        assert_eq!(g.bounded, vec![1]);
+        assert_eq!(g.undecided_at(0), vec![0, 1]);
+        let at = |how| {
+            g.pooled_counting(&[1], how)[0]
+                .iter()
+                .map(|l| (l.n, l.exceed))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(at(Undecided::Left), vec![(2, 0), (1, 1)]);
+        assert_eq!(at(Undecided::NotExceeding), vec![(2, 0), (2, 1)]);
+        assert_eq!(at(Undecided::Exceeding), vec![(2, 0), (2, 2)]);
     }
 
     /// A curve through exact probabilities is recovered to the solver's precision.

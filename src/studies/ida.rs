@@ -1,10 +1,12 @@
 //! An incremental dynamic analysis summary from a results CSV (`pound ida`): per curve (a
 //! record, or a record and a sample) the demand against the intensity, and across curves the
-//! 16, 50 and 84 % fractiles of the demand at each intensity level (collapse-free: every run
-//! has a finite demand, so fractiles of the demand given the intensity are well defined).
+//! 16, 50 and 84 % fractiles of the demand at each intensity level, over the runs with a value
+//! there: a failed run (a collapse or a numerical failure) or one with no value of the demand (a
+//! residual drift where the run did not settle) is left out and counted at its level, so the
+//! fractiles are collapse-free where runs failed, and say so.
 
 use crate::io::table::{caption, label, name, order_key, Filter, Table, TableError};
-use crate::studies::fragility::{demand_rows, quantile, LeftOut};
+use crate::studies::fragility::{demand_rows, quantile, Demand, LeftOut};
 use crate::studies::plot::{Panel, Series};
 use std::collections::{BTreeMap, HashMap};
 
@@ -34,6 +36,9 @@ pub struct Ida {
     /// Per level: the curves with a run there, and the [`FRACTILES`] of their demands.
     pub counts: Vec<usize>,
     pub fractiles: Vec<[f64; 3]>,
+    /// Per level: runs left out there, failed (status not `ok`) and with no value of the demand.
+    pub failed: Vec<usize>,
+    pub no_value: Vec<usize>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -49,8 +54,13 @@ pub enum IdaError {
         first: usize,
         second: usize,
     },
-    #[error("{0}: no runs left (check --where and the status column)")]
-    Empty(String),
+    #[error("{path}: no run with a value of {edp} left to read: of {rows} rows, {why}")]
+    Empty {
+        path: String,
+        edp: String,
+        rows: usize,
+        why: String,
+    },
 }
 
 /// Read the curves of `table` under `spec`, and the rows left out (status not `ok`, no value,
@@ -68,8 +78,15 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
     let mut curve_of: HashMap<String, usize> = HashMap::new();
     // (curve, level key) -> (row, demand)
     let mut points: HashMap<(usize, u64), (usize, f64)> = HashMap::new();
-    for (i, key, edp) in demand_rows(table, &spec.filters, ci, ce, &mut skipped)? {
+    // Runs kept out at a level: failed, and with no value of the demand.
+    let mut missing: HashMap<u64, (usize, usize)> = HashMap::new();
+    for (i, key, demand) in demand_rows(table, &spec.filters, ci, ce, &mut skipped)? {
         ims.insert(order_key(key), key);
+        let Demand::Value(edp) = demand else {
+            skipped.empty_edp += 1;
+            missing.entry(order_key(key)).or_default().1 += 1;
+            continue;
+        };
         let name = by
             .iter()
             .map(|&c| table.rows[i][c].as_str())
@@ -93,7 +110,35 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
         points.insert((c, order_key(key)), (i, edp));
     }
     if names.is_empty() {
-        return Err(IdaError::Empty(table.path.display().to_string()));
+        let kept = table.select(&spec.filters)?.len();
+        let mut why = Vec::new();
+        if kept < table.rows.len() {
+            why.push(format!("--where keeps {kept}"));
+        }
+        if skipped.total() > 0 {
+            why.push(skipped.to_string());
+        }
+        if why.is_empty() {
+            why.push("none to read".into());
+        }
+        return Err(IdaError::Empty {
+            path: table.path.display().to_string(),
+            edp: spec.edp.clone(),
+            rows: table.rows.len(),
+            why: why.join("; "),
+        });
+    }
+    // A failed run's intensity, where it has one, places it at its level.
+    if let Ok(cs) = table.col("status") {
+        for i in table.select(&spec.filters)? {
+            if table.rows[i][cs] != "ok" {
+                if let Ok(Some(im)) = table.num(i, ci) {
+                    let key = format!("{im:.11e}").parse::<f64>().unwrap_or(im);
+                    ims.insert(order_key(key), key);
+                    missing.entry(order_key(key)).or_default().0 += 1;
+                }
+            }
+        }
     }
     let keys: Vec<u64> = ims.keys().copied().collect();
     let curves: Vec<(String, Vec<Option<f64>>)> = names
@@ -115,12 +160,15 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
         counts.push(v.len());
         fractiles.push(FRACTILES.map(|f| quantile(&v, f / 100.0)));
     }
+    let at = |k: &u64| missing.get(k).copied().unwrap_or_default();
     Ok((
         Ida {
             ims: ims.into_values().collect(),
             curves,
             counts,
             fractiles,
+            failed: keys.iter().map(|k| at(k).0).collect(),
+            no_value: keys.iter().map(|k| at(k).1).collect(),
         },
         skipped,
     ))
@@ -148,7 +196,11 @@ impl Ida {
         for (l, im) in self.ims.iter().enumerate() {
             s.push_str(&format!("{im},{}", self.counts[l]));
             for f in self.fractiles[l] {
-                s.push_str(&format!(",{f}"));
+                // No fractile of no runs: an empty cell.
+                s.push(',');
+                if self.counts[l] > 0 {
+                    s.push_str(&f.to_string());
+                }
             }
             for (_, v) in &self.curves {
                 s.push(',');
@@ -186,6 +238,7 @@ impl Ida {
                     .fractiles
                     .iter()
                     .zip(&self.ims)
+                    .filter(|(q, _)| q[k].is_finite())
                     .map(|(q, &im)| (q[k], im))
                     .collect(),
                 scatter: false,
