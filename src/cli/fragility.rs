@@ -117,6 +117,12 @@ pub fn run(a: Args) -> Result<()> {
     }) {
         bail!(why);
     }
+    if let Some(t) = pounding::plan::config::number_given_twice(&a.threshold) {
+        bail!(
+            "--threshold: {} is given twice: give each threshold once",
+            number(t)
+        );
+    }
     let (thresholds, names): (Vec<f64>, Vec<String>) = match &states {
         Some(d) => (d.limits(), d.states.iter().map(|s| s.0.clone()).collect()),
         None => (

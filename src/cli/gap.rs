@@ -124,14 +124,13 @@ pub fn run(a: Args) -> Result<()> {
             c.gap_for(p)
                 .map_or("".into(), |g| format!("{:.2} mm", g * 1e3))
         };
-        let (runs, _, _) = c.points.first().copied().unwrap_or_default();
         match &c.fit {
             Ok(f) => say!(
                 "| {} | {} | {} | {} | {:.2} mm | {:.3} | {} | {} | {} |",
                 study.pair_name(c.pair),
                 study.intensity_label(c.intensity),
-                f.runs,
-                f.closing,
+                c.runs,
+                c.closing,
                 f.median * 1e3,
                 f.beta,
                 g(0.10),
@@ -139,9 +138,11 @@ pub fn run(a: Args) -> Result<()> {
                 g(0.01)
             ),
             Err(e) => say!(
-                "| {} | {} | {runs} | | no fit: {e} | | | | |",
+                "| {} | {} | {} | {} | no fit: {e} | | | | |",
                 study.pair_name(c.pair),
                 study.intensity_label(c.intensity),
+                c.runs,
+                c.closing,
             ),
         }
     }

@@ -1,7 +1,7 @@
 //! `pound ida`: IDA curves and their fractiles from a results CSV.
 
 use super::{check_study_outputs, write_file, Holds};
-use anyhow::Result;
+use anyhow::{bail, Result};
 use pounding::io::table::{Filter, Table};
 use pounding::studies::fragility::default_im;
 use pounding::studies::ida::{read, IdaSpec, FRACTILES};
@@ -46,6 +46,9 @@ pub fn run(a: Args) -> Result<()> {
             ("--plot", a.plot.as_deref(), Holds::Plot),
         ],
     )?;
+    if let Some(twice) = pounding::plan::config::name_given_twice(&a.by) {
+        bail!("--by: `{twice}` is given twice: give each column once");
+    }
     let table = Table::read(&a.results)?;
     let by = if a.by.is_empty() {
         let sampled = table

@@ -469,6 +469,12 @@ pub fn values_arg(flag: &str, text: &str, unit: &str, max: usize, why: &str) -> 
             values.len()
         );
     }
+    if let Some(v) = pounding::plan::config::number_given_twice(&values) {
+        bail!(
+            "{flag} `{text}`: {} is given twice: give each value once",
+            pounding::plan::limits::show(v)
+        );
+    }
     Ok(values)
 }
 

@@ -74,12 +74,14 @@ pub fn run(a: Args) -> Result<()> {
     for line in left_out.lines() {
         note!("{}: {line}", a.results.display());
     }
-    // A log axis cannot show a value <= 0: such points are left out, with a count.
+    // A log axis cannot show a value <= 0: such points are left out, with a count, and a
+    // series left with none is named and not drawn (nor listed in the legend).
+    let off = |&(x, y): &(f64, f64)| (spec.log_x && x <= 0.0) || (spec.log_y && y <= 0.0);
     let off_log = p
         .series
         .iter()
         .flat_map(|s| &s.points)
-        .filter(|(x, y)| (spec.log_x && *x <= 0.0) || (spec.log_y && *y <= 0.0))
+        .filter(|q| off(q))
         .count();
     if off_log > 0 {
         note!(
@@ -87,14 +89,35 @@ pub fn run(a: Args) -> Result<()> {
             a.results.display()
         );
     }
-    let points: usize = p.series.iter().map(|s| s.points.len()).sum::<usize>() - off_log;
+    p.series.retain(|s| {
+        let drawn = s.points.iter().any(|q| !off(q));
+        if !drawn {
+            note!(
+                "{}: no series drawn for {}: every one of its points is <= 0 on a log axis",
+                a.results.display(),
+                s.name
+            );
+        }
+        drawn
+    });
+    let points: usize = p.series.iter().map(|s| s.points.len()).sum::<usize>()
+        - p.series
+            .iter()
+            .flat_map(|s| &s.points)
+            .filter(|q| off(q))
+            .count();
     if points == 0 {
-        bail!(
-            "{}: no rows left to plot (check --where and that {} and {} have values)",
-            a.results.display(),
-            spec.x,
-            spec.y
-        );
+        let why = if table.rows.is_empty() {
+            "the file has a header but no rows".to_string()
+        } else if spec.filters.is_empty() {
+            "every row was left out, as counted above".to_string()
+        } else {
+            format!(
+                "check --where, and that {} and {} have values",
+                spec.x, spec.y
+            )
+        };
+        bail!("{}: no rows left to plot: {why}", a.results.display());
     }
     // The line below says what was written.
     a.figure.save(&output, std::slice::from_ref(&p), 1)?;

@@ -137,6 +137,12 @@ fn parse_periods(text: &str) -> Result<Vec<f64>> {
             periods.len()
         );
     }
+    if let Some(t) = pounding::plan::config::number_given_twice(&periods) {
+        bail!(
+            "--periods: {} s is given twice: give each period once",
+            pounding::plan::limits::show(t)
+        );
+    }
     let lo = pounding::plan::limits::MIN_PERIOD_S;
     if let Some(t) = periods.iter().find(|t| !(**t >= lo && **t <= 100.0)) {
         bail!(

@@ -189,13 +189,20 @@ pub fn run(a: Args) -> Result<()> {
         Kernel::of(&plan).key(),
         pool.install(|| engine.describe()),
     );
-    let (summary, absurd) = pool.install(|| integrate(&engine, &plan, &mut out, todo))?;
+    let (summary, absurd, past_drift) =
+        pool.install(|| integrate(&engine, &plan, &mut out, todo))?;
     // Records are read once, at the start: a file changed since then no longer matches the rows
     // (or the fingerprint), so the output is not put in place.
     let changed = config::changed_records(&config_text, &flags.config, &plan);
     let (path, what) = finish_unless_changed(*out, &changed)?;
     if absurd > 0 {
         note!("warning: {absurd} runs have a building whose peak displacement exceeds its height ({}): check the record's units and the intensity", plan.height_basis());
+    }
+    if past_drift > 0 {
+        note!(
+            "warning: {past_drift} runs have a storey past a drift ratio of {} (where collapse studies call a building collapsed): the model has no P-Delta and no collapse criterion, so these buildings stand where real ones may have fallen; read them as collapsed, or as outside the model's range",
+            pounding::plan::limits::WARN_DRIFT_RATIO
+        );
     }
     finished(&summary, &path, &format!(" ({what})"));
     Ok(())
@@ -326,6 +333,13 @@ impl Flags {
     /// How runs are written ([`Columns`]).
     fn output_columns(&self, plan: &Plan) -> Result<Columns> {
         let header = plan.header();
+        if let Some(twice) = self
+            .columns
+            .as_deref()
+            .and_then(pounding::plan::config::name_given_twice)
+        {
+            bail!("--columns: `{twice}` is given twice: give each column once");
+        }
         let picked = self
             .columns
             .as_ref()
@@ -371,18 +385,18 @@ impl Flags {
 }
 
 /// Run the runs `out` still needs through `engine`, into `out` (rows, or folded into its
-/// summary): the report's totals, and the runs whose peak displacement passed a building's
-/// height.
+/// summary): the report's totals, the runs whose peak displacement passed a building's
+/// height, and the runs with a storey past the collapse drift ratio.
 fn integrate(
     engine: &Engine,
     plan: &Plan,
     out: &mut SweepOutput,
     todo: std::ops::Range<u64>,
-) -> Result<(pounding::engine::Summary, u64)> {
+) -> Result<(pounding::engine::Summary, u64, u64)> {
     let partial = out.partial_path();
     let mut bar = progress_bar(todo.end - todo.start);
     let progress = |done| bar.set_position(done);
-    let mut absurd = 0u64;
+    let (mut absurd, mut past_drift) = (0u64, 0u64);
     let report = match out.aggregator() {
         Some(agg) => engine
             .summarise(plan, todo, agg, progress)
@@ -392,6 +406,7 @@ fn integrate(
             todo,
             |c: Chunk<'_>| {
                 absurd += c.above_height();
+                past_drift += c.past_collapse_drift();
                 out.take_chunk(c).map_err(anyhow::Error::from)
             },
             progress,
@@ -426,7 +441,7 @@ fn integrate(
         });
     }
     bar.finish_and_clear();
-    Ok((report.summary, absurd))
+    Ok((report.summary, absurd, past_drift))
 }
 
 /// The one line a finished sweep ends with.

@@ -243,6 +243,23 @@ impl Chunk<'_> {
             Chunk::Rows(plan, rows) => plan.above_height(rows),
         }
     }
+
+    /// Runs in which a storey's peak drift ratio passes
+    /// [`crate::plan::limits::WARN_DRIFT_RATIO`], where collapse studies call a building
+    /// collapsed (rows; a pair's buildings have no storey height).
+    pub fn past_collapse_drift(&self) -> u64 {
+        match self {
+            Chunk::Pairs(..) => 0,
+            Chunk::Rows(_, rows) => rows
+                .iter()
+                .filter(|(_, o)| {
+                    o.buildings
+                        .iter()
+                        .any(|b| b.peak_drift_ratio > crate::plan::limits::WARN_DRIFT_RATIO)
+                })
+                .count() as u64,
+        }
+    }
 }
 
 /// What a finished engine call reports: the sweep's totals, and on the GPU where time went.

@@ -207,9 +207,11 @@ impl Filter {
         texts.iter().map(|t| Filter::parse(t)).collect()
     }
 
+    /// Numbers are compared at [`level`]: `pga_g=0.2` keeps a record scaled to
+    /// `0.20000000000000004`.
     pub fn keeps(&self, cell: &str) -> bool {
-        let num = cell.trim().parse::<f64>().ok();
-        let want = self.value.parse::<f64>().ok();
+        let num = cell.trim().parse::<f64>().ok().map(level);
+        let want = self.value.parse::<f64>().ok().map(level);
         match (self.op, num, want) {
             (Op::Eq, Some(a), Some(b)) => a == b,
             (Op::Ne, Some(a), Some(b)) => a != b,
@@ -221,6 +223,17 @@ impl Filter {
             (Op::Gt, Some(a), Some(b)) => a > b,
             (Op::Ge, Some(a), Some(b)) => a >= b,
         }
+    }
+}
+
+/// A number as the studies compare it: rounded to 12 significant digits, so that one value
+/// computed per record (a scaled PGA, `0.19999999999999998` and `0.20000000000000004`) is one
+/// value in a filter, a level, a series and an x position.
+pub fn level(x: f64) -> f64 {
+    if x.is_finite() {
+        format!("{x:.11e}").parse().unwrap_or(x)
+    } else {
+        x
     }
 }
 

@@ -171,10 +171,30 @@ fn tidy(v: f64) -> f64 {
     format!("{v:.11e}").parse().unwrap_or(v)
 }
 
+/// The first number `values` holds twice (a list a user typed: each value once).
+pub fn number_given_twice(values: &[f64]) -> Option<f64> {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted.windows(2).find(|w| w[0] == w[1]).map(|w| w[0])
+}
+
+/// The first name `names` holds twice.
+pub fn name_given_twice<S: AsRef<str>>(names: &[S]) -> Option<&str> {
+    let mut seen = std::collections::HashSet::new();
+    names.iter().map(AsRef::as_ref).find(|n| !seen.insert(*n))
+}
+
 impl Axis {
     pub fn values(&self) -> Result<Vec<f64>, String> {
         match self {
-            Axis::List(v) => Ok(v.clone()),
+            Axis::List(v) => match number_given_twice(v) {
+                // A value listed twice runs its runs twice, weighting them double in a fit.
+                Some(x) => Err(format!(
+                    "{} is given twice: give each value once (a repeated value repeats its runs)",
+                    crate::plan::limits::show(x)
+                )),
+                None => Ok(v.clone()),
+            },
             Axis::Range(r) => Self::range_values(r).map(|v| v.into_iter().map(tidy).collect()),
         }
     }
@@ -269,7 +289,17 @@ impl Axis {
 /// `struct RawRun`) where the user wrote a number, a whole number or a table. The one place a
 /// config's TOML error is made, for pairs and rows alike.
 pub(crate) fn toml_error(path: &Path, e: toml::de::Error) -> ConfigError {
-    let mut m = e.to_string();
+    ConfigError::Toml {
+        path: path.into(),
+        message: in_toml_words(e.to_string()),
+    }
+}
+
+/// A TOML reader's message in the words of the file it read (a number, a list, a table), not
+/// Rust's (`f64`, `sequence`, `map`, `struct RawX`), with a refused float shown short: for
+/// configs and every other TOML file a command reads (damage states).
+pub fn in_toml_words(message: String) -> String {
+    let mut m = message;
     for (rust, words) in [
         ("expected f64", "expected a number"),
         ("expected usize", "expected a whole number >= 0"),
@@ -277,6 +307,8 @@ pub(crate) fn toml_error(path: &Path, e: toml::de::Error) -> ConfigError {
         ("expected u32", "expected a whole number >= 0"),
         ("expected i64", "expected a whole number"),
         ("expected a sequence", "expected a list"),
+        ("invalid type: sequence", "invalid type: a list"),
+        ("invalid type: map", "invalid type: a table"),
     ] {
         m = m.replace(rust, words);
     }
@@ -297,10 +329,7 @@ pub(crate) fn toml_error(path: &Path, e: toml::de::Error) -> ConfigError {
             .map_or(m.len(), |j| name + j);
         m.replace_range(i..end, "expected a table");
     }
-    ConfigError::Toml {
-        path: path.into(),
-        message: m,
-    }
+    m
 }
 
 /// A value of a key that takes several forms, read by a visitor that names them all when the
@@ -524,6 +553,9 @@ pub struct RawIntensity {
     pub sa_avg_n: Option<usize>,
     /// Damping ratio of the spectral targets' oscillator (default 5 %).
     pub sa_damping: Option<f64>,
+    /// A record scaled by more than this is named before the first run (default
+    /// [`crate::plan::limits::WARN_SCALE_FACTOR`]).
+    pub warn_scale_factor: Option<f64>,
 }
 
 /// A period as written: seconds, or `"building1"`, `"0.2*building1"`, `"building[0]"`.
@@ -1096,6 +1128,20 @@ fn contact_spec(
     let axis = |key: &str, a: &Axis| a.values().map_err(|m| invalid(key, m));
     let opt_axis = |key: &str, a: Option<&Axis>| a.map_or(Ok(Vec::new()), |a| axis(key, a));
     let intensities = c.intensity.axis(c.buildings, &invalid)?;
+    let warn_scale = c
+        .intensity
+        .warn_scale_factor
+        .unwrap_or(crate::plan::limits::WARN_SCALE_FACTOR);
+    if !(warn_scale.is_finite() && warn_scale >= 1.0) {
+        return Err(invalid(
+            "intensity.warn_scale_factor",
+            format!(
+                "{} is out of range: expected a scale factor >= 1 (default {})",
+                crate::plan::limits::show(warn_scale),
+                crate::plan::limits::WARN_SCALE_FACTOR
+            ),
+        ));
+    }
     let mut recs = Vec::new();
     for (i, r) in c.records.iter().enumerate() {
         let key = format!("record[{i}]");
@@ -1130,6 +1176,7 @@ fn contact_spec(
         intensities,
         scheme: c.scheme,
         tail: c.tail,
+        warn_scale,
     })
 }
 

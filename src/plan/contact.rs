@@ -34,6 +34,8 @@ pub struct ContactSpec {
     pub scheme: Scheme,
     /// Free vibration after each record, s.
     pub tail: f64,
+    /// A record scaled by more than this is named before the first run (no run depends on it).
+    pub warn_scale: f64,
 }
 
 /// Axes of a contact block, outermost first: formula, e, stiffness, record, intensity.
@@ -338,20 +340,32 @@ impl ContactPlan {
         run.pga_g = self.pgas[r] * s.scale / G;
     }
 
-    /// The records scaled past a PGA no earthquake reaches, for buildings of these fundamental
-    /// periods (a spectral target at a building's period scales by the first run's).
+    /// The records scaled past a PGA no earthquake reaches, or by more than the config's
+    /// bound on the scale factor, for buildings of these fundamental periods (a spectral target
+    /// at a building's period scales by the first run's).
     pub fn pga_warnings(&self, periods: &[f64]) -> Vec<String> {
         let mut w = Vec::new();
         for (r, rec) in self.spec.records.iter().enumerate() {
-            let pga = self
+            let scale = self
                 .spec
                 .intensities
                 .iter()
-                .map(|i| {
-                    let s = i.scaling(r, rec, self.pgas[r], periods, &self.ims);
-                    self.pgas[r] * s.scale / G
-                })
+                .map(|i| i.scaling(r, rec, self.pgas[r], periods, &self.ims).scale)
                 .fold(0.0, f64::max);
+            if scale > self.spec.warn_scale {
+                let at = if self.spec.intensities.iter().any(|i| i.follows_a_building()) {
+                    " (at the first run's building periods)"
+                } else {
+                    ""
+                };
+                w.push(format!(
+                    "record `{}` is scaled by up to {}{at}, above {} ([intensity] warn_scale_factor): scaled this far, a record keeps its own duration and spectral shape, not those of an earthquake of that intensity; choose records nearer the target",
+                    rec.name,
+                    crate::plan::limits::show((scale * 100.0).round() / 100.0),
+                    crate::plan::limits::show(self.spec.warn_scale)
+                ));
+            }
+            let pga = self.pgas[r] * scale / G;
             if pga > crate::plan::limits::WARN_PGA_G {
                 w.push(format!(
                     "record `{}` reaches a PGA of {pga:.3} g, above {} g where no recorded earthquake reaches: check its units and the intensity",

@@ -198,6 +198,13 @@ impl ImCache {
 }
 
 impl Intensity {
+    /// A spectral target at a period that follows a building's (so its scale factor varies
+    /// with the run's buildings).
+    pub fn follows_a_building(&self) -> bool {
+        matches!(self, Intensity::Spectral { im, .. }
+            if matches!(im.from, PeriodRef::Building { .. }) || matches!(im.to, PeriodRef::Building { .. }))
+    }
+
     /// The factor for record `r` (`rec`, whose PGA is `pga` m/s^2) in a run whose buildings
     /// have these fundamental periods.
     pub fn scaling(

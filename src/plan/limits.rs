@@ -75,6 +75,16 @@ pub const MAX_BENCH_RUNS: u64 = 1_000_000_000;
 /// Above this PGA (g) a sweep warns: no recorded earthquake comes close (a units mix-up?).
 pub const WARN_PGA_G: f64 = 5.0;
 
+/// A record scaled by more than this factor is named before the first run (`[intensity]
+/// warn_scale_factor` sets another): scaled this far, a record keeps its own duration and
+/// spectral shape, not those of an earthquake of the intensity it is scaled to.
+pub const WARN_SCALE_FACTOR: f64 = 5.0;
+
+/// A storey drift ratio past which a building has collapsed in the field's collapse studies
+/// (FEMA P-695 uses 0.10 with P-Delta). The model has neither P-Delta nor a collapse criterion
+/// yet, so a sweep counts the runs that pass it.
+pub const WARN_DRIFT_RATIO: f64 = 0.10;
+
 /// A building's height estimated from its period (m per s of period: T ~ 0.1 s per storey of
 /// about 3 m). A peak displacement above it is physically absurd, and a sweep warns.
 pub const HEIGHT_PER_PERIOD_M: f64 = 30.0;

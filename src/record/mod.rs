@@ -93,12 +93,32 @@ impl Record {
     /// [`Record::window`], or why not: the one reading of a window, for a config's `window_s`
     /// and the record commands' `--window` alike (each names its own spelling before it).
     pub fn windowed(&self, [start, end]: [f64; 2]) -> Result<Record, String> {
+        let last = self.t0 + (self.npts().max(1) - 1) as f64 * self.dt;
+        let span = || {
+            format!(
+                "the record runs from {} s to {} s, dt {} s",
+                crate::show(self.t0),
+                crate::show(last),
+                crate::show(self.dt)
+            )
+        };
+        // A window reaching past the record would be cut to it without a word: the window
+        // simulated would not be the one asked for. A step before the first sample is the
+        // ground at rest (an AT2 record's first sample is at dt, windowed from 0), and half a
+        // step either side is rounding.
+        let slack = 0.5 * self.dt;
+        if start < self.t0 - self.dt - slack || end > last + slack {
+            return Err(format!(
+                "[{}, {}] reaches outside the record: {}; give a window within it",
+                crate::show(start),
+                crate::show(end),
+                span()
+            ));
+        }
         self.window(start, end).ok_or_else(|| {
             format!(
-                "expected start < end holding at least two samples of the record ({} s to {} s, dt {} s)",
-                crate::show(self.t0),
-                crate::show(self.t0 + (self.npts().max(1) - 1) as f64 * self.dt),
-                crate::show(self.dt)
+                "expected start < end holding at least two samples of the record ({})",
+                span()
             )
         })
     }

@@ -103,12 +103,15 @@ pub fn synthetic(spec: &SyntheticSpec) -> Result<Record, RecordError> {
             crate::show(spec.zeta_g)
         )));
     }
-    let n = (spec.duration / spec.dt).round() as usize;
-    if !(2..=100_000_000).contains(&n) {
+    // The count as a float first: `as usize` saturates (1e300 would read 18446744073709551615).
+    let samples = (spec.duration / spec.dt).round();
+    if !(2.0..=1e8).contains(&samples) {
         return Err(bad(format!(
-            "synthetic record would have {n} samples; expected 2 to 1e8"
+            "synthetic record would have {} samples (duration_s / dt_s); expected 2 to 1e8",
+            crate::show(samples)
         )));
     }
+    let n = samples as usize;
     let wg = 2.0 * std::f64::consts::PI * spec.fg_hz;
     let (k, c) = (wg * wg, 2.0 * spec.zeta_g * wg);
     // Filter x'' + c x' + k x = -w, w held per sample; output ag = -(c x' + k x), the filter's

@@ -83,7 +83,17 @@ impl DamageStates {
         }
         let text =
             std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read: {e}", given))?;
-        let raw: RawStates = toml::from_str(&text).map_err(|e| format!("{given}: {e}"))?;
+        let raw: RawStates = toml::from_str(&text).map_err(|e| {
+            let m = crate::plan::config::in_toml_words(e.to_string());
+            // `unit` is the set's, written before the first [[state]] (after it, TOML puts it
+            // in that state).
+            let hint = if m.contains("unknown field `unit`") {
+                "\nunit is the set's: write it at the top of the file, before the first [[state]]"
+            } else {
+                ""
+            };
+            format!("{given}: {m}{hint}")
+        })?;
         if raw.states.is_empty() {
             return Err(format!("{given}: no [[state]]: give at least one"));
         }
@@ -148,7 +158,7 @@ impl DamageStates {
                 ""
             };
             format!(
-                "--damage-states {}: its limits are in {mine}, but --edp {edp} is in {theirs}: give an EDP in {mine}{example}, or limits in {theirs} (a damage-state file with unit = \"{theirs}\")",
+                "--damage-states {}: its limits are in {mine}, but --edp {edp} is in {theirs}: give an EDP in {mine}{example}, or limits in {theirs} (a damage-state file with unit = \"{theirs}\" at its top, before the first [[state]])",
                 self.name
             )
         })

@@ -411,8 +411,7 @@ pub fn demand_rows(
             skipped.non_finite += 1;
             continue;
         }
-        let level = format!("{im:.11e}").parse::<f64>().unwrap_or(im);
-        out.push((i, level, demand));
+        out.push((i, crate::io::table::level(im), demand));
     }
     Ok(out)
 }

@@ -581,6 +581,8 @@ impl<'a> GapStudy<'a> {
                     pair: a,
                     intensity: i,
                     points,
+                    runs: mine.len() as u64,
+                    closing: mine.iter().filter(|&&r| r > 0.0).count() as u64,
                     fit: GapFit::of(&mine),
                 }
             })
@@ -783,6 +785,9 @@ pub struct PoundingCurve {
     pub intensity: usize,
     /// `(gap, runs, runs that pound)`, at the gaps counted (for display).
     pub points: Vec<(f64, u64, u64)>,
+    /// Runs of the pair at this intensity, and of those, runs whose floors close.
+    pub runs: u64,
+    pub closing: u64,
     /// The lognormal fitted to the runs' required gaps.
     pub fit: Result<GapFit, NoGapFit>,
 }

@@ -3,7 +3,9 @@
 //! plotted nor grouped are aggregated over (max, mean, median or min of the output at each x),
 //! or every row is drawn as a point.
 
-use crate::io::table::{caption, label, name, order_key, value_label, Filter, Table, TableError};
+use crate::io::table::{
+    caption, label, level, name, order_key, value_label, Filter, Table, TableError,
+};
 use crate::studies::plot::{Panel, Series};
 use std::collections::BTreeMap;
 
@@ -133,7 +135,15 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, LeftOut), TableEr
     // Every series a kept row belongs to, drawn or not.
     let mut seen: Vec<String> = Vec::new();
     for i in rows {
-        let g = cby.map_or(String::new(), |c| table.rows[i][c].clone());
+        // A numeric series and x are taken at `level`: one value computed per record is one
+        // series and one x (a scaled PGA of `0.20000000000000004` joins `0.2`'s).
+        let g = cby.map_or(String::new(), |c| {
+            let cell = &table.rows[i][c];
+            match cell.trim().parse::<f64>() {
+                Ok(v) if v.is_finite() => level(v).to_string(),
+                _ => cell.clone(),
+            }
+        });
         if !seen.contains(&g) {
             seen.push(g.clone());
         }
@@ -151,7 +161,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, LeftOut), TableEr
             left.not_finite += 1;
             continue;
         }
-        groups.entry(g).or_default().push((x, y));
+        groups.entry(g).or_default().push((level(x), y));
     }
     left.empty = vec![(spec.x.clone(), empty_x), (spec.y.clone(), empty_y)];
     if let Some(b) = &spec.by {

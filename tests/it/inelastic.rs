@@ -618,3 +618,63 @@ fn columns_ask_for_each_storey() {
     ok(&sweep_cpu(&cfg, &plain, &[]));
     assert!(!table(&plain)[0].contains_key("b1_s1_peak_ductility"));
 }
+
+/// Issue 48, part 5 (implausible inputs named): a record scaled by more than
+/// `[intensity] warn_scale_factor` (default 5) is named before the first run, and runs with a
+/// storey past a 10 % drift ratio (where collapse studies call a building collapsed; the model
+/// has no P-Delta or collapse criterion yet) are counted in a warning at the end, as many as the
+/// CSV holds. A bound below 1 is refused; at moderate intensities neither warning is given.
+#[test]
+fn implausible_scaling_and_drifts_are_named() {
+    let dir = crate::support::tempdir();
+    let base = std::fs::read_to_string("configs/inelastic-row.toml")
+        .unwrap()
+        .replace("duration_s = 15.0", "duration_s = 6.0");
+    let sweep = |intensity: &str, name: &str| {
+        let cfg = dir.path().join(format!("{name}.toml"));
+        let out = dir.path().join(format!("{name}.csv"));
+        std::fs::write(&cfg, base.replace("pga_g = [0.2, 0.4, 0.6]", intensity)).unwrap();
+        let o =
+            crate::support::pound(&["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        (o, out)
+    };
+    let stderr = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).to_string();
+    let (o, out) = sweep("pga_g = [0.4, 2.0, 4.0]", "hard");
+    crate::support::ok(&o);
+    let said = stderr(&o);
+    assert!(
+        said.contains("record `synthetic-s3` is scaled by up to 10, above 5"),
+        "{said}"
+    );
+    let past = crate::support::table(&out)
+        .iter()
+        .filter(|r| {
+            ["b1_peak_drift_ratio", "b2_peak_drift_ratio"]
+                .iter()
+                .any(|c| r[*c].parse::<f64>().unwrap() > 0.1)
+        })
+        .count();
+    assert!(past > 0, "the test needs runs past 10 % drift");
+    assert!(
+        said.contains(&format!(
+            "warning: {past} runs have a storey past a drift ratio of 0.1"
+        )),
+        "{past}: {said}"
+    );
+    let (o, _) = sweep("pga_g = [0.4, 2.0, 4.0]\nwarn_scale_factor = 20", "bound");
+    assert!(!stderr(&o).contains("is scaled by up to"), "{}", stderr(&o));
+    let (o, _) = sweep("pga_g = [0.4]\nwarn_scale_factor = 0.5", "below");
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("intensity.warn_scale_factor"),
+        "{}",
+        stderr(&o)
+    );
+    let (o, _) = sweep("pga_g = [0.2, 0.4]", "moderate");
+    crate::support::ok(&o);
+    let said = stderr(&o);
+    assert!(
+        !said.contains("is scaled by") && !said.contains("past a drift ratio"),
+        "{said}"
+    );
+}

@@ -368,6 +368,79 @@ fn every_row_left_out_is_counted() {
     );
 }
 
+/// Class 6 where it arises in filters and series: a scaled PGA computed per record
+/// (`0.19999999999999998`, `0.20000000000000004`) is one value to `--where` and `--by`, as it
+/// is one level to `pound fragility`. `--where pga_g=0.2` silently dropped a record's rows, and
+/// `--by pga_g` drew twelve series for eight levels.
+#[test]
+fn one_value_computed_per_record_is_one_value() {
+    let dir = tempdir();
+    let runs = dir.path().join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/fragility-example.toml",
+        "-o",
+        runs.to_str().unwrap(),
+    ]));
+    let rows = table(&runs);
+    let pga: Vec<f64> = rows.iter().map(|r| r["pga_g"].parse().unwrap()).collect();
+    let at = |v: f64| pga.iter().filter(|p| (*p / v - 1.0).abs() < 1e-9).count();
+    assert!(
+        pga.iter()
+            .any(|&p| p != 0.2 && (p / 0.2 - 1.0).abs() < 1e-9),
+        "the test needs a PGA of 0.2 g computed inexactly"
+    );
+    let levels = {
+        let mut l: Vec<String> = pga.iter().map(|p| format!("{p:.9}")).collect();
+        l.sort();
+        l.dedup();
+        l.len()
+    };
+    let r = runs.to_str().unwrap();
+    let fit = |filter: &str| {
+        let out = pound(&[
+            "fragility",
+            r,
+            "--im",
+            "pga_g",
+            "--edp",
+            "peak_force_n",
+            "--threshold",
+            "1e6",
+            "--where",
+            filter,
+            "-o",
+            dir.path().join("f.csv").to_str().unwrap(),
+        ]);
+        ok(&out).lines().next().unwrap_or("").to_string()
+    };
+    assert!(fit("pga_g=0.2").starts_with(&format!("{} runs at 1 levels", at(0.2))));
+    let below = pga.iter().filter(|p| **p < 0.2 * (1.0 + 1e-9)).count();
+    assert!(
+        fit("pga_g<=0.2").starts_with(&format!("{below} runs at")),
+        "{}",
+        fit("pga_g<=0.2")
+    );
+    let plot = pound(&[
+        "plot",
+        r,
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--by",
+        "pga_g",
+        "-o",
+        dir.path().join("p.svg").to_str().unwrap(),
+    ]);
+    ok(&plot);
+    let said = String::from_utf8_lossy(&plot.stderr);
+    assert!(
+        said.contains(&format!("{levels} series,")),
+        "{levels} levels: {said}"
+    );
+}
+
 /// `n` with a comma every three digits, as the README writes counts (`37,318`).
 fn thousands(n: u64) -> String {
     let digits = n.to_string();

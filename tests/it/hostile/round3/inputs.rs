@@ -96,15 +96,22 @@ fn a_windowed_record_is_the_one_reported() {
     );
     // A window that holds no record is refused on both sides, naming the record's span, and a
     // far one is an error, not a panic (`window_s = [1e300, 2e300]` indexed past the record).
-    for w in ["50:60", "6:2", "1e300:2e300", "x:1", "1"] {
-        let o = pound(&["record", "info", f, "--window", w]);
+    // A window reaching past either end is refused too, not cut to the record in silence.
+    for w in ["50:60", "6:2", "1e300:2e300", "x:1", "1", "-1:3", "0:100"] {
+        let o = pound(&["record", "info", f, &format!("--window={w}")]);
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(1), "--window {w}: {err}");
         assert!(err.contains("--window"), "--window {w}: {err}");
     }
     let err = stderr(&pound(&["record", "info", f, "--window", "50:60"]));
     assert!(err.contains("0 s to 39.99 s"), "{err}");
-    for w in ["[50.0, 60.0]", "[1e300, 2e300]", "[-1e300, -1e299]"] {
+    for w in [
+        "[50.0, 60.0]",
+        "[1e300, 2e300]",
+        "[-1e300, -1e299]",
+        "[-1.0, 3.0]",
+        "[0.0, 100.0]",
+    ] {
         let text = with_record("", &format!("path = \"{f}\"\nwindow_s = {w}"), "");
         let err = error_of(&text).unwrap_or_else(|| panic!("{w} loads"));
         assert!(err.contains("window_s"), "{err}");
@@ -462,6 +469,97 @@ fn names_do_not_collide() {
             assert!(!out.exists(), "{args:?} wrote a summary");
         }
     }
+    // Every other list a command or a config takes: a value given twice is refused, naming it,
+    // before anything is written (a repeated threshold wrote its curve twice; a repeated axis
+    // value ran its runs twice, weighting them double in a fit).
+    let results = dir.path().join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        row.to_str().unwrap(),
+        "-o",
+        results.to_str().unwrap(),
+    ]));
+    let r = results.to_str().unwrap();
+    let o = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let record = std::fs::canonicalize(records_dir().join(ELCENTRO)).unwrap();
+    for (args, named) in [
+        (
+            vec![
+                "sweep",
+                pair,
+                "--columns",
+                "run,peak_force_n,run",
+                "-o",
+                &o("c.csv"),
+            ],
+            "`run`",
+        ),
+        (
+            vec![
+                "fragility",
+                r,
+                "--im",
+                "pga_g",
+                "--edp",
+                "peak_force_n",
+                "--threshold",
+                "1e6,1e6",
+                "-o",
+                &o("f.csv"),
+            ],
+            "1000000",
+        ),
+        (
+            vec![
+                "ida",
+                r,
+                "--im",
+                "pga_g",
+                "--edp",
+                "b1_peak_drift_ratio",
+                "--by",
+                "record,record",
+                "-o",
+                &o("i.csv"),
+            ],
+            "`record`",
+        ),
+        (
+            vec!["gap", pair, "--gaps", "0.01,0.01", "-o", &o("g.csv")],
+            "0.01",
+        ),
+        (
+            vec!["restitution", "--e", "0.5,0.5", "-o", &o("r.csv")],
+            "0.5",
+        ),
+        (
+            vec![
+                "record",
+                "spectrum",
+                record.to_str().unwrap(),
+                "--periods",
+                "0.5,0.5",
+                "-o",
+                &o("s.csv"),
+            ],
+            "0.5 s",
+        ),
+    ] {
+        let out = pound(&args);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{args:?}: rc 0");
+        assert!(
+            err.contains("twice") && err.contains(named),
+            "{args:?}: {err}"
+        );
+        let written = args.last().unwrap();
+        assert!(!Path::new(written).exists(), "{args:?} wrote {written}");
+    }
+    let err = error_of(&row_config("", "", "gap_m = [0.01, 0.01]", "")).expect("a repeated gap");
+    assert!(
+        err.contains("contact.gap_m") && err.contains("twice"),
+        "{err}"
+    );
 }
 
 /// A run of 25 digits or more: a number written out in full where a bounded form belongs.
