@@ -80,6 +80,10 @@ pub const WARN_PGA_G: f64 = 5.0;
 /// spectral shape, not those of an earthquake of the intensity it is scaled to.
 pub const WARN_SCALE_FACTOR: f64 = 5.0;
 
+/// A building's (or a floor's) mass, kg: the heaviest floors weigh about 1e7 kg, and a mass of
+/// 1e170 kg stalled a sweep with no word.
+pub const MAX_MASS_KG: f64 = 1e12;
+
 /// A storey drift ratio past which a building has collapsed in the field's collapse studies
 /// (FEMA P-695 uses 0.10 with P-Delta). The model has neither P-Delta nor a collapse criterion
 /// yet, so a sweep counts the runs that pass it.

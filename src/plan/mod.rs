@@ -494,7 +494,10 @@ pub(crate) type Check = (fn(f64) -> bool, &'static str);
 pub(crate) const PERIOD: Check = (period_ok, PERIOD_EXPECTED);
 pub(crate) const DAMPING: Check = (|v| (0.0..1.0).contains(&v), "0 <= damping ratio < 1");
 pub(crate) const GAP: Check = (|v| v.is_finite() && v >= 0.0, "a gap >= 0 m");
-pub(crate) const MASS: Check = (|v| v.is_finite() && v > 0.0, "a mass > 0 kg");
+pub(crate) const MASS: Check = (
+    |v| v.is_finite() && v > 0.0 && v <= crate::plan::limits::MAX_MASS_KG,
+    "a mass > 0 kg and at most 1e12 kg (the heaviest floors weigh about 1e7 kg)",
+);
 pub(crate) const POSITIVE: Check = (|v| v.is_finite() && v > 0.0, "a value > 0");
 
 /// `values` of the axis `key`: not empty, each passing `ok` (else an error naming the value and

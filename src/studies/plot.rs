@@ -718,10 +718,12 @@ fn draw<DB: DrawingBackend>(
         }
     };
     // One line goes through plotters' caption; wrapped lines are set one under the other in
-    // the panel's margin, and the chart is built below them.
+    // the panel's margin, and the chart is built below them. So is one line where the legend
+    // stands beside the plot: plotters centres a caption over what the margins leave, and a
+    // title fitted to the panel's width would run off its left edge.
     let below_title;
     let mut builder = match &title[..] {
-        [line] => {
+        [line] if outside.is_none() => {
             let mut b = ChartBuilder::on(area);
             b.caption(line, title_style.clone()).margin(px(10));
             b

@@ -441,6 +441,62 @@ fn one_value_computed_per_record_is_one_value() {
     );
 }
 
+/// Class 5 where it arises in a config: a mass no building has (1e170 kg stalled a sweep with
+/// no word, for seconds on end) is refused with its bound, for a pair's and a row's buildings.
+#[test]
+fn a_mass_beyond_any_building_is_refused() {
+    for (config, line) in [
+        ("configs/quickstart.toml", "mass_kg = 1.0e5"),
+        ("configs/inelastic-row.toml", "mass_kg = 3.0e5"),
+    ] {
+        let text = std::fs::read_to_string(config)
+            .unwrap()
+            .replacen(line, "mass_kg = 1e170", 1);
+        let err = load_text(&text, Path::new(config))
+            .expect_err(config)
+            .to_string();
+        assert!(err.contains("mass_kg") && err.contains("1e12 kg"), "{err}");
+    }
+}
+
+/// Class 14 where a legend stands beside the plot: the title is centred over the whole panel,
+/// so one that fits the panel stays in it (plotters centred it over the plot left of the
+/// legend, and a long default title ran off the panel's left edge).
+#[test]
+fn a_title_stands_over_its_panel() {
+    let dir = tempdir();
+    let runs = dir.path().join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/fragility-example.toml",
+        "-o",
+        runs.to_str().unwrap(),
+    ]));
+    let svg = dir.path().join("p.svg");
+    ok(&pound(&[
+        "plot",
+        runs.to_str().unwrap(),
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--by",
+        "record",
+        "--where",
+        "pga_g>=0.5",
+        "-o",
+        svg.to_str().unwrap(),
+    ]));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    // The first text element is the title; the panel is 640 px wide.
+    let title = text.split("<text ").nth(1).expect("a title");
+    assert!(title.contains("peak force against gap"), "{title}");
+    assert!(
+        title.starts_with("x=\"320\""),
+        "the title is not centred on the panel: {title}"
+    );
+}
+
 /// `n` with a comma every three digits, as the README writes counts (`37,318`).
 fn thousands(n: u64) -> String {
     let digits = n.to_string();
