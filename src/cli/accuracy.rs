@@ -1,6 +1,6 @@
 //! `pound accuracy`: speed against error of every path against the reference.
 
-use super::{check_outputs, config_inputs, write_file, BackendArg, Holds};
+use super::{check_outputs, config_inputs, BackendArg, Holds};
 use anyhow::{bail, Result};
 use pounding::plan::config;
 use pounding::plan::limits::{MAX_SUBSTEPS_PER_CONTACT, WHY_SUBSTEPS};
@@ -115,10 +115,8 @@ pub fn run(a: Args) -> Result<()> {
     for line in rising {
         say!("{line}");
     }
-    write_file(&output, points.csv().as_bytes())?;
-    if let Some(p) = plot {
-        super::save_plot(&p, &points.panels(), 2, &figure)?;
-    }
+    let figure_out = plot.as_deref().map(|p| (p, points.panels(), 2));
+    super::write_and_plot(&output, points.csv().as_bytes(), figure_out, &figure)?;
     let runs = plan.len();
     let measured: Vec<Measured> = points
         .verdicts()

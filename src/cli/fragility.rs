@@ -1,7 +1,7 @@
 //! `pound fragility`: exceedance counts and fitted lognormal curves from a results CSV, per
 //! threshold or per named damage state, with bootstrap bands over records.
 
-use super::{check_study_outputs, write_file, Holds};
+use super::{check_study_outputs, Holds};
 use anyhow::{anyhow, bail, Result};
 use pounding::io::table::{Filter, Table};
 use pounding::studies::damage_states::DamageStates;
@@ -288,8 +288,7 @@ pub fn run(a: Args) -> Result<()> {
         undecided_table(&grouped, &spec, &states.as_ref().map(|_| names.clone()))?;
     }
     let state_names = states.as_ref().map(|_| names.as_slice());
-    write_file(&output, csv(&spec, state_names, &grouped).as_bytes())?;
-    if let Some(p) = &a.plot {
+    let plot = a.plot.as_deref().map(|p| {
         let mut pl = panel(&spec, &lv, &fits);
         if states.is_some() {
             for s in &mut pl.series {
@@ -307,9 +306,14 @@ pub fn run(a: Args) -> Result<()> {
         if bands.iter().any(|b| b.is_some()) {
             pl.title.push_str(" (grey: 90 % bands)");
         }
-        super::save_plot(p, &[pl], 1, &a.figure)?;
-    }
-    Ok(())
+        (p, vec![pl], 1)
+    });
+    super::write_and_plot(
+        &output,
+        csv(&spec, state_names, &grouped).as_bytes(),
+        plot,
+        &a.figure,
+    )
 }
 
 /// A bootstrap band as two grey lines (unnamed: no legend entry).

@@ -146,12 +146,17 @@ pub fn run(a: Args) -> Result<()> {
             ),
         }
     }
+    // The figure is checked before any output is written: one refused leaves none behind.
+    let panels = a.plot.as_deref().map(|p| (p, study.panels(&curves)));
+    if let Some((p, panels)) = &panels {
+        a.figure.check(p, panels, 3)?;
+    }
     write_file(&output, &study.csv())?;
     if let Some(p) = &a.curve {
         write_file(p, curve_csv(&study, &curves).as_bytes())?;
     }
-    if let Some(p) = &a.plot {
-        super::save_plot(p, &study.panels(&curves), 3, &a.figure)?;
+    if let Some((p, panels)) = panels {
+        super::save_plot(p, &panels, 3, &a.figure)?;
     }
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! `pound hysteresis`: force against penetration through one isolated impact, per e.
 
-use super::{check_outputs, e_values, write_file, Holds};
+use super::{check_outputs, e_values, Holds};
 use anyhow::{bail, Context, Result};
 use pounding::physics::contact::LawKind;
 use pounding::physics::restitution::Formula;
@@ -73,9 +73,6 @@ pub fn run(a: Args) -> Result<()> {
     let es = e_values(&a.e)?;
     let loops = fidelity::loops(law, formula, &es, a.v0, a.stiffness, a.m_eff)?;
     super::say_text(&loops.markdown())?;
-    write_file(&output, loops.csv().as_bytes())?;
-    if let Some(p) = &a.plot {
-        super::save_plot(p, &[loops.panel()], 1, &a.figure)?;
-    }
-    Ok(())
+    let plot = a.plot.as_deref().map(|p| (p, vec![loops.panel()], 1));
+    super::write_and_plot(&output, loops.csv().as_bytes(), plot, &a.figure)
 }

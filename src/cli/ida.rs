@@ -1,6 +1,6 @@
 //! `pound ida`: IDA curves and their fractiles from a results CSV.
 
-use super::{check_study_outputs, write_file, Holds};
+use super::{check_study_outputs, Holds};
 use anyhow::{bail, Result};
 use pounding::io::table::{Filter, Table};
 use pounding::studies::fragility::default_im;
@@ -149,9 +149,6 @@ pub fn run(a: Args) -> Result<()> {
             "notice: {failed} failed runs (status not ok: a collapse or a numerical failure) are left out of the fractiles, which are therefore collapse-free: below the fractiles of every run where the failed runs are the most severe"
         );
     }
-    write_file(&output, ida.csv(&spec).as_bytes())?;
-    if let Some(p) = &a.plot {
-        super::save_plot(p, &[ida.panel(&spec)], 1, &a.figure)?;
-    }
-    Ok(())
+    let plot = a.plot.as_deref().map(|p| (p, vec![ida.panel(&spec)], 1));
+    super::write_and_plot(&output, ida.csv(&spec).as_bytes(), plot, &a.figure)
 }

@@ -269,6 +269,24 @@ pub fn default_output(given: Option<std::path::PathBuf>, name: &str) -> std::pat
     free
 }
 
+/// Write `bytes` to `output` and, where a figure is asked for, its `panels` (`cols` a row):
+/// the figure is checked first ([`FigureArgs::check`]), so one refused leaves no output behind.
+pub fn write_and_plot(
+    output: &Path,
+    bytes: &[u8],
+    plot: Option<(&Path, Vec<pounding::studies::plot::Panel>, usize)>,
+    figure: &FigureArgs,
+) -> Result<()> {
+    if let Some((path, panels, cols)) = &plot {
+        figure.check(path, panels, *cols)?;
+    }
+    write_file(output, bytes)?;
+    if let Some((path, panels, cols)) = plot {
+        save_plot(path, &panels, cols, figure)?;
+    }
+    Ok(())
+}
+
 /// Save a plot, saying where.
 pub fn save_plot(
     path: &Path,
@@ -336,6 +354,32 @@ impl FigureArgs {
 }
 
 impl FigureArgs {
+    /// Whether `panels` can be drawn into `path` as asked (labels that agree with the data,
+    /// a PNG within its pixel bound), before a command writes any of its outputs: a figure
+    /// refused leaves nothing behind.
+    pub fn check(
+        &self,
+        path: &Path,
+        panels: &[pounding::studies::plot::Panel],
+        cols: usize,
+    ) -> Result<()> {
+        use pounding::studies::plot;
+        self.apply(&mut panels.to_vec())?;
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+        {
+            plot::check_pixels(
+                panels.len(),
+                cols,
+                self.size.unwrap_or(plot::PANEL),
+                self.dpi.unwrap_or(plot::BASE_DPI),
+            )
+            .map_err(|m| anyhow::anyhow!("{}: cannot draw the plot: {m}", path.display()))?;
+        }
+        Ok(())
+    }
+
     /// Give `panels` the title and axis labels asked for, each axis's values in its label's
     /// unit ([`pounding::studies::plot::relabel`]); Err: a label that contradicts the data. A
     /// second call changes nothing more (the panels are in the labels' units by then).

@@ -232,8 +232,7 @@ fn spectrum(
         periods.len(),
         pounding::show(100.0 * damping)
     );
-    super::write_file(output, csv.as_bytes())?;
-    if let Some(p) = plot {
+    let plot = plot.map(|p| {
         let panel = pounding::studies::plot::Panel {
             title: format!(
                 "{}: {} % damped spectrum",
@@ -252,9 +251,9 @@ fn spectrum(
             }],
             y_span: None,
         };
-        super::save_plot(p, &[panel], 1, figure)?;
-    }
-    Ok(())
+        (p, vec![panel], 1)
+    });
+    super::write_and_plot(output, csv.as_bytes(), plot, figure)
 }
 
 fn info(record: &FileArgs) -> Result<()> {

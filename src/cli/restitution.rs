@@ -1,6 +1,6 @@
 //! `pound restitution`: one isolated collision per damped law, formula and e.
 
-use super::{check_outputs, e_values, write_file, Holds};
+use super::{check_outputs, e_values, Holds};
 use anyhow::Result;
 use pounding::studies::fidelity;
 use std::path::PathBuf;
@@ -31,12 +31,10 @@ pub fn run(a: Args) -> Result<()> {
         ],
     )?;
     let rows = fidelity::table(&e_values(&a.e)?)?;
-    write_file(&output, fidelity::csv(&rows).as_bytes())?;
     say!("max |achieved e - asked e| per law and formula (`own`: the law's own chi(e)):\n");
     super::say_text(&fidelity::summary(&rows))?;
-    if let Some(p) = &a.plot {
-        super::save_plot(p, &fidelity::panels(&rows), 4, &a.figure)?;
-    }
+    let plot = a.plot.as_deref().map(|p| (p, fidelity::panels(&rows), 4));
+    super::write_and_plot(&output, fidelity::csv(&rows).as_bytes(), plot, &a.figure)?;
     note!("{} collisions -> {}", rows.len(), output.display());
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! `pound trace`: one run of a sweep, whole: its time history and its row.
 
-use super::{write_file, Holds};
+use super::Holds;
 use anyhow::Result;
 use pounding::plan::config;
 use pounding::studies::trace;
@@ -43,7 +43,8 @@ pub fn run(a: Args) -> Result<()> {
     // The run's row, as the sweep writes it: the trace's peaks are the sweep's.
     say!("{}", t.header.join(","));
     say!("{}", t.row.join(","));
-    write_file(&output, t.csv().as_bytes())?;
+    let plot = a.plot.as_deref().map(|p| (p, t.panels(), 3));
+    super::write_and_plot(&output, t.csv().as_bytes(), plot, &a.figure)?;
     note!(
         "run {} of {}: {} samples (record steps and located events) -> {}",
         a.run,
@@ -51,8 +52,5 @@ pub fn run(a: Args) -> Result<()> {
         t.len(),
         output.display()
     );
-    if let Some(p) = &a.plot {
-        super::save_plot(p, &t.panels(), 3, &a.figure)?;
-    }
     Ok(())
 }

@@ -497,6 +497,71 @@ fn a_title_stands_over_its_panel() {
     );
 }
 
+/// Classes 4 and 5 before any output: a figure that would be refused (a label that
+/// contradicts the data, a PNG past its pixel bound) is refused before the command writes
+/// anything, so no CSV is left behind (trace, gap, fragility, ida, hysteresis and record
+/// spectrum wrote theirs first).
+#[test]
+fn a_refused_figure_leaves_nothing_behind() {
+    let dir = tempdir();
+    let runs = dir.path().join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/inelastic-row.toml",
+        "-o",
+        runs.to_str().unwrap(),
+    ]));
+    let r = runs.to_str().unwrap();
+    let record = crate::support::records_dir().join("elcentro1940_ns_I-ELC180_peer2000.AT2");
+    let huge = ["--size", "4000x4000", "--dpi", "600"];
+    let cases: Vec<(Vec<&str>, &[&str])> = vec![
+        (
+            vec!["trace", "configs/inelastic-row.toml", "--run", "1"],
+            &["--y-label", "whatever"],
+        ),
+        (
+            vec!["trace", "configs/inelastic-row.toml", "--run", "1"],
+            &huge,
+        ),
+        (vec!["gap", "configs/gap-example.toml"], &huge),
+        (
+            vec![
+                "fragility",
+                r,
+                "--im",
+                "pga_g",
+                "--edp",
+                "b1_peak_drift_ratio",
+                "--threshold",
+                "0.005",
+            ],
+            &huge,
+        ),
+        (
+            vec!["ida", r, "--im", "pga_g", "--edp", "b1_peak_drift_ratio"],
+            &huge,
+        ),
+        (vec!["hysteresis", "hertz"], &huge),
+        (vec!["record", "spectrum", record.to_str().unwrap()], &huge),
+    ];
+    for (i, (command, figure)) in cases.into_iter().enumerate() {
+        let out = dir.path().join(format!("out-{i}.csv"));
+        let plot = dir.path().join(format!("plot-{i}.png"));
+        let mut args = command.clone();
+        args.extend([
+            "-o",
+            out.to_str().unwrap(),
+            "--plot",
+            plot.to_str().unwrap(),
+        ]);
+        args.extend(figure);
+        let o = pound(&args);
+        assert!(!o.status.success(), "{args:?}: rc 0");
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+        assert!(!plot.exists(), "{args:?} drew {}", plot.display());
+    }
+}
+
 /// `n` with a comma every three digits, as the README writes counts (`37,318`).
 fn thousands(n: u64) -> String {
     let digits = n.to_string();
