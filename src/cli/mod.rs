@@ -532,10 +532,14 @@ pub fn e_values(e: &str) -> Result<Vec<f64>> {
         " (each is a root-found collision)",
     )?;
     let es: Vec<f64> = es.iter().map(|e| (e * 1e12).round() / 1e12).collect();
-    if let Some(bad) = es.iter().find(|e| !(**e > 0.0 && **e <= 1.0)) {
+    if let Some(bad) = es
+        .iter()
+        .find(|e| !pounding::physics::restitution::e_in_range(**e))
+    {
         bail!(
-            "--e: e = {} is out of range: expected 0 < e <= 1",
-            pounding::plan::limits::show(*bad)
+            "--e: e = {} is out of range: expected {}",
+            pounding::plan::limits::show(*bad),
+            pounding::physics::restitution::E_EXPECTED
         );
     }
     Ok(es)

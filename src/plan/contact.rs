@@ -169,8 +169,11 @@ impl ContactPlan {
             check_axis(
                 "contact.e",
                 &spec.e,
-                |e| e > 0.0 && e <= 1.0,
-                "a coefficient of restitution 0 < e <= 1",
+                crate::physics::restitution::e_in_range,
+                &format!(
+                    "a coefficient of restitution {}",
+                    crate::physics::restitution::E_EXPECTED
+                ),
             )?;
         }
         if uses_formula && spec.formulas.is_empty() {

@@ -84,6 +84,9 @@ pub const WARN_SCALE_FACTOR: f64 = 5.0;
 /// 1e170 kg stalled a sweep with no word.
 pub const MAX_MASS_KG: f64 = 1e12;
 
+/// The smallest coefficient of restitution (the physics' bound, listed here with the others).
+pub use crate::physics::restitution::MIN_E;
+
 /// A storey drift ratio past which a building has collapsed in the field's collapse studies
 /// (FEMA P-695 uses 0.10 with P-Delta). The model has neither P-Delta nor a collapse criterion
 /// yet, so a sweep counts the runs that pass it.

@@ -114,7 +114,7 @@ fn bad_configs_name_the_key() {
         (
             "e = [0.5, 0.7, 0.9]",
             "e = [0.5, 1.7, 0.9]",
-            "contact.e[1]: 1.7 is out of range: expected a coefficient of restitution 0 < e <= 1",
+            "contact.e[1]: 1.7 is out of range: expected a coefficient of restitution 0.01 <= e <= 1",
         ),
         (
             "e = [0.5, 0.7, 0.9]",

@@ -442,7 +442,8 @@ fn one_value_computed_per_record_is_one_value() {
 }
 
 /// Class 5 where it arises in a config: a mass no building has (1e170 kg stalled a sweep with
-/// no word, for seconds on end) is refused with its bound, for a pair's and a row's buildings.
+/// no word, for seconds on end) is refused with its bound, for a pair's and a row's buildings,
+/// and so is a coefficient of restitution below 0.01.
 #[test]
 fn a_mass_beyond_any_building_is_refused() {
     for (config, line) in [
@@ -456,6 +457,31 @@ fn a_mass_beyond_any_building_is_refused() {
             .expect_err(config)
             .to_string();
         assert!(err.contains("mass_kg") && err.contains("1e12 kg"), "{err}");
+    }
+    // So is an impact all but plastic: the exact damping's search costs as 1/e (a sweep at
+    // e = 1e-4 printed nothing for minutes; `pound restitution --e 1e-3` ran as long).
+    let text = std::fs::read_to_string("configs/quickstart.toml").unwrap();
+    let e_line = text
+        .lines()
+        .find(|l| l.starts_with("e = "))
+        .expect("an e axis");
+    let err = load_text(&text.replace(e_line, "e = 1e-4"), Path::new("q.toml"))
+        .expect_err("e = 1e-4")
+        .to_string();
+    assert!(
+        err.contains("contact.e") && err.contains("0.01 <= e"),
+        "{err}"
+    );
+    for args in [
+        ["restitution", "--e", "0.001"],
+        ["formulas", "--e", "0.001"],
+    ] {
+        let o = pound(&args);
+        let said = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && said.contains("0.01 <= e"),
+            "{args:?}: {said}"
+        );
     }
 }
 
