@@ -123,6 +123,10 @@ fn parse_periods(text: &str) -> Result<Vec<f64>> {
             if !(a > 0.0 && b > a) {
                 bail!("--periods `{text}`: expected 0 < FROM < TO");
             }
+            if n == 1 {
+                // One period would be FROM alone, TO ignored without a word.
+                bail!("--periods `{text}`: N = 1 gives FROM alone and ignores TO: give the one period alone (--periods {a}), or N >= 2");
+            }
             intensity::log_periods(a, b, n)
         }
         [_] => text

@@ -989,7 +989,20 @@ pub fn parse_row(
         }
         let (floor_masses, mass) = match (&mass_kg, &r.floor_masses_kg) {
             (Some(a), None) => (None, axis(&key("mass_kg"), a, MASS)?),
-            (None, Some(v)) => (Some(per_storey(&key("floor_masses_kg"), v, n)?), vec![0.0]),
+            (None, Some(v)) => {
+                let masses = per_storey(&key("floor_masses_kg"), v, n)?;
+                if let Some(i) = masses.iter().position(|m| !(MASS.0)(*m)) {
+                    return Err(invalid(
+                        &format!("{}[{i}]", key("floor_masses_kg")),
+                        format!(
+                            "{} is out of range: expected {}",
+                            crate::plan::limits::show(masses[i]),
+                            MASS.1
+                        ),
+                    ));
+                }
+                (Some(masses), vec![0.0])
+            }
             _ => {
                 return Err(invalid(
                     &key("mass_kg"),

@@ -458,6 +458,14 @@ fn a_mass_beyond_any_building_is_refused() {
             .to_string();
         assert!(err.contains("mass_kg") && err.contains("1e12 kg"), "{err}");
     }
+    let floors = row_config("-mass_kg\nfloor_masses_kg = [3e5, 1e170]", "", "", "");
+    let err = load_text(&floors, Path::new("floors.toml"))
+        .expect_err("a floor of 1e170 kg")
+        .to_string();
+    assert!(
+        err.contains("floor_masses_kg[1]") && err.contains("1e12 kg"),
+        "{err}"
+    );
     // So is an impact all but plastic: the exact damping's search costs as 1/e (a sweep at
     // e = 1e-4 printed nothing for minutes; `pound restitution --e 1e-3` ran as long).
     let text = std::fs::read_to_string("configs/quickstart.toml").unwrap();

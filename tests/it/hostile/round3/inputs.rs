@@ -555,6 +555,21 @@ fn names_do_not_collide() {
         let written = args.last().unwrap();
         assert!(!Path::new(written).exists(), "{args:?} wrote {written}");
     }
+    // A list's form that drops a value it was given is refused too (FROM:TO:1 ignored TO).
+    let o = pound(&[
+        "record",
+        "spectrum",
+        record.to_str().unwrap(),
+        "--periods",
+        "0.05:4:1",
+        "-o",
+        &o("s1.csv"),
+    ]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("ignores TO"),
+        "{}",
+        stderr(&o)
+    );
     let err = error_of(&row_config("", "", "gap_m = [0.01, 0.01]", "")).expect("a repeated gap");
     assert!(
         err.contains("contact.gap_m") && err.contains("twice"),
