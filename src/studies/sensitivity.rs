@@ -133,7 +133,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, LeftOut), TableEr
     let mut left = LeftOut::default();
     let (mut empty_x, mut empty_y) = (0, 0);
     // Every series a kept row belongs to, drawn or not.
-    let mut seen: Vec<String> = Vec::new();
+    let mut seen: std::collections::BTreeSet<String> = std::collections::BTreeSet::new();
     for i in rows {
         // A numeric series and x are taken at `level`: one value computed per record is one
         // series and one x (a scaled PGA of `0.20000000000000004` joins `0.2`'s).
@@ -145,7 +145,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, LeftOut), TableEr
             }
         });
         if !seen.contains(&g) {
-            seen.push(g.clone());
+            seen.insert(g.clone());
         }
         if cstatus.is_some_and(|c| table.rows[i][c] != "ok") {
             left.failed += 1;
@@ -165,7 +165,7 @@ pub fn panel(table: &Table, spec: &PlotSpec) -> Result<(Panel, LeftOut), TableEr
     }
     left.empty = vec![(spec.x.clone(), empty_x), (spec.y.clone(), empty_y)];
     if let Some(b) = &spec.by {
-        left.vanished = sorted_groups(seen)
+        left.vanished = sorted_groups(seen.into_iter().collect())
             .into_iter()
             .filter(|g| !groups.contains_key(g))
             .map(|g| value_label(b, &g))
