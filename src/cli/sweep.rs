@@ -200,8 +200,15 @@ pub fn run(a: Args) -> Result<()> {
     }
     if past_drift > 0 {
         note!(
-            "warning: {past_drift} runs have a storey past a drift ratio of {} (where collapse studies call a building collapsed): the model has no P-Delta and no collapse criterion, so these buildings stand where real ones may have fallen; read them as collapsed, or as outside the model's range",
-            pounding::plan::limits::WARN_DRIFT_RATIO
+            "warning: {past_drift} runs have a storey past a drift ratio of {} without collapsing (where collapse studies call a building collapsed): {}, so these buildings stand where real ones may have fallen; read them as collapsed, or as outside the model's range",
+            pounding::plan::limits::WARN_DRIFT_RATIO,
+            match &plan {
+                pounding::plan::Plan::Row(r) if r.collapse_drift_ratio.is_finite() => format!(
+                    "the collapse limit is a drift ratio of {} ([run] collapse_drift_ratio)",
+                    pounding::show(r.collapse_drift_ratio)
+                ),
+                _ => "the collapse criterion is off ([run] collapse_drift_ratio = \"none\")".into(),
+            }
         );
     }
     finished(&summary, &path, &format!(" ({what})"));
@@ -446,8 +453,13 @@ fn integrate(
 
 /// The one line a finished sweep ends with.
 fn finished(summary: &pounding::engine::Summary, path: &std::path::Path, what: &str) {
+    let collapsed = if summary.collapsed > 0 {
+        format!(", {} collapsed", summary.collapsed)
+    } else {
+        String::new()
+    };
     note!(
-        "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts, {} failures -> {}{what}",
+        "{} runs in {:.2} s ({:.0} runs/s): {} runs pounded, {} impacts{collapsed}, {} failures -> {}{what}",
         summary.runs,
         summary.seconds,
         summary.runs_per_second(),

@@ -141,6 +141,9 @@ impl Sketch {
 pub struct Group {
     pub runs: u64,
     pub failures: u64,
+    /// Runs that collapsed: counted apart, as exceeding every `--exceed` threshold (an
+    /// infinite demand), not in the statistics (their peaks end at the collapse).
+    pub collapsed: u64,
     pub exceed: Vec<u64>,
     pub stats: Vec<Sketch>,
     /// Per `--exceed`, `ok` runs whose cell was empty (neither exceeding nor not; see
@@ -172,15 +175,22 @@ impl Group {
     /// counted, not summarised. The per-run body of `shaders/aggregate.wgsl`, line for line.
     pub fn add(&mut self, o: &RunOutput, exceed: &[(usize, f64)]) {
         // A pair's outputs are never empty.
-        self.add_values(o.status == Status::Ok, &outputs(o).map(Some), exceed);
+        self.add_values(o.status, &outputs(o).map(Some), exceed);
     }
 
     /// Fold in one run's summarised outputs `x` (magnitudes, in the aggregator's output order),
     /// None where its cell was empty: such a run is counted apart (`undecided`, `no_value`),
     /// neither exceeding nor in the statistics.
-    fn add_values(&mut self, ok: bool, x: &[Option<f64>], exceed: &[(usize, f64)]) {
+    fn add_values(&mut self, status: Status, x: &[Option<f64>], exceed: &[(usize, f64)]) {
         self.runs += 1;
-        if !ok {
+        if status == Status::Collapsed {
+            self.collapsed += 1;
+            for e in self.exceed.iter_mut() {
+                *e += 1;
+            }
+            return;
+        }
+        if status != Status::Ok {
             self.failures += 1;
             return;
         }
@@ -356,6 +366,8 @@ pub struct Aggregator {
     label_ids: HashMap<Vec<String>, u32>,
     /// In the order of each group's first run (the summary's row order), with its labels.
     groups: Vec<(Vec<String>, Group)>,
+    /// Its runs may collapse (rows of buildings with storey heights): the summary counts them.
+    collapses: bool,
 }
 
 impl Aggregator {
@@ -374,8 +386,17 @@ impl Aggregator {
                 &r.summarised(),
                 by,
                 exceed,
-            ),
+            )
+            .map(|a| Aggregator {
+                collapses: true,
+                ..a
+            }),
         }
+    }
+
+    /// Whether its runs may collapse: the summary then has a `collapsed` count.
+    pub fn collapses(&self) -> bool {
+        self.collapses
     }
 
     /// Group the pair's runs by the columns `by`; count runs whose `column > threshold` for
@@ -511,6 +532,7 @@ impl Aggregator {
             ids: HashMap::new(),
             label_ids: HashMap::new(),
             groups: Vec::new(),
+            collapses: false,
         })
     }
 
@@ -553,9 +575,13 @@ impl Aggregator {
                 (!c.is_empty()).then(|| c.parse::<f64>().map_or(f64::NAN, f64::abs))
             })
             .collect();
-        let ok = cells[status_at] == Status::Ok.key();
+        let status = match cells[status_at].as_str() {
+            "ok" => Status::Ok,
+            "collapsed" => Status::Collapsed,
+            _ => Status::NonFinite,
+        };
         let exceed = &self.exceed;
-        self.groups[id as usize].1.add_values(ok, &x, exceed);
+        self.groups[id as usize].1.add_values(status, &x, exceed);
     }
 
     /// The (output index, threshold) pairs of `--exceed`.

@@ -35,6 +35,8 @@ pub struct Summary {
     pub runs_with_impacts: u64,
     pub impacts: u64,
     pub failures: u64,
+    /// Runs that collapsed (not failures: a storey reached the collapse drift ratio).
+    pub collapsed: u64,
     /// Exact free record steps and RK4 substeps, summed over runs (not counted by the device
     /// fold: 0 there).
     pub free_steps: u64,
@@ -62,7 +64,8 @@ impl Summary {
         self.runs += 1;
         self.impacts += impacts as u64;
         self.runs_with_impacts += (impacts > 0) as u64;
-        self.failures += (status != Status::Ok) as u64;
+        self.failures += status.failed() as u64;
+        self.collapsed += (status == Status::Collapsed) as u64;
         self.free_steps += free_steps;
         self.substeps += substeps;
     }
@@ -244,18 +247,20 @@ impl Chunk<'_> {
         }
     }
 
-    /// Runs in which a storey's peak drift ratio passes
+    /// Runs that did not collapse in which a storey's peak drift ratio passes
     /// [`crate::plan::limits::WARN_DRIFT_RATIO`], where collapse studies call a building
-    /// collapsed (rows; a pair's buildings have no storey height).
+    /// collapsed (rows whose collapse limit is higher or none; a pair's buildings have no
+    /// storey height).
     pub fn past_collapse_drift(&self) -> u64 {
         match self {
             Chunk::Pairs(..) => 0,
             Chunk::Rows(_, rows) => rows
                 .iter()
                 .filter(|(_, o)| {
-                    o.buildings
-                        .iter()
-                        .any(|b| b.peak_drift_ratio > crate::plan::limits::WARN_DRIFT_RATIO)
+                    o.status != Status::Collapsed
+                        && o.buildings
+                            .iter()
+                            .any(|b| b.peak_drift_ratio > crate::plan::limits::WARN_DRIFT_RATIO)
                 })
                 .count() as u64,
         }

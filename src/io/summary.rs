@@ -9,6 +9,9 @@ pub fn csv(agg: &Aggregator) -> String {
     let mut head: Vec<String> = agg.by().map(str::to_string).collect();
     head.push("runs".into());
     head.push("failures".into());
+    if agg.collapses() {
+        head.push("collapsed".into());
+    }
     // Columns that may be empty (a residual drift not known) say how many runs had no value.
     let exceed_open: Vec<bool> = agg.exceed().map(|(c, _)| may_be_empty(c)).collect();
     let output_open: Vec<bool> = agg.outputs().map(may_be_empty).collect();
@@ -34,6 +37,9 @@ pub fn csv(agg: &Aggregator) -> String {
         let mut r = label.to_vec();
         r.push(g.runs.to_string());
         r.push(g.failures.to_string());
+        if agg.collapses() {
+            r.push(g.collapsed.to_string());
+        }
         for (k, n) in g.exceed.iter().enumerate() {
             r.push(n.to_string());
             if exceed_open[k] {

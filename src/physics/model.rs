@@ -124,6 +124,9 @@ pub enum Status {
     NonFinite,
     /// The step budget ran out (or the substep count a record step needed exceeded its cap).
     StepLimit,
+    /// A storey's drift ratio reached the collapse limit: the run ended there (physics.md
+    /// section 10). Not a failure: the run's outputs are its motion up to the collapse.
+    Collapsed,
 }
 
 impl Status {
@@ -132,7 +135,13 @@ impl Status {
             Status::Ok => "ok",
             Status::NonFinite => "non_finite",
             Status::StepLimit => "step_limit",
+            Status::Collapsed => "collapsed",
         }
+    }
+
+    /// A run that failed (its outputs are not a result): neither `ok` nor `collapsed`.
+    pub fn failed(self) -> bool {
+        !matches!(self, Status::Ok | Status::Collapsed)
     }
 }
 

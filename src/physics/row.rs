@@ -35,6 +35,9 @@ pub struct Row {
     pub gaps: Vec<f64>,
     /// Ordered by adjacent pair, then by elevation.
     pub levels: Vec<Level>,
+    /// A run collapses when any storey's drift ratio reaches this (infinite: never;
+    /// [`Row::with_collapse`]).
+    pub collapse_drift_ratio: f64,
 }
 
 impl Row {
@@ -65,7 +68,14 @@ impl Row {
             buildings,
             gaps,
             levels,
+            collapse_drift_ratio: f64::INFINITY,
         }
+    }
+
+    /// This row with runs that collapse when any storey's drift ratio reaches `drift_ratio`.
+    pub fn with_collapse(mut self, drift_ratio: f64) -> Row {
+        self.collapse_drift_ratio = drift_ratio;
+        self
     }
 
     /// Total storeys (degrees of freedom) of the row.
@@ -202,6 +212,18 @@ pub struct RowOutput {
     /// Per contact level, its floors' closing and peaks, where the run was asked to track them
     /// (the separation of uncoupled buildings); empty otherwise.
     pub closings: Vec<LevelClosing>,
+    /// Where the run collapsed (status `collapsed`).
+    pub collapse: Option<Collapse>,
+}
+
+/// Where and when a run collapsed: the first storey whose drift ratio reached the limit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collapse {
+    /// s
+    pub time: f64,
+    /// Building and storey, from 1.
+    pub building: u32,
+    pub storey: u32,
 }
 
 /// What a contact level's two floors do over a run: the largest closing

@@ -56,6 +56,9 @@ pub struct ShearBuilding {
     pub damping: Damping,
     /// Bilinear storey springs (None: every storey linear elastic).
     pub yielding: Option<Yielding>,
+    /// P-Delta: each storey's geometric stiffness `P_j / h_j`, N/m, `P_j` the gravity load it
+    /// carries (None: no P-Delta; [`ShearBuilding::with_p_delta`]).
+    pub geometric: Option<Vec<f64>>,
 }
 
 /// Storeys that yield: storey `j` is a bilinear spring with kinematic hardening (physics.md
@@ -105,6 +108,7 @@ impl ShearBuilding {
             heights,
             damping,
             yielding: None,
+            geometric: None,
         };
         let w1 = b.eigen().0[0].sqrt();
         let target = 2.0 * std::f64::consts::PI / period;
@@ -123,6 +127,44 @@ impl ShearBuilding {
             heights: vec![height],
             damping: Damping::Modal(xi),
             yielding: None,
+            geometric: None,
+        }
+    }
+
+    /// This building with P-Delta (physics.md section 10): floor `j` carries the gravity load
+    /// `g m_j ratio` (`ratio`: the gravity mass ratio, 1 where the frame carries its floors'
+    /// own weight, more where a leaning column adds gravity the frame does not resist), storey
+    /// `j` the loads at and above it, and its lateral force gains `-P_j d_j / h_j`.
+    pub fn with_p_delta(mut self, ratio: f64) -> ShearBuilding {
+        // No gravity load, no geometric term: the building without P-Delta, bit for bit.
+        if ratio == 0.0 {
+            self.geometric = None;
+            return self;
+        }
+        let mut above = 0.0;
+        let mut g = vec![0.0; self.storeys()];
+        for j in (0..self.storeys()).rev() {
+            above += crate::record::G * self.masses[j] * ratio;
+            g[j] = above / self.heights[j];
+        }
+        self.geometric = Some(g);
+        self
+    }
+
+    /// Each storey's stability coefficient `theta_j = P_j / (k_j h_j)` (all 0 without
+    /// P-Delta); a storey with `theta_j >= 1` is unstable under gravity alone.
+    pub fn stability_coefficients(&self) -> Vec<f64> {
+        match &self.geometric {
+            Some(g) => g.iter().zip(&self.stiffness).map(|(g, k)| g / k).collect(),
+            None => vec![0.0; self.storeys()],
+        }
+    }
+
+    /// The storey stiffnesses the motion sees: `k_j - P_j / h_j` with P-Delta, else `k_j`.
+    pub fn effective_stiffness(&self) -> Vec<f64> {
+        match &self.geometric {
+            Some(g) => self.stiffness.iter().zip(g).map(|(k, g)| k - g).collect(),
+            None => self.stiffness.clone(),
         }
     }
 
@@ -163,14 +205,20 @@ impl ShearBuilding {
     /// slow (`O(N^3)` per sweep) but accurate to rounding for any spread of stiffnesses.
     #[allow(clippy::needless_range_loop)] // rotations index rows and columns alike
     fn eigen(&self) -> (Vec<f64>, Vec<Vec<f64>>) {
+        self.eigen_of(&self.stiffness)
+    }
+
+    /// [`ShearBuilding::eigen`] with storey stiffnesses `stiffness`.
+    #[allow(clippy::needless_range_loop)] // rotations index rows and columns alike
+    fn eigen_of(&self, stiffness: &[f64]) -> (Vec<f64>, Vec<Vec<f64>>) {
         let n = self.storeys();
         let s: Vec<f64> = self.masses.iter().map(|m| 1.0 / m.sqrt()).collect();
         let mut a = vec![vec![0.0; n]; n];
         for j in 0..n {
-            let kj = self.stiffness[j] + self.stiffness.get(j + 1).copied().unwrap_or(0.0);
+            let kj = stiffness[j] + stiffness.get(j + 1).copied().unwrap_or(0.0);
             a[j][j] = kj * s[j] * s[j];
             if j + 1 < n {
-                let off = -self.stiffness[j + 1] * s[j] * s[j + 1];
+                let off = -stiffness[j + 1] * s[j] * s[j + 1];
                 a[j][j + 1] = off;
                 a[j + 1][j] = off;
             }
@@ -240,8 +288,12 @@ impl ShearBuilding {
         }
     }
 
-    /// The building's modes (see the module docs).
+    /// The building's modes (see the module docs). With P-Delta, the modes of
+    /// `(K0 - K_G, M)` ([`ShearBuilding::p_delta_modes`]).
     pub fn modes(&self) -> Modes {
+        if self.geometric.is_some() {
+            return self.p_delta_modes();
+        }
         let n = self.storeys();
         let (w2, v) = self.eigen();
         let omega: Vec<f64> = w2.iter().map(|x| x.sqrt()).collect();
@@ -261,6 +313,65 @@ impl ShearBuilding {
         let participation = (0..n)
             .map(|i| (0..n).map(|j| self.masses[j] * shape[j][i]).sum())
             .collect();
+        Modes {
+            omega,
+            xi,
+            shape,
+            participation,
+        }
+    }
+}
+
+impl ShearBuilding {
+    /// Mass-normalised shapes from the eigenvectors of `eigen_of`, each column signed so its
+    /// roof component is >= 0, and the participations `phi_i^T M 1`.
+    fn shapes(&self, v: &[Vec<f64>]) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let n = self.storeys();
+        let mut shape = vec![vec![0.0; n]; n];
+        for i in 0..n {
+            let sign = if v[n - 1][i] < 0.0 { -1.0 } else { 1.0 };
+            for j in 0..n {
+                shape[j][i] = sign * v[j][i] / self.masses[j].sqrt();
+            }
+        }
+        let participation = (0..n)
+            .map(|i| (0..n).map(|j| self.masses[j] * shape[j][i]).sum())
+            .collect();
+        (shape, participation)
+    }
+
+    /// The modes of a P-Delta building: shapes and frequencies of `(K0 - K_G, M)`. Damping
+    /// stays the elastic building's (physics.md section 10): modal damping puts its ratio on
+    /// every mode; Rayleigh's `C = a0 M + a1 K0` (coefficients from modes 1 and 2 of
+    /// `(K0, M)`) is taken on each mode as `phi_i^T C phi_i = a0 + a1 phi_i^T K0 phi_i`, its
+    /// diagonal in these modes, so free flight stays an exact step per mode. That is `C`
+    /// itself wherever it is classical in them (one storey; every storey at the same
+    /// stability coefficient); otherwise the small coupling `a1 phi_i^T K0 phi_k` (i != k) is
+    /// left out (docs/collapse.md measures what that changes against OpenSees).
+    fn p_delta_modes(&self) -> Modes {
+        let n = self.storeys();
+        let (w2, v) = self.eigen_of(&self.effective_stiffness());
+        let omega: Vec<f64> = w2.iter().map(|x| x.sqrt()).collect();
+        let (shape, participation) = self.shapes(&v);
+        let xi = match self.damping {
+            Damping::Modal(x) => vec![x; n],
+            Damping::Rayleigh(_) => {
+                let omega0: Vec<f64> = self.eigen().0.iter().map(|x| x.sqrt()).collect();
+                let (a0, a1) = self.rayleigh(&omega0).expect("Rayleigh damping");
+                (0..n)
+                    .map(|i| {
+                        let k0: f64 = (0..n)
+                            .map(|j| {
+                                let below = if j == 0 { 0.0 } else { shape[j - 1][i] };
+                                let d = shape[j][i] - below;
+                                self.stiffness[j] * d * d
+                            })
+                            .sum();
+                        (a0 + a1 * k0) / (2.0 * omega[i])
+                    })
+                    .collect()
+            }
+        };
         Modes {
             omega,
             xi,
@@ -328,6 +439,7 @@ mod tests {
             heights: vec![3.0; n],
             damping,
             yielding: None,
+            geometric: None,
         }
     }
 
@@ -361,6 +473,7 @@ mod tests {
             heights: vec![4.0, 3.0, 3.0, 3.0, 3.0],
             damping: Damping::Rayleigh(0.05),
             yielding: None,
+            geometric: None,
         };
         let md = b.modes();
         let n = b.storeys();
@@ -419,5 +532,110 @@ mod tests {
         for (a, b) in u.iter().zip(&back) {
             assert!((a - b).abs() < 1e-15, "{a} vs {b}");
         }
+    }
+
+    /// A one-storey building whose storey carries `P` with `P / (k h) = theta`.
+    fn leaning_sdof(theta: f64, damping: Damping) -> ShearBuilding {
+        let (m, h, t0) = (2e5, 3.5, 0.6);
+        let b = ShearBuilding::from_period(vec![m], &[1.0], vec![h], t0, damping);
+        // P = g m r, so r = theta k h / (g m).
+        let r = theta * b.stiffness[0] * h / (crate::record::G * m);
+        b.with_p_delta(r)
+    }
+
+    /// physics.md section 10: an elastic SDOF with P-Delta has the period `T0 / sqrt(1 -
+    /// theta)`; its damping is the elastic building's (`c = 2 xi m w0` for Rayleigh on one
+    /// storey; the ratio on the mode for modal damping).
+    #[test]
+    fn p_delta_lengthens_the_period_by_one_over_root_one_minus_theta() {
+        let w0 = 2.0 * std::f64::consts::PI / 0.6;
+        for theta in [0.02, 0.1, 0.3, 0.9] {
+            let rayleigh = leaning_sdof(theta, Damping::Rayleigh(0.05));
+            assert!((rayleigh.stability_coefficients()[0] - theta).abs() < 1e-12);
+            let md = rayleigh.modes();
+            let w = w0 * (1.0 - theta).sqrt();
+            assert!(
+                (md.omega[0] - w).abs() < 1e-12 * w,
+                "{theta}: {}",
+                md.omega[0]
+            );
+            // c / m = 2 xi w0, whatever the geometric stiffness.
+            let c_over_m = 2.0 * md.xi[0] * md.omega[0];
+            assert!((c_over_m - 2.0 * 0.05 * w0).abs() < 1e-12 * w0, "{theta}");
+            let modal = leaning_sdof(theta, Damping::Modal(0.05)).modes();
+            assert_eq!(modal.xi, vec![0.05]);
+        }
+    }
+
+    /// Where every storey has the same stability coefficient, `K_G = theta K0` and Rayleigh's
+    /// `C = a0 M + a1 K0` is classical in the P-Delta modes: the modes' damping is exactly
+    /// `Phi^T C Phi`, with zeros off the diagonal.
+    #[test]
+    fn rayleigh_on_k0_is_exact_where_every_storey_leans_alike() {
+        let n = 5;
+        let (m, h) = (3e5, 3.2);
+        // k_j proportional to the floors above it: P_j / (k_j h) is the same in every storey.
+        let profile: Vec<f64> = (0..n).map(|j| (n - j) as f64).collect();
+        let b = ShearBuilding::from_period(
+            vec![m; n],
+            &profile,
+            vec![h; n],
+            1.2,
+            Damping::Rayleigh(0.05),
+        )
+        .with_p_delta(2.0);
+        let theta = b.stability_coefficients();
+        for t in &theta {
+            assert!((t - theta[0]).abs() < 1e-12 * theta[0], "{theta:?}");
+        }
+        let elastic = ShearBuilding {
+            geometric: None,
+            ..b.clone()
+        };
+        let w0 = elastic.modes().omega;
+        let (a0, a1) = elastic.rayleigh(&w0).unwrap();
+        let md = b.modes();
+        // Frequencies: w0 sqrt(1 - theta).
+        for (w, w_0) in md.omega.iter().zip(&w0) {
+            assert!((w - w_0 * (1.0 - theta[0]).sqrt()).abs() < 1e-9 * w_0);
+        }
+        for i in 0..n {
+            for k in 0..n {
+                let mut c = 0.0;
+                for j in 0..n {
+                    c += a0 * m * md.shape[j][i] * md.shape[j][k];
+                }
+                let kx =
+                    elastic.stiffness_force(&(0..n).map(|j| md.shape[j][k]).collect::<Vec<_>>());
+                for j in 0..n {
+                    c += a1 * md.shape[j][i] * kx[j];
+                }
+                let want = if i == k {
+                    2.0 * md.xi[i] * md.omega[i]
+                } else {
+                    0.0
+                };
+                assert!(
+                    (c - want).abs() < 1e-9 * md.omega[n - 1],
+                    "({i}, {k}): {c} vs {want}"
+                );
+            }
+        }
+    }
+
+    /// A gravity mass ratio of 0 carries no load: the building without P-Delta, bit for bit.
+    #[test]
+    fn no_gravity_load_is_no_p_delta() {
+        let b = ShearBuilding::from_period(
+            vec![2e5, 2e5, 1e5],
+            &[1.0, 0.8, 0.6],
+            vec![4.0, 3.0, 3.0],
+            0.5,
+            Damping::Rayleigh(0.05),
+        );
+        let zero = b.clone().with_p_delta(0.0);
+        assert_eq!(zero, b);
+        assert_eq!(zero.modes(), b.modes());
+        assert_eq!(zero.stability_coefficients(), vec![0.0; 3]);
     }
 }

@@ -447,7 +447,26 @@ pub struct RawRun {
     pub tail_s: Option<f64>,
     /// Report each run's energy balance (fast scheme; the reference always does).
     pub energy: Option<bool>,
+    /// Rows: a run collapses when any storey's drift ratio reaches this (default
+    /// [`crate::plan::limits::COLLAPSE_DRIFT_RATIO`]), or `"none"`.
+    pub collapse_drift_ratio: Option<CollapseLimit>,
 }
+
+/// `collapse_drift_ratio` as written: a drift ratio, or `"none"` (runs never collapse).
+#[derive(Debug, Clone, PartialEq)]
+pub enum CollapseLimit {
+    Ratio(f64),
+    None,
+    /// Any other text, refused by name when the plan is read.
+    Other(String),
+}
+
+forms!(CollapseLimit, "a drift ratio (> 0 and <= 1), or \"none\" (runs never collapse)", {
+    number: Some(CollapseLimit::Ratio),
+    text: Some(|s| if s == "none" { CollapseLimit::None } else { CollapseLimit::Other(s) }),
+    list: None,
+    table: None,
+});
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -926,6 +945,12 @@ fn parse_raw(
         message,
     };
     let axis = |key: &str, a: &Axis| a.values().map_err(|m| invalid(key, m));
+    if raw.run.collapse_drift_ratio.is_some() {
+        return Err(invalid(
+            "run.collapse_drift_ratio",
+            "a collapse is a storey's drift ratio, and [building1]/[building2] have no storey height: write the buildings as [[building]] entries with storey_height_m".into(),
+        ));
+    }
     let scheme = parse_scheme(&raw.run, &invalid)?;
     let (laws, formulas) = parse_laws(&raw.contact, &invalid)?;
     let count = |key: &str, a: &Option<Axis>| -> Result<usize, ConfigError> {

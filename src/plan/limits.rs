@@ -110,3 +110,12 @@ pub const MAX_AXIS_POINTS: usize = 10_000_000;
 
 /// A number as a message shows it ([`crate::show`], beside the records that show numbers too).
 pub use crate::show;
+
+/// A row's run collapses when any storey's drift ratio reaches this, unless its config says
+/// otherwise (`[run] collapse_drift_ratio`): the limit FEMA P-695 collapse studies often use
+/// with P-Delta (physics.md section 10).
+pub const COLLAPSE_DRIFT_RATIO: f64 = 0.10;
+
+/// The largest gravity mass ratio a P-Delta building takes: the gravity its leaning column
+/// carries over its frame's own floors' (2 or 3 in the archetypes of FEMA P-695).
+pub const MAX_GRAVITY_MASS_RATIO: f64 = 10.0;

@@ -14,7 +14,7 @@ pub struct Meaning {
 }
 
 /// The columns of one run that do not depend on the scene: name, unit, short name, meaning.
-const FIXED: [(&str, &str, &str, &str); 36] = [
+const FIXED: [(&str, &str, &str, &str); 39] = [
     ("run", "-", "run", "run number"),
     ("law", "-", "contact law", "contact law"),
     (
@@ -171,6 +171,24 @@ const FIXED: [(&str, &str, &str, &str); 36] = [
         "integration work beyond the exact free steps (RK4 substeps or trial steps)",
     ),
     (
+        "collapse_time_s",
+        "s",
+        "collapse time",
+        "when a storey's drift ratio reached the collapse limit ([run] collapse_drift_ratio; the run ends there; empty where the run did not collapse)",
+    ),
+    (
+        "collapse_building",
+        "-",
+        "collapsed building",
+        "the building of that storey (from 1; empty where the run did not collapse)",
+    ),
+    (
+        "collapse_storey",
+        "-",
+        "collapsed storey",
+        "the storey that reached the collapse limit (from 1; empty where the run did not collapse)",
+    ),
+    (
         "input_energy_j",
         "J",
         "input energy",
@@ -195,7 +213,7 @@ const ENERGY: [(&str, &str, &str, &str); 2] = [
 ];
 
 /// Per building `k`: suffix, unit, short name, meaning.
-const PER_BUILDING: [(&str, &str, &str, &str); 17] = [
+const PER_BUILDING: [(&str, &str, &str, &str); 18] = [
     ("storeys", "-", "storeys, building {k}", "storeys of building {k}"),
     ("mass_kg", "kg", "floor mass, building {k}", "floor mass of building {k} (empty where floor masses are given)"),
     ("t1_s", "s", "period T1, building {k}", "fundamental period of building {k}"),
@@ -213,6 +231,7 @@ const PER_BUILDING: [(&str, &str, &str, &str); 17] = [
     ("ductility_storey", "-", "storey of peak ductility, building {k}", "the storey of that ductility (from 1)"),
     ("hysteretic_energy_j", "J", "hysteretic energy, building {k}", "hysteretic energy of building {k}'s storeys: their work less the elastic energy they hold at the end"),
     ("yielded_storeys", "-", "yielded storeys, building {k}", "storeys of building {k} that yielded"),
+    ("stability_coefficient", "-", "stability coefficient, building {k}", "largest storey stability coefficient P/(k h) of building {k} (P-Delta): gravity load over storey stiffness times height"),
 ];
 
 /// Per contact level: suffix, unit, short name, meaning.

@@ -87,6 +87,11 @@ pub struct RawShearBuilding {
     /// Which stiffness the Rayleigh or modal damping is built on: `initial` (the only choice;
     /// tangent-stiffness damping can create spurious damping forces after yielding).
     pub damping_stiffness: Option<String>,
+    /// P-Delta (physics.md section 10): storey `j`'s force gains `-P_j d_j / h_j`.
+    pub p_delta: Option<bool>,
+    /// With `p_delta`: floor `j` carries the gravity load `g m_j gravity_mass_ratio` (default
+    /// 1; 2 or 3 where a leaning column carries gravity the frame does not resist).
+    pub gravity_mass_ratio: Option<f64>,
 }
 
 /// `yield_drift_ratio` as written: one value for every storey, one per storey, or a range
@@ -212,6 +217,12 @@ pub struct ShearAxes {
     pub period: Vec<f64>,
     pub damping: Vec<f64>,
     pub modal: bool,
+    /// With P-Delta, its gravity mass ratio (None: no P-Delta).
+    pub p_delta: Option<f64>,
+    /// With P-Delta, its largest storey stability coefficient at a period of 1 s: at period
+    /// `T` it is this times `T^2` (the storey stiffnesses scale as `1 / T^2`, the gravity loads
+    /// and the stiffnesses alike with a uniform floor mass).
+    pub stability_at_1s: f64,
 }
 
 impl ShearAxes {
@@ -311,6 +322,8 @@ pub struct RowPlan {
     /// Laws, formulas, `e`, stiffness, records, intensities and the scheme: the axes every
     /// scene shares.
     pub contact: ContactPlan,
+    /// A run collapses when any storey's drift ratio reaches this (infinite: never).
+    pub collapse_drift_ratio: f64,
     pub buildings: Vec<ShearAxes>,
     /// m, per adjacent pair.
     pub gaps: Vec<Vec<f64>>,
@@ -608,11 +621,15 @@ impl RowPlan {
                 s.yielding = self.yielding[b]
                     .as_ref()
                     .map(|y| y.of(&s, run.yield_value[b]));
-                s
+                match a.p_delta {
+                    Some(ratio) => s.with_p_delta(ratio),
+                    None => s,
+                }
             })
             .collect();
         let s = &run.contact;
         Row::new(buildings, run.gaps.clone(), s.law, s.stiffness, s.damping)
+            .with_collapse(self.collapse_drift_ratio)
     }
 
     pub fn forcing(&self, run: &RowRunSpec) -> Forcing<'_> {
@@ -665,9 +682,17 @@ impl RowPlan {
         ] {
             h.push(c.into());
         }
+        if self.collapse_drift_ratio.is_finite() {
+            for c in COLLAPSE_OUTPUTS {
+                h.push(c.into());
+            }
+        }
         for (b, y) in self.yielding.iter().enumerate() {
             for c in BUILDING_OUTPUTS {
                 h.push(format!("b{}_{c}", b + 1));
+            }
+            if self.buildings[b].p_delta.is_some() {
+                h.push(format!("b{}_stability_coefficient", b + 1));
             }
             if y.is_some() {
                 for c in INELASTIC_OUTPUTS {
@@ -723,6 +748,8 @@ impl RowPlan {
             .skip(self.parameter_columns() + 1)
             .filter(|c| {
                 !skip.contains(&c.as_str())
+                    && !COLLAPSE_OUTPUTS.contains(&c.as_str())
+                    && !c.ends_with("_stability_coefficient")
                     && !c.ends_with("_drift_storey")
                     && !c.ends_with("_accel_floor")
                     && !c.ends_with("_residual_storey")
@@ -763,6 +790,14 @@ impl RowPlan {
             num(out.dissipated_energy),
             out.substeps.to_string(),
         ]);
+        if self.collapse_drift_ratio.is_finite() {
+            let cl = out.collapse;
+            c.extend([
+                opt(cl.map(|x| x.time)),
+                cl.map(|x| x.building.to_string()).unwrap_or_default(),
+                cl.map(|x| x.storey.to_string()).unwrap_or_default(),
+            ]);
+        }
         let mut storeys = out.storeys.iter();
         for (k, (b, y)) in out.buildings.iter().zip(&self.yielding).enumerate() {
             c.extend([
@@ -772,6 +807,10 @@ impl RowPlan {
                 num(b.peak_accel),
                 b.accel_floor.to_string(),
             ]);
+            let a = &self.buildings[k];
+            if a.p_delta.is_some() {
+                c.push(num(a.stability_at_1s * run.period[k] * run.period[k]));
+            }
             if y.is_some() {
                 // A run that failed, or did not settle, has no residual drift: empty.
                 let ie = b.inelastic.unwrap_or_default();
@@ -834,6 +873,10 @@ pub const BUILDING_OUTPUTS: [&str; 5] = [
     "peak_accel_m_s2",
     "accel_floor",
 ];
+
+/// Where a run collapsed (empty where it did not): the time, the building and its storey (from
+/// 1). Rows with a collapse limit have them.
+pub const COLLAPSE_OUTPUTS: [&str; 3] = ["collapse_time_s", "collapse_building", "collapse_storey"];
 
 /// A yielding building's further output columns (after its `b1_` prefix).
 pub const INELASTIC_OUTPUTS: [&str; 6] = [
@@ -1035,6 +1078,29 @@ pub fn parse_row(
         yielding.push(parse_yielding(r, n, sampled_yield, &key, &invalid)?);
         let period_s = required(RowSampled::Period(b), r.period_s.as_ref())?;
         let damping_ratio = required(RowSampled::Damping(b), r.damping_ratio.as_ref())?;
+        let p_delta = match (r.p_delta, r.gravity_mass_ratio) {
+            (Some(true), ratio) => {
+                let ratio = ratio.unwrap_or(1.0);
+                let max = crate::plan::limits::MAX_GRAVITY_MASS_RATIO;
+                if !(0.0..=max).contains(&ratio) {
+                    return Err(invalid(
+                        &key("gravity_mass_ratio"),
+                        format!(
+                            "{} is out of range: expected a ratio >= 0 and <= {max} (the gravity load over the floors' own weight)",
+                            crate::show(ratio)
+                        ),
+                    ));
+                }
+                Some(ratio)
+            }
+            (_, Some(_)) => {
+                return Err(invalid(
+                    &key("gravity_mass_ratio"),
+                    "applies with p_delta = true: add it, or remove gravity_mass_ratio".into(),
+                ))
+            }
+            _ => None,
+        };
         buildings.push(ShearAxes {
             heights,
             floor_masses,
@@ -1043,6 +1109,8 @@ pub fn parse_row(
             period: axis(&key("period_s"), &period_s, PERIOD)?,
             damping: axis(&key("damping_ratio"), &damping_ratio, DAMPING)?,
             modal,
+            p_delta,
+            stability_at_1s: 0.0,
         });
         let gap_right = if b + 1 < nb {
             grid_or_sampled(RowSampled::Gap(b), r.gap_right_m.as_ref())?
@@ -1097,6 +1165,25 @@ pub fn parse_row(
         .collect();
     crate::plan::intensity::check_periods(&contact.spec.intensities, &taken)
         .map_err(|(k, m)| invalid(&k, m))?;
+    check_stability(&mut buildings, &taken).map_err(|(k, m)| invalid(&k, m))?;
+    let collapse_drift_ratio = match &raw.run.collapse_drift_ratio {
+        None => crate::plan::limits::COLLAPSE_DRIFT_RATIO,
+        Some(config::CollapseLimit::Ratio(x)) if *x > 0.0 && *x <= 1.0 => *x,
+        Some(config::CollapseLimit::None) => f64::INFINITY,
+        Some(other) => {
+            let given = match other {
+                config::CollapseLimit::Ratio(x) => crate::show(*x),
+                config::CollapseLimit::Other(t) => format!("`{t}`"),
+                config::CollapseLimit::None => unreachable!(),
+            };
+            return Err(invalid(
+                "run.collapse_drift_ratio",
+                format!(
+                    "{given}: expected a drift ratio > 0 and <= 1 (a storey's drift over its height), or \"none\""
+                ),
+            ));
+        }
+    };
     let mut dims = vec![samples.as_ref().map_or(1, |s| s.points.len())];
     dims.extend(
         buildings
@@ -1143,6 +1230,7 @@ pub fn parse_row(
         })?;
     Ok(RowPlan {
         contact,
+        collapse_drift_ratio,
         buildings,
         gaps,
         samples,
@@ -1155,6 +1243,50 @@ pub fn parse_row(
         yield_dim,
         storey_columns: false,
     })
+}
+
+/// Every P-Delta building stable under gravity alone at every period it takes (`taken`): each
+/// storey's stability coefficient `theta_j = P_j / (k_j h_j)` below 1. With the floor masses
+/// fixed, or all one swept mass, `theta` grows with the period squared and does not depend on
+/// the mass, so the longest period decides. Err: the key and why.
+fn check_stability(
+    buildings: &mut [ShearAxes],
+    taken: &[Vec<f64>],
+) -> Result<(), (String, String)> {
+    for (b, (a, periods)) in buildings.iter_mut().zip(taken).enumerate() {
+        let Some(ratio) = a.p_delta else { continue };
+        let period = periods.iter().cloned().fold(0.0, f64::max);
+        let masses = a
+            .floor_masses
+            .clone()
+            .unwrap_or_else(|| vec![1.0; a.storeys()]);
+        let at = |period: f64| {
+            ShearBuilding::from_period(
+                masses.clone(),
+                &a.profile,
+                a.heights.clone(),
+                period,
+                Damping::Modal(0.05),
+            )
+            .with_p_delta(ratio)
+            .stability_coefficients()
+        };
+        a.stability_at_1s = at(1.0).into_iter().fold(0.0, f64::max);
+        let theta = at(period);
+        if let Some(j) = theta.iter().position(|t| *t >= 1.0) {
+            return Err((
+                format!("building[{b}].p_delta"),
+                format!(
+                    "storey {} is unstable under gravity alone at period_s = {}: its stability coefficient P/(k h) is {} (>= 1; gravity_mass_ratio {}): a shorter period, a lower gravity_mass_ratio or a stiffer storey",
+                    j + 1,
+                    crate::show(period),
+                    crate::show(theta[j]),
+                    crate::show(ratio)
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A building's yielding storeys as its `[[building]]` gives them (`key` names its keys), or

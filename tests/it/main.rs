@@ -2,6 +2,7 @@
 
 mod accuracy;
 mod cli;
+mod collapse;
 mod config;
 mod convergence;
 mod damage;

@@ -809,7 +809,15 @@ pub fn sweep_rows<E: From<GpuError>>(
             .zip(outs)
             .zip(&models)
             .map(|((s, o), m)| {
-                let o = o.unwrap_or_else(|| simulate_row(m, &plan.forcing(&s), m.at_rest(), &cpu));
+                // The kernel has no collapse event: a run whose storey reached the limit is
+                // run again on the CPU, which ends it there.
+                let o = o
+                    .filter(|o| {
+                        o.buildings
+                            .iter()
+                            .all(|b| b.peak_drift_ratio < plan.collapse_drift_ratio)
+                    })
+                    .unwrap_or_else(|| simulate_row(m, &plan.forcing(&s), m.at_rest(), &cpu));
                 (s, o)
             })
             .collect();

@@ -34,7 +34,41 @@ impl<'m> RowRun<'m> {
                 }
             },
         );
-        levels.chain(storeys)
+        // A watched storey's collapse: its drift past the limit.
+        let limit = self.m.collapse_limit;
+        let drifts = self.m.drifts.iter().map(move |d| {
+            if self.watch[d.building] && self.active[d.building] {
+                d.drift(z, 0).abs() - limit * d.height
+            } else {
+                f64::NEG_INFINITY
+            }
+        });
+        levels.chain(storeys).chain(drifts)
+    }
+
+    /// The collapse the located events at `zb` (time `t`) mark, if one of them is a storey's
+    /// drift reaching the limit: the storey furthest past it.
+    fn collapse_transition(&mut self, t: f64, zb: &[f64]) {
+        let first = self.m.levels.len() + self.m.storeys.len();
+        let limit = self.m.collapse_limit;
+        let mut best: Option<(f64, usize)> = None;
+        for (i, d) in self.m.drifts.iter().enumerate() {
+            if !self.firing.get(first + i).copied().unwrap_or(false) {
+                continue;
+            }
+            let v = d.drift(zb, 0).abs() - limit * d.height;
+            if best.is_none_or(|(b, _)| v > b) {
+                best = Some((v, i));
+            }
+        }
+        if let Some((_, i)) = best {
+            let d = &self.m.drifts[i];
+            self.collapse = Some(crate::physics::row::Collapse {
+                time: t,
+                building: d.building as u32 + 1,
+                storey: d.storey as u32 + 1,
+            });
+        }
     }
 
     /// The largest event value of the checked levels and storeys (positive once any level's
@@ -229,6 +263,9 @@ impl<'m> RowRun<'m> {
                 |s: &Vec<f64>| self.firing_max(s),
             );
             self.track(t, x, &z0, &zb, (ag(t), ag(t + x)));
+            if !self.m.drifts.is_empty() {
+                self.collapse_transition(t + x, &zb);
+            }
             self.transitions(t + x, &zb, &z0);
             self.z = zb;
             if !self.m.storeys.is_empty() {
@@ -238,6 +275,9 @@ impl<'m> RowRun<'m> {
         } else {
             self.track(t, h, &z0, &trial, (ag(t), ag(t + h)));
             self.z = trial;
+            if !self.m.drifts.is_empty() {
+                self.collapse_by_peaks(t + h);
+            }
             // A level whose phase is not an event (the law's force does not depend on it).
             for (lm, ls) in self.m.levels.iter().zip(self.levels.iter_mut()) {
                 if lm.reapproaches(n, ls.mode, &self.z) {

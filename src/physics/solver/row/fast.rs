@@ -304,6 +304,8 @@ fn run_with<'a>(
     let mut i = 0;
     while let Some(seg) = super::yielding::next_segment(m, forcing, i, &mut run) {
         i += 1;
+        // A building near collapse moves in substeps, where its storeys' collapse is an event.
+        let watched = !m.drifts.is_empty() && run.refresh_watch();
         let z = run.z.clone();
         // The exact free step of every mode: the step itself when no level may touch, and the
         // buildings' that stand still through a step of substeps (none in a row of two).
@@ -337,6 +339,15 @@ fn run_with<'a>(
             m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
             bounded = true;
             yielding = m.yield_watch(&run.storey_modes, (&z, &z1), &bounds, dt, &mut yield_watch);
+        }
+        if watched {
+            if !yields {
+                yield_watch.fill(false);
+            }
+            for (y, w) in yield_watch.iter_mut().zip(&run.watch) {
+                *y |= *w;
+            }
+            yielding = true;
         }
         if !any_contact {
             if !bounded {
@@ -383,6 +394,9 @@ fn run_with<'a>(
                 if !run.z.iter().all(|x| x.is_finite()) {
                     return finish(run, Status::NonFinite, substeps, tally);
                 }
+                if run.collapse.is_some() {
+                    return finish(run, Status::Collapsed, substeps, tally);
+                }
                 continue;
             }
         }
@@ -397,7 +411,7 @@ fn run_with<'a>(
                     active[lm.buildings.1] = true;
                 }
             }
-            if yielding {
+            if yielding || watched {
                 for (a, w) in active.iter_mut().zip(&yield_watch) {
                     *a |= *w;
                 }
@@ -584,6 +598,9 @@ fn run_with<'a>(
                 );
                 if !run.z.iter().all(|x| x.is_finite()) {
                     return finish(run, Status::NonFinite, substeps, tally);
+                }
+                if run.collapse.is_some() {
+                    return finish(run, Status::Collapsed, substeps, tally);
                 }
             }
             t = t_target;

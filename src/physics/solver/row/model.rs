@@ -102,6 +102,32 @@ pub struct RowModel {
     pub(crate) levels: Vec<LevelModel>,
     /// The yielding storeys, building by building (none in an elastic row).
     pub(crate) storeys: Vec<StoreyModel>,
+    /// The collapse limit on any storey's drift ratio (infinite: none), and every storey of
+    /// every building as its collapse event sees it (empty without a limit).
+    pub(crate) collapse_limit: f64,
+    pub(crate) drifts: Vec<DriftRow>,
+}
+
+/// A storey's drift in the model's coordinates, for its collapse event:
+/// `d = row . z[off..off + row.len()]`.
+#[derive(Debug, Clone)]
+pub(crate) struct DriftRow {
+    pub building: usize,
+    /// From 0.
+    pub storey: usize,
+    pub height: f64,
+    pub off: usize,
+    pub row: Vec<f64>,
+    /// The drift in the building's modes.
+    pub modal_row: Vec<f64>,
+}
+
+impl DriftRow {
+    /// Drift (`n = 0`) or drift rate (`n` the mode count) in state `z`.
+    #[inline]
+    pub fn drift(&self, z: &[f64], n: usize) -> f64 {
+        dot(&self.row, &z[n + self.off..n + self.off + self.row.len()])
+    }
 }
 
 impl RowModel {
@@ -118,7 +144,10 @@ impl RowModel {
                 part.push(modes.participation[i]);
             }
             let n = modes.count();
-            let floor_form = b.rayleigh(&modes.omega).map(|(a0, a1)| FloorForm {
+            // With P-Delta the modes' damping is not `a0 M + a1 K` of any `K` (see
+            // `ShearBuilding::modes`): the building takes its substeps in modes.
+            let rayleigh = b.geometric.is_none().then(|| b.rayleigh(&modes.omega));
+            let floor_form = rayleigh.flatten().map(|(a0, a1)| FloorForm {
                 k: b.stiffness.clone(),
                 a0,
                 a1,
@@ -147,6 +176,7 @@ impl RowModel {
                         d_y: y.force[j] / b.stiffness[j],
                         b: y.post_yield[j],
                         height: b.heights[j],
+                        geometric: b.geometric.as_ref().map_or(0.0, |g| g[j]),
                         off,
                         row: modal_row.clone(),
                         psi: modal_row.clone(),
@@ -188,6 +218,33 @@ impl RowModel {
                 }
             })
             .collect();
+        let collapse_limit = row.collapse_drift_ratio;
+        let drifts = if collapse_limit.is_finite() {
+            buildings
+                .iter()
+                .enumerate()
+                .flat_map(|(k, b)| {
+                    (0..b.n()).map(move |j| {
+                        let modal_row: Vec<f64> = (0..b.n())
+                            .map(|i| {
+                                b.modes.shape[j][i]
+                                    - if j == 0 { 0.0 } else { b.modes.shape[j - 1][i] }
+                            })
+                            .collect();
+                        DriftRow {
+                            building: k,
+                            storey: j,
+                            height: b.heights[j],
+                            off: b.off,
+                            row: modal_row.clone(),
+                            modal_row,
+                        }
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         RowModel {
             n: off,
             w2,
@@ -196,6 +253,8 @@ impl RowModel {
             buildings,
             levels,
             storeys,
+            collapse_limit,
+            drifts,
         }
     }
 
@@ -228,6 +287,14 @@ impl RowModel {
             }
         }
         m.storeys_to_coordinates();
+        for d in m.drifts.iter_mut() {
+            let b = &m.buildings[d.building];
+            (d.off, d.row) = match (b.in_floors, d.storey) {
+                (false, _) => (b.off, d.modal_row.clone()),
+                (true, 0) => (b.off, vec![1.0]),
+                (true, j) => (b.off + j - 1, vec![-1.0, 1.0]),
+            };
+        }
         Some(m)
     }
 

@@ -377,6 +377,7 @@ impl<'m> RowRun<'m> {
             energy,
             storeys,
             closings: self.closings.unwrap_or_default(),
+            collapse: self.collapse,
             ..RowOutput::default()
         };
         if ns > 0 {

@@ -96,6 +96,7 @@ pub(crate) fn run_tracked<'a>(
     let n = m.n;
     let mut run = RowRun::start(m, z0, forcing.t0);
     run.observer = observer;
+    run.watch_all();
     if closings {
         run.track_closings();
     }
@@ -159,6 +160,9 @@ pub(crate) fn run_tracked<'a>(
             }
             let step = |x: f64| dopri(m, (&modes, &storeys), &seg, t, &z0, x, o.rtol).0;
             t += run.accept(&seg, t, hs, trial, 1e-13, 100, step);
+            if run.collapse.is_some() {
+                return run.finish(Status::Collapsed, steps);
+            }
             h = hs * (0.9 * err.max(1e-12).powf(-0.2)).min(5.0);
         }
     }

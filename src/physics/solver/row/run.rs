@@ -4,7 +4,7 @@
 
 use super::yielding::StoreyMode;
 use super::{Floors, LevelModel, LevelState, RowModel, RowObserver, StoreyState};
-use crate::physics::row::{BuildingOutput, LevelClosing};
+use crate::physics::row::{BuildingOutput, Collapse, LevelClosing};
 use crate::physics::solver::hermite::{quintic_max_bound, quintic_range, raise_quintic_peak};
 use crate::physics::solver::{Mode, Segment};
 
@@ -91,7 +91,18 @@ pub(crate) struct RowRun<'m> {
     pub(super) closings: Option<Vec<LevelClosing>>,
     /// Hears every accepted step and event ([`RowRun::emit`]).
     pub observer: Option<RowObserver<'m>>,
+    /// Per building, whether its storeys' collapse events are checked: from the time its peak
+    /// drift ratio reaches [`COLLAPSE_WATCH`] of the limit (every building in the reference
+    /// scheme, [`RowRun::watch_all`]).
+    pub(super) watch: Vec<bool>,
+    /// Where the run collapsed; it ends there.
+    pub collapse: Option<Collapse>,
 }
+
+/// A building's storeys are watched for collapse once its peak drift ratio reaches this share
+/// of the limit: from there to the limit within one record step would take a drift velocity of
+/// metres per second per storey, and below it the collapse events cost nothing.
+pub(crate) const COLLAPSE_WATCH: f64 = 0.5;
 
 impl<'m> RowRun<'m> {
     /// Start at `t0` from state `z` (levels already overlapping start in contact).
@@ -122,6 +133,8 @@ impl<'m> RowRun<'m> {
             firing: Vec::with_capacity(m.levels.len() + m.storeys.len()),
             closings: None,
             observer: None,
+            watch: vec![false; m.buildings.len()],
+            collapse: None,
             z,
         };
         let z = run.z.clone();
@@ -130,6 +143,41 @@ impl<'m> RowRun<'m> {
             run.storey_transitions();
         }
         run
+    }
+
+    /// Check every building's storeys for collapse at every step (the reference scheme).
+    pub fn watch_all(&mut self) {
+        if self.m.collapse_limit.is_finite() {
+            self.watch.fill(true);
+        }
+    }
+
+    /// Watch the buildings whose peak drift ratio has reached [`COLLAPSE_WATCH`] of the limit;
+    /// whether any is watched.
+    pub fn refresh_watch(&mut self) -> bool {
+        let limit = COLLAPSE_WATCH * self.m.collapse_limit;
+        for (w, b) in self.watch.iter_mut().zip(&self.buildings) {
+            *w |= b.peak_drift_ratio >= limit;
+        }
+        self.watch.iter().any(|&w| w)
+    }
+
+    /// A run that has not collapsed by an event but whose tracked peaks reached the limit
+    /// inside a step (a crossing between its ends) collapses at the step's end `t`.
+    pub(super) fn collapse_by_peaks(&mut self, t: f64) {
+        if self.collapse.is_some() {
+            return;
+        }
+        let limit = self.m.collapse_limit;
+        if let Some((k, b)) =
+            (self.buildings.iter().enumerate()).find(|(_, b)| b.peak_drift_ratio >= limit)
+        {
+            self.collapse = Some(Collapse {
+                time: t,
+                building: k as u32 + 1,
+                storey: b.drift_storey,
+            });
+        }
     }
 
     /// Track each level's closing and its floors' peaks from here on (into
@@ -330,6 +378,7 @@ impl<'m> RowRun<'m> {
         self.track(seg.t0, seg.dt, &z0, &z1, (seg.a0, seg.a1));
         self.free_steps += 1;
         self.z = z1;
+        self.collapse_by_peaks(seg.t1());
         self.emit(seg, seg.t1());
     }
 }

@@ -56,6 +56,8 @@ pub(crate) struct StoreyModel {
     pub d_y: f64,
     pub b: f64,
     pub height: f64,
+    /// Geometric stiffness `P / h` of P-Delta, N/m (0 without).
+    pub geometric: f64,
     /// The drift in the building's modes: `d = modal_row . q`.
     pub modal_row: Vec<f64>,
     /// The drift in the model's coordinates: `d = row . z[off..off + row.len()]` (the modes, or
@@ -210,10 +212,38 @@ impl RowModel {
     /// Can no storey yield again in the free motion from modal state `z` (no level in contact,
     /// every storey in its band)? See the module's text.
     pub(crate) fn settled(&self, z: &[f64]) -> bool {
+        if self.storeys.iter().any(|sm| sm.geometric != 0.0) {
+            return self.settled_p_delta(z);
+        }
         let e = (self.mechanical_energy(z)).max(0.0);
         self.storeys.iter().enumerate().all(|(s, sm)| {
             let p = z[self.plastic_slot(s)];
             (2.0 * e / sm.k).sqrt() + sm.b * p.abs() / (1.0 - sm.b) <= sm.d_y * (1.0 + YIELD_SLACK)
+        })
+    }
+
+    /// [`RowModel::settled`] with P-Delta: about the static response `q_s` to the plastic loads
+    /// the drifts are `d_s` (no longer the plastic drifts: gravity leans on them), and the
+    /// energy `E` of the motion about it bounds each storey's excursion by
+    /// `sqrt(2 E / (k - P/h))` (the stiffness `K0 - K_G` is a sum of storey terms
+    /// `k_j - P_j/h_j`, all positive). A storey stays in its band while
+    /// `|d_s - p / (1 - b)| + sqrt(2 E / (k - P/h)) <= d_y`.
+    fn settled_p_delta(&self, z: &[f64]) -> bool {
+        let n = self.n;
+        let mut qs = vec![0.0; n];
+        self.static_offsets(z, &mut qs);
+        let e: f64 = (0..n)
+            .map(|i| {
+                let x = z[i] - qs[i];
+                0.5 * (z[n + i] * z[n + i] + self.w2[i] * x * x)
+            })
+            .sum();
+        self.storeys.iter().enumerate().all(|(s, sm)| {
+            let p = z[self.plastic_slot(s)];
+            let o = self.buildings[sm.building].off;
+            let d_s = dot(&sm.modal_row, &qs[o..]);
+            (2.0 * e / (sm.k - sm.geometric)).sqrt() + sm.back_drift(d_s, p).abs()
+                <= sm.d_y * (1.0 + YIELD_SLACK)
         })
     }
 
@@ -332,6 +362,7 @@ mod tests {
                 force: vec![k * d_y],
                 post_yield: vec![b],
             }),
+            geometric: None,
         }
     }
 
@@ -774,5 +805,113 @@ mod tests {
         for s in 0..m.storeys.len() {
             assert!(fz[m.plastic_slot(s)] != 0.0 || modes[s] == StoreyMode::Elastic);
         }
+    }
+
+    /// An elastic-perfectly-plastic storey with P-Delta (`theta = P / (k h) = 0.1`) set moving
+    /// outwards from its yield drift, with no ground motion: on its plateau the storey force is
+    /// `F_y - (P/h) d` (the softening slope `-P/h`), so `m d'' + c d' - (P/h) d = -F_y`, whose
+    /// solution runs away from `d_p = F_y h / P` exponentially; the run collapses when
+    /// `d = L h` (`L` the collapse drift ratio), at the time the closed form gives, with the
+    /// peak drift ratio `L`, no residual drift, and the same from both schemes.
+    #[test]
+    fn a_leaning_storey_past_yield_runs_away_and_collapses_as_the_closed_form() {
+        let (m, t, d_y, v0, theta, limit) = (1e5, 0.5, 0.01, 0.6, 0.1, 0.1);
+        let h = 3.0;
+        for damping in [Damping::Modal(0.05), Damping::Rayleigh(0.05)] {
+            let mut b = sdof(m, t, 0.05, d_y, 0.0);
+            b.damping = damping;
+            let k = b.stiffness[0];
+            let g = theta * k;
+            b.geometric = Some(vec![g]);
+            // c: the elastic building's (Rayleigh on one storey: 2 xi m w0), or the ratio on
+            // the P-Delta mode (modal).
+            let w0 = (k / m).sqrt();
+            let c = match damping {
+                Damping::Rayleigh(x) => 2.0 * x * m * w0,
+                Damping::Modal(x) => 2.0 * x * m * ((k - g) / m).sqrt(),
+            };
+            let row = Row::new(
+                vec![b, tower(1, 0.3, false, None, 0.0)],
+                vec![10.0],
+                LawKind::Linear,
+                1e9,
+                0.0,
+            )
+            .with_collapse(limit);
+            let model = RowModel::new(&row);
+            let z0 = model.state_of_floors(&[vec![d_y], vec![0.0]], &[vec![v0], vec![0.0]]);
+            // x = d - d_p: m x'' + c x' - g x = 0.
+            let d_p = k * d_y / g;
+            let disc = (c * c + 4.0 * m * g).sqrt();
+            let (l1, l2) = ((-c + disc) / (2.0 * m), (-c - disc) / (2.0 * m));
+            let x0 = d_y - d_p;
+            let a = (v0 - l2 * x0) / (l1 - l2);
+            assert!(a > 0.0, "the storey runs away");
+            let x = |t: f64| a * (l1 * t).exp() + (x0 - a) * (l2 * t).exp();
+            // x rises monotonically: bisect x(t) = L h - d_p.
+            let target = limit * h - d_p;
+            let (mut lo, mut hi) = (0.0, 10.0);
+            for _ in 0..200 {
+                let mid = 0.5 * (lo + hi);
+                if x(mid) < target {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let t_c = 0.5 * (lo + hi);
+            assert!(t_c > 0.1 && t_c < 2.5, "{t_c}");
+            let accel = vec![0.0; 301];
+            for scheme in schemes() {
+                let out = simulate_row(&model, &forcing(&accel), z0.clone(), &scheme);
+                let what = format!("{damping:?}, {}", scheme.key());
+                assert_eq!(out.status, Status::Collapsed, "{what}");
+                let cl = out.collapse.expect("where it collapsed");
+                assert_eq!((cl.building, cl.storey), (1, 1), "{what}");
+                assert!(
+                    relative(cl.time, t_c) < 1e-6,
+                    "{what}: {} against {t_c}",
+                    cl.time
+                );
+                let bo = &out.buildings[0];
+                assert!(
+                    relative(bo.peak_drift_ratio, limit) < 1e-9,
+                    "{what}: {}",
+                    bo.peak_drift_ratio
+                );
+                let ie = bo.inelastic.unwrap();
+                assert!(
+                    ie.residual_drift_ratio.is_nan(),
+                    "{what}: no residual drift"
+                );
+                // The plateau's plastic work, F_y (d - d_y) at the collapse.
+                assert!(
+                    relative(ie.hysteretic_energy, k * d_y * (limit * h - d_y)) < 1e-6,
+                    "{what}"
+                );
+            }
+        }
+    }
+
+    /// Without a collapse limit the same storey runs on past it (a building that stands in
+    /// the model where a real one fell), as it did before collapse existed.
+    #[test]
+    fn without_a_collapse_limit_the_run_goes_on() {
+        let mut b = sdof(1e5, 0.5, 0.05, 0.01, 0.0);
+        b.geometric = Some(vec![0.1 * b.stiffness[0]]);
+        let row = Row::new(
+            vec![b, tower(1, 0.3, false, None, 0.0)],
+            vec![10.0],
+            LawKind::Linear,
+            1e9,
+            0.0,
+        );
+        let model = RowModel::new(&row);
+        let z0 = model.state_of_floors(&[vec![0.01], vec![0.0]], &[vec![0.6], vec![0.0]]);
+        let accel = vec![0.0; 101];
+        let out = simulate_row(&model, &forcing(&accel), z0, &schemes()[0]);
+        assert_ne!(out.status, Status::Collapsed);
+        assert!(out.collapse.is_none());
+        assert!(out.buildings[0].peak_drift_ratio > 0.1);
     }
 }
