@@ -2,6 +2,7 @@
 
 mod accuracy;
 mod cli;
+mod collapse_opensees;
 mod config;
 mod convergence;
 mod damage;
