@@ -3,6 +3,7 @@
 mod accuracy;
 mod cli;
 mod collapse;
+mod collapse_opensees;
 mod config;
 mod convergence;
 mod damage;
