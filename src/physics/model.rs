@@ -7,6 +7,10 @@
 
 use crate::physics::contact::Contact;
 
+/// Standard gravity, m/s^2 (the gravity loads of P-Delta; the factor of PEER files,
+/// where the records re-export it).
+pub const G: f64 = 9.80665;
+
 /// One lumped mass on a spring and dashpot to the ground (one floor, or a whole SDOF building).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Oscillator {

@@ -144,7 +144,7 @@ impl ShearBuilding {
         let mut above = 0.0;
         let mut g = vec![0.0; self.storeys()];
         for j in (0..self.storeys()).rev() {
-            above += crate::record::G * self.masses[j] * ratio;
+            above += crate::physics::model::G * self.masses[j] * ratio;
             g[j] = above / self.heights[j];
         }
         self.geometric = Some(g);
@@ -539,7 +539,7 @@ mod tests {
         let (m, h, t0) = (2e5, 3.5, 0.6);
         let b = ShearBuilding::from_period(vec![m], &[1.0], vec![h], t0, damping);
         // P = g m r, so r = theta k h / (g m).
-        let r = theta * b.stiffness[0] * h / (crate::record::G * m);
+        let r = theta * b.stiffness[0] * h / (crate::physics::model::G * m);
         b.with_p_delta(r)
     }
 

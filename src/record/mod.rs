@@ -13,7 +13,7 @@ pub use synthetic::{synthetic, SyntheticSpec};
 use std::path::PathBuf;
 
 /// Standard gravity, m/s^2 (the factor used by PEER files).
-pub const G: f64 = 9.80665;
+pub use crate::physics::model::G;
 
 /// A uniformly sampled ground acceleration history.
 #[derive(Debug, Clone, PartialEq)]

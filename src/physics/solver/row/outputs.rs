@@ -355,6 +355,20 @@ impl<'m> RowRun<'m> {
                 ls.end_impact();
             }
         }
+        // At rest a storey's drift is its plastic drift, but with P-Delta gravity leans on it:
+        // the static response to the plastic loads, `d_s = p / (1 - theta)` in one storey.
+        let leaning = m.storeys.iter().any(|sm| sm.geometric != 0.0).then(|| {
+            let mut qs = vec![0.0; n];
+            m.static_offsets(&self.z, &mut qs);
+            qs
+        });
+        let residual = |s: usize, sm: &super::yielding::StoreyModel| match &leaning {
+            Some(qs) if sm.geometric != 0.0 => {
+                let o = m.buildings[sm.building].off;
+                super::dot(&sm.modal_row, &qs[o..]) / sm.height
+            }
+            _ => self.z[m.plastic_slot(s)] / sm.height,
+        };
         // Each storey's outputs, which each yielding building gathers.
         let storeys: Vec<StoreyOutput> = m
             .storeys
@@ -362,7 +376,7 @@ impl<'m> RowRun<'m> {
             .zip(&self.storeys)
             .enumerate()
             .map(|(s, (sm, st))| StoreyOutput {
-                residual_drift_ratio: self.z[m.plastic_slot(s)] / sm.height,
+                residual_drift_ratio: residual(s, sm),
                 peak_ductility: st.peak_drift_ratio * sm.height / sm.d_y,
                 hysteretic_energy: self.z[m.plastic_slot(s) + ns],
                 yielded: st.yielded,
