@@ -5,6 +5,7 @@ mod cli;
 mod config;
 mod convergence;
 mod damage;
+mod damage_states;
 mod fast_vs_reference;
 mod fidelity;
 mod figures;
