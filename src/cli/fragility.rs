@@ -4,7 +4,7 @@
 use super::{check_study_outputs, Holds};
 use anyhow::{anyhow, bail, Result};
 use pounding::io::table::{Filter, Table};
-use pounding::studies::damage_states::DamageStates;
+use pounding::studies::damage_states::{self, DamageStates};
 use pounding::studies::fragility::{
     bootstrap, crossings, csv, default_im, fit, number, panel, Band, FragilitySpec, Grouped,
     Undecided,
@@ -22,8 +22,9 @@ const MIN_BOOTSTRAP: usize = 100;
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("limits").required(true).args(["threshold", "damage_states"])))]
 pub struct Args {
-    /// A CSV written by `pound sweep`.
-    results: PathBuf,
+    /// A CSV written by `pound sweep` (not needed with `--damage-states list`).
+    #[arg(required_unless_present = "damage_states")]
+    results: Option<PathBuf>,
     /// Intensity measure: any numeric column (e.g. pga_g, target_sa_g, target_sa_avg_g,
     /// scale_factor). Default: the spectral target the CSV was scaled to, else pga_g.
     #[arg(long)]
@@ -35,9 +36,12 @@ pub struct Args {
     /// Exceedance thresholds (EDP > threshold), comma-separated.
     #[arg(long, value_delimiter = ',')]
     threshold: Vec<f64>,
-    /// Named damage states instead of thresholds: a built-in set (hazus-c1l-high,
-    /// hazus-c1l-moderate, hazus-c1l-low, hazus-c1l-pre: HAZUS-MH drift ratios of low-rise
-    /// concrete moment frames) or a TOML file of `[[state]]` entries with `name` and `limit`.
+    /// Named damage states instead of thresholds: a built-in set (hazus-TYPE-LEVEL, e.g.
+    /// hazus-c1l-high or hazus-s1m-moderate: HAZUS-MH peak drift ratios per model building type
+    /// and code level, read on bK_peak_drift_ratio; fema-p58-residual: FEMA P-58 residual drift
+    /// ratios, read on bK_residual_drift_ratio) or a TOML file of `[[state]]` entries with `name`
+    /// and `limit`. `--damage-states list` prints the built-in sets with their sources and
+    /// limits.
     #[arg(long, value_name = "SET")]
     damage_states: Option<String>,
     /// Bootstrap replicates over the groups of `--by` (records), for 90 % bands of each
@@ -66,6 +70,14 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<()> {
+    if a.damage_states.as_deref() == Some(damage_states::LIST) {
+        use std::io::Write;
+        std::io::stdout().write_all(DamageStates::list().as_bytes())?;
+        return Ok(());
+    }
+    let Some(results) = a.results.clone() else {
+        bail!("give the results CSV (written by pound sweep): pound fragility RESULTS.csv --damage-states SET ... (`--damage-states list` alone prints the built-in sets)");
+    };
     let output = super::default_output(a.output.clone(), "fragility.csv");
     // A damage-state file is an input like the results (a built-in set's name is no file).
     let states_file = a
@@ -78,7 +90,7 @@ pub fn run(a: Args) -> Result<()> {
         .into_iter()
         .collect();
     check_study_outputs(
-        &a.results,
+        &results,
         &other,
         &[
             ("-o", Some(&output), Holds::Csv),
@@ -111,9 +123,11 @@ pub fn run(a: Args) -> Result<()> {
         .map(DamageStates::get)
         .transpose()
         .map_err(|e| anyhow!(e))?;
+    // Limits in another unit, or of another demand (a built-in set names its own).
     if let Some(why) = states.as_ref().and_then(|d| {
         let unit = pounding::plan::meaning::meaning(&a.edp).map(|m| m.unit);
         d.unit_mismatch(&a.edp, unit)
+            .or_else(|| d.demand_mismatch(&a.edp))
     }) {
         bail!(why);
     }
@@ -130,7 +144,7 @@ pub fn run(a: Args) -> Result<()> {
             a.threshold.iter().map(|&t| number(t)).collect(),
         ),
     };
-    let table = Table::read(&a.results)?;
+    let table = Table::read(&results)?;
     let spec = FragilitySpec {
         im: a.im.unwrap_or_else(|| default_im(&table)),
         edp: a.edp,
@@ -144,7 +158,7 @@ pub fn run(a: Args) -> Result<()> {
     if runs == 0 {
         bail!(
             "{}: no run left to count: {}",
-            a.results.display(),
+            results.display(),
             why_none(&table, &spec, &a.filters, &skipped)?
         );
     }

@@ -7,6 +7,7 @@ mod collapse_opensees;
 mod config;
 mod convergence;
 mod damage;
+mod damage_states;
 mod fast_vs_reference;
 mod fidelity;
 mod figures;
