@@ -13,6 +13,7 @@ mod gpu;
 mod gpu_rows;
 mod hard;
 mod hostile;
+mod im_columns;
 mod inelastic;
 mod intensity;
 mod layers;
