@@ -26,7 +26,9 @@ pub struct Args {
     #[arg(required_unless_present = "damage_states")]
     results: Option<PathBuf>,
     /// Intensity measure: any numeric column (e.g. pga_g, target_sa_g, target_sa_avg_g,
-    /// scale_factor). Default: the spectral target the CSV was scaled to, else pga_g.
+    /// scale_factor, or an intensity measure every run writes of its scaled record: pgv_m_s,
+    /// arias_m_s, cav_m_s, sa_t1_g / sa_t2_g of a pair, b1_sa_t1_g ... of a row). Default: the
+    /// spectral target the CSV was scaled to, else pga_g.
     #[arg(long)]
     im: Option<String>,
     /// Demand column (e.g. peak_force_n, b1_peak_drift_ratio; `impacts` with threshold 0 for

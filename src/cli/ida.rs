@@ -11,8 +11,10 @@ use std::path::PathBuf;
 pub struct Args {
     /// A CSV written by `pound sweep`.
     results: PathBuf,
-    /// Intensity measure column (e.g. target_sa_g, target_sa_avg_g, pga_g). Default: the
-    /// spectral target the CSV was scaled to, else pga_g.
+    /// Intensity measure column (e.g. target_sa_g, target_sa_avg_g, pga_g, or an intensity
+    /// measure every run writes of its scaled record: pgv_m_s, arias_m_s, cav_m_s, sa_t1_g /
+    /// sa_t2_g of a pair, b1_sa_t1_g ... of a row). Default: the spectral target the CSV was
+    /// scaled to, else pga_g.
     #[arg(long)]
     im: Option<String>,
     /// Demand column (e.g. b1_peak_drift_ratio, peak_force_n).

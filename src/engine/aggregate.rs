@@ -279,6 +279,10 @@ enum Param {
     Target(usize),
     Scale,
     Pga,
+    /// One of [`crate::plan::intensity::IM_COLUMNS`].
+    RecordIm(usize),
+    /// `Sa(T1)` of building 1 or 2 (0 or 1).
+    SaT1(usize),
     M1,
     T1,
     Xi1,
@@ -309,6 +313,11 @@ impl Param {
             "sa_avg_to_s" => Target(5),
             "scale_factor" => Scale,
             "pga_g" => Pga,
+            "pgv_m_s" => RecordIm(0),
+            "arias_m_s" => RecordIm(1),
+            "cav_m_s" => RecordIm(2),
+            "sa_t1_g" => SaT1(0),
+            "sa_t2_g" => SaT1(1),
             "m1_kg" => M1,
             "t1_s" => T1,
             "xi1" => Xi1,
@@ -321,7 +330,7 @@ impl Param {
         })
     }
 
-    fn key(self, s: &RunSpec) -> u64 {
+    fn key(self, plan: &PairPlan, s: &RunSpec) -> u64 {
         const NONE: u64 = u64::MAX;
         let bits = |x: Option<f64>| x.map_or(NONE, f64::to_bits);
         let hertz = s.law.is_hertzian();
@@ -337,6 +346,11 @@ impl Param {
             Param::Target(i) => bits(target_values(&s.intensity, s.im_periods)[i]),
             Param::Scale => s.scale.to_bits(),
             Param::Pga => s.pga_g.to_bits(),
+            Param::RecordIm(i) => plan.contact.record_ims(s)[i].to_bits(),
+            Param::SaT1(b) => plan
+                .contact
+                .sa_g(s, if b == 0 { s.t1 } else { s.t2 })
+                .to_bits(),
             Param::M1 => s.m1.to_bits(),
             Param::T1 => s.t1.to_bits(),
             Param::Xi1 => s.xi1.to_bits(),
@@ -594,7 +608,7 @@ impl Aggregator {
         let key: Vec<u64> = self
             .by
             .iter()
-            .map(|(_, _, p)| p.expect("a pair's aggregator").key(spec))
+            .map(|(_, _, p)| p.expect("a pair's aggregator").key(plan, spec))
             .collect();
         let next = self.groups.len() as u32;
         let id = *self.ids.entry(key).or_insert(next);
@@ -686,6 +700,17 @@ mod tests {
                 .parse()
                 .unwrap();
             assert_eq!(cell.abs(), value, "{name}");
+        }
+    }
+
+    /// A pair's summary may group by any parameter column (every one before `status`, the
+    /// intensity measures of the scaled record among them), and by none after it.
+    #[test]
+    fn every_parameter_column_of_a_pair_is_a_key() {
+        let h = header();
+        let status = h.iter().position(|c| *c == "status").unwrap();
+        for (i, c) in h.iter().enumerate() {
+            assert_eq!(Param::from_column(c).is_some(), i < status, "{c}");
         }
     }
 

@@ -3,13 +3,14 @@
 //! device fold all name columns from here.
 
 use crate::physics::model::RunOutput;
-use crate::plan::intensity::target_values;
+use crate::plan::intensity::{target_values, IM_COLUMNS};
 use crate::plan::{ContactPlan, ContactRun, PairPlan, RunSpec};
 
-/// Every column, in file order: the swept parameters, then the status and the outputs. Units are
-/// in the names. The last three, the energy balance, are empty unless it was asked for
-/// (`run.energy`, `--energy`).
-pub const HEADER: [&str; 38] = [
+/// Every column, in file order: the swept parameters (with the intensity measures of the scaled
+/// record, which every run writes whatever it was scaled to), then the status and the outputs.
+/// Units are in the names. The last three, the energy balance, are empty unless it was asked
+/// for (`run.energy`, `--energy`).
+pub const HEADER: [&str; 43] = [
     "run",
     "law",
     "formula",
@@ -26,6 +27,11 @@ pub const HEADER: [&str; 38] = [
     "sa_avg_to_s",
     "scale_factor",
     "pga_g",
+    "pgv_m_s",
+    "arias_m_s",
+    "cav_m_s",
+    "sa_t1_g",
+    "sa_t2_g",
     "m1_kg",
     "t1_s",
     "xi1",
@@ -50,21 +56,50 @@ pub const HEADER: [&str; 38] = [
     "energy_residual",
 ];
 
-/// Where [`SUMMARISED`] lies in [`HEADER`].
-const SUMMARISED_AT: [usize; 8] = [25, 26, 27, 28, 29, 30, 32, 33];
-
 /// The outputs an `--aggregate` summary folds per group (as magnitudes): every numeric output
 /// but the first impact's time (absent where nothing touches), the step count and the energy
-/// balance (absent unless asked for).
+/// balance (absent unless asked for). Each is a column of [`HEADER`] after `status`, checked
+/// when compiled ([`at`]).
 pub const SUMMARISED: [&str; 8] = {
-    let mut names = [""; 8];
+    let names = [
+        "impacts",
+        "peak_force_n",
+        "peak_penetration_m",
+        "peak_u1_m",
+        "peak_u2_m",
+        "impact_velocity_m_s",
+        "contact_time_s",
+        "dissipated_energy_j",
+    ];
     let mut i = 0;
     while i < names.len() {
-        names[i] = HEADER[SUMMARISED_AT[i]];
+        assert!(
+            at(names[i]) > at("status"),
+            "a summarised column is an output"
+        );
         i += 1;
     }
     names
 };
+
+/// The index of `name` in [`HEADER`] (a compile-time error in a constant where it is none).
+pub const fn at(name: &str) -> usize {
+    let mut i = 0;
+    while i < HEADER.len() {
+        let (a, b) = (HEADER[i].as_bytes(), name.as_bytes());
+        if a.len() == b.len() {
+            let mut k = 0;
+            while k < a.len() && a[k] == b[k] {
+                k += 1;
+            }
+            if k == a.len() {
+                return i;
+            }
+        }
+        i += 1;
+    }
+    panic!("not a column of HEADER")
+}
 
 /// Shortest round-trip text; scientific notation outside [1e-4, 1e15) so tiny values stay short
 /// ([`crate::show`], the one form of a number every output and message writes).
@@ -73,14 +108,23 @@ pub(crate) fn num(x: f64) -> String {
 }
 
 /// The columns of the contact and the ground motion: the first [`CONTACT_AND_MOTION`] of
-/// [`HEADER`], which rows of multi-storey buildings share ([`crate::plan::row`]).
-pub const CONTACT_AND_MOTION: usize = 16;
+/// [`HEADER`], which rows of multi-storey buildings share ([`crate::plan::row`]): through
+/// `pga_g`, then the intensity measures that do not depend on the buildings
+/// ([`IM_COLUMNS`]). Each building's `Sa(T1)` follows them (`sa_t1_g`, `sa_t2_g` in a pair;
+/// `b1_sa_t1_g`, ... in a row).
+pub const CONTACT_AND_MOTION: usize = RECORD_IMS + IM_COLUMNS.len();
+
+/// Where the record's intensity measures ([`IM_COLUMNS`]) start in [`HEADER`]: after the
+/// record, its targets, `scale_factor` and `pga_g` (the columns `record..RECORD_IMS`).
+pub const RECORD_IMS: usize = at("pga_g") + 1;
 
 /// The fields of one row, in [`HEADER`] order.
 pub fn row(plan: &PairPlan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
     let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
     let mut cells = contact_and_motion(&plan.contact, &spec.contact);
     cells.extend([
+        num(plan.contact.sa_g(&spec.contact, spec.t1)),
+        num(plan.contact.sa_g(&spec.contact, spec.t2)),
         num(spec.m1),
         num(spec.t1),
         num(spec.xi1),
@@ -141,6 +185,7 @@ pub fn contact_and_motion(plan: &ContactPlan, spec: &ContactRun) -> Vec<String> 
             .map(opt),
     );
     cells.extend([num(spec.scale), num(spec.pga_g)]);
+    cells.extend(plan.record_ims(spec).map(num));
     cells
 }
 
@@ -200,6 +245,23 @@ mod tests {
         let at = HEADER.iter().position(|c| *c == "record").unwrap() + 1;
         assert_eq!(HEADER[at..at + TARGET_COLUMNS.len()], TARGET_COLUMNS);
         assert_eq!(HEADER[at + TARGET_COLUMNS.len()], "scale_factor");
+    }
+
+    /// The record's intensity measures follow `pga_g`, the contact and motion columns end with
+    /// them, and the pair's `Sa(T1)` of each building come next; all are parameters.
+    #[test]
+    fn intensity_measures_follow_the_pga_as_parameters() {
+        let pga = at("pga_g");
+        assert_eq!(HEADER[pga + 1..pga + 4], IM_COLUMNS);
+        assert_eq!(RECORD_IMS, pga + 1);
+        assert_eq!(CONTACT_AND_MOTION, pga + 4);
+        assert_eq!(
+            HEADER[CONTACT_AND_MOTION..CONTACT_AND_MOTION + 3],
+            ["sa_t1_g", "sa_t2_g", "m1_kg"]
+        );
+        assert!(at("sa_t2_g") < at("status"));
+        assert_eq!(at("run"), 0);
+        assert_eq!(HEADER[at("dissipated_energy_j")], "dissipated_energy_j");
     }
 
     #[test]

@@ -76,6 +76,9 @@ pub struct ContactPlan {
     pgas: Vec<f64>,
     /// Spectral measures of the records, as runs ask for them.
     ims: intensity::ImCache,
+    /// The intensity measures each run writes of its record ([`ContactPlan::record_ims`],
+    /// [`ContactPlan::sa_g`]), computed once per record (and period) as runs ask for them.
+    motion_ims: Arc<intensity::MotionIms>,
 }
 
 /// One contact run, decoded: what a run holds but its buildings and gaps.
@@ -263,11 +266,13 @@ impl ContactPlan {
                 .checked_add(len)
                 .ok_or_else(|| err("contact", "more than 2^64 contact runs"))?;
         }
+        let records = spec.records.len();
         Ok(ContactPlan {
             spec,
             blocks,
             total,
             damping,
+            motion_ims: Arc::new(intensity::MotionIms::new(records, [])),
             pgas,
             ims: intensity::ImCache::default(),
         })
@@ -341,6 +346,31 @@ impl ContactPlan {
         run.scale = s.scale;
         run.im_periods = s.periods;
         run.pga_g = self.pgas[r] * s.scale / G;
+    }
+
+    /// List the fundamental periods (s) the scene's buildings take (`periods[b]`: every value
+    /// of building `b`, its axis or its samples), whose `Sa` runs write: each is computed once
+    /// per record.
+    pub(crate) fn list_periods(&mut self, periods: &[Vec<f64>]) {
+        self.motion_ims = Arc::new(intensity::MotionIms::new(
+            self.spec.records.len(),
+            periods.iter().flatten().copied(),
+        ));
+    }
+
+    /// PGV, Arias intensity and CAV (m/s) of `run`'s scaled record, in
+    /// [`intensity::IM_COLUMNS`] order.
+    pub fn record_ims(&self, run: &ContactRun) -> [f64; 3] {
+        let r = run.record;
+        self.motion_ims
+            .record(r, &self.spec.records[r])
+            .scaled(run.scale)
+    }
+
+    /// `Sa(period, 5 %)` of `run`'s scaled record, g.
+    pub fn sa_g(&self, run: &ContactRun, period: f64) -> f64 {
+        let r = run.record;
+        self.motion_ims.sa(r, &self.spec.records[r], period) * run.scale / G
     }
 
     /// The records scaled past a PGA no earthquake reaches, or by more than the config's

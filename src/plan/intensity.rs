@@ -4,10 +4,11 @@
 //! period scales it per run, so its factor is resolved where the run's periods are known
 //! ([`crate::plan::PairPlan::run`], [`crate::plan::row::RowPlan::run`]).
 
-use crate::record::intensity::{log_periods, sa_avg};
+use crate::record::intensity::{arias_cav, log_periods, pgv_pgd, sa, sa_avg, DEFAULT_DAMPING};
 use crate::record::{Record, G};
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// The longest period a spectral target reads (s); the shortest is a building's
 /// ([`crate::plan::limits::MIN_PERIOD_S`]).
@@ -197,6 +198,108 @@ impl ImCache {
     }
 }
 
+/// The intensity measures every run writes of its scaled record, whatever it was scaled to,
+/// that do not depend on the buildings (units in the names), in file order after `pga_g`; each
+/// building's `Sa(T1)` follows them ([`MotionIms::sa_g`]).
+pub const IM_COLUMNS: [&str; 3] = ["pgv_m_s", "arias_m_s", "cav_m_s"];
+
+/// The suffix of a building's `Sa(T1)` column in a row (`b2_sa_t1_g`); a pair's are `sa_t1_g` and
+/// `sa_t2_g`.
+pub const SA_T1_COLUMN: &str = "sa_t1_g";
+
+/// PGV, Arias intensity and CAV of an unscaled record (m/s), over its samples as simulated (its
+/// window, not the free tail): [`crate::record::intensity`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RecordIms {
+    pub pgv: f64,
+    pub arias: f64,
+    pub cav: f64,
+}
+
+impl RecordIms {
+    pub fn of(rec: &Record) -> RecordIms {
+        let (arias, cav) = arias_cav(rec);
+        RecordIms {
+            pgv: pgv_pgd(rec).0,
+            arias,
+            cav,
+        }
+    }
+
+    /// The values of [`IM_COLUMNS`] for the record scaled by `scale` (> 0): PGV and CAV scale
+    /// with it, Arias intensity with its square.
+    pub fn scaled(&self, scale: f64) -> [f64; 3] {
+        [
+            self.pgv * scale,
+            self.arias * scale * scale,
+            self.cav * scale,
+        ]
+    }
+}
+
+/// Sentinel of a value not yet computed in [`MotionIms`]' table (a NaN no arithmetic makes).
+const NOT_YET: u64 = u64::MAX;
+
+/// The intensity measures of a sweep's unscaled records that its runs write: PGV, Arias and CAV
+/// once per record, and `Sa(T, 5 %)` once per record and fundamental period a building takes
+/// (every period is known when the plan is built: an axis's values or a sample's), each
+/// computed when a run first asks and read lock-free after. A period the plan did not list
+/// (a run built by hand) is computed when asked.
+#[derive(Debug, Default)]
+pub struct MotionIms {
+    records: Vec<OnceLock<RecordIms>>,
+    /// Each listed period's bits, and its index in a record's row of `sa`.
+    periods: HashMap<u64, usize>,
+    /// Per record, lazily: `Sa` (m/s^2) at each listed period, as bits (`NOT_YET` until asked).
+    sa: Vec<OnceLock<Box<[AtomicU64]>>>,
+}
+
+impl MotionIms {
+    /// For `records` records and the fundamental periods `periods` (s) the buildings take.
+    pub fn new(records: usize, periods: impl IntoIterator<Item = f64>) -> MotionIms {
+        let mut index = HashMap::new();
+        for t in periods {
+            let next = index.len();
+            index.entry(t.to_bits()).or_insert(next);
+        }
+        MotionIms {
+            records: (0..records).map(|_| OnceLock::new()).collect(),
+            periods: index,
+            sa: (0..records).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// PGV, Arias and CAV of record `r` (`rec`), unscaled.
+    pub fn record(&self, r: usize, rec: &Record) -> RecordIms {
+        match self.records.get(r) {
+            Some(cell) => *cell.get_or_init(|| RecordIms::of(rec)),
+            None => RecordIms::of(rec),
+        }
+    }
+
+    /// `Sa(period, 5 %)` of record `r` (`rec`), unscaled, m/s^2.
+    pub fn sa(&self, r: usize, rec: &Record, period: f64) -> f64 {
+        let compute = || sa(rec, period, DEFAULT_DAMPING);
+        let (Some(&i), Some(row)) = (self.periods.get(&period.to_bits()), self.sa.get(r)) else {
+            return compute();
+        };
+        let row = row.get_or_init(|| {
+            (0..self.periods.len())
+                .map(|_| AtomicU64::new(NOT_YET))
+                .collect()
+        });
+        match row[i].load(Ordering::Relaxed) {
+            NOT_YET => {
+                // Two threads asking at once both compute it: the same value.
+                let v = compute();
+                row[i].store(v.to_bits(), Ordering::Relaxed);
+                v
+            }
+            bits => f64::from_bits(bits),
+        }
+    }
+}
+
 impl Intensity {
     /// A spectral target at a period that follows a building's (so its scale factor varies
     /// with the run's buildings).
@@ -331,6 +434,35 @@ pub fn check_periods(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A listed period's Sa is computed once per record and read back the same; an unlisted one
+    /// is computed when asked, to the same value; PGV, Arias and CAV scale as their units do.
+    #[test]
+    fn motion_ims_are_the_records_own() {
+        let rec = |seed: f64| Record {
+            name: "r".into(),
+            dt: 0.01,
+            t0: 0.0,
+            accel: (0..500).map(|i| (i as f64 * 0.05 * seed).sin()).collect(),
+        };
+        let (r0, r1) = (rec(1.0), rec(1.7));
+        let ims = MotionIms::new(2, [0.5, 1.0, 0.5]);
+        assert_eq!(ims.periods.len(), 2);
+        for (r, x) in [(0, &r0), (1, &r1)] {
+            for t in [0.5, 1.0, 0.75] {
+                let want = sa(x, t, DEFAULT_DAMPING);
+                assert_eq!(ims.sa(r, x, t), want);
+                assert_eq!(ims.sa(r, x, t), want, "read back");
+            }
+            assert_eq!(ims.record(r, x), RecordIms::of(x));
+        }
+        let one = RecordIms::of(&r0);
+        let [pgv, arias, cav] = one.scaled(3.0);
+        assert_eq!(
+            [pgv, arias, cav],
+            [3.0 * one.pgv, 9.0 * one.arias, 3.0 * one.cav]
+        );
+    }
 
     #[test]
     fn period_references_parse_and_resolve() {

@@ -14,7 +14,7 @@ pub struct Meaning {
 }
 
 /// The columns of one run that do not depend on the scene: name, unit, short name, meaning.
-const FIXED: [(&str, &str, &str, &str); 39] = [
+const FIXED: [(&str, &str, &str, &str); 44] = [
     ("run", "-", "run", "run number"),
     ("law", "-", "contact law", "contact law"),
     (
@@ -91,6 +91,36 @@ const FIXED: [(&str, &str, &str, &str); 39] = [
         "factor applied to the record",
     ),
     ("pga_g", "g", "PGA", "PGA of the scaled record"),
+    (
+        "pgv_m_s",
+        "m/s",
+        "PGV",
+        "PGV of the scaled record, whatever it was scaled to: the largest magnitude of the ground velocity, the integral of its acceleration from rest over the record as simulated (its window if any, not the free tail), the acceleration linear between samples (so the trapezoid rule is exact, and peaks between samples count), no baseline correction",
+    ),
+    (
+        "arias_m_s",
+        "m/s",
+        "Arias intensity",
+        "Arias intensity of the scaled record, pi / (2 g) * integral of ag^2 dt over the record as simulated (its window if any, not the free tail), the acceleration linear between samples and integrated exactly (it grows as the square of the scale factor)",
+    ),
+    (
+        "cav_m_s",
+        "m/s",
+        "CAV",
+        "cumulative absolute velocity of the scaled record, integral of abs(ag) dt over the record as simulated (its window if any, not the free tail), the acceleration linear between samples and integrated exactly (a step that changes sign split at its zero), no threshold",
+    ),
+    (
+        "sa_t1_g",
+        "g",
+        "Sa(T1), building 1",
+        "Sa(T1, 5 %) of the scaled record at building 1's period t1_s, whatever it was scaled to: pseudo-spectral acceleration (w^2 times the peak displacement) of a linear oscillator from rest, exact for the acceleration linear between samples, over the record as simulated (its window if any, not the free tail)",
+    ),
+    (
+        "sa_t2_g",
+        "g",
+        "Sa(T2), building 2",
+        "Sa(T2, 5 %) of the scaled record at building 2's period t2_s, whatever it was scaled to: pseudo-spectral acceleration (w^2 times the peak displacement) of a linear oscillator from rest, exact for the acceleration linear between samples, over the record as simulated (its window if any, not the free tail)",
+    ),
     ("m1_kg", "kg", "mass, building 1", "mass of building 1"),
     ("t1_s", "s", "period, building 1", "period of building 1"),
     (
@@ -213,7 +243,8 @@ const ENERGY: [(&str, &str, &str, &str); 2] = [
 ];
 
 /// Per building `k`: suffix, unit, short name, meaning.
-const PER_BUILDING: [(&str, &str, &str, &str); 18] = [
+const PER_BUILDING: [(&str, &str, &str, &str); 19] = [
+    ("sa_t1_g", "g", "Sa(T1), building {k}", "Sa(T1, 5 %) of the scaled record at building {k}'s fundamental period b{k}_t1_s, whatever it was scaled to: pseudo-spectral acceleration (w^2 times the peak displacement) of a linear oscillator from rest, exact for the acceleration linear between samples, over the record as simulated (its window if any, not the free tail)"),
     ("storeys", "-", "storeys, building {k}", "storeys of building {k}"),
     ("mass_kg", "kg", "floor mass, building {k}", "floor mass of building {k} (empty where floor masses are given)"),
     ("t1_s", "s", "period T1, building {k}", "fundamental period of building {k}"),

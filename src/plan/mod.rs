@@ -581,8 +581,9 @@ impl PairPlan {
             periods(&spec.building1, SampledAxis::Period1),
             periods(&spec.building2, SampledAxis::Period2),
         ];
-        let contact = ContactPlan::new(spec.contact)?;
+        let mut contact = ContactPlan::new(spec.contact)?;
         intensity::check_periods(&contact.spec.intensities, &taken).map_err(|(k, m)| err(k, m))?;
+        contact.list_periods(&taken);
         let c = &contact.spec;
         let counts = AxisCounts {
             formulas: c.formulas.len(),

@@ -649,7 +649,8 @@ impl RowPlan {
     }
 
     /// Every column, in file order: the contact and motion columns of the pair, each
-    /// building's parameters (`b1_...`), each gap, the status and totals, each building's
+    /// building's `Sa(T1)` of the scaled record (`b1_sa_t1_g`, ...), each building's
+    /// parameters (`b1_...`), each gap, the status and totals, each building's
     /// peaks, each level's, and the energy balance (empty unless asked for).
     pub fn header(&self) -> Vec<String> {
         let mut h: Vec<String> = columns::HEADER[..columns::CONTACT_AND_MOTION]
@@ -657,6 +658,9 @@ impl RowPlan {
             .map(|s| s.to_string())
             .collect();
         let nb = self.buildings.len();
+        for b in 1..=nb {
+            h.push(format!("b{b}_{}", crate::plan::intensity::SA_T1_COLUMN));
+        }
         for b in 1..=nb {
             for c in ["storeys", "mass_kg", "t1_s", "xi"] {
                 h.push(format!("b{b}_{c}"));
@@ -723,7 +727,7 @@ impl RowPlan {
         let swept = (0..self.buildings.len())
             .filter(|&b| self.swept_yield(b).is_some())
             .count();
-        columns::CONTACT_AND_MOTION + 4 * self.buildings.len() + swept + self.gaps.len() + 1
+        columns::CONTACT_AND_MOTION + 5 * self.buildings.len() + swept + self.gaps.len() + 1
     }
 
     /// Building `b`'s yielding storeys where their strength is swept or sampled (it then has
@@ -763,6 +767,11 @@ impl RowPlan {
         let num = columns::num;
         let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
         let mut c = columns::contact_and_motion(&self.contact, &run.contact);
+        c.extend(
+            run.period
+                .iter()
+                .map(|&t| num(self.contact.sa_g(&run.contact, t))),
+        );
         for (b, a) in self.buildings.iter().enumerate() {
             c.push(a.storeys().to_string());
             c.push(opt(run.mass[b]));
@@ -969,7 +978,7 @@ pub fn parse_row(
     let k_grid = grid_or_sampled(RowSampled::KLinear, raw.contact.k_n_per_m.as_ref())?;
     let beta_grid = grid_or_sampled(RowSampled::Beta, raw.contact.beta_n_per_m1_5.as_ref())?;
     let shared_gap = grid_or_sampled(RowSampled::SharedGap, raw.contact.gap_m.as_ref())?;
-    let contact = parse_contact(
+    let mut contact = parse_contact(
         &raw.run,
         &raw.contact,
         k_grid.as_ref(),
@@ -1184,6 +1193,7 @@ pub fn parse_row(
             ));
         }
     };
+    contact.list_periods(&taken);
     let mut dims = vec![samples.as_ref().map_or(1, |s| s.points.len())];
     dims.extend(
         buildings

@@ -10,6 +10,9 @@
 //! - PGV and PGD: the velocity and displacement of the ground, integrated exactly from the
 //!   piecewise-linear acceleration (the trapezoid rule for the velocity is exact then), from
 //!   rest and with no baseline correction; peaks between samples are included.
+//! - Arias intensity `I_a = pi / (2 g) * integral ag^2 dt` and CAV `integral |ag| dt` (both
+//!   m/s): integrated exactly for the piecewise-linear acceleration (`|ag|` split at the zero
+//!   of a step whose samples change sign).
 
 use super::Record;
 use crate::physics::model::Oscillator;
@@ -142,6 +145,27 @@ pub fn pgv_pgd(rec: &Record) -> (f64, f64) {
     (pgv, pgd)
 }
 
+/// Arias intensity `pi / (2 g) * integral ag^2 dt` and cumulative absolute velocity
+/// `integral |ag| dt` (both m/s) over the record's samples ([module docs](self)): exact for the
+/// acceleration linear between samples.
+pub fn arias_cav(rec: &Record) -> (f64, f64) {
+    let h = rec.dt;
+    let (mut squares, mut absolute) = (0.0f64, 0.0f64);
+    for pair in rec.accel.windows(2) {
+        let (a0, a1) = (pair[0], pair[1]);
+        // Over a step, a = a0 + (a1 - a0) t / h: integral a^2 = h (a0^2 + a0 a1 + a1^2) / 3.
+        squares += h * (a0 * a0 + a0 * a1 + a1 * a1) / 3.0;
+        let (b0, b1) = (a0.abs(), a1.abs());
+        absolute += if a0 * a1 < 0.0 {
+            // Two triangles either side of the zero at t = h b0 / (b0 + b1).
+            0.5 * h * (b0 * b0 + b1 * b1) / (b0 + b1)
+        } else {
+            0.5 * h * (b0 + b1)
+        };
+    }
+    (std::f64::consts::PI / (2.0 * super::G) * squares, absolute)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -250,5 +274,29 @@ mod tests {
         // a = 0, A, -A, 0: v(1) = A/2, a crosses 0 at t = 1.5 where v = A/2 + A/4 = 3A/4.
         let (pgv, _) = pgv_pgd(&record(1.0, vec![0.0, a, -a, 0.0]));
         assert!((pgv - 0.75 * a).abs() < 1e-14, "{pgv}");
+    }
+
+    /// Closed forms of the piecewise-linear acceleration: a constant A over duration D gives
+    /// `integral a^2 = A^2 D` and `integral |a| = A D`; a ramp 0 to A over one step gives
+    /// `A^2 h / 3` and `A h / 2`; a step from A to -B crosses zero at `h A / (A + B)`, so
+    /// `integral |a| = h (A^2 + B^2) / (2 (A + B))`, not the trapezoid's `h (A - B) / 2`.
+    #[test]
+    fn arias_and_cav_of_piecewise_linear_records() {
+        let k = std::f64::consts::PI / (2.0 * crate::record::G);
+        let rel = |x: f64, y: f64| ((x - y) / y).abs();
+        let (a, dt, n) = (-2.0, 0.02, 101);
+        let (arias, cav) = arias_cav(&record(dt, vec![a; n]));
+        let d = (n - 1) as f64 * dt;
+        assert!(rel(arias, k * a * a * d) < 1e-13 && rel(cav, a.abs() * d) < 1e-13);
+        let (arias, cav) = arias_cav(&record(0.5, vec![0.0, 3.0]));
+        assert!(rel(arias, k * 9.0 * 0.5 / 3.0) < 1e-15 && rel(cav, 0.75) < 1e-15);
+        let (arias, cav) = arias_cav(&record(1.0, vec![3.0, -1.0]));
+        assert!(rel(cav, (9.0 + 1.0) / 8.0) < 1e-15, "{cav}");
+        assert!(rel(arias, k * (9.0 - 3.0 + 1.0) / 3.0) < 1e-15, "{arias}");
+        // Scaling: Arias with the square of the factor, CAV with the factor.
+        let accel: Vec<f64> = (0..300).map(|i| (i as f64 * 0.21).sin()).collect();
+        let (a1, c1) = arias_cav(&record(0.01, accel.clone()));
+        let (a2, c2) = arias_cav(&record(0.01, accel.iter().map(|x| 2.0 * x).collect()));
+        assert!(rel(a2, 4.0 * a1) < 1e-13 && rel(c2, 2.0 * c1) < 1e-13);
     }
 }

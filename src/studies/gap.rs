@@ -16,7 +16,7 @@ use crate::physics::shear::ShearBuilding;
 use crate::physics::solver::separation::{
     separation, yielding_separation, LevelSeparation, Separation,
 };
-use crate::plan::columns::{contact_and_motion, num, CONTACT_AND_MOTION};
+use crate::plan::columns::{at, contact_and_motion, num, RECORD_IMS};
 use crate::plan::intensity::TARGET_COLUMNS;
 use crate::plan::row::level_name;
 use crate::plan::sample::phi;
@@ -105,7 +105,7 @@ impl Scenes<'_> {
         let motion_cells = |plan: &crate::plan::ContactPlan, spec: &crate::plan::ContactRun| {
             let mut c = vec![m.to_string()];
             // record, the targets, scale_factor, pga_g
-            c.extend(contact_and_motion(plan, spec).drain(7..CONTACT_AND_MOTION));
+            c.extend(contact_and_motion(plan, spec).drain(at("record")..RECORD_IMS));
             c
         };
         let sample = |s: Option<usize>| s.map(|s| s.to_string()).unwrap_or_default();

@@ -16,6 +16,7 @@ mod gpu;
 mod gpu_rows;
 mod hard;
 mod hostile;
+mod im_columns;
 mod inelastic;
 mod intensity;
 mod layers;

@@ -104,6 +104,11 @@ fn compare(pair: &[HashMap<String, String>], row: &[HashMap<String, String>]) ->
             ("gap_m", "gap_1_2_m"),
             ("t1_s", "b1_t1_s"),
             ("scale_factor", "scale_factor"),
+            ("pgv_m_s", "pgv_m_s"),
+            ("arias_m_s", "arias_m_s"),
+            ("cav_m_s", "cav_m_s"),
+            ("sa_t1_g", "b1_sa_t1_g"),
+            ("sa_t2_g", "b2_sa_t1_g"),
             ("impacts", "impacts"),
         ] {
             assert_eq!(p[a], r[b], "run {}: {a}", p["run"]);
