@@ -266,8 +266,9 @@ impl RowOutput {
     /// Fill the totals from the levels.
     pub(crate) fn gather(&mut self) {
         self.impacts = self.levels.iter().map(|l| l.impacts).sum();
-        self.contact_time = self.levels.iter().map(|l| l.contact_time).sum();
-        self.dissipated_energy = self.levels.iter().map(|l| l.dissipated_energy).sum();
+        // From +0 (a float sum starts at -0): a building alone has no level.
+        self.contact_time = self.levels.iter().fold(0.0, |a, l| a + l.contact_time);
+        self.dissipated_energy = (self.levels.iter()).fold(0.0, |a, l| a + l.dissipated_energy);
         self.first_impact = self
             .levels
             .iter()

@@ -143,16 +143,27 @@ impl Plan {
                     .filter(|&b| r.yielding[b].is_some())
                     .map(|b| (b + 1).to_string())
                     .collect();
-                format!(
-                    "a row of {} buildings ({} storeys, {} contact levels{})",
-                    r.buildings.len(),
-                    r.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
-                    r.row(&r.run(0)).levels.len(),
+                let leaning = r.buildings.iter().any(|b| b.p_delta.is_some());
+                let tail = format!(
+                    "{}{}",
                     if yielding.is_empty() {
                         String::new()
                     } else {
                         format!("; yielding storeys in building {}", yielding.join(", "))
-                    }
+                    },
+                    if leaning { "; P-Delta" } else { "" }
+                );
+                if r.buildings.len() == 1 {
+                    return format!(
+                        "one building alone ({} storeys{tail})",
+                        r.buildings[0].storeys()
+                    );
+                }
+                format!(
+                    "a row of {} buildings ({} storeys, {} contact levels{tail})",
+                    r.buildings.len(),
+                    r.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
+                    r.row(&r.run(0)).levels.len(),
                 )
             }
         }

@@ -197,7 +197,8 @@ pub struct RawRowConfig {
     #[serde(default)]
     pub run: RawRun,
     pub building: Vec<RawShearBuilding>,
-    pub contact: RawContact,
+    /// May be left out for a building alone (nothing to touch).
+    pub contact: Option<RawContact>,
     #[serde(rename = "record", default)]
     pub records: Vec<RawRecord>,
     #[serde(default)]
@@ -942,13 +943,11 @@ pub fn parse_row(
         key: key.into(),
         message,
     };
-    if raw.building.len() < 2 {
+    // One building is a scene too: the no-pounding baseline of a study.
+    if raw.building.is_empty() {
         return Err(invalid(
             "building",
-            format!(
-                "{} [[building]] entries: a row needs at least two",
-                raw.building.len()
-            ),
+            "no [[building]] entries: give at least one".into(),
         ));
     }
     let nb = raw.building.len();
@@ -975,12 +974,36 @@ pub fn parse_row(
     let grid_or_sampled = |a: RowSampled, given: Option<&Axis>| {
         config::grid_or_sampled(given, sampled(a)).map_err(|m| invalid(&a.key(), m))
     };
-    let k_grid = grid_or_sampled(RowSampled::KLinear, raw.contact.k_n_per_m.as_ref())?;
-    let beta_grid = grid_or_sampled(RowSampled::Beta, raw.contact.beta_n_per_m1_5.as_ref())?;
-    let shared_gap = grid_or_sampled(RowSampled::SharedGap, raw.contact.gap_m.as_ref())?;
+    // A building alone touches nothing: without [contact] it takes a linear law it never uses.
+    let contact_given = raw.contact.clone();
+    let raw_contact = match (contact_given, nb) {
+        (Some(c), _) => c,
+        (None, 1) => RawContact {
+            law: config::Names::One("linear".into()),
+            formula: None,
+            e: None,
+            gap_m: None,
+            k_n_per_m: Some(Axis::List(vec![1e9])),
+            beta_n_per_m1_5: None,
+        },
+        (None, _) => return Err(invalid(
+            "contact",
+            "missing: a row of buildings that may touch needs [contact] (law and its stiffness)"
+                .into(),
+        )),
+    };
+    let raw = RawRowConfig {
+        contact: Some(raw_contact),
+        ..raw
+    };
+    let contact_of = |r: &RawRowConfig| r.contact.clone().expect("set above");
+    let rc = contact_of(&raw);
+    let k_grid = grid_or_sampled(RowSampled::KLinear, rc.k_n_per_m.as_ref())?;
+    let beta_grid = grid_or_sampled(RowSampled::Beta, rc.beta_n_per_m1_5.as_ref())?;
+    let shared_gap = grid_or_sampled(RowSampled::SharedGap, rc.gap_m.as_ref())?;
     let mut contact = parse_contact(
         &raw.run,
-        &raw.contact,
+        &rc,
         k_grid.as_ref(),
         beta_grid.as_ref(),
         &raw.records,
@@ -1147,7 +1170,7 @@ pub fn parse_row(
     }
     shared.truncate(nb - 1);
     let mut ignored = Vec::new();
-    if raw.contact.gap_m.is_some() && !shared.contains(&true) {
+    if rc.gap_m.is_some() && !shared.contains(&true) {
         ignored.push("contact.gap_m is ignored: every pair has its own gap_right_m".to_string());
     }
     if sampled(RowSampled::SharedGap) && !shared.contains(&true) {

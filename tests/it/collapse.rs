@@ -348,3 +348,77 @@ fn the_gpu_runs_elastic_p_delta_and_hands_collapses_to_the_cpu() {
         assert!((a - b).abs() <= 1e-5 * a.abs(), "{c}: {a} {b}");
     }
 }
+
+/// A `[[building]]` list of one is a scene (the no-pounding baseline): no `[contact]` needed,
+/// no gap or level columns, the same motion as the building beside a neighbour too far to
+/// touch; the gap study refuses it by name, and two buildings still need `[contact]`.
+#[test]
+fn a_building_alone_is_a_scene() {
+    let dir = tempdir();
+    let frame_end = FRAME
+        .find("[[building]]\nstoreys = 3\nstorey_height_m = 3.5\nmass_kg = 2.5e5")
+        .unwrap();
+    let record_at = FRAME.find("[[record]]").unwrap();
+    let alone = format!(
+        "{}{}",
+        &FRAME[..frame_end].replace("gap_right_m = [0.02]\n", ""),
+        &FRAME[record_at..]
+    );
+    assert!(!alone.contains("[contact]"));
+    let o = sweep(dir.path(), "alone", &alone, &[]);
+    ok(&o);
+    assert!(
+        stderr(&o)
+            .contains("one building alone (3 storeys; yielding storeys in building 1; P-Delta)"),
+        "{}",
+        stderr(&o)
+    );
+    let far = FRAME.replace("gap_right_m = [0.02]", "gap_right_m = [100.0]");
+    ok(&sweep(dir.path(), "far", &far, &[]));
+    let (a, f) = (
+        table(&dir.path().join("alone.csv")),
+        table(&dir.path().join("far.csv")),
+    );
+    assert_eq!(a.len(), 5);
+    assert!(!a[0].contains_key("gap_1_2_m") && !a[0].contains_key("b2_peak_roof_m"));
+    assert!(a.iter().any(|r| r["status"] == "collapsed"));
+    for (x, y) in a.iter().zip(&f) {
+        assert_eq!(x["status"], y["status"]);
+        assert_eq!(x["impacts"], "0");
+        assert_eq!(x["contact_time_s"], "0");
+        for c in [
+            "b1_peak_drift_ratio",
+            "b1_peak_roof_m",
+            "collapse_time_s",
+            "b1_residual_drift_ratio",
+        ] {
+            if x[c].is_empty() {
+                assert!(y[c].is_empty(), "{c}");
+                continue;
+            }
+            let (p, q): (f64, f64) = (x[c].parse().unwrap(), y[c].parse().unwrap());
+            assert!(
+                (p - q).abs() <= 1e-4 * p.abs(),
+                "{c}: alone {p}, beside a far neighbour {q}"
+            );
+        }
+    }
+    let cfg = dir.path().join("alone.toml");
+    let g = pound(&[
+        "gap",
+        cfg.to_str().unwrap(),
+        "-o",
+        dir.path().join("g.csv").to_str().unwrap(),
+    ]);
+    assert!(!g.status.success());
+    assert!(
+        stderr(&g).contains("one building stands alone"),
+        "{}",
+        stderr(&g)
+    );
+    let contact_at = FRAME.find("[contact]").unwrap();
+    let no_contact = format!("{}{}", &FRAME[..contact_at], &FRAME[record_at..]);
+    let o = sweep(dir.path(), "two", &no_contact, &[]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("contact: missing"), "{}", stderr(&o));
+}
