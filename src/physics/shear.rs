@@ -571,6 +571,7 @@ mod tests {
     /// `C = a0 M + a1 K0` is classical in the P-Delta modes: the modes' damping is exactly
     /// `Phi^T C Phi`, with zeros off the diagonal.
     #[test]
+    #[allow(clippy::needless_range_loop)] // floors j of the shapes and forces alike
     fn rayleigh_on_k0_is_exact_where_every_storey_leans_alike() {
         let n = 5;
         let (m, h) = (3e5, 3.2);
