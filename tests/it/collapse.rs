@@ -422,3 +422,26 @@ fn a_building_alone_is_a_scene() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("contact: missing"), "{}", stderr(&o));
 }
+
+/// The README's worked example says how many runs collapse beside the neighbour and alone:
+/// what the two sweeps give now.
+#[test]
+fn the_readme_counts_the_collapses_its_commands_give() {
+    let dir = tempdir();
+    let mut counts = Vec::new();
+    for c in ["collapse-ida", "collapse-ida-alone"] {
+        let out = dir.path().join(format!("{c}.csv"));
+        ok(&pound(&[
+            "sweep",
+            &format!("configs/{c}.toml"),
+            "-o",
+            out.to_str().unwrap(),
+        ]));
+        let rows = table(&out);
+        assert_eq!(rows.len(), 50);
+        counts.push(rows.iter().filter(|r| r["status"] == "collapsed").count());
+    }
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let said = format!("(50 runs each, {} and {} collapse)", counts[0], counts[1]);
+    assert!(readme.contains(&said), "README.md does not say `{said}`");
+}
