@@ -318,6 +318,7 @@ impl ShearBuilding {
             xi,
             shape,
             participation,
+            coupling: None,
         }
     }
 }
@@ -353,23 +354,35 @@ impl ShearBuilding {
         let (w2, v) = self.eigen_of(&self.effective_stiffness());
         let omega: Vec<f64> = w2.iter().map(|x| x.sqrt()).collect();
         let (shape, participation) = self.shapes(&v);
-        let xi = match self.damping {
-            Damping::Modal(x) => vec![x; n],
+        let (xi, coupling) = match self.damping {
+            Damping::Modal(x) => (vec![x; n], None),
             Damping::Rayleigh(_) => {
                 let omega0: Vec<f64> = self.eigen().0.iter().map(|x| x.sqrt()).collect();
                 let (a0, a1) = self.rayleigh(&omega0).expect("Rayleigh damping");
-                (0..n)
+                // phi_i^T K0 phi_k, storey by storey.
+                let k0 = |i: usize, k: usize| -> f64 {
+                    (0..n)
+                        .map(|j| {
+                            let below = |m: usize| if j == 0 { 0.0 } else { shape[j - 1][m] };
+                            self.stiffness[j] * (shape[j][i] - below(i)) * (shape[j][k] - below(k))
+                        })
+                        .sum()
+                };
+                let xi: Vec<f64> = (0..n)
+                    .map(|i| (a0 + a1 * k0(i, i)) / (2.0 * omega[i]))
+                    .collect();
+                // The coupling between modes, where it is more than rounding (it is exactly 0
+                // where every storey leans alike).
+                let scale = (0..n).map(|i| 2.0 * xi[i] * omega[i]).fold(0.0, f64::max);
+                let e: Vec<Vec<f64>> = (0..n)
                     .map(|i| {
-                        let k0: f64 = (0..n)
-                            .map(|j| {
-                                let below = if j == 0 { 0.0 } else { shape[j - 1][i] };
-                                let d = shape[j][i] - below;
-                                self.stiffness[j] * d * d
-                            })
-                            .sum();
-                        (a0 + a1 * k0) / (2.0 * omega[i])
+                        (0..n)
+                            .map(|k| if i == k { 0.0 } else { a1 * k0(i, k) })
+                            .collect()
                     })
-                    .collect()
+                    .collect();
+                let coupled = e.iter().flatten().any(|x| x.abs() > 1e-9 * scale);
+                (xi, coupled.then_some(e))
             }
         };
         Modes {
@@ -377,6 +390,7 @@ impl ShearBuilding {
             xi,
             shape,
             participation,
+            coupling,
         }
     }
 }
@@ -391,6 +405,10 @@ pub struct Modes {
     pub shape: Vec<Vec<f64>>,
     /// `L_i = phi_i^T M 1`, kg^1/2.
     pub participation: Vec<f64>,
+    /// Damping that couples the modes, `E` (`q'' + 2 xi w q' + E q' + w^2 q = ...`, zero
+    /// diagonal), where the damping is not classical in them: Rayleigh on `K0` in the modes of
+    /// a P-Delta building whose storeys lean unequally. None where it is classical.
+    pub coupling: Option<Vec<Vec<f64>>>,
 }
 
 impl Modes {
@@ -596,6 +614,7 @@ mod tests {
         let w0 = elastic.modes().omega;
         let (a0, a1) = elastic.rayleigh(&w0).unwrap();
         let md = b.modes();
+        assert_eq!(md.coupling, None);
         // Frequencies: w0 sqrt(1 - theta).
         for (w, w_0) in md.omega.iter().zip(&w0) {
             assert!((w - w_0 * (1.0 - theta[0]).sqrt()).abs() < 1e-9 * w_0);
@@ -622,6 +641,55 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Where the storeys lean unequally, the modes' damping is all of `C = a0 M + a1 K0` in
+    /// them: `2 xi w` on the diagonal, the coupling `E` off it.
+    #[test]
+    #[allow(clippy::needless_range_loop)] // floors j of the shapes and forces alike
+    fn rayleigh_on_k0_couples_the_modes_where_storeys_lean_unequally() {
+        let n = 4;
+        let b = ShearBuilding::from_period(
+            vec![3e5, 3e5, 2.5e5, 2e5],
+            &[1.0, 0.9, 0.8, 0.6],
+            vec![4.0, 3.5, 3.5, 3.5],
+            1.0,
+            Damping::Rayleigh(0.05),
+        )
+        .with_p_delta(2.0);
+        let elastic = ShearBuilding {
+            geometric: None,
+            ..b.clone()
+        };
+        let (a0, a1) = elastic.rayleigh(&elastic.modes().omega).unwrap();
+        let md = b.modes();
+        let e = md
+            .coupling
+            .clone()
+            .expect("unequal storeys couple the modes");
+        for i in 0..n {
+            for k in 0..n {
+                let mut c = 0.0;
+                for j in 0..n {
+                    c += a0 * b.masses[j] * md.shape[j][i] * md.shape[j][k];
+                }
+                let kx =
+                    elastic.stiffness_force(&(0..n).map(|j| md.shape[j][k]).collect::<Vec<_>>());
+                for j in 0..n {
+                    c += a1 * md.shape[j][i] * kx[j];
+                }
+                let want = if i == k {
+                    2.0 * md.xi[i] * md.omega[i]
+                } else {
+                    e[i][k]
+                };
+                assert!(
+                    (c - want).abs() < 1e-9 * md.omega[n - 1],
+                    "({i}, {k}): {c} vs {want}"
+                );
+            }
+        }
+        assert!(e[0][1].abs() > 1e-6 * md.omega[n - 1]);
     }
 
     /// A gravity mass ratio of 0 carries no load: the building without P-Delta, bit for bit.

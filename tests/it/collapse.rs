@@ -290,17 +290,32 @@ fn collapsed_runs_end_at_the_limit_and_are_counted_apart() {
     assert!(low.iter().filter(|r| r["status"] == "collapsed").count() >= collapsed.len());
 }
 
-/// The GPU row kernel runs elastic P-Delta buildings (their modes come from the host); a run
-/// that reaches the collapse limit is run again on the CPU, which ends it there: the CPU's row
-/// exactly. P-Delta buildings whose storeys yield run on the CPU only (the kernel would settle
-/// them and report their residual drifts as if no gravity leaned on them).
+/// The GPU row kernel runs elastic P-Delta buildings with modal damping (their modes come from
+/// the host); a run that reaches the collapse limit is run again on the CPU, which ends it
+/// there: the CPU's row exactly. P-Delta buildings of several storeys with Rayleigh damping
+/// (whose damping may couple their modes) and P-Delta buildings whose storeys yield (the kernel
+/// would settle them and report their residual drifts as if no gravity leaned on them) run on
+/// the CPU only, refused by name with `--backend gpu`.
 #[test]
 fn the_gpu_runs_elastic_p_delta_and_hands_collapses_to_the_cpu() {
     if crate::support::gpu::ctx().is_none() {
         return;
     }
     let dir = tempdir();
-    let o = sweep(dir.path(), "yielding", FRAME, &["--backend", "gpu"]);
+    let o = sweep(dir.path(), "rayleigh", FRAME, &["--backend", "gpu"]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains(
+            "P-Delta buildings of several storeys with Rayleigh damping run on the CPU only"
+        ),
+        "{}",
+        stderr(&o)
+    );
+    let modal = FRAME.replace(
+        "period_s = 0.8\ndamping_ratio = 0.05",
+        "period_s = 0.8\ndamping_ratio = 0.05\ndamping = \"modal\"",
+    );
+    let o = sweep(dir.path(), "yielding", &modal, &["--backend", "gpu"]);
     assert!(!o.status.success());
     assert!(
         stderr(&o).contains("P-Delta buildings with yielding storeys run on the CPU only"),
@@ -320,6 +335,10 @@ fn the_gpu_runs_elastic_p_delta_and_hands_collapses_to_the_cpu() {
             "storeys = 2\nstorey_height_m = 3.5\nmass_kg = 3.0e5",
         )
         .replace("tail_s = 2.0", "tail_s = 1.0\ncollapse_drift_ratio = 0.005")
+        .replace(
+            "period_s = 0.8\ndamping_ratio = 0.05",
+            "period_s = 0.8\ndamping_ratio = 0.05\ndamping = \"modal\"",
+        )
         .replace("duration_s = 6.0", "duration_s = 4.0")
         .replace("pga_g = [0.2, 0.6, 1.0, 1.5, 2.0]", "pga_g = [0.02, 1.0]");
     ok(&sweep(dir.path(), "cpu", &elastic, &["--backend", "cpu"]));

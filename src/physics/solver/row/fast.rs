@@ -23,6 +23,7 @@
 //!    touch), is taken in substeps by its building, yield onset and unloading located as
 //!    events; after the record the run goes on at rest until no storey can yield again.
 
+use super::run::CoupledStep;
 use super::{rhs, Motion, RowModel, RowObserver, RowRun, FLOOR_SUBSTEPS_FROM};
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
@@ -262,6 +263,15 @@ fn run_with<'a>(
             .collect()
     });
     let rates = m.building_rates();
+    // Buildings whose damping couples their modes take their free steps whole.
+    let coupled: Vec<CoupledStep> = (0..m.buildings.len())
+        .filter_map(|k| CoupledStep::new(m, k, dt, o.energy))
+        .collect();
+    let mut in_coupled = vec![false; n];
+    for c in &coupled {
+        let b = &m.buildings[c.building()];
+        in_coupled[b.off..b.off + b.n()].fill(true);
+    }
     let mut run = RowRun::start(m, z0, forcing.t0);
     run.energy = o.energy;
     run.observer = observer;
@@ -317,6 +327,12 @@ fn run_with<'a>(
                 m.static_offsets(&z, &mut q_static);
             }
             for k in 0..n {
+                if in_coupled[k] {
+                    if forms.is_some() {
+                        work.push((0.0, 0.0));
+                    }
+                    continue;
+                }
                 let (a0, a1) = (m.part[k] * seg.a0, m.part[k] * seg.a1);
                 let q = if yields { z[k] - q_static[k] } else { z[k] };
                 (z1[k], z1[n + k]) = props[k].step(q, z[n + k], a0, a1);
@@ -328,6 +344,19 @@ fn run_with<'a>(
                     z1[2 * n + nl] -= agv;
                     z1[2 * n + nl + 1] += m.two_xi_w[k] * vv;
                     work.push((agv, vv));
+                }
+            }
+            for c in &coupled {
+                let qs = yields.then_some(&q_static[..]);
+                let w = forms.is_some().then_some(&mut work[..]);
+                c.step(m, &z, qs, (seg.a0, seg.a1), &mut z1, w);
+                if forms.is_some() {
+                    let b = &m.buildings[c.building()];
+                    for i in b.off..b.off + b.n() {
+                        let (agv, vv) = work[i];
+                        z1[2 * n + nl] -= agv;
+                        z1[2 * n + nl + 1] += m.two_xi_w[i] * vv;
+                    }
                 }
             }
         }

@@ -142,6 +142,22 @@ impl Floors {
                 self.jrk[i] += self.pl_jerk[i];
             }
         }
+        // Damping that couples the modes: `-E q'` in the accelerations, `-E q''` in the jerks.
+        if let Some(e) = &b.modes.coupling {
+            let v = &z[n + o..n + o + nb];
+            for (i, row) in e.iter().enumerate() {
+                let ev = dot(row, v);
+                self.acc[i] -= ev;
+                // The jerk's own damping term read the acceleration without it.
+                self.jrk[i] += m.two_xi_w[o + i] * ev;
+            }
+            for (i, row) in e.iter().enumerate() {
+                let eq: f64 = (0..nb)
+                    .map(|k| row[k] * (self.acc[k] - m.part[o + k] * ag))
+                    .sum();
+                self.jrk[i] -= eq;
+            }
+        }
         let sh = &b.modes.shape;
         for j in 0..nb {
             self.u[j] = dot(&sh[j], &z[o..o + nb]);

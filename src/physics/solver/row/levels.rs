@@ -43,7 +43,18 @@ impl LevelModel {
                 .map(|i| phi[i] * (-m.two_xi_w[o + i] * z[n + o + i] - m.w2[o + i] * z[o + i]))
                 .sum()
         };
-        acc(&self.phi_a, self.a) - acc(&self.phi_b, self.b)
+        let coupled = |k: usize, phi: &[f64], (o, len): (usize, usize)| -> f64 {
+            match &m.buildings[k].modes.coupling {
+                Some(e) if len == e.len() => (0..len)
+                    .map(|i| phi[i] * dot(&e[i], &z[n + o..n + o + len]))
+                    .sum(),
+                _ => 0.0,
+            }
+        };
+        acc(&self.phi_a, self.a)
+            - acc(&self.phi_b, self.b)
+            - coupled(self.buildings.0, &self.phi_a, self.a)
+            + coupled(self.buildings.1, &self.phi_b, self.b)
     }
 
     /// Contact force in `mode`.

@@ -472,5 +472,46 @@ impl RowModel {
             let qd = z0[n + k].abs().max(z1[n + k].abs());
             fourth_derivative_bound(&osc, q, qd, &s)
         }));
+        // Modes coupled by their damping: each bound's terms gain the coupling's, `|E|` times
+        // the other modes' (as `fourth_derivative_bound` builds them, from the ends).
+        for b in &self.buildings {
+            let Some(e) = &b.modes.coupling else { continue };
+            let (o, nb) = (b.off, b.n());
+            let at = |s: &Vec<f64>, k: usize| s.get(k).copied().unwrap_or(0.0);
+            let q = |k: usize| {
+                (z0[k] - at(&shift[0], k))
+                    .abs()
+                    .max((z1[k] - at(&shift[1], k)).abs())
+            };
+            let v: Vec<f64> = (o..o + nb)
+                .map(|k| z0[n + k].abs().max(z1[n + k].abs()))
+                .collect();
+            let coupled =
+                |x: &[f64], i: usize| -> f64 { e[i].iter().zip(x).map(|(c, y)| c.abs() * y).sum() };
+            let a2: Vec<f64> = (0..nb)
+                .map(|i| {
+                    let k = o + i;
+                    self.w2[k] * q(k)
+                        + self.two_xi_w[k] * v[i]
+                        + (self.part[k] * seg.a0)
+                            .abs()
+                            .max((self.part[k] * seg.a1).abs())
+                        + coupled(&v, i)
+                })
+                .collect();
+            let a3: Vec<f64> = (0..nb)
+                .map(|i| {
+                    let k = o + i;
+                    self.w2[k] * v[i]
+                        + self.two_xi_w[k] * a2[i]
+                        + (self.part[k] * (seg.a1 - seg.a0) / seg.dt).abs()
+                        + coupled(&a2, i)
+                })
+                .collect();
+            for i in 0..nb {
+                let k = o + i;
+                out[k] = self.w2[k] * a2[i] + self.two_xi_w[k] * a3[i] + coupled(&a3, i);
+            }
+        }
     }
 }

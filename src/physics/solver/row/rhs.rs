@@ -67,6 +67,17 @@ pub(crate) fn rhs(m: &RowModel, motion: &Motion, ag: f64, z: &[f64], out: &mut [
                         e_damp += m.two_xi_w[i] * v * v;
                     }
                 }
+                // Damping that couples the modes (P-Delta with Rayleigh damping on K0).
+                if let Some(e) = &b.modes.coupling {
+                    let v = &z[n + o..n + o + nb];
+                    for (i, row) in e.iter().enumerate() {
+                        let ev = super::dot(row, v);
+                        out[n + o + i] -= ev;
+                        if energy {
+                            e_damp += v[i] * ev;
+                        }
+                    }
+                }
             }
         }
     }
