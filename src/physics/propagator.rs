@@ -200,9 +200,9 @@ impl CoupledPropagator {
     /// The state `[q, q']` after the step, into `out`.
     pub fn step(&self, x0: &[f64], a0: f64, a1: f64, out: &mut [f64]) {
         let n2 = 2 * self.n;
-        for i in 0..n2 {
+        for (i, o) in out.iter_mut().enumerate().take(n2) {
             let row = &self.p[i * n2..(i + 1) * n2];
-            out[i] = row.iter().zip(x0).map(|(p, x)| p * x).sum::<f64>()
+            *o = row.iter().zip(x0).map(|(p, x)| p * x).sum::<f64>()
                 + self.f0[i] * a0
                 + self.f1[i] * a1;
         }

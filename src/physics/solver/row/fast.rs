@@ -264,7 +264,7 @@ fn run_with<'a>(
     });
     let rates = m.building_rates();
     // Buildings whose damping couples their modes take their free steps whole.
-    let coupled: Vec<CoupledStep> = (0..m.buildings.len())
+    let mut coupled: Vec<CoupledStep> = (0..m.buildings.len())
         .filter_map(|k| CoupledStep::new(m, k, dt, o.energy))
         .collect();
     let mut in_coupled = vec![false; n];
@@ -346,14 +346,13 @@ fn run_with<'a>(
                     work.push((agv, vv));
                 }
             }
-            for c in &coupled {
+            for c in coupled.iter_mut() {
                 let qs = yields.then_some(&q_static[..]);
                 let w = forms.is_some().then_some(&mut work[..]);
                 c.step(m, &z, qs, (seg.a0, seg.a1), &mut z1, w);
                 if forms.is_some() {
                     let b = &m.buildings[c.building()];
-                    for i in b.off..b.off + b.n() {
-                        let (agv, vv) = work[i];
+                    for (i, &(agv, vv)) in work.iter().enumerate().skip(b.off).take(b.n()) {
                         z1[2 * n + nl] -= agv;
                         z1[2 * n + nl + 1] += m.two_xi_w[i] * vv;
                     }

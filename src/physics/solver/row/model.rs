@@ -45,6 +45,9 @@ pub(crate) struct FloorForm {
     pub a0: f64,
     pub a1: f64,
     pub inv_m: Vec<f64>,
+    /// With P-Delta, each storey's geometric stiffness `P / h`: the stiffness is `K - K_G`,
+    /// the damping stays `a0 M + a1 K`.
+    pub geometric: Option<Vec<f64>>,
 }
 
 impl FloorForm {
@@ -58,6 +61,22 @@ impl FloorForm {
         for j in 0..nb {
             let above = if j + 1 < nb { storey(j + 1) } else { 0.0 };
             out[j] = (s - above) * self.inv_m[j];
+            s = above;
+        }
+    }
+}
+
+impl FloorForm {
+    /// `out[j] += (K_G x)_j / m_j` (nothing without P-Delta).
+    #[inline]
+    pub(super) fn add_geometric_over_m(&self, x: impl Fn(usize) -> f64, out: &mut [f64]) {
+        let Some(g) = &self.geometric else { return };
+        let nb = g.len();
+        let storey = |j: usize| g[j] * (x(j) - if j == 0 { 0.0 } else { x(j - 1) });
+        let mut s = storey(0);
+        for j in 0..nb {
+            let above = if j + 1 < nb { storey(j + 1) } else { 0.0 };
+            out[j] += (s - above) * self.inv_m[j];
             s = above;
         }
     }
@@ -144,14 +163,24 @@ impl RowModel {
                 part.push(modes.participation[i]);
             }
             let n = modes.count();
-            // With P-Delta the modes' damping is not `a0 M + a1 K` of any `K` (see
-            // `ShearBuilding::modes`): the building takes its substeps in modes.
-            let rayleigh = b.geometric.is_none().then(|| b.rayleigh(&modes.omega));
-            let floor_form = rayleigh.flatten().map(|(a0, a1)| FloorForm {
+            // Rayleigh's coefficients are of the elastic building's modes (with P-Delta its
+            // damping stays `a0 M + a1 K0`, its stiffness is `K0 - K_G`).
+            let omega0: Vec<f64> = match &b.geometric {
+                None => modes.omega.clone(),
+                Some(_) => {
+                    let elastic = crate::physics::shear::ShearBuilding {
+                        geometric: None,
+                        ..b.clone()
+                    };
+                    elastic.modes().omega
+                }
+            };
+            let floor_form = b.rayleigh(&omega0).map(|(a0, a1)| FloorForm {
                 k: b.stiffness.clone(),
                 a0,
                 a1,
                 inv_m: b.masses.iter().map(|m| 1.0 / m).collect(),
+                geometric: b.geometric.clone(),
             });
             let shape_max = (0..n)
                 .map(|i| {

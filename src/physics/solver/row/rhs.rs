@@ -45,6 +45,7 @@ pub(crate) fn rhs(m: &RowModel, motion: &Motion, ag: f64, z: &[f64], out: &mut [
                 for j in 0..nb {
                     acc[j] = -f.a0 * v[j] - acc[j] - ag;
                 }
+                f.add_geometric_over_m(|j| u[j], acc);
                 if energy {
                     for j in 0..nb {
                         let mv = b.masses[j] * v[j];

@@ -30,7 +30,7 @@ pub(super) fn step_still(
         modal.static_offsets(z0, &mut qs);
         qs
     });
-    if let Some(c) = CoupledStep::new(modal, k, h, energy) {
+    if let Some(mut c) = CoupledStep::new(modal, k, h, energy) {
         let mut work = vec![(0.0, 0.0); n];
         let ag = (seg.a0, seg.at(t));
         c.step(
@@ -81,6 +81,9 @@ pub(crate) struct CoupledStep {
     /// Per node: its fraction of the step, its weight (of `h`), the propagator to it.
     nodes: Vec<(f64, f64, CoupledPropagator)>,
     h: f64,
+    /// Scratch: the modes' state `[q, q']` before and after.
+    x0: Vec<f64>,
+    x: Vec<f64>,
 }
 
 impl CoupledStep {
@@ -119,6 +122,8 @@ impl CoupledStep {
             prop: at(h),
             nodes,
             h,
+            x0: vec![0.0; 2 * b.n()],
+            x: vec![0.0; 2 * b.n()],
         })
     }
 
@@ -127,7 +132,7 @@ impl CoupledStep {
     /// from `ag.0` to `ag.1`; with the energy kept, each mode's input work `int L_i ag q_i'`
     /// and its share of the damping work over `2 xi_i w_i` into `work` (at the mode's index).
     pub fn step(
-        &self,
+        &mut self,
         m: &RowModel,
         z: &[f64],
         qs: Option<&[f64]>,
@@ -138,13 +143,12 @@ impl CoupledStep {
         let (n, b) = (m.n, &m.buildings[self.k]);
         let (o, nb) = (b.off, b.n());
         let shift = |i: usize| qs.map_or(0.0, |q| q[o + i]);
-        let mut x0 = vec![0.0; 2 * nb];
+        let (x0, x) = (&mut self.x0, &mut self.x);
         for i in 0..nb {
             x0[i] = z[o + i] - shift(i);
             x0[nb + i] = z[n + o + i];
         }
-        let mut x = vec![0.0; 2 * nb];
-        self.prop.step(&x0, ag.0, ag.1, &mut x);
+        self.prop.step(x0, ag.0, ag.1, x);
         for i in 0..nb {
             z1[o + i] = x[i] + shift(i);
             z1[n + o + i] = x[nb + i];
@@ -156,7 +160,7 @@ impl CoupledStep {
         }
         for (s, weight, p) in &self.nodes {
             let a = ag.0 + (ag.1 - ag.0) * s;
-            p.step(&x0, ag.0, a, &mut x);
+            p.step(x0, ag.0, a, x);
             let v = &x[nb..];
             for i in 0..nb {
                 let dv = m.two_xi_w[o + i] * v[i] + super::dot(&e[i], v);
