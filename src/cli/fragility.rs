@@ -6,8 +6,8 @@ use anyhow::{anyhow, bail, Result};
 use pounding::io::table::{Filter, Table};
 use pounding::studies::damage_states::{self, DamageStates};
 use pounding::studies::fragility::{
-    bootstrap, crossings, csv, default_im, fit, number, panel, Band, FragilitySpec, Grouped,
-    Undecided,
+    bootstrap, check_collapse_table, crossings, csv, default_im, fit, number, panel, Band,
+    FragilitySpec, Grouped, Undecided, COLLAPSED,
 };
 use pounding::studies::plot::Series;
 use std::path::{Path, PathBuf};
@@ -20,7 +20,7 @@ const MAX_BOOTSTRAP: usize = 100_000;
 const MIN_BOOTSTRAP: usize = 100;
 
 #[derive(clap::Args)]
-#[command(group(clap::ArgGroup::new("limits").required(true).args(["threshold", "damage_states"])))]
+#[command(group(clap::ArgGroup::new("limits").args(["threshold", "damage_states"])))]
 pub struct Args {
     /// A CSV written by `pound sweep` (not needed with `--damage-states list`).
     #[arg(required_unless_present = "damage_states")]
@@ -32,10 +32,13 @@ pub struct Args {
     #[arg(long)]
     im: Option<String>,
     /// Demand column (e.g. peak_force_n, b1_peak_drift_ratio; `impacts` with threshold 0 for
-    /// "pounds at all").
+    /// "pounds at all"), or `collapsed` for the collapse fragility P(collapse | IM) (no
+    /// threshold: a run collapsed, its status `collapsed`, or it did not). A collapsed run counts
+    /// as exceeding every threshold and damage state of any column (an infinite demand).
     #[arg(long, default_value = "peak_force_n")]
     edp: String,
-    /// Exceedance thresholds (EDP > threshold), comma-separated.
+    /// Exceedance thresholds (EDP > threshold), comma-separated (one of --threshold and
+    /// --damage-states, except with --edp collapsed, which takes neither).
     #[arg(long, value_delimiter = ',')]
     threshold: Vec<f64>,
     /// Named damage states instead of thresholds: a built-in set (hazus-TYPE-LEVEL, e.g.
@@ -117,6 +120,19 @@ pub fn run(a: Args) -> Result<()> {
             bail!("{flag} applies to the bootstrap bands: give --bootstrap N (N >= {MIN_BOOTSTRAP}) with it, or leave {flag} out");
         }
     }
+    let collapse = a.edp == COLLAPSED;
+    if collapse {
+        for (flag, given) in [
+            ("--threshold", !a.threshold.is_empty()),
+            ("--damage-states", a.damage_states.is_some()),
+        ] {
+            if given {
+                bail!("{flag} makes no sense with --edp {COLLAPSED}: a run collapsed (status `collapsed`) or it did not, and P(collapse | IM) is fitted to that; leave {flag} out, or give a demand column to --edp");
+            }
+        }
+    } else if a.threshold.is_empty() && a.damage_states.is_none() {
+        bail!("give --threshold T1,T2 (EDP > threshold) or --damage-states SET, or --edp {COLLAPSED} for the collapse fragility (which takes neither)");
+    }
     let by = a.by.clone().unwrap_or_else(|| "record".into());
     let seed = a.seed.unwrap_or(1);
     let states = a
@@ -141,6 +157,7 @@ pub fn run(a: Args) -> Result<()> {
     }
     let (thresholds, names): (Vec<f64>, Vec<String>) = match &states {
         Some(d) => (d.limits(), d.states.iter().map(|s| s.0.clone()).collect()),
+        None if collapse => (vec![0.0], vec!["collapse".into()]),
         None => (
             a.threshold.clone(),
             a.threshold.iter().map(|&t| number(t)).collect(),
@@ -153,6 +170,9 @@ pub fn run(a: Args) -> Result<()> {
         thresholds,
         filters: Filter::parse_all(&a.filters)?,
     };
+    if collapse {
+        check_collapse_table(&table)?;
+    }
     let group = (a.bootstrap > 0).then_some(by.as_str());
     let (grouped, skipped) = Grouped::read(&table, &spec, group)?;
     let lv = grouped.pooled(&[1]);
@@ -165,10 +185,23 @@ pub fn run(a: Args) -> Result<()> {
         );
     }
     let fits: Vec<_> = lv.iter().map(|l| fit(l)).collect();
+    let collapsed = skipped.collapsed;
     say!(
-        "{runs} runs at {} levels of {}{}",
+        "{runs} runs at {} levels of {}{}{}",
         grouped.ims.len(),
         spec.im,
+        match (collapse, collapsed) {
+            (true, _) => format!(", {collapsed} collapsed"),
+            (false, 0) => String::new(),
+            (false, _) => format!(
+                ", {collapsed} collapsed (counted as exceeding every {}: an infinite demand)",
+                if states.is_some() {
+                    "state"
+                } else {
+                    "threshold"
+                }
+            ),
+        },
         if skipped.total() > 0 {
             format!(" ({} rows left out: {skipped})", skipped.total())
         } else {
@@ -213,7 +246,9 @@ pub fn run(a: Args) -> Result<()> {
     } else {
         vec![None; spec.thresholds.len()]
     };
-    let first = if states.is_some() {
+    let first = if collapse {
+        "P(collapse)".to_string()
+    } else if states.is_some() {
         format!("state ({} >)", spec.edp)
     } else {
         format!("{} >", spec.edp)
@@ -266,8 +301,17 @@ pub fn run(a: Args) -> Result<()> {
                     poor.push(label);
                 }
             }
+            Err(e) if collapse => say!("| {label} | no fit: {} | | | | | | |{band}", e.collapse()),
             Err(e) => say!("| {label} | no fit: {e} | | | | | | |{band}"),
         }
+    }
+    if collapse && collapsed == 0 {
+        note!(
+            "notice: no run collapsed (of {runs}, at {} levels of {} up to {}): P(collapse | IM) has no fit; a collapse fragility needs runs that collapse, at intensities higher than these or with a lower [run] collapse_drift_ratio",
+            grouped.ims.len(),
+            spec.im,
+            hi
+        );
     }
     if !unfitted.is_empty() {
         note!(
@@ -372,7 +416,10 @@ fn why_none(
         why.push(format!("--where keeps {kept} of {rows} rows"));
     }
     if skipped.failed > 0 {
-        why.push(format!("{} have status not ok", skipped.failed));
+        why.push(format!(
+            "{} failed (status neither ok nor collapsed)",
+            skipped.failed
+        ));
     }
     let empty_everywhere = |c: &str| {
         table

@@ -627,8 +627,8 @@ mod tests {
                 }
                 let kx =
                     elastic.stiffness_force(&(0..n).map(|j| md.shape[j][k]).collect::<Vec<_>>());
-                for j in 0..n {
-                    c += a1 * md.shape[j][i] * kx[j];
+                for (j, kx_j) in kx.iter().enumerate().take(n) {
+                    c += a1 * md.shape[j][i] * kx_j;
                 }
                 let want = if i == k {
                     2.0 * md.xi[i] * md.omega[i]

@@ -3,6 +3,12 @@
 //! `P(EDP > threshold | IM) = Phi(ln(IM / median) / beta)` fitted to the counts by maximum
 //! likelihood (binomial at each level; Baker 2015), solved as a probit regression on `ln IM` by
 //! Fisher scoring.
+//!
+//! Collapse (physics.md section 10): a run whose status is `collapsed` ended where a storey's
+//! drift ratio reached the limit; its demand is taken as infinite, so it exceeds every threshold
+//! and damage state (counted, not left out), and `--edp collapsed` ([`COLLAPSED`]) fits the
+//! collapse fragility `P(collapse | IM)` itself: each run is 1 if it collapsed, else 0 (FEMA
+//! P-695; Baker 2015). Runs of any other status but `ok` failed, and are left out.
 
 use crate::io::table::{caption, label, order_key, Filter, Table, TableError};
 use crate::plan::sample::phi;
@@ -70,6 +76,25 @@ impl NoFit {
             NoFit::OneLevel => "one intensity",
             NoFit::NonPositiveIm => "intensity <= 0",
             NoFit::Separated => "counts separate perfectly",
+        }
+    }
+
+    /// The reason in full for the collapse fragility, whose "threshold" is collapse itself.
+    pub fn collapse(&self) -> String {
+        match self {
+            NoFit::NoneExceed => "no run collapsed".into(),
+            NoFit::AllExceed => "every run collapsed".into(),
+            NoFit::Separated => "the counts separate perfectly (no collapse below one intensity, all collapse above): the dispersion is 0".into(),
+            e => e.to_string(),
+        }
+    }
+
+    /// [`NoFit::short`] for the collapse fragility.
+    pub fn short_collapse(&self) -> &'static str {
+        match self {
+            NoFit::NoneExceed => "none collapsed",
+            NoFit::AllExceed => "all collapsed",
+            e => e.short(),
         }
     }
 }
@@ -264,6 +289,9 @@ pub fn chi_square_sf(x: f64, dof: f64) -> f64 {
     }
 }
 
+/// The `--edp` of the collapse fragility: not a column, the runs' status (`collapsed` or not).
+pub const COLLAPSED: &str = "collapsed";
+
 /// What to count.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FragilitySpec {
@@ -274,10 +302,63 @@ pub struct FragilitySpec {
     pub filters: Vec<Filter>,
 }
 
+impl FragilitySpec {
+    /// The collapse fragility `P(collapse | IM)`: the demand is 1 for a run that collapsed, 0 for
+    /// one that did not, read against the one threshold 0.
+    pub fn collapse(im: &str, filters: Vec<Filter>) -> FragilitySpec {
+        FragilitySpec {
+            im: im.into(),
+            edp: COLLAPSED.into(),
+            thresholds: vec![0.0],
+            filters,
+        }
+    }
+
+    /// Whether this is the collapse fragility (`--edp collapsed`).
+    pub fn is_collapse(&self) -> bool {
+        self.edp == COLLAPSED
+    }
+}
+
+/// Whether `table` can give a collapse fragility, or why not (named): it needs a status column
+/// (whose `collapsed` runs it counts), the collapse columns a sweep with a collapse limit writes
+/// ([`crate::plan::row::COLLAPSE_OUTPUTS`]: without them its runs could not collapse, and a
+/// curve of none would be no result) and rows.
+pub fn check_collapse_table(table: &Table) -> Result<(), TableError> {
+    let refuse = |message: String| {
+        Err(TableError::Read {
+            path: table.path.clone(),
+            message,
+        })
+    };
+    if table.col("status").is_err() {
+        return refuse(format!(
+            "--edp {COLLAPSED} counts the runs whose status is `collapsed`, and this table has no status column (the runs of a `pound sweep` table have one; a table of --aggregate or of a study has none)"
+        ));
+    }
+    let missing: Vec<&str> = crate::plan::row::COLLAPSE_OUTPUTS
+        .iter()
+        .copied()
+        .filter(|c| table.col(c).is_err())
+        .collect();
+    if !missing.is_empty() {
+        return refuse(format!(
+            "--edp {COLLAPSED}: this table has no collapse columns ({} missing): its runs could not collapse (a sweep writes them where its runs can: rows of buildings with storey heights under a collapse limit, [run] collapse_drift_ratio, default 0.10; a pair, or a row with collapse_drift_ratio = \"none\", has none), so a collapse fragility of it would be no result",
+            missing.join(", ")
+        ));
+    }
+    if table.rows.is_empty() {
+        return refuse(format!(
+            "--edp {COLLAPSED}: the table has no rows: no run to count"
+        ));
+    }
+    Ok(())
+}
+
 /// Rows a fragility count left out, by reason.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct LeftOut {
-    /// `status` not `ok`.
+    /// Failed: `status` neither `ok` nor `collapsed`.
     pub failed: usize,
     /// An empty IM cell.
     pub empty_im: usize,
@@ -286,9 +367,14 @@ pub struct LeftOut {
     pub empty_edp: usize,
     /// A NaN or infinite IM or EDP: neither exceeding nor not.
     pub non_finite: usize,
+    /// Not left out, counted here to be reported: the runs kept that collapsed (status
+    /// `collapsed`, [`Demand::Collapsed`]), which a fragility counts as exceeding every threshold
+    /// and an IDA as an infinite demand. Not in [`LeftOut::total`].
+    pub collapsed: usize,
 }
 
 impl LeftOut {
+    /// The rows left out (the collapsed runs, counted, are not).
     pub fn total(&self) -> usize {
         self.failed + self.empty_im + self.empty_edp + self.non_finite
     }
@@ -297,7 +383,7 @@ impl LeftOut {
 impl std::fmt::Display for LeftOut {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let parts: Vec<String> = [
-            (self.failed, "status not ok"),
+            (self.failed, "failed (status neither ok nor collapsed)"),
             (self.empty_im, "no value of the intensity"),
             (self.empty_edp, "no value of the demand"),
             (self.non_finite, "a value not finite (NaN or infinite)"),
@@ -357,6 +443,10 @@ pub fn bounding_column(edp: &str) -> Option<String> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Demand {
     Value(f64),
+    /// The run collapsed (status `collapsed`): an infinite demand, above every threshold
+    /// (physics.md section 10), whatever its cells hold (its peaks end at the collapse, its
+    /// residual drifts are empty).
+    Collapsed,
     /// No value in a run that did not fail, of a column that may be empty there (a residual
     /// drift where the run did not settle: [`crate::engine::aggregate::may_be_empty`]): not
     /// known, but at most `bound` where the [`bounding_column`] has a finite value.
@@ -365,9 +455,11 @@ pub enum Demand {
     },
 }
 
-/// The rows of `table` that `filters` keep, whose status is `ok` (where there is a status column)
-/// and whose IM (column `ci`) and EDP (`ce`) are finite numbers: (row, intensity level, EDP).
-/// An empty EDP of a column that may be empty in a run that did not fail is kept as
+/// The rows of `table` that `filters` keep, whose status is `ok` or `collapsed` (where there is a
+/// status column) and whose IM (column `ci`) and EDP (`ce`) are finite numbers: (row, intensity
+/// level, EDP). A collapsed run is [`Demand::Collapsed`] whatever its EDP cell holds (counted in
+/// `skipped.collapsed`); with `ce` None (the collapse fragility) a run that did not collapse is
+/// `Value(0)`. An empty EDP of a column that may be empty in a run that did not fail is kept as
 /// [`Demand::Unknown`] (with its bound where the table has the [`bounding_column`]); an empty one
 /// of another column is left out. The level is the IM rounded to 12 significant digits (CSV
 /// text round-trips exactly, but scaled PGAs computed per record may differ in the last bits).
@@ -376,16 +468,20 @@ pub fn demand_rows(
     table: &Table,
     filters: &[Filter],
     ci: usize,
-    ce: usize,
+    ce: Option<usize>,
     skipped: &mut LeftOut,
 ) -> Result<Vec<(usize, f64, Demand)>, TableError> {
     let cs = table.col("status").ok();
-    let edp = &table.header[ce];
-    let may_be_empty = crate::engine::aggregate::may_be_empty(edp);
-    let cb = bounding_column(edp).and_then(|b| table.col(&b).ok());
+    let edp = ce.map(|c| table.header[c].as_str());
+    let may_be_empty = edp.is_some_and(crate::engine::aggregate::may_be_empty);
+    let cb = edp
+        .and_then(bounding_column)
+        .and_then(|b| table.col(&b).ok());
     let mut out = Vec::new();
     for i in table.select(filters)? {
-        if cs.is_some_and(|c| table.rows[i][c] != "ok") {
+        let status = cs.map(|c| table.rows[i][c].as_str());
+        let collapsed = status == Some("collapsed");
+        if status.is_some_and(|s| s != "ok" && !collapsed) {
             skipped.failed += 1;
             continue;
         }
@@ -393,24 +489,29 @@ pub fn demand_rows(
             skipped.empty_im += 1;
             continue;
         };
-        let demand = match table.num(i, ce)? {
-            Some(v) => Demand::Value(v),
-            None if may_be_empty => {
-                let bound = cb.map(|c| table.num(i, c)).transpose()?.flatten();
-                Demand::Unknown {
-                    bound: bound.filter(|b| b.is_finite()),
+        let demand = match ce {
+            _ if collapsed => Demand::Collapsed,
+            None => Demand::Value(0.0),
+            Some(ce) => match table.num(i, ce)? {
+                Some(v) => Demand::Value(v),
+                None if may_be_empty => {
+                    let bound = cb.map(|c| table.num(i, c)).transpose()?.flatten();
+                    Demand::Unknown {
+                        bound: bound.filter(|b| b.is_finite()),
+                    }
                 }
-            }
-            None => {
-                skipped.empty_edp += 1;
-                continue;
-            }
+                None => {
+                    skipped.empty_edp += 1;
+                    continue;
+                }
+            },
         };
         let finite = im.is_finite() && !matches!(demand, Demand::Value(v) if !v.is_finite());
         if !finite {
             skipped.non_finite += 1;
             continue;
         }
+        skipped.collapsed += usize::from(collapsed);
         out.push((i, crate::io::table::level(im), demand));
     }
     Ok(out)
@@ -437,6 +538,9 @@ pub struct Grouped {
     pub bounded: Vec<u64>,
     /// The column that bounds the demand from above, where the table has it.
     pub bound: Option<String>,
+    /// Per level (over every group): the runs that collapsed, counted as exceeding every
+    /// threshold ([`Demand::Collapsed`]).
+    pub collapsed: Vec<u64>,
 }
 
 /// How [`Grouped::pooled_counting`] counts the undecided runs.
@@ -462,7 +566,21 @@ impl Grouped {
                 message: format!("--threshold {t}: expected a finite number (EDP > threshold is never decided by NaN or infinity)"),
             });
         }
-        let (ci, ce) = (table.col(&spec.im)?, table.col(&spec.edp)?);
+        let ci = table.col(&spec.im)?;
+        let ce = if spec.is_collapse() {
+            check_collapse_table(table)?;
+            if spec.thresholds != [0.0] {
+                return Err(TableError::Read {
+                    path: table.path.clone(),
+                    message: format!(
+                        "--edp {COLLAPSED} takes no threshold: a run collapsed or it did not"
+                    ),
+                });
+            }
+            None
+        } else {
+            Some(table.col(&spec.edp)?)
+        };
         let cg = group.map(|g| table.col(g)).transpose()?;
         let mut skipped = LeftOut::default();
         let mut ims: BTreeMap<u64, f64> = BTreeMap::new();
@@ -483,14 +601,21 @@ impl Grouped {
         let mut counts = vec![vec![vec![(0u64, 0u64); ims.len()]; nt]; groups.len()];
         let mut undecided = vec![vec![vec![0u64; ims.len()]; nt]; groups.len()];
         let mut bounded = vec![0u64; nt];
+        let mut collapsed = vec![0u64; ims.len()];
         let unknown = runs
             .iter()
             .filter(|r| matches!(r.2, Demand::Unknown { .. }))
             .count();
         for &(g, key, demand) in &runs {
+            collapsed[at[&key]] += u64::from(demand == Demand::Collapsed);
             for (t, &limit) in spec.thresholds.iter().enumerate() {
                 let c = &mut counts[g][t][at[&key]];
                 match demand {
+                    // An infinite demand: above every threshold.
+                    Demand::Collapsed => {
+                        c.0 += 1;
+                        c.1 += 1;
+                    }
                     Demand::Value(edp) => {
                         c.0 += 1;
                         c.1 += u64::from(edp > limit);
@@ -513,6 +638,7 @@ impl Grouped {
             unknown,
             bounded,
             bound: bounding_column(&spec.edp).filter(|b| table.col(b).is_ok()),
+            collapsed,
         };
         Ok((grouped, skipped))
     }
@@ -675,9 +801,11 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
 }
 
 /// The counts as CSV, a row per threshold and level: the state's name (with `states`), the
-/// threshold, the intensity, the runs decided, those exceeding, their fraction, the runs
-/// undecided (no value, not decided by the bound: [`Demand::Unknown`]) and the fraction's bounds
-/// with those counted as none exceeding and as all exceeding.
+/// threshold, the intensity, the runs decided, those exceeding, the runs among them that
+/// collapsed (counted as exceeding), their fraction, the runs undecided (no value, not decided by
+/// the bound: [`Demand::Unknown`]) and the fraction's bounds with those counted as none exceeding
+/// and as all exceeding. The collapse fragility ([`FragilitySpec::is_collapse`]) has a row per
+/// level: the intensity, the runs, those that collapsed and their fraction.
 pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -> String {
     let quote = |s: &str| {
         if s.contains([',', '"', '\n', '\r']) {
@@ -686,14 +814,6 @@ pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -
             s.to_string()
         }
     };
-    let mut s = String::new();
-    if states.is_some() {
-        s.push_str("state,");
-    }
-    s.push_str(&format!(
-        "threshold,{},runs,exceed,fraction,undecided,fraction_if_none_exceed,fraction_if_all_exceed\n",
-        quote(&spec.im)
-    ));
     let ratio = |k: u64, n: u64| {
         if n > 0 {
             (k as f64 / n as f64).to_string()
@@ -701,6 +821,27 @@ pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -
             String::new()
         }
     };
+    let mut s = String::new();
+    if spec.is_collapse() {
+        s.push_str(&format!("{},runs,collapsed,fraction\n", quote(&spec.im)));
+        for l in grouped.pooled(&[1]).first().into_iter().flatten() {
+            s.push_str(&format!(
+                "{},{},{},{}\n",
+                l.im,
+                l.n,
+                l.exceed,
+                ratio(l.exceed, l.n)
+            ));
+        }
+        return s;
+    }
+    if states.is_some() {
+        s.push_str("state,");
+    }
+    s.push_str(&format!(
+        "threshold,{},runs,exceed,collapsed,fraction,undecided,fraction_if_none_exceed,fraction_if_all_exceed\n",
+        quote(&spec.im)
+    ));
     for (t, &limit) in spec.thresholds.iter().enumerate() {
         let undecided = grouped.undecided_at(t);
         for (l, &im) in grouped.ims.iter().enumerate() {
@@ -717,8 +858,9 @@ pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -
                 s.push(',');
             }
             s.push_str(&format!(
-                "{},{im},{n},{k},{},{u},{},{}\n",
+                "{},{im},{n},{k},{},{},{u},{},{}\n",
                 number(limit),
+                grouped.collapsed.get(l).copied().unwrap_or(0),
                 ratio(k, n),
                 ratio(k, n + u),
                 ratio(k + u, n + u)
@@ -743,7 +885,8 @@ pub fn threshold_name(edp: &str, t: f64) -> String {
     format!("> {}", crate::io::table::quantity(edp, t))
 }
 
-/// One panel: the observed fractions (points) and the fitted curves (lines), per threshold.
+/// One panel: the observed fractions (points) and the fitted curves (lines), per threshold (the
+/// collapse fragility's one curve is named `collapse`).
 pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, NoFit>]) -> Panel {
     let mut series = Vec::new();
     let (lo, hi) = levels
@@ -755,10 +898,17 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
     for (k, ((t, lv), f)) in spec.thresholds.iter().zip(levels).zip(fits).enumerate() {
         // The EDP is in the title; a threshold's points and its curve share one style; a failed
         // fit says why.
-        let name = threshold_name(&spec.edp, *t);
+        let name = if spec.is_collapse() {
+            "collapse".to_string()
+        } else {
+            threshold_name(&spec.edp, *t)
+        };
         series.push(Series {
             name: match f {
                 Ok(_) => format!("{name}: observed"),
+                Err(e) if spec.is_collapse() => {
+                    format!("{name}: observed (no fit: {})", e.short_collapse())
+                }
                 Err(e) => format!("{name}: observed (no fit: {})", e.short()),
             },
             points: lv
@@ -787,13 +937,22 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
         crate::io::table::name(&spec.edp),
         crate::io::table::name(&spec.im),
     );
+    let what = if spec.is_collapse() {
+        "P(collapse)".to_string()
+    } else {
+        format!("P({edp} > threshold)")
+    };
     Panel {
         title: match caption(&spec.filters) {
-            c if c.is_empty() => format!("P({edp} > threshold) against {im}"),
-            c => format!("P({edp} > threshold) against {im}; {c}"),
+            c if c.is_empty() => format!("{what} against {im}"),
+            c => format!("{what} against {im}; {c}"),
         },
         x_label: label(&spec.im),
-        y_label: "probability of exceedance".into(),
+        y_label: if spec.is_collapse() {
+            "probability of collapse".into()
+        } else {
+            "probability of exceedance".into()
+        },
         log_x: false,
         log_y: false,
         series,
@@ -816,6 +975,7 @@ mod tests {
             unknown: 0,
             bounded: vec![0],
             bound: None,
+            collapsed: vec![0; ims.len()],
         }
     }
 
@@ -949,6 +1109,63 @@ mod tests {
         assert_eq!(at(Undecided::Left), vec![(2, 0), (1, 1)]);
         assert_eq!(at(Undecided::NotExceeding), vec![(2, 0), (2, 1)]);
         assert_eq!(at(Undecided::Exceeding), vec![(2, 0), (2, 2)]);
+    }
+
+    /// A collapsed run counts as exceeding every threshold whatever its cell holds (empty, or
+    /// below every threshold), a failed one is left out; the collapse fragility counts the
+    /// collapsed runs among those that did not fail, and refuses a table that cannot collapse.
+    #[test]
+    fn collapsed_runs_exceed_every_threshold() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.csv");
+        std::fs::write(
+            &p,
+            "status,pga_g,collapse_time_s,collapse_building,collapse_storey,b2_peak_drift_ratio,b1_residual_drift_ratio\n\
+             ok,0.1,,,,0.001,0.001\ncollapsed,0.1,2,1,1,0.0005,\nok,0.2,,,,0.02,0.004\ncollapsed,0.2,1,1,2,0.001,\nfailed,0.2,,,,,\n",
+        )
+        .unwrap();
+        let table = Table::read(&p).unwrap();
+        let spec = |edp: &str, thresholds: Vec<f64>| FragilitySpec {
+            im: "pga_g".into(),
+            edp: edp.into(),
+            thresholds,
+            filters: Vec::new(),
+        };
+        let counts = |g: &Grouped| -> Vec<Vec<(u64, u64)>> {
+            g.pooled(&[1])
+                .iter()
+                .map(|t| t.iter().map(|l| (l.n, l.exceed)).collect())
+                .collect()
+        };
+        let (g, left) =
+            Grouped::read(&table, &spec("b2_peak_drift_ratio", vec![0.01, 0.5]), None).unwrap();
+        assert_eq!((left.failed, left.collapsed, left.total()), (1, 2, 1));
+        assert_eq!(counts(&g), vec![vec![(2, 1), (2, 2)], vec![(2, 1), (2, 1)]]);
+        assert_eq!(g.collapsed, vec![1, 1]);
+        // A residual drift: the collapsed runs' empty cells are no undecided runs.
+        let (g, _) =
+            Grouped::read(&table, &spec("b1_residual_drift_ratio", vec![0.002]), None).unwrap();
+        assert_eq!((g.unknown, counts(&g)), (0, vec![vec![(2, 1), (2, 2)]]));
+        let collapse = FragilitySpec::collapse("pga_g", Vec::new());
+        let (g, left) = Grouped::read(&table, &collapse, None).unwrap();
+        assert_eq!((left.failed, g.runs), (1, 4));
+        assert_eq!(counts(&g), vec![vec![(2, 1), (2, 1)]]);
+        assert_eq!(
+            csv(&collapse, None, &g),
+            "pga_g,runs,collapsed,fraction\n0.1,2,1,0.5\n0.2,2,1,0.5\n"
+        );
+        assert!(csv(&spec("b2_peak_drift_ratio", vec![0.01]), None, &g)
+            .starts_with("threshold,pga_g,runs,exceed,collapsed,fraction,"));
+        // A threshold with it is refused; so is a table with no collapse columns.
+        let mut with = collapse.clone();
+        with.thresholds = vec![0.1];
+        assert!(Grouped::read(&table, &with, None).is_err());
+        let q = dir.path().join("pair.csv");
+        std::fs::write(&q, "status,pga_g,peak_force_n\nok,0.1,1\n").unwrap();
+        let e = Grouped::read(&Table::read(&q).unwrap(), &collapse, None)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no collapse columns"), "{e}");
     }
 
     /// A curve through exact probabilities is recovered to the solver's precision.

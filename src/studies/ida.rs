@@ -1,13 +1,23 @@
 //! An incremental dynamic analysis summary from a results CSV (`pound ida`): per curve (a
 //! record, or a record and a sample) the demand against the intensity, and across curves the
-//! 16, 50 and 84 % fractiles of the demand at each intensity level, over the runs with a value
-//! there: a failed run (a collapse or a numerical failure) or one with no value of the demand (a
-//! residual drift where the run did not settle) is left out and counted at its level, so the
-//! fractiles are collapse-free where runs failed, and say so.
+//! 16, 50 and 84 % fractiles of the demand at each intensity level.
+//!
+//! Collapse (Vamvatsikos & Cornell 2002; physics.md section 10): a run whose status is
+//! `collapsed` is an infinite demand. A curve flatlines at its first collapse: from that level up
+//! it is infinite, at every level (a run above it that did not collapse, "structural
+//! resurrection", is counted as collapsed and reported; a level with no run there is collapsed
+//! too), and it is drawn through its points up to the last it survived, then at that demand up to
+//! the level of its first collapse and along it to the right edge of the plot. The fractiles are
+//! over every curve with a value at a level, collapsed ones included as infinite: a fractile is
+//! infinite (`inf` in the table, a flatline in the plot) where the curves collapsed there reach
+//! its position among the sorted demands, about where more than `100 - p` % of them collapsed.
+//! A failed run (status neither `ok` nor `collapsed`: a numerical failure) or one with no value of
+//! the demand (a residual drift where the run did not settle) is left out and counted at its
+//! level, and the fractiles there are over the others, and say so.
 
 use crate::io::table::{caption, label, name, order_key, Filter, Table, TableError};
-use crate::studies::fragility::{demand_rows, quantile, Demand, LeftOut};
-use crate::studies::plot::{Panel, Series};
+use crate::studies::fragility::{demand_rows, Demand, LeftOut};
+use crate::studies::plot::{Panel, Series, SMOOTH};
 use std::collections::{BTreeMap, HashMap};
 
 /// Curves named in a plot's legend at most.
@@ -31,12 +41,23 @@ pub struct IdaSpec {
 pub struct Ida {
     /// The intensity levels, ascending.
     pub ims: Vec<f64>,
-    /// Per curve: its name and its demand at each level (None where it has no run there).
+    /// Per curve: its name and its demand at each level (None where it has no run there;
+    /// infinite from its first collapse up).
     pub curves: Vec<(String, Vec<Option<f64>>)>,
-    /// Per level: the curves with a run there, and the [`FRACTILES`] of their demands.
+    /// Per level: the curves with a value there (collapsed ones included), and the
+    /// [`FRACTILES`] of their demands (infinite where collapses reach them; NaN where no curve
+    /// has a value).
     pub counts: Vec<usize>,
     pub fractiles: Vec<[f64; 3]>,
-    /// Per level: runs left out there, failed (status not `ok`) and with no value of the demand.
+    /// Per level: the curves collapsed there (a run that collapsed there or at a lower level).
+    pub collapsed: Vec<usize>,
+    /// Runs that did not collapse at a level above their curve's first collapse (structural
+    /// resurrection), counted as collapsed; and the levels with no run of a curve above its
+    /// first collapse, filled as collapsed.
+    pub resurrected: usize,
+    pub filled: usize,
+    /// Per level: runs left out there, failed (status neither `ok` nor `collapsed`) and with no
+    /// value of the demand.
     pub failed: Vec<usize>,
     pub no_value: Vec<usize>,
 }
@@ -63,8 +84,29 @@ pub enum IdaError {
     },
 }
 
-/// Read the curves of `table` under `spec`, and the rows left out (status not `ok`, no value,
-/// a value not finite).
+/// Quantile `q` of sorted values that may end in infinities (collapses), interpolated linearly
+/// between order statistics as [`crate::studies::fragility::quantile`] (type 7): infinite where
+/// either order statistic it interpolates between (with a weight above 0) is.
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    match sorted.len() {
+        0 => f64::NAN,
+        n => {
+            let x = q * (n - 1) as f64;
+            let (i, f) = (x.floor() as usize, x - x.floor());
+            let (here, next) = (sorted[i], sorted[(i + 1).min(n - 1)]);
+            if f == 0.0 || here.is_infinite() {
+                here
+            } else if next.is_infinite() {
+                next
+            } else {
+                here + f * (next - here)
+            }
+        }
+    }
+}
+
+/// Read the curves of `table` under `spec`, and the rows left out (failed, no value, a value not
+/// finite; the collapsed runs, kept, counted in `collapsed`).
 pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
     let (ci, ce) = (table.col(&spec.im)?, table.col(&spec.edp)?);
     let by: Vec<usize> = spec
@@ -76,16 +118,20 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
     let mut ims: BTreeMap<u64, f64> = BTreeMap::new();
     let mut names: Vec<String> = Vec::new();
     let mut curve_of: HashMap<String, usize> = HashMap::new();
-    // (curve, level key) -> (row, demand)
+    // (curve, level key) -> (row, demand: infinite where the run collapsed)
     let mut points: HashMap<(usize, u64), (usize, f64)> = HashMap::new();
     // Runs kept out at a level: failed, and with no value of the demand.
     let mut missing: HashMap<u64, (usize, usize)> = HashMap::new();
-    for (i, key, demand) in demand_rows(table, &spec.filters, ci, ce, &mut skipped)? {
+    for (i, key, demand) in demand_rows(table, &spec.filters, ci, Some(ce), &mut skipped)? {
         ims.insert(order_key(key), key);
-        let Demand::Value(edp) = demand else {
-            skipped.empty_edp += 1;
-            missing.entry(order_key(key)).or_default().1 += 1;
-            continue;
+        let edp = match demand {
+            Demand::Value(edp) => edp,
+            Demand::Collapsed => f64::INFINITY,
+            Demand::Unknown { .. } => {
+                skipped.empty_edp += 1;
+                missing.entry(order_key(key)).or_default().1 += 1;
+                continue;
+            }
         };
         let name = by
             .iter()
@@ -131,9 +177,9 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
     // A failed run's intensity, where it has one, places it at its level.
     if let Ok(cs) = table.col("status") {
         for i in table.select(&spec.filters)? {
-            if table.rows[i][cs] != "ok" {
+            if !matches!(table.rows[i][cs].as_str(), "ok" | "collapsed") {
                 if let Ok(Some(im)) = table.num(i, ci) {
-                    let key = format!("{im:.11e}").parse::<f64>().unwrap_or(im);
+                    let key = crate::io::table::level(im);
                     ims.insert(order_key(key), key);
                     missing.entry(order_key(key)).or_default().0 += 1;
                 }
@@ -141,23 +187,37 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
         }
     }
     let keys: Vec<u64> = ims.keys().copied().collect();
+    let (mut resurrected, mut filled) = (0, 0);
     let curves: Vec<(String, Vec<Option<f64>>)> = names
         .into_iter()
         .enumerate()
         .map(|(c, n)| {
-            let v = keys
+            let mut v: Vec<Option<f64>> = keys
                 .iter()
                 .map(|k| points.get(&(c, *k)).map(|p| p.1))
                 .collect();
+            // The flatline: infinite from the first collapse up.
+            if let Some(first) = v.iter().position(|x| x.is_some_and(f64::is_infinite)) {
+                for x in &mut v[first + 1..] {
+                    match x {
+                        Some(d) if d.is_finite() => resurrected += 1,
+                        Some(_) => {}
+                        None => filled += 1,
+                    }
+                    *x = Some(f64::INFINITY);
+                }
+            }
             (n, v)
         })
         .collect();
     let mut counts = Vec::new();
     let mut fractiles = Vec::new();
+    let mut collapsed = Vec::new();
     for l in 0..keys.len() {
         let mut v: Vec<f64> = curves.iter().filter_map(|c| c.1[l]).collect();
         v.sort_by(f64::total_cmp);
         counts.push(v.len());
+        collapsed.push(v.iter().filter(|x| x.is_infinite()).count());
         fractiles.push(FRACTILES.map(|f| quantile(&v, f / 100.0)));
     }
     let at = |k: &u64| missing.get(k).copied().unwrap_or_default();
@@ -167,6 +227,9 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
             curves,
             counts,
             fractiles,
+            collapsed,
+            resurrected,
+            filled,
             failed: keys.iter().map(|k| at(k).0).collect(),
             no_value: keys.iter().map(|k| at(k).1).collect(),
         },
@@ -175,7 +238,19 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
 }
 
 impl Ida {
-    /// One row per level: the intensity, the curves there, the fractiles, each curve's demand.
+    /// Whether any curve collapsed.
+    pub fn any_collapsed(&self) -> bool {
+        self.collapsed.iter().any(|&c| c > 0)
+    }
+
+    /// The share of the curves at level `l` that collapsed (None with no curve there).
+    pub fn collapsed_fraction(&self, l: usize) -> Option<f64> {
+        (self.counts[l] > 0).then(|| self.collapsed[l] as f64 / self.counts[l] as f64)
+    }
+
+    /// One row per level: the intensity, the curves there, the fractiles, the curves collapsed
+    /// there and their share, each curve's demand. A collapse is an infinite demand, written
+    /// `inf` (a fractile it reaches too); an empty cell is no value (no run there, or none left).
     pub fn csv(&self, spec: &IdaSpec) -> String {
         let quote = |s: &str| {
             if s.contains([',', '"', '\n']) {
@@ -188,6 +263,7 @@ impl Ida {
         for f in FRACTILES {
             s.push_str(&format!(",{}_p{f}", quote(&spec.edp)));
         }
+        s.push_str(",collapsed,collapsed_fraction");
         for (n, _) in &self.curves {
             s.push(',');
             s.push_str(&quote(n));
@@ -202,6 +278,10 @@ impl Ida {
                     s.push_str(&f.to_string());
                 }
             }
+            s.push_str(&format!(",{},", self.collapsed[l]));
+            if let Some(f) = self.collapsed_fraction(l) {
+                s.push_str(&f.to_string());
+            }
             for (_, v) in &self.curves {
                 s.push(',');
                 if let Some(x) = v[l] {
@@ -213,46 +293,134 @@ impl Ida {
         s
     }
 
+    /// A line through `(demand, intensity)` per level (None: no point there) up to its first
+    /// infinite demand, and its flatline there: from the last finite point it rises at that
+    /// demand to the intensity of the collapse, and runs along it to `right` (from `left` where
+    /// no level before the collapse has a value). The flatline is sampled densely, so that it is
+    /// drawn as a line with no markers (it holds no run); with the intensity of the collapse.
+    #[allow(clippy::type_complexity)]
+    fn flatlined(
+        &self,
+        values: impl Iterator<Item = Option<f64>>,
+        left: f64,
+        right: f64,
+    ) -> (Vec<(f64, f64)>, Option<(Vec<(f64, f64)>, f64)>) {
+        let mut points: Vec<(f64, f64)> = Vec::new();
+        for (x, &im) in values.zip(&self.ims) {
+            match x {
+                Some(x) if x.is_infinite() => {
+                    let corners = match points.last() {
+                        Some(&(x, below)) => vec![(x, below), (x, im), (right, im)],
+                        None => vec![(left, im), (right, im)],
+                    };
+                    let per = SMOOTH / (corners.len() - 1) + 1;
+                    let mut flat: Vec<(f64, f64)> = corners
+                        .windows(2)
+                        .flat_map(|w| {
+                            let ((ax, ay), (bx, by)) = (w[0], w[1]);
+                            (0..per).map(move |k| {
+                                let f = k as f64 / per as f64;
+                                (ax + f * (bx - ax), ay + f * (by - ay))
+                            })
+                        })
+                        .collect();
+                    flat.push((right, im));
+                    return (points, Some((flat, im)));
+                }
+                Some(x) if x.is_finite() => points.push((x, im)),
+                _ => {}
+            }
+        }
+        (points, None)
+    }
+
     /// The curves (demand on x, intensity on y, as IDA curves are drawn) and the fractiles;
-    /// beyond [`NAMED_CURVES`] curves, each is a grey line with no legend entry.
+    /// beyond [`NAMED_CURVES`] curves, each is a grey line with no legend entry. A collapsed curve
+    /// or an infinite fractile ends in its flatline (see the module's note), a second series of
+    /// its name and style, to the right edge: a fifth beyond the largest finite demand drawn.
     pub fn panel(&self, spec: &IdaSpec) -> Panel {
         let named = self.curves.len() <= NAMED_CURVES;
-        let mut series: Vec<Series> = self
+        let finite = self
             .curves
             .iter()
-            .map(|(n, v)| Series {
-                name: if named { n.clone() } else { String::new() },
-                points: v
-                    .iter()
-                    .zip(&self.ims)
-                    .filter_map(|(x, &im)| x.map(|x| (x, im)))
-                    .collect(),
-                scatter: false,
-                style: None,
-            })
-            .collect();
-        for (k, f) in FRACTILES.iter().enumerate() {
+            .flat_map(|c| c.1.iter().flatten())
+            .chain(self.fractiles.iter().flatten())
+            .copied()
+            .filter(|x| x.is_finite());
+        let (lo, hi) = finite.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+        // No finite demand at all (every run collapsed): the flatlines span 0 to 1.
+        let left = if lo.is_finite() { lo.min(0.0) } else { 0.0 };
+        let right = if hi.is_finite() && hi > left {
+            left + 1.2 * (hi - left)
+        } else {
+            left + 1.0
+        };
+        let mut series: Vec<Series> = Vec::new();
+        let mut collapsed = 0;
+        for (c, (n, v)) in self.curves.iter().enumerate() {
+            let (points, flat) = self.flatlined(v.iter().copied(), left, right);
+            let name = if named { n.clone() } else { String::new() };
             series.push(Series {
-                name: format!("{f} % fractile"),
-                points: self
-                    .fractiles
-                    .iter()
-                    .zip(&self.ims)
-                    .filter(|(q, _)| q[k].is_finite())
-                    .map(|(q, &im)| (q[k], im))
-                    .collect(),
+                name: name.clone(),
+                points,
                 scatter: false,
-                style: None,
+                style: Some(c),
             });
+            if let Some((flat, _)) = flat {
+                collapsed += 1;
+                series.push(Series {
+                    name,
+                    points: flat,
+                    scatter: false,
+                    style: Some(c),
+                });
+            }
+        }
+        for (k, f) in FRACTILES.iter().enumerate() {
+            let values = self
+                .fractiles
+                .iter()
+                .zip(&self.counts)
+                .map(|(q, &n)| (n > 0).then_some(q[k]));
+            let (points, flat) = self.flatlined(values, left, right);
+            let style = Some(self.curves.len() + k);
+            let name = match &flat {
+                Some((_, im)) => format!(
+                    "{f} % fractile (collapse from {})",
+                    crate::io::table::quantity(&spec.im, *im)
+                ),
+                None => format!("{f} % fractile"),
+            };
+            series.push(Series {
+                name: name.clone(),
+                points,
+                scatter: false,
+                style,
+            });
+            if let Some((flat, _)) = flat {
+                series.push(Series {
+                    name,
+                    points: flat,
+                    scatter: false,
+                    style,
+                });
+            }
         }
         Panel {
             // The rows kept, as pound plot's and pound fragility's titles say them.
             title: format!(
-                "IDA: {} against {} ({} curves{}){}",
+                "IDA: {} against {} ({} curves{}{}){}",
                 name(&spec.edp),
                 name(&spec.im),
                 self.curves.len(),
                 if named { "" } else { " in grey" },
+                if collapsed > 0 {
+                    format!(", {collapsed} collapse: flatlines")
+                } else {
+                    String::new()
+                },
                 match caption(&spec.filters) {
                     c if c.is_empty() => c,
                     c => format!("; {c}"),
@@ -265,6 +433,37 @@ impl Ida {
             series,
             y_span: None,
         }
+    }
+
+    /// The share of the curves collapsed at each level, against the intensity (the observed
+    /// collapse fragility of the curves); None where none collapsed.
+    pub fn collapse_panel(&self, spec: &IdaSpec) -> Option<Panel> {
+        if !self.any_collapsed() {
+            return None;
+        }
+        Some(Panel {
+            title: format!(
+                "Share of the curves collapsed against {}{}",
+                name(&spec.im),
+                match caption(&spec.filters) {
+                    c if c.is_empty() => c,
+                    c => format!("; {c}"),
+                }
+            ),
+            x_label: label(&spec.im),
+            y_label: "share of curves collapsed".into(),
+            log_x: false,
+            log_y: false,
+            series: vec![Series {
+                name: "collapsed".into(),
+                points: (0..self.ims.len())
+                    .filter_map(|l| self.collapsed_fraction(l).map(|f| (self.ims[l], f)))
+                    .collect(),
+                scatter: false,
+                style: None,
+            }],
+            y_span: Some((0.0, 1.0)),
+        })
     }
 }
 
@@ -314,8 +513,92 @@ mod tests {
         }
         assert_eq!(ida.curves[4].1[2], None);
         assert!(ida.csv(&spec(&["record"])).starts_with(
-            "target_sa_g,curves,drift_p16,drift_p50,drift_p84,rec1,rec2,rec3,rec4,rec5\n0.1,5,"
+            "target_sa_g,curves,drift_p16,drift_p50,drift_p84,collapsed,collapsed_fraction,rec1,rec2,rec3,rec4,rec5\n0.1,5,"
         ));
+    }
+
+    /// Type-7 quantiles with collapses (infinities) at the end: infinite where the position
+    /// falls on one, or between a finite value and one; the finite ones as before.
+    #[test]
+    fn quantiles_reach_infinity_where_the_collapses_are() {
+        let inf = f64::INFINITY;
+        assert_eq!(quantile(&[1.0, 2.0, 3.0, 4.0, inf], 0.5), 3.0);
+        assert!((quantile(&[1.0, 2.0, 3.0, 4.0, inf], 0.16) - 1.64).abs() < 1e-12);
+        assert_eq!(quantile(&[1.0, 2.0, 3.0, 4.0, inf], 0.84), inf);
+        // Exactly on the last finite value: finite (no weight on the collapse).
+        assert_eq!(quantile(&[1.0, 2.0, inf], 0.5), 2.0);
+        assert_eq!(quantile(&[1.0, inf, inf], 0.5), inf);
+        assert_eq!(quantile(&[inf], 0.16), inf);
+        assert!(quantile(&[], 0.5).is_nan());
+        // Nine finite of ten: the 84 % stays finite (position 7.56, between the 8th and 9th).
+        let mut v: Vec<f64> = (1..=9).map(f64::from).collect();
+        v.push(inf);
+        assert!((quantile(&v, 0.84) - 8.56).abs() < 1e-12);
+        v[8] = inf;
+        assert_eq!(quantile(&v, 0.84), inf);
+    }
+
+    /// A curve flatlines at its first collapse: infinite at every level above (a run that
+    /// stood there counted as resurrected, a level with no run filled), drawn through its points,
+    /// up at its last demand to the collapse's intensity and along it to the right edge (a fifth
+    /// beyond the largest finite demand); a curve that collapsed at its first level flatlines
+    /// from the left edge.
+    #[test]
+    fn a_collapse_flatlines_the_curve() {
+        let text = "record,target_sa_g,status,drift\n\
+            a,0.1,ok,1\na,0.2,ok,2\na,0.4,collapsed,0.1\na,0.8,ok,3\n\
+            b,0.1,ok,2\nb,0.2,ok,4\nb,0.4,ok,5\nb,0.8,ok,8\n\
+            c,0.1,collapsed,\n";
+        let (ida, left) = read(&table(text), &spec(&["record"])).unwrap();
+        assert_eq!((left.collapsed, left.total()), (2, 0));
+        let inf = f64::INFINITY;
+        assert_eq!(
+            ida.curves[0].1,
+            vec![Some(1.0), Some(2.0), Some(inf), Some(inf)]
+        );
+        assert_eq!(ida.curves[2].1, vec![Some(inf); 4]);
+        assert_eq!((ida.resurrected, ida.filled), (1, 3));
+        assert_eq!(ida.collapsed, vec![1, 1, 2, 2]);
+        assert_eq!(ida.counts, vec![3; 4]);
+        assert_eq!(ida.collapsed_fraction(2), Some(2.0 / 3.0));
+        // [2, 4, inf] at 0.2: the 50 % is b's 4; [5, inf, inf] at 0.4: infinite.
+        assert_eq!(ida.fractiles[1][1], 4.0);
+        assert_eq!(ida.fractiles[2][1], inf);
+        let p = ida.panel(&spec(&["record"]));
+        // The right edge: 0 + 1.2 x 8 (the largest finite demand).
+        let right = 1.2 * 8.0;
+        let a: Vec<&Series> = p.series.iter().filter(|s| s.name == "a").collect();
+        assert_eq!(a.len(), 2);
+        assert_eq!(a[0].points, vec![(1.0, 0.1), (2.0, 0.2)]);
+        let flat = &a[1].points;
+        assert!(flat.len() > SMOOTH, "drawn with no markers");
+        assert_eq!(flat[0], (2.0, 0.2));
+        assert_eq!(*flat.last().unwrap(), (right, 0.4));
+        // Up at the last demand, then along the collapse's intensity: no other point.
+        assert!(flat
+            .iter()
+            .all(|&(x, y)| (x == 2.0 && (0.2..=0.4).contains(&y)) || (y == 0.4 && x >= 2.0)));
+        assert!(flat.contains(&(2.0, 0.4)));
+        // b stands: one series through its four points.
+        let b: Vec<&Series> = p.series.iter().filter(|s| s.name == "b").collect();
+        assert_eq!(b.len(), 1);
+        assert_eq!(b[0].points.len(), 4);
+        // c collapsed at its first level: from the left edge (0).
+        let c: Vec<&Series> = p.series.iter().filter(|s| s.name == "c").collect();
+        assert!(c[0].points.is_empty());
+        assert_eq!(c[1].points[0], (0.0, 0.1));
+        assert_eq!(*c[1].points.last().unwrap(), (right, 0.1));
+        // The 50 % fractile: finite at 0.1 and 0.2, its flatline at 0.4.
+        assert!(p
+            .series
+            .iter()
+            .any(|s| s.name.starts_with("50 % fractile (collapse from 0.4")));
+        let share = ida.collapse_panel(&spec(&["record"])).unwrap();
+        assert_eq!(share.series[0].points[2], (0.4, 2.0 / 3.0));
+        assert_eq!(share.y_span, Some((0.0, 1.0)));
+        let csv = ida.csv(&spec(&["record"]));
+        assert!(csv.contains("\n0.4,3,"), "{csv}");
+        assert!(csv.ends_with(",2,0.6666666666666666,inf,8,inf\n"), "{csv}");
     }
 
     #[test]

@@ -23,7 +23,8 @@ pub struct Series {
     pub scatter: bool,
     /// Series with the same style share colour and marker (a fitted curve and the points it
     /// fits); None: a style of its own. An empty name draws a thin grey line with no legend
-    /// entry (one of many, as IDA curves).
+    /// entry (one of many, as IDA curves). Series of one style and one name are one entry in
+    /// the legend (a line drawn in pieces, as an IDA curve and its flatline).
     pub style: Option<usize>,
 }
 
@@ -50,7 +51,7 @@ const DENSE: usize = 400;
 const LINE_SAMPLES: usize = 16;
 
 /// Lines of more points than this are smooth curves: no markers on their points.
-const SMOOTH: usize = 40;
+pub const SMOOTH: usize = 40;
 
 /// A marker of kind `k` at `at`: a filled circle, a triangle, a cross or a ring.
 fn marker<DB: DrawingBackend, C: Clone + 'static>(
@@ -598,7 +599,20 @@ fn draw<DB: DrawingBackend>(
     let (x0, x1) = range(all.iter().map(|q| q.0));
     let span = p.y_span.iter().flat_map(|&(a, b)| [ty(a), ty(b)]);
     let (y0, y1) = range(all.iter().map(|q| q.1).chain(span));
-    let named: Vec<&Series> = p.series.iter().filter(|s| !s.name.is_empty()).collect();
+    // A series is a legend entry where it has a name, unless an earlier one of its style and
+    // name has it already.
+    let listed: Vec<bool> = {
+        let mut seen = std::collections::HashSet::new();
+        p.series
+            .iter()
+            .map(|s| !s.name.is_empty() && s.style.is_none_or(|k| seen.insert((k, &s.name))))
+            .collect()
+    };
+    let entry = |i: usize| listed[i];
+    let named: Vec<&Series> = (0..p.series.len())
+        .filter(|&i| entry(i))
+        .map(|i| &p.series[i])
+        .collect();
     // The legend box as a share of the plot area (the panel less about 105 x 100 px of axis
     // labels, caption and margins: 535 x 380 px in a 640 x 480 panel): 7 px a character at
     // the legend's 12 px font, 40 px of marker and margins; 20 px a line.
@@ -777,7 +791,8 @@ fn draw<DB: DrawingBackend>(
             }
         };
         let color = PALETTE[slot % PALETTE.len()].to_rgba();
-        if !s.name.is_empty() {
+        let listed = entry(i);
+        if listed {
             entries.push((&s.name, slot, color));
         }
         let data = pts(s);
@@ -795,11 +810,14 @@ fn draw<DB: DrawingBackend>(
             } else {
                 color
             };
-            chart
+            let drawn = chart
                 .draw_series(data.into_iter().map(|q| marker(slot, q, fill, scale)))
-                .map_err(|x| e(&x))?
-                .label(&s.name)
-                .legend(move |(x, y)| marker(slot, (x + px(8) as i32, y), color, scale));
+                .map_err(|x| e(&x))?;
+            if listed {
+                drawn
+                    .label(&s.name)
+                    .legend(move |(x, y)| marker(slot, (x + px(8) as i32, y), color, scale));
+            }
         } else {
             // Markers on the points of a line of data, so that it reads without its colour
             // too; a smooth curve (a fit) takes none, which would pass for observations.
@@ -808,11 +826,14 @@ fn draw<DB: DrawingBackend>(
             } else {
                 Vec::new()
             };
-            chart
+            let drawn = chart
                 .draw_series(LineSeries::new(data, color.stroke_width(px(2))))
-                .map_err(|x| e(&x))?
-                .label(&s.name)
-                .legend(move |(x, y)| marker(slot, (x + px(8) as i32, y), color, scale));
+                .map_err(|x| e(&x))?;
+            if listed {
+                drawn
+                    .label(&s.name)
+                    .legend(move |(x, y)| marker(slot, (x + px(8) as i32, y), color, scale));
+            }
             chart
                 .draw_series(marks.into_iter().map(|q| marker(slot, q, color, scale)))
                 .map_err(|x| e(&x))?;

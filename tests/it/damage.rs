@@ -176,11 +176,15 @@ fn ida_of_a_spectral_ladder_on_real_records() {
             "b1_peak_drift_ratio_p84"
         ]
     );
-    assert_eq!(head.len(), 5 + 15);
+    // Then the curves collapsed and their share (none: this pair cannot collapse), and the
+    // curves.
+    assert_eq!(head[5..7], ["collapsed", "collapsed_fraction"]);
+    assert_eq!(head.len(), 7 + 15);
     for line in lines {
         let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
         assert_eq!(v[1], 15.0);
-        let mut d = v[5..].to_vec();
+        assert_eq!((v[5], v[6]), (0.0, 0.0));
+        let mut d = v[7..].to_vec();
         d.sort_by(f64::total_cmp);
         // Type-7 quantiles of the 15 demands: the 50 % is the 8th.
         assert_eq!(v[3], d[7]);

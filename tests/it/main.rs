@@ -4,6 +4,7 @@ mod accuracy;
 mod cli;
 mod collapse;
 mod collapse_opensees;
+mod collapse_studies;
 mod config;
 mod convergence;
 mod damage;

@@ -191,7 +191,7 @@ fn runs_without_a_value_are_decided_or_bounded() {
     ]));
     // Every run is counted (one failed): none is left out for want of a value.
     assert!(
-        out.contains("49 runs at 5 levels of pga_g (1 rows left out: 1 status not ok)"),
+        out.contains("49 runs at 5 levels of pga_g (1 rows left out: 1 failed (status neither ok nor collapsed))"),
         "{out}"
     );
     assert!(out.contains(&format!("{} runs have no value", undecided + bounded)));
@@ -240,7 +240,7 @@ fn runs_without_a_value_are_decided_or_bounded() {
     let (stdout, stderr) = (ok(&out), String::from_utf8_lossy(&out.stderr).to_string());
     assert!(!stderr.contains("no run at"), "{stderr}");
     assert!(
-        stderr.contains("0.5: 5 of 10 curves (1 failed (status not ok), 4 with no value of b1_residual_drift_ratio"),
+        stderr.contains("0.5: 5 of 10 curves (1 failed (status neither ok nor collapsed), 4 with no value of b1_residual_drift_ratio"),
         "{stderr}"
     );
     assert!(stdout.contains("16 % (collapse-free)"), "{stdout}");
@@ -323,7 +323,10 @@ fn fragility_says_why_nothing_was_fitted() {
         "-o",
         &f,
     ]);
-    assert!(e.contains("40 have status not ok"), "{e}");
+    assert!(
+        e.contains("40 failed (status neither ok nor collapsed)"),
+        "{e}"
+    );
     assert!(!e.contains("check --where"), "{e}");
     // A `--where` that keeps nothing is named as the cause.
     let e = run(&[
