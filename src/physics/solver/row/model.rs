@@ -69,6 +69,7 @@ impl FloorForm {
 impl FloorForm {
     /// `out[j] += (K_G x)_j / m_j` (nothing without P-Delta).
     #[inline]
+    #[allow(clippy::needless_range_loop)] // floor j of `out`, `g` and `inv_m`
     pub(super) fn add_geometric_over_m(&self, x: impl Fn(usize) -> f64, out: &mut [f64]) {
         let Some(g) = &self.geometric else { return };
         let nb = g.len();
