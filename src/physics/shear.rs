@@ -297,28 +297,20 @@ impl ShearBuilding {
         let n = self.storeys();
         let (w2, v) = self.eigen();
         let omega: Vec<f64> = w2.iter().map(|x| x.sqrt()).collect();
-        // Phi = M^(-1/2) V, each column signed so its roof component is >= 0.
-        let mut shape = vec![vec![0.0; n]; n];
-        for i in 0..n {
-            let sign = if v[n - 1][i] < 0.0 { -1.0 } else { 1.0 };
-            for j in 0..n {
-                shape[j][i] = sign * v[j][i] / self.masses[j].sqrt();
-            }
-        }
-        let xi = match (self.damping, self.rayleigh(&omega)) {
+        let (shape, participation) = self.shapes(&v);
+        let rayleigh = self.rayleigh(&omega);
+        let xi = match (self.damping, rayleigh) {
             (Damping::Rayleigh(x), _) if n == 1 => vec![x],
             (_, Some((a0, a1))) => omega.iter().map(|w| 0.5 * (a0 / w + a1 * w)).collect(),
             (Damping::Modal(x), _) | (Damping::Rayleigh(x), None) => vec![x; n],
         };
-        let participation = (0..n)
-            .map(|i| (0..n).map(|j| self.masses[j] * shape[j][i]).sum())
-            .collect();
         Modes {
             omega,
             xi,
             shape,
             participation,
             coupling: None,
+            rayleigh,
         }
     }
 }
@@ -354,11 +346,16 @@ impl ShearBuilding {
         let (w2, v) = self.eigen_of(&self.effective_stiffness());
         let omega: Vec<f64> = w2.iter().map(|x| x.sqrt()).collect();
         let (shape, participation) = self.shapes(&v);
-        let (xi, coupling) = match self.damping {
-            Damping::Modal(x) => (vec![x; n], None),
+        let rayleigh = match self.damping {
+            Damping::Modal(_) => None,
             Damping::Rayleigh(_) => {
                 let omega0: Vec<f64> = self.eigen().0.iter().map(|x| x.sqrt()).collect();
-                let (a0, a1) = self.rayleigh(&omega0).expect("Rayleigh damping");
+                self.rayleigh(&omega0)
+            }
+        };
+        let (xi, coupling) = match (self.damping, rayleigh) {
+            (Damping::Modal(x), _) | (Damping::Rayleigh(x), None) => (vec![x; n], None),
+            (Damping::Rayleigh(_), Some((a0, a1))) => {
                 // phi_i^T K0 phi_k, storey by storey.
                 let k0 = |i: usize, k: usize| -> f64 {
                     (0..n)
@@ -391,6 +388,7 @@ impl ShearBuilding {
             shape,
             participation,
             coupling,
+            rayleigh,
         }
     }
 }
@@ -409,6 +407,9 @@ pub struct Modes {
     /// diagonal), where the damping is not classical in them: Rayleigh on `K0` in the modes of
     /// a P-Delta building whose storeys lean unequally. None where it is classical.
     pub coupling: Option<Vec<Vec<f64>>>,
+    /// Rayleigh's `(a0, a1)` of `C = a0 M + a1 K0`, from the elastic building's modes 1 and 2
+    /// (with P-Delta too: its damping is the elastic building's); None for modal damping.
+    pub rayleigh: Option<(f64, f64)>,
 }
 
 impl Modes {

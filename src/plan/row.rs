@@ -975,9 +975,8 @@ pub fn parse_row(
         config::grid_or_sampled(given, sampled(a)).map_err(|m| invalid(&a.key(), m))
     };
     // A building alone touches nothing: without [contact] it takes a linear law it never uses.
-    let contact_given = raw.contact.clone();
-    let raw_contact = match (contact_given, nb) {
-        (Some(c), _) => c,
+    let rc = match (&raw.contact, nb) {
+        (Some(c), _) => c.clone(),
         (None, 1) => RawContact {
             law: config::Names::One("linear".into()),
             formula: None,
@@ -992,12 +991,6 @@ pub fn parse_row(
                 .into(),
         )),
     };
-    let raw = RawRowConfig {
-        contact: Some(raw_contact),
-        ..raw
-    };
-    let contact_of = |r: &RawRowConfig| r.contact.clone().expect("set above");
-    let rc = contact_of(&raw);
     let k_grid = grid_or_sampled(RowSampled::KLinear, rc.k_n_per_m.as_ref())?;
     let beta_grid = grid_or_sampled(RowSampled::Beta, rc.beta_n_per_m1_5.as_ref())?;
     let shared_gap = grid_or_sampled(RowSampled::SharedGap, rc.gap_m.as_ref())?;
@@ -1293,19 +1286,18 @@ fn check_stability(
             .floor_masses
             .clone()
             .unwrap_or_else(|| vec![1.0; a.storeys()]);
-        let at = |period: f64| {
-            ShearBuilding::from_period(
-                masses.clone(),
-                &a.profile,
-                a.heights.clone(),
-                period,
-                Damping::Modal(0.05),
-            )
-            .with_p_delta(ratio)
-            .stability_coefficients()
-        };
-        a.stability_at_1s = at(1.0).into_iter().fold(0.0, f64::max);
-        let theta = at(period);
+        let at_1s = ShearBuilding::from_period(
+            masses,
+            &a.profile,
+            a.heights.clone(),
+            1.0,
+            Damping::Modal(0.05),
+        )
+        .with_p_delta(ratio)
+        .stability_coefficients();
+        a.stability_at_1s = at_1s.iter().cloned().fold(0.0, f64::max);
+        // As the column reads it: theta at `period` is theta at 1 s times `period^2`.
+        let theta: Vec<f64> = at_1s.iter().map(|t| t * period * period).collect();
         if let Some(j) = theta.iter().position(|t| *t >= 1.0) {
             return Err((
                 format!("building[{b}].p_delta"),

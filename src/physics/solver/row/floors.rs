@@ -105,12 +105,10 @@ impl Floors {
             }
             let (u, v) = (&self.u, &self.v);
             f.k_over_m(|j| u[j] + f.a1 * v[j], &mut self.acc);
+            // With P-Delta the stiffness is `K - K_G`.
+            f.add_geometric_over_m(|j| -u[j], &mut self.acc);
             for j in 0..nb {
-                self.acc[j] = -self.acc[j];
-            }
-            f.add_geometric_over_m(|j| u[j], &mut self.acc);
-            for j in 0..nb {
-                let mut acc = -f.a0 * v[j] + self.acc[j];
+                let mut acc = -f.a0 * v[j] - self.acc[j];
                 if yields {
                     acc += self.pl_acc[j];
                 }
@@ -121,12 +119,9 @@ impl Floors {
             }
             let (acc, v) = (&self.acc, &self.v);
             f.k_over_m(|j| v[j] + f.a1 * (acc[j] - ag), &mut self.jrk);
+            f.add_geometric_over_m(|j| -v[j], &mut self.jrk);
             for j in 0..nb {
-                self.jrk[j] = -self.jrk[j];
-            }
-            f.add_geometric_over_m(|j| self.v[j], &mut self.jrk);
-            for j in 0..nb {
-                self.jerk[j] = -f.a0 * (self.acc[j] - ag) + self.jrk[j];
+                self.jerk[j] = -f.a0 * (self.acc[j] - ag) - self.jrk[j];
                 if yields {
                     self.jerk[j] += self.pl_jerk[j];
                 }

@@ -87,7 +87,26 @@ impl BuildingModel {
     pub fn n(&self) -> usize {
         self.modes.count()
     }
+
+    /// Storey `j`'s drift in this building's current coordinates (`modal_row` in its modes):
+    /// the offset in the state and the row, `d = row . z[off..]`.
+    pub(crate) fn drift_row(&self, j: usize, modal_row: &[f64]) -> (usize, Vec<f64>) {
+        match (self.in_floors, j) {
+            (false, _) => (self.off, modal_row.to_vec()),
+            (true, 0) => (self.off, vec![1.0]),
+            (true, j) => (self.off + j - 1, vec![-1.0, 1.0]),
+        }
+    }
 }
+
+/// Storey `j`'s drift in a building's modes: `d_j = u_j - u_(j-1) = row . q`.
+fn modal_drift_row(modes: &Modes, j: usize) -> Vec<f64> {
+    (0..modes.count())
+        .map(|i| modes.shape[j][i] - if j == 0 { 0.0 } else { modes.shape[j - 1][i] })
+        .collect()
+}
+
+impl BuildingModel {}
 
 /// One contact level, as the integrators see it.
 #[derive(Debug, Clone)]
@@ -164,19 +183,8 @@ impl RowModel {
                 part.push(modes.participation[i]);
             }
             let n = modes.count();
-            // Rayleigh's coefficients are of the elastic building's modes (with P-Delta its
-            // damping stays `a0 M + a1 K0`, its stiffness is `K0 - K_G`).
-            let omega0: Vec<f64> = match &b.geometric {
-                None => modes.omega.clone(),
-                Some(_) => {
-                    let elastic = crate::physics::shear::ShearBuilding {
-                        geometric: None,
-                        ..b.clone()
-                    };
-                    elastic.modes().omega
-                }
-            };
-            let floor_form = b.rayleigh(&omega0).map(|(a0, a1)| FloorForm {
+            // With P-Delta the damping stays `a0 M + a1 K0`, the stiffness is `K0 - K_G`.
+            let floor_form = modes.rayleigh.map(|(a0, a1)| FloorForm {
                 k: b.stiffness.clone(),
                 a0,
                 a1,
@@ -194,11 +202,7 @@ impl RowModel {
             let first_storey = b.yielding.as_ref().map(|y| {
                 let first = storeys.len();
                 for j in 0..n {
-                    let modal_row: Vec<f64> = (0..n)
-                        .map(|i| {
-                            modes.shape[j][i] - if j == 0 { 0.0 } else { modes.shape[j - 1][i] }
-                        })
-                        .collect();
+                    let modal_row = modal_drift_row(&modes, j);
                     storeys.push(StoreyModel {
                         building: k,
                         storey: j,
@@ -255,12 +259,7 @@ impl RowModel {
                 .enumerate()
                 .flat_map(|(k, b)| {
                     (0..b.n()).map(move |j| {
-                        let modal_row: Vec<f64> = (0..b.n())
-                            .map(|i| {
-                                b.modes.shape[j][i]
-                                    - if j == 0 { 0.0 } else { b.modes.shape[j - 1][i] }
-                            })
-                            .collect();
+                        let modal_row = modal_drift_row(&b.modes, j);
                         DriftRow {
                             building: k,
                             storey: j,
@@ -318,12 +317,7 @@ impl RowModel {
         }
         m.storeys_to_coordinates();
         for d in m.drifts.iter_mut() {
-            let b = &m.buildings[d.building];
-            (d.off, d.row) = match (b.in_floors, d.storey) {
-                (false, _) => (b.off, d.modal_row.clone()),
-                (true, 0) => (b.off, vec![1.0]),
-                (true, j) => (b.off + j - 1, vec![-1.0, 1.0]),
-            };
+            (d.off, d.row) = m.buildings[d.building].drift_row(d.storey, &d.modal_row);
         }
         Some(m)
     }

@@ -137,17 +137,12 @@ impl RowModel {
         for s in self.storeys.iter_mut() {
             let b = &self.buildings[s.building];
             let j = s.storey;
-            if b.in_floors {
-                if j == 0 {
-                    (s.off, s.row, s.psi) = (b.off, vec![1.0], vec![1.0 / b.masses[0]]);
-                } else {
-                    s.off = b.off + j - 1;
-                    s.row = vec![-1.0, 1.0];
-                    s.psi = vec![-1.0 / b.masses[j - 1], 1.0 / b.masses[j]];
-                }
-            } else {
-                (s.off, s.row, s.psi) = (b.off, s.modal_row.clone(), s.modal_row.clone());
-            }
+            (s.off, s.row) = b.drift_row(j, &s.modal_row);
+            s.psi = match (b.in_floors, j) {
+                (false, _) => s.modal_row.clone(),
+                (true, 0) => vec![1.0 / b.masses[0]],
+                (true, j) => vec![-1.0 / b.masses[j - 1], 1.0 / b.masses[j]],
+            };
         }
     }
 
