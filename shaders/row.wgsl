@@ -161,6 +161,11 @@ fn floor_accel(b: u32, f: u32, z: ptr<function, ZA>) -> real {
         let k = o + i;
         s += shape_at(b, f, i) * (-TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k]);
     }
+    if (coupled(b)) {
+        for (var i = 0u; i < B_N[b]; i++) {
+            s -= shape_at(b, f, i) * coupled_term(b, i, z, NM);
+        }
+    }
     return s;
 }
 
@@ -207,8 +212,8 @@ fn side_bound(b: u32, f: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function,
     let o = B_OFF[b];
     for (var i = 0u; i < B_N[b]; i++) {
         let k = o + i;
-        if (NS > 0u) {
-            // About the static response to the plastic loads (yield_watch's bounds).
+        if (NS > 0u || COUPLED) {
+            // mode_bounds: about the static response to the plastic loads, coupled modes'.
             s += abs(shape_at(b, f, i)) * MBND[k];
             continue;
         }
@@ -244,6 +249,15 @@ fn rhs(ag: real, z: ptr<function, ZA>, out: ptr<function, ZA>) {
         let v = (*z)[NM + i];
         (*out)[i] = v;
         (*out)[NM + i] = -TXW[i] * v - W2[i] * (*z)[i] - PART[i] * ag;
+    }
+    if (COUPLED) {
+        for (var b = 0u; b < NB; b++) {
+            if (coupled(b)) {
+                for (var i = 0u; i < B_N[b]; i++) {
+                    (*out)[NM + B_OFF[b] + i] -= coupled_term(b, i, z, NM);
+                }
+            }
+        }
     }
     if (NS > 0u) {
         plastic_rhs(z, out);
@@ -328,6 +342,114 @@ fn mark_firing(z: ptr<function, ZA>) {
     }
 }
 
+// ---- Modes::coupling: damping that couples a building's modes (P-Delta, Rayleigh on K0) ----
+
+// Does building b's damping couple its modes in this run? Its block's coupled part (where the
+// shape lets it couple, B_CP) starts with 1 where it does; COUPLED (a constant) leaves the
+// loops out of every other kernel.
+fn coupled(b: u32) -> bool {
+    return COUPLED && B_CP[b] != 0u && models[MB[b] + B_CP[b]] != 0.0;
+}
+
+// E[i][k] of building b.
+fn cpl_e(b: u32, i: u32, k: u32) -> real {
+    return models[MB[b] + B_CP[b] + 1u + B_N[b] * i + k];
+}
+
+// (E x)_i of building b, x its modes of z from offset `at` (NM: the velocities).
+fn coupled_term(b: u32, i: u32, z: ptr<function, ZA>, at: u32) -> real {
+    var s: real = 0.0;
+    let o = at + B_OFF[b];
+    for (var k = 0u; k < B_N[b]; k++) {
+        s += cpl_e(b, i, k) * (*z)[o + k];
+    }
+    return s;
+}
+
+// CoupledStep::step over a record step: building b's modes of z (about QS where storeys
+// yield) into z1, the ground from seg.a0 to seg.a1; the host packed the exact step over DT.
+fn coupled_step(b: u32, seg: Seg, z: ptr<function, ZA>, z1: ptr<function, ZA>) {
+    let n = B_N[b];
+    let o = B_OFF[b];
+    let n2 = 2u * n;
+    let at = MB[b] + B_CP[b] + 1u + n * n;
+    for (var i = 0u; i < n2; i++) {
+        var x: real = 0.0;
+        for (var j = 0u; j < n2; j++) {
+            var x0: real;
+            if (j < n) {
+                x0 = (*z)[o + j];
+                if (NS > 0u) {
+                    x0 = x0 - QS[o + j];
+                }
+            } else {
+                x0 = (*z)[NM + o + j - n];
+            }
+            x += models[at + n2 * i + j] * x0;
+        }
+        x = x + models[at + n2 * n2 + i] * seg.a0 + models[at + n2 * n2 + n2 + i] * seg.a1;
+        if (i < n) {
+            if (NS > 0u) {
+                x = x + QS[o + i];
+            }
+            (*z1)[o + i] = x;
+        } else {
+            (*z1)[NM + o + i - n] = x;
+        }
+    }
+}
+
+// RowModel::fourth_derivative_bounds into MBND over the free step z0 -> z1: each mode's
+// |q''''| bound (about QS where storeys yield; QS stays 0 in a kernel without), and where
+// damping couples a building's modes, each bound's terms gain the coupling's, |E| times the
+// other modes'.
+fn mode_bounds(seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>) {
+    for (var k = 0u; k < NM; k++) {
+        MBND[k] = shifted_mode_bound(k, seg, z0, z1);
+    }
+    if (!COUPLED) {
+        return;
+    }
+    for (var b = 0u; b < NB; b++) {
+        if (!coupled(b)) {
+            continue;
+        }
+        let o = B_OFF[b];
+        let n = B_N[b];
+        var v: array<real, MAXN>;
+        var a2: array<real, MAXN>;
+        var a3: array<real, MAXN>;
+        for (var i = 0u; i < n; i++) {
+            v[i] = max(abs((*z0)[NM + o + i]), abs((*z1)[NM + o + i]));
+        }
+        for (var i = 0u; i < n; i++) {
+            let k = o + i;
+            let q = max(abs((*z0)[k] - QS[k]), abs((*z1)[k] - QS[k]));
+            var c: real = 0.0;
+            for (var j = 0u; j < n; j++) {
+                c += abs(cpl_e(b, i, j)) * v[j];
+            }
+            a2[i] = W2[k] * q + TXW[k] * v[i] + max(abs(PART[k] * seg.a0), abs(PART[k] * seg.a1)) + c;
+        }
+        for (var i = 0u; i < n; i++) {
+            let k = o + i;
+            var c: real = 0.0;
+            for (var j = 0u; j < n; j++) {
+                c += abs(cpl_e(b, i, j)) * a2[j];
+            }
+            a3[i] = W2[k] * v[i] + TXW[k] * a2[i] + abs(PART[k] * (seg.a1 - seg.a0) / seg.dt) + c;
+        }
+        for (var i = 0u; i < n; i++) {
+            let k = o + i;
+            var c: real = 0.0;
+            for (var j = 0u; j < n; j++) {
+                c += abs(cpl_e(b, i, j)) * a3[j];
+            }
+            MBND[k] = W2[k] * a2[i] + TXW[k] * a3[i] + c;
+        }
+    }
+}
+
 // ---- row/mod.rs: RowRun ----
 
 fn set_floor_forces(z: ptr<function, ZA>) {
@@ -364,6 +486,22 @@ fn fill(b: u32, e: u32, z: ptr<function, ZA>, ag: real) {
         jrk[i] = -TXW[k] * qdd - W2[k] * (*z)[NM + k];
         if (yields) {
             jrk[i] += PLJ[i];
+        }
+    }
+    // Damping that couples the modes: -E q' in the accelerations, -E q'' in the jerks (whose
+    // own damping term read the acceleration without it).
+    if (coupled(b)) {
+        for (var i = 0u; i < n; i++) {
+            let ev = coupled_term(b, i, z, NM);
+            acc[i] -= ev;
+            jrk[i] += TXW[o + i] * ev;
+        }
+        for (var i = 0u; i < n; i++) {
+            var eq: real = 0.0;
+            for (var k = 0u; k < n; k++) {
+                eq += cpl_e(b, i, k) * (acc[k] - PART[o + k] * ag);
+            }
+            jrk[i] -= eq;
         }
     }
     for (var j = 0u; j < n; j++) {
@@ -704,6 +842,10 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
         }
         var z1 = *z;
         for (var b = 0u; b < NB; b++) {
+            if (coupled(b)) {
+                coupled_step(b, seg, z, &z1);
+                continue;
+            }
             for (var i = 0u; i < B_N[b]; i++) {
                 let k = B_OFF[b] + i;
                 let c = MB[b] + MW * i + 3u;
@@ -723,9 +865,12 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
             }
         }
         // A storey that yields, or may in the free step, takes the step in substeps.
+        if (NS > 0u || COUPLED) {
+            mode_bounds(seg, z, &z1);
+        }
         var yielding = false;
         if (NS > 0u) {
-            yielding = yield_watch(seg, z, &z1, dt);
+            yielding = yield_watch(z, &z1, dt);
         }
         var touching = false;
         for (var l = 0u; l < NL; l++) {

@@ -11,7 +11,7 @@
 // (NSA = max(NS, 1) sizes their arrays), each one's building and storey (S_B, S_J), each
 // building's first (B_S0, NS where elastic), PS0 the slot of the first plastic drift (each
 // storey's plastic work NS slots later), YIELD_SLACK per precision. Each yielding building's
-// model block ends with its storeys' STOREY_HEAD reals (k, d_y, b) and modal rows.
+// model block ends with its storeys' STOREY_HEAD reals (k, d_y, b, P / h) and modal rows.
 
 const SM_ELASTIC: u32 = 0u;
 const SM_UP: u32 = 1u;
@@ -25,7 +25,7 @@ var<private> SETTLED: u32;
 // The last record step of a run that has not settled (yielding::settle_intervals).
 var<private> END: u32;
 // The static modal response to the plastic loads, and each mode's |q''''| bound about it,
-// over the free step being tried.
+// over the free step being tried (mode_bounds; QS stays 0 in a kernel without storeys).
 var<private> QS: array<real, NM>;
 var<private> MBND: array<real, NM>;
 // A yielding building's plastic loads on its modes and their rates (Floors::plastic).
@@ -41,6 +41,8 @@ fn st_at(s: u32, f: u32) -> real {
 fn st_k(s: u32) -> real { return st_at(s, 0u); }
 fn st_dy(s: u32) -> real { return st_at(s, 1u); }
 fn st_b(s: u32) -> real { return st_at(s, 2u); }
+// Its geometric stiffness P / h (0 without P-Delta).
+fn st_geo(s: u32) -> real { return st_at(s, 3u); }
 fn st_row(s: u32, i: u32) -> real { return st_at(s, STOREY_HEAD + i); }
 
 // StoreyModel::drift: the drift (at 0) or its rate (at NM) in state z.
@@ -191,12 +193,9 @@ fn may_yield(s: u32, d0: real, r0: real, d1: real, r1: real, p: real, bound: rea
     return false;
 }
 
-// RowModel::yield_watch over the exact free step z0 -> z1 of length h (QS set): does a
-// storey yield now, or may it reach a bounding line? Leaves each mode's bound in MBND.
-fn yield_watch(seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) -> bool {
-    for (var k = 0u; k < NM; k++) {
-        MBND[k] = shifted_mode_bound(k, seg, z0, z1);
-    }
+// RowModel::yield_watch over the exact free step z0 -> z1 of length h (QS and, by
+// mode_bounds, MBND set): does a storey yield now, or may it reach a bounding line?
+fn yield_watch(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) -> bool {
     var watch = false;
     for (var s = 0u; s < NS; s++) {
         if (SM[s] != SM_ELASTIC) {
@@ -288,6 +287,11 @@ fn settles(z: ptr<function, ZA>) -> bool {
             return false;
         }
     }
+    for (var s = 0u; s < NS; s++) {
+        if (st_geo(s) != 0.0) {
+            return settles_leaning(z);
+        }
+    }
     // RowModel::mechanical_energy: the modes' kinetic and strain energy, and what the
     // springs hold beyond it (plastic_strain_correction).
     var e: real = 0.0;
@@ -304,6 +308,31 @@ fn settles(z: ptr<function, ZA>) -> bool {
         let p = (*z)[PS0 + s];
         let b = st_b(s);
         if (!(sqrt(2.0 * e / st_k(s)) + b * abs(p) / (1.0 - b) <= st_dy(s) * (1.0 + YIELD_SLACK))) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// RowModel::settled_p_delta: about the static response QS to the plastic loads the drifts
+// are d_s (gravity leans on them); the energy of the motion about it bounds each storey's
+// excursion by sqrt(2 E / (k - P/h)). Overwrites QS (begin_interval sets it before use).
+fn settles_leaning(z: ptr<function, ZA>) -> bool {
+    static_offsets(z);
+    var e: real = 0.0;
+    for (var k = 0u; k < NM; k++) {
+        let x = (*z)[k] - QS[k];
+        e += 0.5 * ((*z)[NM + k] * (*z)[NM + k] + W2[k] * x * x);
+    }
+    for (var s = 0u; s < NS; s++) {
+        let o = B_OFF[S_B[s]];
+        var d_s: real = 0.0;
+        for (var i = 0u; i < B_N[S_B[s]]; i++) {
+            d_s += st_row(s, i) * QS[o + i];
+        }
+        let p = (*z)[PS0 + s];
+        if (!(sqrt(2.0 * e / (st_k(s) - st_geo(s))) + abs(back_drift(s, d_s, p))
+              <= st_dy(s) * (1.0 + YIELD_SLACK))) {
             return false;
         }
     }

@@ -193,13 +193,6 @@ impl Kernel {
             Kernel::Row if fast.energy => Some(EngineError::GpuUnfit(
                 "the energy balance of rows is integrated on the CPU only",
             )),
-            // The kernel's settling test and residual drifts are those without gravity.
-            Kernel::Row if plan.couples_modes() => Some(EngineError::GpuUnfit(
-                "P-Delta buildings of several storeys with Rayleigh damping run on the CPU only (where their storeys lean unequally the damping couples their modes, which the row kernel steps one by one); modal damping runs on the GPU",
-            )),
-            Kernel::Row if plan.leans_and_yields() => Some(EngineError::GpuUnfit(
-                "P-Delta buildings with yielding storeys run on the CPU only (the row kernel settles them and reports their residual drifts as if no gravity leaned on them)",
-            )),
             Kernel::Row if calibrated && precision == Precision::F32 => {
                 Some(EngineError::GpuUnfit(
                     "--target-error on rows is calibrated in f64 (add --precision f64)",

@@ -197,6 +197,11 @@ impl CoupledPropagator {
         CoupledPropagator { n, p, f0, f1 }
     }
 
+    /// Its coefficients: the step `P` (`2N x 2N`, row-major) and the ground's `f0`, `f1`.
+    pub fn coefficients(&self) -> (&[f64], &[f64], &[f64]) {
+        (&self.p, &self.f0, &self.f1)
+    }
+
     /// The state `[q, q']` after the step, into `out`.
     pub fn step(&self, x0: &[f64], a0: f64, a1: f64, out: &mut [f64]) {
         let n2 = 2 * self.n;

@@ -336,11 +336,10 @@ impl ShearBuilding {
     /// The modes of a P-Delta building: shapes and frequencies of `(K0 - K_G, M)`. Damping
     /// stays the elastic building's (physics.md section 10): modal damping puts its ratio on
     /// every mode; Rayleigh's `C = a0 M + a1 K0` (coefficients from modes 1 and 2 of
-    /// `(K0, M)`) is taken on each mode as `phi_i^T C phi_i = a0 + a1 phi_i^T K0 phi_i`, its
-    /// diagonal in these modes, so free flight stays an exact step per mode. That is `C`
-    /// itself wherever it is classical in them (one storey; every storey at the same
-    /// stability coefficient); otherwise the small coupling `a1 phi_i^T K0 phi_k` (i != k) is
-    /// left out (docs/collapse.md measures what that changes against OpenSees).
+    /// `(K0, M)`) is `phi_i^T C phi_k = a0 delta_ik + a1 phi_i^T K0 phi_k` in these modes: its
+    /// diagonal gives each mode's ratio, and where it is not classical in them (storeys that
+    /// lean unequally) the rest is the coupling `E` (`a1 phi_i^T K0 phi_k`, i != k), which the
+    /// schemes carry exactly (docs/collapse.md).
     fn p_delta_modes(&self) -> Modes {
         let n = self.storeys();
         let (w2, v) = self.eigen_of(&self.effective_stiffness());

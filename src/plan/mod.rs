@@ -117,27 +117,6 @@ impl Plan {
     }
 
     /// The most storeys of any building (1 for a pair).
-    /// Has it a P-Delta building of several storeys with Rayleigh damping, whose damping may
-    /// couple its modes (where its storeys lean unequally)?
-    pub fn couples_modes(&self) -> bool {
-        match self {
-            Plan::Pair(_) => false,
-            Plan::Row(r) => r
-                .buildings
-                .iter()
-                .any(|b| b.p_delta.is_some_and(|r| r > 0.0) && !b.modal && b.storeys() > 1),
-        }
-    }
-
-    /// Has it a P-Delta building whose storeys yield?
-    pub fn leans_and_yields(&self) -> bool {
-        match self {
-            Plan::Pair(_) => false,
-            Plan::Row(r) => (r.buildings.iter().zip(&r.yielding))
-                .any(|(b, y)| b.p_delta.is_some() && y.is_some()),
-        }
-    }
-
     pub fn max_storeys(&self) -> usize {
         match self {
             Plan::Pair(_) => 1,

@@ -226,7 +226,8 @@ fn rows_too_large_for_the_software_loop_limit_are_refused() {
 
 /// The row kernel's source parses and validates (naga, f32 and f64) for shapes from single
 /// storeys to a row of five and a row with no common floor level, elastic and yielding: the
-/// constants the host prepends make a complete module for every shape.
+/// constants the host prepends make a complete module for every shape (P-Delta buildings whose
+/// damping couples their modes among them).
 #[test]
 fn row_kernel_builds_for_every_shape() {
     use pounding::engine::gpu::shader::row_source;
@@ -243,11 +244,20 @@ fn row_kernel_builds_for_every_shape() {
             storeys: vec![1, 1],
             levels: vec![[0, 0, 0]],
             yielding: vec![true, true],
+            coupled: vec![false, false],
         },
         RowShape {
             storeys: vec![3, 6, 2],
             levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [1, 0, 0], [1, 1, 1]],
             yielding: vec![false, true, true],
+            coupled: vec![false, false, false],
+        },
+        // P-Delta buildings whose damping may couple their modes, elastic and yielding.
+        RowShape {
+            storeys: vec![3, 6, 2],
+            levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [1, 0, 0], [1, 1, 1]],
+            yielding: vec![false, true, false],
+            coupled: vec![true, true, false],
         },
     ];
     for shape in &shapes {
@@ -363,9 +373,20 @@ fn yielding(n: usize, period: f64, damping: Damping, theta: f64, b: f64) -> Shea
     s
 }
 
+/// A yielding 3-storey P-Delta frame whose Rayleigh damping couples its modes.
+fn leaning_frame() -> ShearBuilding {
+    let b = yielding(3, 0.6, Damping::Rayleigh(0.05), 0.003, 0.03).with_p_delta(4.0);
+    assert!(
+        b.modes().coupling.is_some(),
+        "the damping couples the modes"
+    );
+    b
+}
+
 /// Yielding storeys, rows of two (lavapipe's loop limit keeps them small): single storeys
 /// pounding (elastic-perfectly-plastic beside hardening), a yielding 3-storey frame beside an
-/// elastic 2-storey one, and two yielding frames at gap 0; each on its own record.
+/// elastic 2-storey one, two yielding frames at gap 0, and a yielding P-Delta frame; each on
+/// its own record.
 fn yielding_scenes() -> (Vec<Vec<RowModel>>, Vec<Vec<f64>>) {
     let row = |a: ShearBuilding, b: ShearBuilding, gap: f64, law: LawKind| {
         let stiffness = if law.is_hertzian() { 2.75e9 } else { 1e9 };
@@ -392,8 +413,17 @@ fn yielding_scenes() -> (Vec<Vec<RowModel>>, Vec<Vec<f64>>) {
             0.005,
             LawKind::Hertz,
         )],
+        // P-Delta: gravity (four times the floors' weight, as a leaning column carries) leans
+        // on two yielding frames, which settle about the static drifts it holds; the first's
+        // Rayleigh damping on K0 couples its modes (its storeys lean unequally).
+        vec![row(
+            leaning_frame(),
+            yielding(2, 0.3, Damping::Modal(0.05), 0.003, 0.05).with_p_delta(4.0),
+            0.004,
+            LawKind::Hertz,
+        )],
     ];
-    let records = (0..3).map(|s| record(80 + s, 3.0, 0.8)).collect();
+    let records = (0..4).map(|s| record(80 + s, 3.0, 0.8)).collect();
     (groups, records)
 }
 

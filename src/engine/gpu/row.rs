@@ -19,11 +19,11 @@ use super::shader::Precision;
 use crate::engine::Summary;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
-use crate::physics::propagator::Propagator;
+use crate::physics::propagator::{CoupledPropagator, Propagator};
 use crate::physics::row::{BuildingOutput, LevelOutput, RowOutput, StoreyOutput};
 use crate::physics::solver::fast::{LOCATE_BISECTIONS, LOCATE_ITERATIONS};
 use crate::physics::solver::row::yielding::settle_intervals;
-use crate::physics::solver::row::{simulate_row, RowModel, RowScheme};
+use crate::physics::solver::row::{simulate_row, BuildingModel, RowModel, RowScheme};
 use crate::physics::solver::FastOptions;
 use crate::plan::row::{RowPlan, RowRunSpec};
 use rayon::prelude::*;
@@ -89,7 +89,7 @@ pub const BS_STRIDE: usize = 3;
 pub const MW: usize = 11;
 /// Reals per yielding storey after its building's model block: `k`, `d_y`, `b`, then its
 /// modal row (the drift in the building's modes).
-pub const STOREY_HEAD: usize = 3;
+pub const STOREY_HEAD: usize = 4;
 
 /// The band's slack in f32 (`row::yielding::YIELD_SLACK` is f64's): a storey leaves its band edge
 /// inside the band once f32 has rounded its back drift `d - p / (1 - b)`, whose terms are up
@@ -110,6 +110,10 @@ pub struct RowShape {
     pub levels: Vec<[usize; 3]>,
     /// Each building: do its storeys yield?
     pub yielding: Vec<bool>,
+    /// Each building: may its damping couple its modes (P-Delta with Rayleigh damping on
+    /// `K0`, several storeys)? Its block then carries the coupling and the exact step of its
+    /// modes together (zeros and the per-mode step where a run's storeys lean alike).
+    pub coupled: Vec<bool>,
 }
 
 impl RowShape {
@@ -126,16 +130,19 @@ impl RowShape {
                 .iter()
                 .map(|b| b.first_storey.is_some())
                 .collect(),
+            coupled: m.buildings.iter().map(may_couple).collect(),
         }
     }
 
     /// An elastic row's shape.
     pub fn elastic(storeys: Vec<usize>, levels: Vec<[usize; 3]>) -> RowShape {
         let yielding = vec![false; storeys.len()];
+        let coupled = yielding.clone();
         RowShape {
             storeys,
             levels,
             yielding,
+            coupled,
         }
     }
 
@@ -227,9 +234,17 @@ impl RowShape {
         reals.max(4 * self.c_stride().max(self.m_stride()))
     }
 
-    /// Reals of one building's model block (with its storeys' where they yield).
-    fn model_len(n: usize, yields: bool) -> usize {
+    /// Reals of one building's model block before its coupled part (with its storeys' where
+    /// they yield).
+    fn model_head_len(n: usize, yields: bool) -> usize {
         MW * n + n * n + 2 * n + if yields { n * (STOREY_HEAD + n) } else { 0 }
+    }
+
+    /// Reals of one building's model block: where its modes may couple, whether they do in
+    /// this run (1 or 0), the coupling `E` (`N x N`), the exact step of its `[q, q']` (`2N x
+    /// 2N`) and its ground terms (`2 x 2N`).
+    fn model_len(n: usize, yields: bool, coupled: bool) -> usize {
+        Self::model_head_len(n, yields) + if coupled { 1 + 5 * n * n + 4 * n } else { 0 }
     }
 
     /// The shape and layout as WGSL constants, prepended to `row.wgsl`.
@@ -364,6 +379,15 @@ impl RowShape {
         a("S_B", "NSA", &sb);
         a("S_J", "NSA", &sj);
         a("B_S0", "NB", &first);
+        // Where each building's coupled part starts in its block (0: its modes are uncoupled).
+        let cp: Vec<usize> = (self.storeys.iter().zip(&self.yielding).zip(&self.coupled))
+            .map(|((&n, &y), &c)| if c { Self::model_head_len(n, y) } else { 0 })
+            .collect();
+        a("B_CP", "NB", &cp);
+        s.push_str(&format!(
+            "const COUPLED: bool = {};\n",
+            self.coupled.iter().any(|&c| c)
+        ));
         s
     }
 
@@ -375,17 +399,24 @@ impl RowShape {
         let nmax = *self.storeys.iter().max().unwrap_or(&1) as u64;
         let zlen = self.zlen() as u64;
         let sq: u64 = self.storeys.iter().map(|&n| (n * n + 2 * n) as u64).sum();
+        let nb_all = self.storeys.len() as u64;
         let level = 4 * nmax + 1;
         // Yielding storeys (none in an elastic row): each one's drift and rate are products
         // with its modal row.
         let ns = self.yielding_storeys() as u64;
         let storeys = ns * (2 * nmax + 4);
-        let rhs = nm + nl * (2 * level + 2 * nmax) + 1 + storeys + ns * nmax;
+        // Buildings whose damping couples their modes: `E q'` (n^2) in every right-hand side
+        // and floor acceleration, twice in a fill, the coupled bounds and the exact step.
+        let sqc: u64 = (self.storeys.iter().zip(&self.coupled))
+            .filter(|(_, &c)| c)
+            .map(|(&n, _)| (n * n) as u64)
+            .sum();
+        let rhs = nm + nl * (2 * level + 2 * nmax) + 1 + storeys + ns * nmax + sqc + nb_all;
         let rk4 = 4 * rhs + 4 * zlen;
         let event_max = nl * level + storeys;
         let forces = nm + nl * level;
         let track = 5 * nm + 2 * forces + 2 * sq + nl + nm + nl * (3 * level);
-        let track = track + 2 * (storeys + ns * nmax) + ns;
+        let track = track + 2 * (storeys + ns * nmax) + ns + 4 * sqc + 2 * nb_all;
         let transitions = nl * (3 * level) + storeys;
         let locate = (2 * LOCATE_ITERATIONS + LOCATE_BISECTIONS) as u64 * (rk4 + event_max + 1);
         let accept = 4 * event_max + nl * (2 * level) + rk4 + locate + track + transitions;
@@ -393,6 +424,9 @@ impl RowShape {
         let piece = rk4 + accept + zlen;
         let begin = nl + nm + nl * (6 * level + 2 * nmax) + track + zlen;
         let begin = begin + 3 * nm * (ns > 0) as u64 + 2 * storeys + ns * nmax;
+        // The settling test with P-Delta: the static response and each storey's drift in it.
+        let begin = begin + (2 * nm + ns + 2 * ns * nmax) * (ns > 0) as u64;
+        let begin = begin + 8 * sqc + 3 * nm + nb_all + nl * 4 * nmax * nmax * (sqc > 0) as u64;
         piece.max(begin) + 1
     }
 }
@@ -416,6 +450,38 @@ impl ModelTable {
     }
 }
 
+/// What a yielding storey's outputs need beside the kernel's state: its height and yield
+/// drift, and where gravity leans on it (P-Delta) its drift at rest as a combination of its
+/// building's plastic drifts (`RowModel::residual_row`).
+#[derive(Debug, Clone)]
+struct StoreyReadout {
+    /// Its index among the run's yielding storeys.
+    index: usize,
+    height: f64,
+    d_y: f64,
+    leaning: Option<(usize, Vec<f64>)>,
+}
+
+impl StoreyReadout {
+    fn of(m: &RowModel, s: usize) -> StoreyReadout {
+        let sm = &m.storeys[s];
+        StoreyReadout {
+            index: s,
+            height: sm.height,
+            d_y: sm.d_y,
+            leaning: (sm.geometric != 0.0).then(|| m.residual_row(s)),
+        }
+    }
+
+    /// Its drift at rest from the run's plastic drifts `p` (every yielding storey's).
+    fn residual(&self, p: &[f64]) -> f64 {
+        match &self.leaning {
+            Some((first, c)) => c.iter().zip(&p[*first..]).map(|(c, p)| c * p).sum(),
+            None => p[self.index],
+        }
+    }
+}
+
 /// A chunk of row runs packed for the kernel.
 #[derive(Debug)]
 pub struct PackedRows {
@@ -424,8 +490,8 @@ pub struct PackedRows {
     meta: Vec<u32>,
     models: ModelTable,
     runs: usize,
-    /// Each run's yielding storeys' heights and yield drifts (for their outputs).
-    storey_scales: Vec<[f64; 2]>,
+    /// Each run's yielding storeys, for their outputs.
+    storey_readouts: Vec<StoreyReadout>,
 }
 
 fn law_code(l: LawKind) -> u32 {
@@ -440,7 +506,7 @@ impl PackedRows {
             meta: Vec::new(),
             models: ModelTable::default(),
             runs: 0,
-            storey_scales: Vec::new(),
+            storey_readouts: Vec::new(),
         }
     }
 
@@ -500,8 +566,8 @@ impl PackedRows {
         }
         if !m.storeys.is_empty() {
             self.meta.push(settle_intervals(m, forcing) as u32);
-            self.storey_scales
-                .extend(m.storeys.iter().map(|s| [s.height, s.d_y]));
+            self.storey_readouts
+                .extend((0..m.storeys.len()).map(|s| StoreyReadout::of(m, s)));
         }
         self.runs += 1;
     }
@@ -514,7 +580,9 @@ fn model_blocks(m: &RowModel, dt: f64) -> Vec<Vec<f64>> {
         .iter()
         .map(|b| {
             let n = b.n();
-            let mut block = Vec::with_capacity(RowShape::model_len(n, b.first_storey.is_some()));
+            let coupled = may_couple(b);
+            let mut block =
+                Vec::with_capacity(RowShape::model_len(n, b.first_storey.is_some(), coupled));
             for i in 0..n {
                 let k = b.off + i;
                 let osc = Oscillator {
@@ -544,17 +612,45 @@ fn model_blocks(m: &RowModel, dt: f64) -> Vec<Vec<f64>> {
             block.extend_from_slice(&b.heights);
             if let Some(first) = b.first_storey {
                 for s in &m.storeys[first..first + n] {
-                    block.extend([s.k, s.d_y, s.b]);
+                    block.extend([s.k, s.d_y, s.b, s.geometric]);
                     block.extend_from_slice(&s.modal_row);
                 }
             }
+            if coupled {
+                // The coupling (zero where this run's storeys lean alike) and the exact step of
+                // the building's modes over dt with it, as the CPU's CoupledStep takes it.
+                let r = b.off..b.off + n;
+                let zero = vec![vec![0.0; n]; n];
+                block.push(b.modes.coupling.is_some() as u8 as f64);
+                let e = b.modes.coupling.as_ref().unwrap_or(&zero);
+                for row in e {
+                    block.extend_from_slice(row);
+                }
+                let p = CoupledPropagator::new(
+                    &m.w2[r.clone()],
+                    &m.two_xi_w[r.clone()],
+                    e,
+                    &m.part[r],
+                    dt,
+                );
+                let (step, f0, f1) = p.coefficients();
+                block.extend_from_slice(step);
+                block.extend_from_slice(f0);
+                block.extend_from_slice(f1);
+            }
             debug_assert_eq!(
                 block.len(),
-                RowShape::model_len(n, b.first_storey.is_some())
+                RowShape::model_len(n, b.first_storey.is_some(), coupled)
             );
             block
         })
         .collect()
+}
+
+/// May building `b`'s damping couple its modes (P-Delta with Rayleigh damping on `K0`, over one
+/// storey)? Where it does in a run, `b.modes.coupling` is set.
+fn may_couple(b: &BuildingModel) -> bool {
+    b.n() > 1 && b.floor_form.as_ref().is_some_and(|f| f.geometric.is_some())
 }
 
 /// Units of work per dispatch on a software adapter (unbounded on hardware), or an error when
@@ -682,7 +778,7 @@ pub fn run_rows(
             let s = &reals[r * shape.s_stride()..(r + 1) * shape.s_stride()];
             let c = &words[r * shape.c_stride()..(r + 1) * shape.c_stride()];
             let ns = shape.yielding_storeys();
-            output(shape, s, c, &chunk.storey_scales[r * ns..(r + 1) * ns])
+            output(shape, s, c, &chunk.storey_readouts[r * ns..(r + 1) * ns])
         })
         .collect();
     times.readback = t.elapsed();
@@ -690,9 +786,8 @@ pub fn run_rows(
 }
 
 /// A run's results from its final state and counters (what `RowRun::finish` does on the CPU,
-/// without the energy balance), `scales`: its yielding storeys' heights and yield drifts; None
-/// for a run handed back.
-fn output(shape: &RowShape, s: &[f64], c: &[u32], scales: &[[f64; 2]]) -> Option<RowOutput> {
+/// without the energy balance), `storeys`: its yielding storeys'; None for a run handed back.
+fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> Option<RowOutput> {
     let status = match c[C_STATUS] {
         STATUS_HANDOFF => return None,
         STATUS_OK => Status::Ok,
@@ -745,12 +840,12 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], scales: &[[f64; 2]]) -> Option
     let ns = shape.yielding_storeys();
     if ns > 0 {
         let ps = shape.plastic_slot0();
-        out.storeys = scales
+        out.storeys = storeys
             .iter()
             .enumerate()
-            .map(|(k, &[height, d_y])| StoreyOutput {
-                residual_drift_ratio: s[ps + k] / height,
-                peak_ductility: s[shape.s_storeys() + k] * height / d_y,
+            .map(|(k, st)| StoreyOutput {
+                residual_drift_ratio: st.residual(&s[ps..ps + ns]) / st.height,
+                peak_ductility: s[shape.s_storeys() + k] * st.height / st.d_y,
                 hysteretic_energy: s[ps + ns + k],
                 yielded: c[shape.c_storeys() + SC_STRIDE * k + SC_YIELDED] != 0,
             })

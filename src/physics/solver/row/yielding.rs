@@ -162,6 +162,26 @@ impl RowModel {
         }
     }
 
+    /// Storey `s`'s drift at rest as a combination of its building's plastic drifts: `d_s =
+    /// sum_j c_j p_(first + j)` (the building's storeys from `first`), the static response
+    /// [`RowModel::static_offsets`] gives, as one row. Without P-Delta `d_s = p_s`; with it
+    /// gravity leans on every storey's plastic drift (the GPU's readback takes its residual
+    /// drifts from it).
+    pub(crate) fn residual_row(&self, s: usize) -> (usize, Vec<f64>) {
+        let sm = &self.storeys[s];
+        let b = &self.buildings[sm.building];
+        let first = b.first_storey.expect("a yielding storey's building yields");
+        let c = self.storeys[first..first + b.n()]
+            .iter()
+            .map(|other| {
+                (0..b.n())
+                    .map(|i| sm.modal_row[i] * other.modal_row[i] * other.k / self.w2[b.off + i])
+                    .sum()
+            })
+            .collect();
+        (first, c)
+    }
+
     /// Building `k`'s plastic load and its rate in its current coordinates, added to `acc`
     /// and `jerk` (indexed by its modes or floors from 0): `psi k p` and `psi k p'`, `p'` from
     /// the storeys' `modes`.
@@ -908,5 +928,60 @@ mod tests {
         assert_ne!(out.status, Status::Collapsed);
         assert!(out.collapse.is_none());
         assert!(out.buildings[0].peak_drift_ratio > 0.1);
+    }
+    /// A storey's drift at rest from its building's plastic drifts: each plastic drift itself
+    /// without gravity (`D K^-1 D^T diag(k) = I` for a shear building), and with P-Delta the
+    /// static response to the plastic loads, `p / (1 - theta)` in one storey.
+    #[test]
+    fn residual_rows_give_the_static_drifts_gravity_leans_on() {
+        let plain = tower(4, 0.6, true, Some(0.01), 0.03);
+        let leaning = plain.clone().with_p_delta(3.0);
+        for (b, lean) in [(plain, false), (leaning, true)] {
+            let row = Row::new(
+                vec![b, tower(1, 0.3, false, None, 0.0)],
+                vec![1.0],
+                LawKind::Linear,
+                1e9,
+                0.0,
+            );
+            let model = RowModel::new(&row);
+            let mut z = model.at_rest();
+            let p = [0.004, -0.002, 0.001, 0.003];
+            for (s, &x) in p.iter().enumerate() {
+                z[model.plastic_slot(s)] = x;
+            }
+            let mut qs = vec![0.0; model.n];
+            model.static_offsets(&z, &mut qs);
+            for s in 0..4 {
+                let (first, c) = model.residual_row(s);
+                assert_eq!(first, 0);
+                let d: f64 = c.iter().zip(&p).map(|(c, p)| c * p).sum();
+                let d_s = dot(&model.storeys[s].modal_row, &qs);
+                assert!(
+                    (d - d_s).abs() < 1e-12 * p[0].abs(),
+                    "storey {s}: {d} {d_s}"
+                );
+                if !lean {
+                    assert!((d - p[s]).abs() < 1e-12, "storey {s}: {d} against {}", p[s]);
+                } else {
+                    assert!(
+                        (d - p[s]).abs() > 1e-6 * p[s].abs(),
+                        "gravity leans on storey {s}"
+                    );
+                }
+            }
+        }
+        let mut one = sdof(1e5, 0.5, 0.05, 0.01, 0.0);
+        let k = one.stiffness[0];
+        one.geometric = Some(vec![0.2 * k]);
+        let row = Row::new(
+            vec![one, tower(1, 0.3, false, None, 0.0)],
+            vec![1.0],
+            LawKind::Linear,
+            1e9,
+            0.0,
+        );
+        let (_, c) = RowModel::new(&row).residual_row(0);
+        assert!((c[0] - 1.0 / 0.8).abs() < 1e-12, "{}", c[0]);
     }
 }
