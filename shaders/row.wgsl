@@ -401,8 +401,8 @@ fn coupled_step(b: u32, seg: Seg, z: ptr<function, ZA>, z1: ptr<function, ZA>) {
 
 // RowModel::fourth_derivative_bounds into MBND over the free step z0 -> z1: each mode's
 // |q''''| bound (about QS where storeys yield; QS stays 0 in a kernel without), and where
-// damping couples a building's modes, each bound's terms gain the coupling's, |E| times the
-// other modes'.
+// damping couples a building's modes, each bound's terms gain the coupling's, at most
+// sum_k |E_ik| (coupling_sums) times the largest of the other modes'.
 fn mode_bounds(seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>) {
     for (var k = 0u; k < NM; k++) {
         MBND[k] = shifted_mode_bound(k, seg, z0, z1);
@@ -416,36 +416,36 @@ fn mode_bounds(seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>) {
         }
         let o = B_OFF[b];
         let n = B_N[b];
-        var v: array<real, MAXN>;
+        var sums: array<real, MAXN>;
         var a2: array<real, MAXN>;
-        var a3: array<real, MAXN>;
+        var vm: real = 0.0;
         for (var i = 0u; i < n; i++) {
-            v[i] = max(abs((*z0)[NM + o + i]), abs((*z1)[NM + o + i]));
+            var c: real = 0.0;
+            for (var j = 0u; j < n; j++) {
+                c += abs(cpl_e(b, i, j));
+            }
+            sums[i] = c;
+            vm = max(vm, max(abs((*z0)[NM + o + i]), abs((*z1)[NM + o + i])));
         }
+        var a2m: real = 0.0;
         for (var i = 0u; i < n; i++) {
             let k = o + i;
             let q = max(abs((*z0)[k] - QS[k]), abs((*z1)[k] - QS[k]));
-            var c: real = 0.0;
-            for (var j = 0u; j < n; j++) {
-                c += abs(cpl_e(b, i, j)) * v[j];
-            }
-            a2[i] = W2[k] * q + TXW[k] * v[i] + max(abs(PART[k] * seg.a0), abs(PART[k] * seg.a1)) + c;
+            let v = max(abs((*z0)[NM + k]), abs((*z1)[NM + k]));
+            a2[i] = W2[k] * q + TXW[k] * v + max(abs(PART[k] * seg.a0), abs(PART[k] * seg.a1)) + sums[i] * vm;
+            a2m = max(a2m, a2[i]);
+        }
+        var a3: array<real, MAXN>;
+        var a3m: real = 0.0;
+        for (var i = 0u; i < n; i++) {
+            let k = o + i;
+            let v = max(abs((*z0)[NM + k]), abs((*z1)[NM + k]));
+            a3[i] = W2[k] * v + TXW[k] * a2[i] + abs(PART[k] * (seg.a1 - seg.a0) / seg.dt) + sums[i] * a2m;
+            a3m = max(a3m, a3[i]);
         }
         for (var i = 0u; i < n; i++) {
             let k = o + i;
-            var c: real = 0.0;
-            for (var j = 0u; j < n; j++) {
-                c += abs(cpl_e(b, i, j)) * a2[j];
-            }
-            a3[i] = W2[k] * v[i] + TXW[k] * a2[i] + abs(PART[k] * (seg.a1 - seg.a0) / seg.dt) + c;
-        }
-        for (var i = 0u; i < n; i++) {
-            let k = o + i;
-            var c: real = 0.0;
-            for (var j = 0u; j < n; j++) {
-                c += abs(cpl_e(b, i, j)) * a3[j];
-            }
-            MBND[k] = W2[k] * a2[i] + TXW[k] * a3[i] + c;
+            MBND[k] = W2[k] * a2[i] + TXW[k] * a3[i] + sums[i] * a3m;
         }
     }
 }

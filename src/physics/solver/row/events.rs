@@ -1,7 +1,7 @@
 //! A row run's events: each level's contact mode and each yielding storey's spring state
 //! ending, located within a step, and the transitions they call for; the acceptance of a step.
 
-use super::yielding::StoreyMode;
+use super::yielding::{may_reach, StoreyMode};
 use super::RowRun;
 use crate::physics::solver::events::{hidden_rise, locate, touch};
 use crate::physics::solver::{Mode, Segment};
@@ -44,6 +44,49 @@ impl<'m> RowRun<'m> {
             }
         });
         levels.chain(storeys).chain(drifts)
+    }
+
+    /// The watched buildings (near collapse) with a storey that may reach the collapse limit
+    /// inside the exact free step `z -> z1` of length `h` (modal states, each mode's `|q''''|`
+    /// bound in `bounds`), marked in `out` (the others left as they are); whether any. Its
+    /// drift's edges `[d - D, -d - D]`, `D` the limit's drift, as a storey's band edges in
+    /// `may_yield`: a building that passed half the limit moves in substeps only while the
+    /// limit is within reach, not for the rest of the run.
+    pub(super) fn collapse_watch(
+        &self,
+        (z, z1): (&[f64], &[f64]),
+        bounds: &[f64],
+        h: f64,
+        out: &mut [bool],
+    ) -> bool {
+        let n = self.m.n;
+        let limit = self.m.collapse_limit;
+        let mut any = false;
+        for d in &self.m.drifts {
+            let k = d.building;
+            if !self.watch[k] || out[k] {
+                any |= out[k];
+                continue;
+            }
+            let o = self.m.buildings[k].off;
+            let row = &d.modal_row;
+            let at = |z: &[f64], from: usize| super::dot(row, &z[from + o..from + o + row.len()]);
+            let top = limit * d.height;
+            let edges = |x: f64, r: f64| [(x - top, r), (-x - top, -r)];
+            let bound: f64 = (row.iter().enumerate())
+                .map(|(i, c)| c.abs() * bounds[o + i])
+                .sum();
+            if may_reach(
+                edges(at(z, 0), at(z, n)),
+                edges(at(z1, 0), at(z1, n)),
+                bound,
+                h,
+            ) {
+                out[k] = true;
+                any = true;
+            }
+        }
+        any
     }
 
     /// The collapse the located events at `zb` (time `t`) mark, if one of them is a storey's

@@ -372,10 +372,19 @@ fn run_with<'a>(
             if !yields {
                 yield_watch.fill(false);
             }
-            for (y, w) in yield_watch.iter_mut().zip(&run.watch) {
-                *y |= *w;
+            if can_stand || !any_contact {
+                // Near collapse: in substeps while a storey may reach the limit in the step.
+                if !bounded {
+                    m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
+                    bounded = true;
+                }
+                yielding |= run.collapse_watch((&z, &z1), &bounds, dt, &mut yield_watch);
+            } else {
+                for (y, w) in yield_watch.iter_mut().zip(&run.watch) {
+                    *y |= *w;
+                }
+                yielding = true;
             }
-            yielding = true;
         }
         if !any_contact {
             if !bounded {

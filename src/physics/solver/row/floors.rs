@@ -22,6 +22,8 @@ pub(super) struct Floors {
     /// Scratch of a yielding building: its plastic loads' accelerations and their rates.
     pub(super) pl_acc: Vec<f64>,
     pub(super) pl_jerk: Vec<f64>,
+    /// Scratch of a building whose damping couples its modes: `q''` with the ground's part.
+    pub(super) qdd: Vec<f64>,
 }
 
 impl Floors {
@@ -37,7 +39,8 @@ impl Floors {
             acc: v.clone(),
             jrk: v.clone(),
             pl_acc: v.clone(),
-            pl_jerk: v,
+            pl_jerk: v.clone(),
+            qdd: v,
         }
     }
 
@@ -154,11 +157,11 @@ impl Floors {
                 // The jerk's own damping term read the acceleration without it.
                 self.jrk[i] += m.two_xi_w[o + i] * ev;
             }
+            for k in 0..nb {
+                self.qdd[k] = self.acc[k] - m.part[o + k] * ag;
+            }
             for (i, row) in e.iter().enumerate() {
-                let eq: f64 = (0..nb)
-                    .map(|k| row[k] * (self.acc[k] - m.part[o + k] * ag))
-                    .sum();
-                self.jrk[i] -= eq;
+                self.jrk[i] -= dot(row, &self.qdd);
             }
         }
         let sh = &b.modes.shape;

@@ -24,6 +24,9 @@ pub(crate) struct BuildingModel {
     pub floor_form: Option<FloorForm>,
     /// Per mode, its largest `|phi|` over the floors: a bound on any floor's share of it.
     pub shape_max: Vec<f64>,
+    /// Where its damping couples its modes, each mode's `sum_k |E_ik|` (for the free steps'
+    /// bounds); empty where it does not.
+    pub coupling_sums: Vec<f64>,
     /// Its slice of the state holds floor displacements and velocities instead of modes
     /// (in the fast scheme's contact substeps, [`RowModel::substep_model`]).
     pub in_floors: bool,
@@ -105,8 +108,6 @@ fn modal_drift_row(modes: &Modes, j: usize) -> Vec<f64> {
         .map(|i| modes.shape[j][i] - if j == 0 { 0.0 } else { modes.shape[j - 1][i] })
         .collect()
 }
-
-impl BuildingModel {}
 
 /// One contact level, as the integrators see it.
 #[derive(Debug, Clone)]
@@ -219,9 +220,13 @@ impl RowModel {
                 }
                 first
             });
+            let coupling_sums = (modes.coupling.iter().flatten())
+                .map(|row| row.iter().map(|c| c.abs()).sum())
+                .collect();
             buildings.push(BuildingModel {
                 off,
                 shape_max,
+                coupling_sums,
                 first_storey,
                 modes,
                 heights: b.heights.clone(),
@@ -465,17 +470,23 @@ impl RowModel {
         out: &mut Vec<f64>,
     ) {
         let n = self.n;
-        // About the static response to the plastic loads: the motion the propagator steps.
-        let mut shift = [Vec::new(), Vec::new()];
-        if !self.storeys.is_empty() {
-            for (s, z) in shift.iter_mut().zip([z0, z1]) {
-                s.resize(n, 0.0);
-                self.static_offsets(z, s);
-            }
-        }
-        let at = |s: &Vec<f64>, k: usize| s.get(k).copied().unwrap_or(0.0);
+        // Scratch after the bounds (no allocation once `out` has grown): each mode's
+        // displacement amplitude, the static responses at both ends, a coupled building's
+        // velocity and acceleration amplitudes.
         out.clear();
-        out.extend((0..n).map(|k| {
+        out.resize(7 * n, 0.0);
+        let (bound, rest) = out.split_at_mut(n);
+        let (q, rest) = rest.split_at_mut(n);
+        let (shift0, rest) = rest.split_at_mut(n);
+        let (shift1, scratch) = rest.split_at_mut(n);
+        // About the static response to the plastic loads: the motion the propagator steps
+        // (0 without yielding storeys).
+        if !self.storeys.is_empty() {
+            self.static_offsets(z0, shift0);
+            self.static_offsets(z1, shift1);
+        }
+        for k in 0..n {
+            q[k] = (z0[k] - shift0[k]).abs().max((z1[k] - shift1[k]).abs());
             let osc = crate::physics::model::Oscillator {
                 m: 1.0,
                 k: self.w2[k],
@@ -486,56 +497,50 @@ impl RowModel {
                 a1: seg.a1 * self.part[k],
                 ..*seg
             };
-            let q = if shift[0].is_empty() {
-                z0[k].abs().max(z1[k].abs())
-            } else {
-                (z0[k] - at(&shift[0], k))
-                    .abs()
-                    .max((z1[k] - at(&shift[1], k)).abs())
-            };
             let qd = z0[n + k].abs().max(z1[n + k].abs());
-            fourth_derivative_bound(&osc, q, qd, &s)
-        }));
-        // Modes coupled by their damping: each bound's terms gain the coupling's, `|E|` times
-        // the other modes' (as `fourth_derivative_bound` builds them, from the ends).
+            bound[k] = fourth_derivative_bound(&osc, q[k], qd, &s);
+        }
+        // Modes coupled by their damping: each bound's terms gain the coupling's, at most
+        // `sum_k |E_ik|` times the largest of the other modes' (as `fourth_derivative_bound`
+        // builds them, from the ends; O(N) where `|E|` times each would be O(N^2)).
         for b in &self.buildings {
-            let Some(e) = &b.modes.coupling else { continue };
+            if b.coupling_sums.is_empty() {
+                continue;
+            }
             let (o, nb) = (b.off, b.n());
-            let at = |s: &Vec<f64>, k: usize| s.get(k).copied().unwrap_or(0.0);
-            let q = |k: usize| {
-                (z0[k] - at(&shift[0], k))
-                    .abs()
-                    .max((z1[k] - at(&shift[1], k)).abs())
-            };
-            let v: Vec<f64> = (o..o + nb)
-                .map(|k| z0[n + k].abs().max(z1[n + k].abs()))
-                .collect();
-            let coupled =
-                |x: &[f64], i: usize| -> f64 { e[i].iter().zip(x).map(|(c, y)| c.abs() * y).sum() };
-            let a2: Vec<f64> = (0..nb)
-                .map(|i| {
-                    let k = o + i;
-                    self.w2[k] * q(k)
-                        + self.two_xi_w[k] * v[i]
-                        + (self.part[k] * seg.a0)
-                            .abs()
-                            .max((self.part[k] * seg.a1).abs())
-                        + coupled(&v, i)
-                })
-                .collect();
-            let a3: Vec<f64> = (0..nb)
-                .map(|i| {
-                    let k = o + i;
-                    self.w2[k] * v[i]
-                        + self.two_xi_w[k] * a2[i]
-                        + (self.part[k] * (seg.a1 - seg.a0) / seg.dt).abs()
-                        + coupled(&a2, i)
-                })
-                .collect();
+            let (v, rest) = scratch.split_at_mut(nb);
+            let (a2, rest) = rest.split_at_mut(nb);
+            let a3 = &mut rest[..nb];
+            for (i, v) in v.iter_mut().enumerate() {
+                *v = z0[n + o + i].abs().max(z1[n + o + i].abs());
+            }
+            let largest = |x: &[f64]| x.iter().fold(0.0, |m: f64, y| m.max(*y));
+            let sums = &b.coupling_sums;
+            let coupled = |x: f64, i: usize| -> f64 { sums[i] * x };
+            let vm = largest(v);
             for i in 0..nb {
                 let k = o + i;
-                out[k] = self.w2[k] * a2[i] + self.two_xi_w[k] * a3[i] + coupled(&a3, i);
+                a2[i] = self.w2[k] * q[k]
+                    + self.two_xi_w[k] * v[i]
+                    + (self.part[k] * seg.a0)
+                        .abs()
+                        .max((self.part[k] * seg.a1).abs())
+                    + coupled(vm, i);
+            }
+            let a2m = largest(a2);
+            for i in 0..nb {
+                let k = o + i;
+                a3[i] = self.w2[k] * v[i]
+                    + self.two_xi_w[k] * a2[i]
+                    + (self.part[k] * (seg.a1 - seg.a0) / seg.dt).abs()
+                    + coupled(a2m, i);
+            }
+            let a3m = largest(a3);
+            for i in 0..nb {
+                let k = o + i;
+                bound[k] = self.w2[k] * a2[i] + self.two_xi_w[k] * a3[i] + coupled(a3m, i);
             }
         }
+        out.truncate(n);
     }
 }

@@ -97,13 +97,7 @@ impl StoreyModel {
     /// bounds `|d''''|` over it? As a level's `may_touch`: the Hermite cubic of each edge
     /// function within twice its error bound of 0.
     pub fn may_yield(&self, [d0, r0, d1, r1]: [f64; 4], p: f64, bound: f64, h: f64) -> bool {
-        let margin = -error_margin(bound, h);
-        let e0 = self.edges(d0, r0, p);
-        let e1 = self.edges(d1, r1, p);
-        e0.iter().zip(&e1).any(|(a, b)| {
-            cubic_max_bound(a.0, a.1, b.0, b.1, h) > margin
-                && (a.0 > 0.0 || b.0 > 0.0 || hermite_range(a.0, a.1, b.0, b.1, h).1 > margin)
-        })
+        may_reach(self.edges(d0, r0, p), self.edges(d1, r1, p), bound, h)
     }
 
     /// The band's two edges as functions that reach 0 on them: `[s - d_y, -s - d_y]` with
@@ -114,6 +108,17 @@ impl StoreyModel {
         let dy = self.d_y * (1.0 + YIELD_SLACK);
         [(s - dy, rate), (-s - dy, -rate)]
     }
+}
+
+/// Could an edge function (value and rate at both ends of a free step of length `h`, `bound`
+/// bounding its fourth derivative) reach 0 inside the step? As a level's `may_touch`: the
+/// Hermite cubic of each within twice its error bound of 0.
+pub(crate) fn may_reach(e0: [(f64, f64); 2], e1: [(f64, f64); 2], bound: f64, h: f64) -> bool {
+    let margin = -error_margin(bound, h);
+    e0.iter().zip(&e1).any(|(a, b)| {
+        cubic_max_bound(a.0, a.1, b.0, b.1, h) > margin
+            && (a.0 > 0.0 || b.0 > 0.0 || hermite_range(a.0, a.1, b.0, b.1, h).1 > margin)
+    })
 }
 
 impl RowModel {
