@@ -562,17 +562,16 @@ impl Aggregator {
         plan: &crate::plan::row::RowPlan,
         rows: &[(crate::plan::row::RowRunSpec, crate::physics::row::RowOutput)],
     ) {
-        let status = plan.parameter_columns();
         for (s, o) in rows {
-            self.add_cells(&plan.cells(s, o), status);
+            self.add_cells(&plan.cells(s, o), o.status);
         }
     }
 
-    /// Fold in one row given as its cells (in the header's order): grouped by the text of its
-    /// `by` cells; a row whose status is not `ok` is a failure. An empty output cell of an `ok`
-    /// row is counted apart (no value: a residual drift not known); an unreadable one counts
-    /// as NaN (the zero bucket).
-    pub fn add_cells(&mut self, cells: &[String], status_at: usize) {
+    /// Fold in one run given as its cells (in the header's order) and its status: grouped by
+    /// the text of its `by` cells; a failed run is counted as one, a collapsed one apart. An
+    /// empty output cell of an `ok` row is counted apart (no value: a residual drift not
+    /// known); an unreadable one counts as NaN (the zero bucket).
+    pub fn add_cells(&mut self, cells: &[String], status: Status) {
         let label: Vec<String> = self.by.iter().map(|(_, i, _)| cells[*i].clone()).collect();
         let next = self.groups.len() as u32;
         let nout = self.outputs.len();
@@ -589,11 +588,6 @@ impl Aggregator {
                 (!c.is_empty()).then(|| c.parse::<f64>().map_or(f64::NAN, f64::abs))
             })
             .collect();
-        let status = match cells[status_at].as_str() {
-            "ok" => Status::Ok,
-            "collapsed" => Status::Collapsed,
-            _ => Status::NonFinite,
-        };
         let exceed = &self.exceed;
         self.groups[id as usize].1.add_values(status, &x, exceed);
     }

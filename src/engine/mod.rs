@@ -405,19 +405,17 @@ impl<'c> Engine<'c> {
             Plan::Row(r) => r,
         };
         let sink = |rows: &[_]| sink(Chunk::Rows(row, rows));
-        let summary = match self {
+        let (summary, gpu) = match self {
             Engine::Cpu { scheme, chunk } => {
                 debug_assert_eq!(*scheme, plan.scheme(), "the engine runs the plan's scheme");
-                cpu::run_rows(row, runs, *chunk, sink, progress)?
+                let summary = cpu::run_rows(row, runs, *chunk, sink, progress)?;
+                (summary, GpuTimes::default())
             }
             Engine::Gpu { ctx, opts, chunk } => {
                 gpu::row::sweep_rows(ctx, row, runs, *chunk, opts, sink, progress)?
             }
         };
-        Ok(Report {
-            summary,
-            gpu: GpuTimes::default(),
-        })
+        Ok(Report { summary, gpu })
     }
 
     /// Run the runs `runs` of any plan and fold each into its group of `agg` (built for this

@@ -92,7 +92,7 @@ mod tests {
         .unwrap();
         for (residual, impacts) in [("0.02", "3"), ("", "5"), ("0.001", "0"), ("", "1")] {
             let cells: Vec<String> = ["0.01", "ok", residual, impacts].map(String::from).to_vec();
-            a.add_cells(&cells, 1);
+            a.add_cells(&cells, crate::physics::model::Status::Ok);
         }
         let csv = super::csv(&a);
         let mut lines = csv.lines();

@@ -326,6 +326,8 @@ pub struct StoreyRow {
     pub summary: Summary,
     /// Formatting the rows as CSV, s (inside `summary.seconds`).
     pub csv: f64,
+    /// On the GPU: the share of the lane trips the kernel held that did work.
+    pub lane_utilisation: Option<f64>,
 }
 
 /// Seconds to format a chunk of row results as CSV (the text is thrown away).
@@ -359,6 +361,7 @@ pub fn run_storeys(storeys: usize, plan: &RowPlan) -> StoreyRow {
         backend: format!("cpu ({} threads)", rayon::current_num_threads()),
         summary,
         csv,
+        lane_utilisation: None,
     }
 }
 
@@ -375,7 +378,7 @@ pub fn run_storeys_gpu(
     let shape = RowShape::of(&RowModel::new(&plan.row(&plan.run(0))));
     ctx.row_kernel(opts.precision, &shape)?;
     let mut csv = 0.0;
-    let summary = sweep_rows(
+    let (summary, times) = sweep_rows(
         ctx,
         plan,
         0..plan.len(),
@@ -393,19 +396,20 @@ pub fn run_storeys_gpu(
         backend: format!("gpu {} ({})", opts.precision.key(), ctx.info.name),
         summary,
         csv,
+        lane_utilisation: times.lane_utilisation(),
     })
 }
 
 /// A markdown table of the multi-storey suite.
 pub fn storey_table(rows: &[StoreyRow]) -> String {
     let mut s = String::from(
-        "| storeys per building | runs | backend | total s | runs/s | storeys x runs/s | free steps/s | RK4 substeps/s | csv s | impacts |\n|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| storeys per building | runs | backend | total s | runs/s | storeys x runs/s | free steps/s | RK4 substeps/s | csv s | impacts | lanes busy |\n|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         let m = &r.summary;
         let per_s = |x: u64| x as f64 / m.seconds.max(1e-12);
         s.push_str(&format!(
-            "| {}{} | {} | {} | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} |\n",
+            "| {}{} | {} | {} | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} | {} |\n",
             r.storeys,
             if r.yielding { ", yielding" } else { "" },
             m.runs,
@@ -416,7 +420,9 @@ pub fn storey_table(rows: &[StoreyRow]) -> String {
             per_s(m.free_steps),
             per_s(m.substeps),
             r.csv,
-            m.impacts
+            m.impacts,
+            r.lane_utilisation
+                .map_or("-".to_string(), |u| format!("{:.1} %", 100.0 * u))
         ));
     }
     s

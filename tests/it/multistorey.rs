@@ -665,23 +665,36 @@ fn example_row_configs_load() {
     }
 }
 
-/// `pound bench --storeys`: one line per storey count with every run of its sweep counted, and a
-/// storey count out of range refused.
+/// `pound bench --storeys`: one line per storey count with every run of its sweep counted, on
+/// the CPU and on the GPU adapter found (lavapipe in CI) with the share of its lanes busy; a
+/// row the adapter cannot run is named and left out; a storey count out of range refused.
 #[test]
 fn bench_storeys_suite_times_each_storey_count() {
-    let table = crate::support::ok(&crate::support::pound(&[
-        "bench",
-        "--storeys",
-        "1,4",
-        "--storey-runs",
-        "20",
-    ]));
+    let out = crate::support::pound(&["bench", "--storeys", "1,4", "--storey-runs", "20"]);
+    let table = crate::support::ok(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
     let lines: Vec<&str> = table.lines().filter(|l| l.contains("cpu (")).collect();
     assert_eq!(lines.len(), 2, "{table}");
     for (line, n) in lines.iter().zip(["1", "4"]) {
         let cells: Vec<&str> = line.split('|').map(str::trim).collect();
         assert_eq!((cells[1], cells[2]), (n, "20"), "{line}");
         assert!(cells[5].parse::<f64>().unwrap() > 0.0, "{line}");
+        assert_eq!(cells[11], "-", "no lanes on the CPU: {line}");
+    }
+    if crate::support::gpu::ctx().is_some() {
+        let gpu: Vec<&str> = table.lines().filter(|l| l.contains("| gpu ")).collect();
+        let one = gpu
+            .iter()
+            .find(|l| l.starts_with("| 1 |"))
+            .expect("1-storey rows on the GPU");
+        let cells: Vec<&str> = one.split('|').map(str::trim).collect();
+        assert_eq!(cells[2], "20", "{one}");
+        let busy: f64 = cells[11].trim_end_matches(" %").parse().unwrap();
+        assert!(busy > 0.0 && busy <= 100.0, "{one}");
+        assert!(
+            gpu.iter().any(|l| l.starts_with("| 4 |")) || stderr.contains("4-storey rows on"),
+            "the 4-storey rows are run or named: {table}\n{stderr}"
+        );
     }
     let bad = crate::support::pound(&["bench", "--storeys", "0"]);
     assert!(!bad.status.success());

@@ -16,6 +16,7 @@ use super::run::{
     WorkLists,
 };
 use super::shader::Precision;
+use super::sweep::GpuTimes;
 use crate::engine::Summary;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
@@ -411,12 +412,14 @@ impl RowShape {
             .filter(|(_, &c)| c)
             .map(|(&n, _)| (n * n) as u64)
             .sum();
-        let rhs = nm + nl * (2 * level + 2 * nmax) + 1 + storeys + ns * nmax + sqc + nb_all;
+        let coupled = (sqc > 0) as u64;
+        let rhs =
+            nm + nl * (2 * level + 2 * nmax) + 1 + storeys + ns * nmax + sqc + nb_all * coupled;
         let rk4 = 4 * rhs + 4 * zlen;
         let event_max = nl * level + storeys;
         let forces = nm + nl * level;
         let track = 5 * nm + 2 * forces + 2 * sq + nl + nm + nl * (3 * level);
-        let track = track + 2 * (storeys + ns * nmax) + ns + 4 * sqc + 2 * nb_all;
+        let track = track + 2 * (storeys + ns * nmax) + ns + 4 * sqc + 2 * nb_all * coupled;
         let transitions = nl * (3 * level) + storeys;
         let locate = (2 * LOCATE_ITERATIONS + LOCATE_BISECTIONS) as u64 * (rk4 + event_max + 1);
         let accept = 4 * event_max + nl * (2 * level) + rk4 + locate + track + transitions;
@@ -426,7 +429,9 @@ impl RowShape {
         let begin = begin + 3 * nm * (ns > 0) as u64 + 2 * storeys + ns * nmax;
         // The settling test with P-Delta: the static response and each storey's drift in it.
         let begin = begin + (2 * nm + ns + 2 * ns * nmax) * (ns > 0) as u64;
-        let begin = begin + 8 * sqc + 3 * nm + nb_all + nl * 4 * nmax * nmax * (sqc > 0) as u64;
+        // mode_bounds (with yielding storeys or coupled modes) and the coupled parts.
+        let begin = begin + 3 * nm * ((ns > 0) as u64).max(coupled);
+        let begin = begin + (8 * sqc + nb_all + nl * 4 * nmax * nmax) * coupled;
         piece.max(begin) + 1
     }
 }
@@ -863,7 +868,9 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> 
 
 /// The runs `runs` of a row plan on the GPU in chunks of `chunk`, each chunk's runs handed back
 /// by the kernel finished on the CPU in f64 (as for pairs); `sink` gets each chunk in run order,
-/// `progress` the runs done after each.
+/// `progress` the runs done after each. With the summary, where the time went and the kernel's
+/// lane tally (`handed_off`: the runs the kernel handed back; `handoff` also times the runs
+/// that reached the collapse limit, run again on the CPU).
 pub fn sweep_rows<E: From<GpuError>>(
     ctx: &GpuContext,
     plan: &RowPlan,
@@ -872,10 +879,11 @@ pub fn sweep_rows<E: From<GpuError>>(
     opts: &GpuOptions,
     mut sink: impl FnMut(&[(RowRunSpec, RowOutput)]) -> Result<(), E>,
     mut progress: impl FnMut(u64),
-) -> Result<Summary, E> {
+) -> Result<(Summary, GpuTimes), E> {
     let start = Instant::now();
+    let mut times = GpuTimes::default();
     if runs.is_empty() {
-        return Ok(Summary::default());
+        return Ok((Summary::default(), times));
     }
     let accels = plan.contact.accels();
     let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
@@ -898,7 +906,9 @@ pub fn sweep_rows<E: From<GpuError>>(
         for (s, m) in specs.iter().zip(&models) {
             packed.push(m, &plan.forcing(s), s.contact.record, &recs, &opts.fast);
         }
-        let (outs, _) = run_rows(ctx, &recs, &packed, opts)?;
+        let (outs, ct) = run_rows(ctx, &recs, &packed, opts)?;
+        times.add_chunk(&ct);
+        let t = Instant::now();
         let rows: Vec<(RowRunSpec, RowOutput)> = specs
             .into_iter()
             .zip(outs)
@@ -906,16 +916,21 @@ pub fn sweep_rows<E: From<GpuError>>(
             .map(|((s, o), m)| {
                 // The kernel has no collapse event: a run whose storey reached the limit is
                 // run again on the CPU, which ends it there.
-                let o = o
-                    .filter(|o| {
-                        o.buildings
-                            .iter()
-                            .all(|b| b.peak_drift_ratio < plan.collapse_drift_ratio)
-                    })
-                    .unwrap_or_else(|| simulate_row(m, &plan.forcing(&s), m.at_rest(), &cpu));
+                let handed = o.is_none();
+                let o = o.filter(|o| {
+                    o.buildings
+                        .iter()
+                        .all(|b| b.peak_drift_ratio < plan.collapse_drift_ratio)
+                });
+                let o = o.unwrap_or_else(|| simulate_row(m, &plan.forcing(&s), m.at_rest(), &cpu));
+                (s, o, handed)
+            })
+            .map(|(s, o, handed)| {
+                times.handed_off += handed as u64;
                 (s, o)
             })
             .collect();
+        times.handoff += t.elapsed().as_secs_f64();
         for (_, o) in &rows {
             summary.count_row(o);
         }
@@ -924,5 +939,5 @@ pub fn sweep_rows<E: From<GpuError>>(
         first = end;
     }
     summary.seconds = start.elapsed().as_secs_f64();
-    Ok(summary)
+    Ok((summary, times))
 }
