@@ -35,8 +35,12 @@ fn mul<const N: usize>(a: &[[f64; N]; N], b: &[[f64; N]; N]) -> [[f64; N]; N] {
 
 /// Halvings that bring the row-sum norm of `a` to at most `limit` (scaling and squaring).
 fn halvings<const N: usize>(a: &[[f64; N]; N], limit: f64) -> i32 {
-    let norm = a
-        .iter()
+    halvings_of(a.iter().map(|r| &r[..]), limit)
+}
+
+/// [`halvings`] of a matrix given by its rows.
+fn halvings_of<'a>(rows: impl Iterator<Item = &'a [f64]>, limit: f64) -> i32 {
+    let norm = rows
         .map(|r| r.iter().map(|x| x.abs()).sum::<f64>())
         .fold(0.0, f64::max);
     if norm > limit {
@@ -124,14 +128,7 @@ fn mul_dyn(a: &[f64], b: &[f64], n: usize) -> Vec<f64> {
 
 /// `exp(a)` of an `n x n` matrix by scaling and squaring (as [`expm`]).
 fn expm_dyn(a: &[f64], n: usize) -> Vec<f64> {
-    let norm = (0..n)
-        .map(|i| a[i * n..(i + 1) * n].iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    let s = if norm > 0.5 {
-        (norm / 0.5).log2().ceil() as i32
-    } else {
-        0
-    };
+    let s = halvings_of(a.chunks(n), 0.5);
     let f = 0.5f64.powi(s);
     let a: Vec<f64> = a.iter().map(|x| x * f).collect();
     let mut result = vec![0.0; n * n];

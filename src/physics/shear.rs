@@ -356,12 +356,10 @@ impl ShearBuilding {
             (Damping::Modal(x), _) | (Damping::Rayleigh(x), None) => (vec![x; n], None),
             (Damping::Rayleigh(_), Some((a0, a1))) => {
                 // phi_i^T K0 phi_k, storey by storey.
+                let drifts: Vec<Vec<f64>> = (0..n).map(|j| storey_drift_row(&shape, j)).collect();
                 let k0 = |i: usize, k: usize| -> f64 {
                     (0..n)
-                        .map(|j| {
-                            let below = |m: usize| if j == 0 { 0.0 } else { shape[j - 1][m] };
-                            self.stiffness[j] * (shape[j][i] - below(i)) * (shape[j][k] - below(k))
-                        })
+                        .map(|j| self.stiffness[j] * drifts[j][i] * drifts[j][k])
                         .sum()
                 };
                 let xi: Vec<f64> = (0..n)
@@ -390,6 +388,14 @@ impl ShearBuilding {
             rayleigh,
         }
     }
+}
+
+/// Storey `j`'s drift in modes of shapes `shape` (`shape[j][i]`: floor `j + 1` in mode `i`):
+/// `d_j = u_j - u_(j-1) = row . q`, the ground below storey 0.
+pub fn storey_drift_row(shape: &[Vec<f64>], j: usize) -> Vec<f64> {
+    (0..shape[j].len())
+        .map(|i| shape[j][i] - if j == 0 { 0.0 } else { shape[j - 1][i] })
+        .collect()
 }
 
 /// A building's modes: mass-normalised shapes, frequencies, damping ratios, participation.

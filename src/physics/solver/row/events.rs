@@ -59,7 +59,6 @@ impl<'m> RowRun<'m> {
         h: f64,
         out: &mut [bool],
     ) -> bool {
-        let n = self.m.n;
         let limit = self.m.collapse_limit;
         let mut any = false;
         for d in &self.m.drifts {
@@ -68,20 +67,11 @@ impl<'m> RowRun<'m> {
                 any |= out[k];
                 continue;
             }
-            let o = self.m.buildings[k].off;
-            let row = &d.modal_row;
-            let at = |z: &[f64], from: usize| super::dot(row, &z[from + o..from + o + row.len()]);
+            let ([d0, r0, d1, r1], bound) =
+                self.m.drift_over_step(k, &d.modal_row, (z, z1), bounds);
             let top = limit * d.height;
             let edges = |x: f64, r: f64| [(x - top, r), (-x - top, -r)];
-            let bound: f64 = (row.iter().enumerate())
-                .map(|(i, c)| c.abs() * bounds[o + i])
-                .sum();
-            if may_reach(
-                edges(at(z, 0), at(z, n)),
-                edges(at(z1, 0), at(z1, n)),
-                bound,
-                h,
-            ) {
+            if may_reach(edges(d0, r0), edges(d1, r1), bound, h) {
                 out[k] = true;
                 any = true;
             }

@@ -341,8 +341,7 @@ fn run_with<'a>(
                 }
                 if let Some(f) = &forms {
                     let (vv, agv) = f[k].integrals(q, z[n + k], a0, a1);
-                    z1[2 * n + nl] -= agv;
-                    z1[2 * n + nl + 1] += m.two_xi_w[k] * vv;
+                    m.add_free_work(&mut z1, k, (agv, vv));
                     work.push((agv, vv));
                 }
             }
@@ -352,9 +351,8 @@ fn run_with<'a>(
                 c.step(m, &z, qs, (seg.a0, seg.a1), &mut z1, w);
                 if forms.is_some() {
                     let b = &m.buildings[c.building()];
-                    for (i, &(agv, vv)) in work.iter().enumerate().skip(b.off).take(b.n()) {
-                        z1[2 * n + nl] -= agv;
-                        z1[2 * n + nl + 1] += m.two_xi_w[i] * vv;
+                    for (i, &w) in work.iter().enumerate().skip(b.off).take(b.n()) {
+                        m.add_free_work(&mut z1, i, w);
                     }
                 }
             }

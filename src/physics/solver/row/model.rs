@@ -5,7 +5,7 @@
 use super::yielding::StoreyModel;
 use crate::physics::contact::Contact;
 use crate::physics::row::Row;
-use crate::physics::shear::Modes;
+use crate::physics::shear::{storey_drift_row, Modes};
 use crate::physics::solver::events::fourth_derivative_bound;
 use crate::physics::solver::Segment;
 
@@ -102,13 +102,6 @@ impl BuildingModel {
     }
 }
 
-/// Storey `j`'s drift in a building's modes: `d_j = u_j - u_(j-1) = row . q`.
-fn modal_drift_row(modes: &Modes, j: usize) -> Vec<f64> {
-    (0..modes.count())
-        .map(|i| modes.shape[j][i] - if j == 0 { 0.0 } else { modes.shape[j - 1][i] })
-        .collect()
-}
-
 /// One contact level, as the integrators see it.
 #[derive(Debug, Clone)]
 pub(crate) struct LevelModel {
@@ -203,7 +196,7 @@ impl RowModel {
             let first_storey = b.yielding.as_ref().map(|y| {
                 let first = storeys.len();
                 for j in 0..n {
-                    let modal_row = modal_drift_row(&modes, j);
+                    let modal_row = storey_drift_row(&modes.shape, j);
                     storeys.push(StoreyModel {
                         building: k,
                         storey: j,
@@ -264,7 +257,7 @@ impl RowModel {
                 .enumerate()
                 .flat_map(|(k, b)| {
                     (0..b.n()).map(move |j| {
-                        let modal_row = modal_drift_row(&b.modes, j);
+                        let modal_row = storey_drift_row(&b.modes.shape, j);
                         DriftRow {
                             building: k,
                             storey: j,
@@ -457,6 +450,15 @@ impl RowModel {
                 .map(|(p, q)| p * q)
                 .sum::<f64>()
         }));
+    }
+
+    /// Mode `i`'s work over an exact free step, `(int L_i ag q_i', int q_i'^2)`, into the energy
+    /// balance's input and damping slots of `z`.
+    #[inline]
+    pub(crate) fn add_free_work(&self, z: &mut [f64], i: usize, (agv, vv): (f64, f64)) {
+        let (n, nl) = (self.n, self.levels.len());
+        z[2 * n + nl] -= agv;
+        z[2 * n + nl + 1] += self.two_xi_w[i] * vv;
     }
 
     /// Each mode's bound on `|q''''|` over a free step from `z0` to `z1` in `seg`

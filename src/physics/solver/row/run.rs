@@ -23,7 +23,7 @@ pub(super) fn step_still(
     energy: bool,
 ) {
     let b = &modal.buildings[k];
-    let (n, nl) = (modal.n, modal.levels.len());
+    let n = modal.n;
     let h = t - seg.t0;
     let qs = b.first_storey.map(|_| {
         let mut qs = vec![0.0; n];
@@ -42,9 +42,8 @@ pub(super) fn step_still(
             energy.then_some(&mut work[..]),
         );
         if energy {
-            for (i, &(agv, vv)) in work.iter().enumerate().skip(b.off).take(b.n()) {
-                z[2 * n + nl] -= agv;
-                z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
+            for (i, &w) in work.iter().enumerate().skip(b.off).take(b.n()) {
+                modal.add_free_work(z, i, w);
             }
         }
         return;
@@ -64,8 +63,7 @@ pub(super) fn step_still(
         if energy {
             let f = crate::physics::propagator::EnergyForms::new(&osc, h);
             let (vv, agv) = f.integrals(q0, z0[n + i], a0, a1);
-            z[2 * n + nl] -= agv;
-            z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
+            modal.add_free_work(z, i, (agv, vv));
         }
     }
 }
@@ -432,9 +430,8 @@ impl<'m> RowRun<'m> {
             for i in b.off..b.off + b.n() {
                 self.z[i] = z1[i];
                 self.z[n + i] = z1[n + i];
-                if let Some(&(agv, vv)) = work.get(i) {
-                    self.z[2 * n + nl] -= agv;
-                    self.z[2 * n + nl + 1] += modal.two_xi_w[i] * vv;
+                if let Some(&w) = work.get(i) {
+                    modal.add_free_work(&mut self.z, i, w);
                 }
             }
             self.track_still(k, z0, z1, (seg.a0, seg.a1), seg.dt);

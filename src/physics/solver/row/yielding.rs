@@ -279,25 +279,37 @@ impl RowModel {
         out: &mut [bool],
     ) -> bool {
         out.fill(false);
-        let n = self.n;
         for (s, (sm, mode)) in self.storeys.iter().zip(modes).enumerate() {
             if out[sm.building] {
                 continue;
             }
-            let o = self.buildings[sm.building].off;
-            let nb = self.buildings[sm.building].n();
-            let at = |z: &[f64], part: usize| dot(&sm.modal_row, &z[part + o..part + o + nb]);
-            let bound: f64 = sm
-                .modal_row
-                .iter()
-                .zip(&bounds[o..o + nb])
-                .map(|(r, q)| r.abs() * q)
-                .sum();
-            let ends = [at(z, 0), at(z, n), at(z1, 0), at(z1, n)];
+            let (ends, bound) = self.drift_over_step(sm.building, &sm.modal_row, (z, z1), bounds);
             out[sm.building] = *mode != StoreyMode::Elastic
                 || sm.may_yield(ends, z[self.plastic_slot(s)], bound, h);
         }
         out.iter().any(|&x| x)
+    }
+
+    /// A drift `d = row . q` of building `k`'s modes (`row` its modal row) over the exact free
+    /// step `z -> z1` (modal states): `[d0, d0', d1, d1']` at its ends, and the bound on
+    /// `|d''''|` over it from each mode's in `bounds` (for `may_yield` and the collapse watch).
+    pub(crate) fn drift_over_step(
+        &self,
+        k: usize,
+        row: &[f64],
+        (z, z1): (&[f64], &[f64]),
+        bounds: &[f64],
+    ) -> ([f64; 4], f64) {
+        let n = self.n;
+        let o = self.buildings[k].off;
+        let nb = self.buildings[k].n();
+        let at = |z: &[f64], part: usize| dot(row, &z[part + o..part + o + nb]);
+        let bound: f64 = row
+            .iter()
+            .zip(&bounds[o..o + nb])
+            .map(|(r, q)| r.abs() * q)
+            .sum();
+        ([at(z, 0), at(z, n), at(z1, 0), at(z1, n)], bound)
     }
 
     /// The run's last settling time after a record that ends at `t_end`: `SETTLE_PERIODS` of
