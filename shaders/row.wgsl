@@ -7,7 +7,10 @@
 // through a step's substeps and steps them exactly at its end where this kernel substeps the
 // whole row (the CPU's `simulate_whole_row` is this kernel's twin step for step). The fast scheme on a row of shear buildings, in modal coordinates,
 // one invocation per run; resumable as fast.wgsl (at most `disp.budget` units of work per run
-// and dispatch: a free record interval, or one piece of an RK4 substep).
+// and dispatch: a record interval's start with its free step, or one RK4 step of a substep's
+// piece (its trial, a probe of a hidden touch or of the event search, the step to the event),
+// each followed by the tracking all units share, so that a unit's loop trips stay those of about
+// one RK4 step and one tracking, however long the event search).
 //
 // The host prepends the prelude, then the row's shape (src/engine/gpu/row.rs, `RowShape`): NB
 // buildings, NM modes in all, NL contact levels (NLA = max(NL, 1) sizes their arrays), ZLEN
@@ -54,6 +57,38 @@ var<private> LMODE: array<u32, NLA>;
 var<private> LV0: array<real, NLA>;
 // Each level's event fires in the step being located (RowRun::firing).
 var<private> LFIRE: array<bool, NLA>;
+
+// events.rs `Locator`: the event search in a step from (TAU, z), kept between units of work,
+// and the piece's steps before it. phase: LOC_IDLE (a new piece is due), LOC_ESTIMATE (an
+// estimate is due), LOC_GUARD (the probe `guard` is due), LOC_HIDDEN (the probe `guard` of a
+// touch hidden inside the trial of length b), LOC_RETAKE (the trial of length b is accepted: no
+// touch was hidden); last: the side the last estimate moved (1: b, -1: a, 0: none yet).
+struct Locator {
+    a: real,
+    fa: real,
+    b: real,
+    fb: real,
+    tol: real,
+    guard: real,
+    phase: u32,
+    it: u32,
+    last: i32,
+}
+
+const LOC_IDLE: u32 = 0u;
+const LOC_ESTIMATE: u32 = 1u;
+const LOC_GUARD: u32 = 2u;
+const LOC_HIDDEN: u32 = 3u;
+const LOC_RETAKE: u32 = 4u;
+
+// What a unit of work ends with (run_unit): nothing to track, a free record step, an accepted
+// piece, a piece ended at a located event.
+const END_NONE: u32 = 0u;
+const END_FREE: u32 = 1u;
+const END_STEP: u32 = 2u;
+const END_EVENT: u32 = 3u;
+
+var<private> LOC: Locator;
 var<private> LAW: u32;
 var<private> REC_OFF: u32;
 var<private> REC_LEN: u32;
@@ -704,109 +739,144 @@ fn transitions(tau: real, z: ptr<function, ZA>, before: ptr<function, ZA>) {
     }
 }
 
-// events::locate (Illinois regula falsi with a guard probe, then bisections if the bracket
-// is still open) on the largest value of the events that fire; the step is re-taken by rk4
-// from (tau, z0). Returns the length, the state at it in `zb`.
-fn locate(h: real, f0: real, f1: real, tol: real, seg: Seg, tau: real, z0: ptr<function, ZA>,
-          zb: ptr<function, ZA>) -> real {
-    var a: real = 0.0;
-    var fa = min(f0, 0.0);
-    var b = h;
-    var fb = f1;
-    var last = 0;
-    var zx: ZA;
-    for (var it = 0u; it < LOCATE_ITER + LOCATE_BISECT; it++) {
-        if (b - a <= tol) { break; }
-        var x = 0.5 * (a + b);
-        if (it < LOCATE_ITER && fb != fa) {
-            x = b - fb * (b - a) / (fb - fa);
-        }
-        if (!(x > a && x < b)) {
-            x = 0.5 * (a + b);
-        }
-        rk4(seg, tau, z0, x, &zx);
-        let fx = firing_max(&zx);
-        var g: real;
-        if (fx > 0.0) {
-            b = x; fb = fx; *zb = zx;
-            if (last == 1) { fa = fa * 0.5; }
-            last = 1;
-            g = x - 0.5 * tol;
-        } else {
-            a = x; fa = fx;
-            if (last == -1) { fb = fb * 0.5; }
-            last = -1;
-            g = x + 0.5 * tol;
-        }
-        if (it < LOCATE_ITER && g > a && g < b) {
-            rk4(seg, tau, z0, g, &zx);
-            let fg = firing_max(&zx);
-            if (fg > 0.0) {
-                b = g; fb = fg; *zb = zx;
-            } else {
-                a = g; fa = fg;
-            }
-        }
+// Locator::next: the length to probe next, or -1 once the bracket is closed.
+fn locator_next() -> real {
+    if (LOC.phase == LOC_GUARD) {
+        return LOC.guard;
     }
-    return b;
+    let a = LOC.a;
+    let b = LOC.b;
+    if (LOC.it >= LOCATE_ITER + LOCATE_BISECT || b - a <= LOC.tol) {
+        return -1.0;
+    }
+    var x = 0.5 * (a + b);
+    if (LOC.it < LOCATE_ITER && LOC.fb != LOC.fa) {
+        x = b - LOC.fb * (b - a) / (LOC.fb - LOC.fa);
+    }
+    if (!(x > a && x < b)) {
+        x = 0.5 * (a + b);
+    }
+    return x;
 }
 
-// RowRun::accept for the RK4 trial step tau -> tau + h from z0; returns the length advanced
-// and leaves the new state in `out`.
-fn accept(tau: real, h_in: real, trial_in: ptr<function, ZA>, seg: Seg, z0: ptr<function, ZA>,
-          out: ptr<function, ZA>) -> real {
-    var trial = *trial_in;
-    var h = h_in;
-    var f1 = event_max(&trial);
-    if (f1 <= 0.0) {
-        // The earliest touch hidden inside the step at a free level.
-        var best: real = -1.0;
-        for (var l = 0u; l < NL; l++) {
-            if (LMODE[l] != MODE_FREE) {
-                continue;
-            }
-            let s = hidden_rise(delta(l, z0), ddelta(l, z0), delta(l, &trial), ddelta(l, &trial), h);
-            if (s >= 0.0 && (best < 0.0 || s < best)) {
-                best = s;
-            }
+// Locator::take: the event value fx at the probe x; regula falsi (Illinois), each estimate
+// followed by a guard probe, then bisections (events::locate).
+fn locator_take(x: real, fx: real) {
+    let fires = fx > 0.0;
+    if (LOC.phase == LOC_GUARD) {
+        if (fires) {
+            LOC.b = x; LOC.fb = fx;
+        } else {
+            LOC.a = x; LOC.fa = fx;
         }
-        if (NS > 0u) {
-            best = hidden_yield(z0, &trial, h, best);
-        }
-        if (best >= 0.0) {
-            var zs: ZA;
-            rk4(seg, tau, z0, best * h, &zs);
-            let fs = event_max(&zs);
-            if (fs > 0.0) {
-                trial = zs;
-                f1 = fs;
-                h = best * h;
-            }
-        }
+        LOC.it = LOC.it + 1u;
+        LOC.phase = LOC_ESTIMATE;
+        return;
     }
+    var g: real;
+    if (fires) {
+        LOC.b = x; LOC.fb = fx;
+        if (LOC.last == 1) { LOC.fa = LOC.fa * 0.5; }
+        LOC.last = 1;
+        g = x - 0.5 * LOC.tol;
+    } else {
+        LOC.a = x; LOC.fa = fx;
+        if (LOC.last == -1) { LOC.fb = LOC.fb * 0.5; }
+        LOC.last = -1;
+        g = x + 0.5 * LOC.tol;
+    }
+    if (LOC.it < LOCATE_ITER && g > LOC.a && g < LOC.b) {
+        LOC.guard = g;
+        LOC.phase = LOC_GUARD;
+    } else {
+        LOC.it = LOC.it + 1u;
+    }
+}
+
+// RowRun::accept, step by step: each of its RK4 steps from (TAU, z) is a unit of work (the
+// trial, the probe of a hidden touch, the trial re-taken, each probe of the event search, the
+// step to its far end); substep_unit takes the step `step_length` gives and `step_taken` says
+// what it means.
+
+// The event search over the step of length h whose end `trial` (event value f1 > 0) has
+// events firing, from z0 (RowRun::accept's `locate`).
+fn start_search(h: real, f1: real, trial: ptr<function, ZA>, z0: ptr<function, ZA>) {
+    mark_firing(trial);
+    let f0 = firing_max(z0);
+    let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
+    LOC = Locator(0.0, min(f0, 0.0), h, f1, tol, 0.0, LOC_ESTIMATE, 0u, 0);
+}
+
+// The trial of length h from z0 ended at `trial`: an event inside starts the search; a touch
+// hidden inside a free level (or a storey's yield) is probed next; else the step is accepted.
+fn trial_taken(h: real, trial: ptr<function, ZA>, z0: ptr<function, ZA>) -> u32 {
+    let f1 = event_max(trial);
     if (f1 > 0.0) {
-        mark_firing(&trial);
-        let f0 = firing_max(z0);
-        let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
-        *out = trial;
-        let x = locate(h, f0, f1, tol, seg, tau, z0, out);
-        track(tau, x, z0, out, seg_at(seg, tau), seg_at(seg, tau + x));
-        transitions(tau + x, out, z0);
-        if (NS > 0u) {
-            storey_transitions(out);
-        }
-        return x;
+        start_search(h, f1, trial, z0);
+        return END_NONE;
     }
-    track(tau, h, z0, &trial, seg_at(seg, tau), seg_at(seg, tau + h));
-    *out = trial;
-    // A level whose phase is not an event (the law's force does not depend on it).
+    // The earliest touch hidden inside the step at a free level.
+    var best: real = -1.0;
     for (var l = 0u; l < NL; l++) {
-        if (reapproaches(l, LMODE[l], out)) {
-            LMODE[l] = MODE_APPROACH;
-            ENDS_VALID = false;
+        if (LMODE[l] != MODE_FREE) {
+            continue;
+        }
+        let s = hidden_rise(delta(l, z0), ddelta(l, z0), delta(l, trial), ddelta(l, trial), h);
+        if (s >= 0.0 && (best < 0.0 || s < best)) {
+            best = s;
         }
     }
-    return h;
+    if (NS > 0u) {
+        best = hidden_yield(z0, trial, h, best);
+    }
+    if (best >= 0.0) {
+        LOC.b = h;
+        LOC.guard = best * h;
+        LOC.phase = LOC_HIDDEN;
+        return END_NONE;
+    }
+    return END_STEP;
+}
+
+// The length of this unit's RK4 step from (TAU, z) in a search or probe; `last` is set where
+// it is the step to the search's far end.
+fn step_length(last: ptr<function, bool>) -> real {
+    *last = false;
+    switch LOC.phase {
+        case LOC_HIDDEN: { return LOC.guard; }
+        case LOC_RETAKE: { return LOC.b; }
+        default: {
+            let x = locator_next();
+            if (x >= 0.0) {
+                return x;
+            }
+            *last = true;
+            return LOC.b;
+        }
+    }
+}
+
+// What the step of length x from z0 to zx (not the trial) means for the piece's phase.
+fn step_taken(x: real, last: bool, zx: ptr<function, ZA>, z0: ptr<function, ZA>) -> u32 {
+    switch LOC.phase {
+        case LOC_HIDDEN: {
+            let fs = event_max(zx);
+            if (fs > 0.0) {
+                start_search(x, fs, zx, z0);
+            } else {
+                LOC.phase = LOC_RETAKE;
+            }
+            return END_NONE;
+        }
+        case LOC_RETAKE: { return END_STEP; }
+        default: {
+            if (last) {
+                return END_EVENT;
+            }
+            locator_take(x, firing_max(zx));
+            return END_NONE;
+        }
+    }
 }
 
 fn finite(z: ptr<function, ZA>) -> bool {
@@ -826,9 +896,10 @@ fn h_rate_of(d_est: real, v0: real) -> real {
     return TWO_PI / PER_CONTACT / max(local_rate(2.0 * d_est, v0), RATE);
 }
 
-// The start of the current record interval: take it with the exact modal propagators if no
-// level can touch inside, else set up its M RK4 substeps.
-fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
+// The start of the current record interval: its exact step with the modal propagators into z1,
+// taken (true; run_unit tracks it) where no level can touch inside, else its M RK4 substeps
+// set up.
+fn begin_interval(seg: Seg, z: ptr<function, ZA>, z1: ptr<function, ZA>) -> bool {
     let dt = DT;
     var h = TWO_PI / PER_CONTACT / RATE;
     var contact = false;
@@ -840,10 +911,10 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
         if (NS > 0u) {
             static_offsets(z);
         }
-        var z1 = *z;
+        *z1 = *z;
         for (var b = 0u; b < NB; b++) {
             if (coupled(b)) {
-                coupled_step(b, seg, z, &z1);
+                coupled_step(b, seg, z, z1);
                 continue;
             }
             for (var i = 0u; i < B_N[b]; i++) {
@@ -856,43 +927,37 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
                     u = u - QS[k];
                 }
                 let v = (*z)[NM + k];
-                z1[k] = models[c] * u + models[c + 1u] * v + models[c + 2u] * a0 + models[c + 3u] * a1;
+                (*z1)[k] = models[c] * u + models[c + 1u] * v + models[c + 2u] * a0 + models[c + 3u] * a1;
                 if (NS > 0u) {
-                    z1[k] = z1[k] + QS[k];
+                    (*z1)[k] = (*z1)[k] + QS[k];
                 }
-                z1[NM + k] = models[c + 4u] * u + models[c + 5u] * v + models[c + 6u] * a0
+                (*z1)[NM + k] = models[c + 4u] * u + models[c + 5u] * v + models[c + 6u] * a0
                     + models[c + 7u] * a1;
             }
         }
         // A storey that yields, or may in the free step, takes the step in substeps.
         if (NS > 0u || COUPLED) {
-            mode_bounds(seg, z, &z1);
+            mode_bounds(seg, z, z1);
         }
         var yielding = false;
         if (NS > 0u) {
-            yielding = yield_watch(z, &z1, dt);
+            yielding = yield_watch(z, z1, dt);
         }
         var touching = false;
         for (var l = 0u; l < NL; l++) {
-            if (!may_touch(l, seg, z, &z1, dt, LV0[l])) {
+            if (!may_touch(l, seg, z, z1, dt, LV0[l])) {
                 continue;
             }
             touching = true;
-            let v_est = 1.5 * max(abs(ddelta(l, z)), abs(ddelta(l, &z1)));
-            let d_est = max(delta(l, z), delta(l, &z1));
-            let a_est = max(abs(structural_rel_accel(l, z)), abs(structural_rel_accel(l, &z1)));
+            let v_est = 1.5 * max(abs(ddelta(l, z)), abs(ddelta(l, z1)));
+            let d_est = max(delta(l, z), delta(l, z1));
+            let a_est = max(abs(structural_rel_accel(l, z)), abs(structural_rel_accel(l, z1)));
             use_level(l);
             h = min(h, min(impact_step(v_est, a_est, PER_CONTACT), h_rate_of(d_est, LV0[l])));
         }
         if (!touching && !yielding) {
-            track(0.0, dt, z, &z1, seg.a0, seg.a1);
-            FREE_STEPS = FREE_STEPS + 1u;
-            *z = z1;
-            if (!finite(z)) {
-                STATUS = STATUS_NON_FINITE;
-            }
-            CI = CI + 1u;
-            return;
+            // The free step: run_unit tracks it.
+            return true;
         }
     } else {
         for (var l = 0u; l < NL; l++) {
@@ -929,6 +994,7 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>) {
         PIECES = 0u;
         TAU = 0.0;
     }
+    return false;
 }
 
 fn end_substep(tau_target: real) {
@@ -941,46 +1007,113 @@ fn end_substep(tau_target: real) {
     }
 }
 
-// One piece of substep j of the current interval (as fast.wgsl `piece`).
-fn piece(seg: Seg, z: ptr<function, ZA>) {
+// One unit of substep j of the current interval (as fast.wgsl `piece`): a new piece's trial
+// or one of its later steps, from (TAU, z) into zx over *x; returns what it ends with.
+fn substep_unit(seg: Seg, z: ptr<function, ZA>, zx: ptr<function, ZA>, x: ptr<function, real>) -> u32 {
+    if (LOC.phase != LOC_IDLE) {
+        var last: bool;
+        *x = step_length(&last);
+        rk4(seg, TAU, z, *x, zx);
+        return step_taken(*x, last, zx, z);
+    }
     let h = DT / real(CM);
     var tau_target = DT;
     if (CJ < CM) {
         tau_target = real(CJ) * h;
     }
     let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
-    if (tau_target - TAU > tol) {
-        SUBSTEPS = SUBSTEPS + 1u;
-        // Cut at the graded mesh after a touch (RowRun::onset_cut); such pieces do not count
-        // against the cap on event cuts.
-        var hs = tau_target - TAU;
-        for (var l = 0u; l < NL; l++) {
-            if (LMODE[l] == MODE_APPROACH) {
-                use_level(l);
-                hs = min(hs, onset_cut(since_onset(l, TAU), LV0[l], PER_CONTACT, tol));
-            }
+    if (!(tau_target - TAU > tol)) {
+        end_substep(tau_target);
+        return END_NONE;
+    }
+    SUBSTEPS = SUBSTEPS + 1u;
+    // Cut at the graded mesh after a touch (RowRun::onset_cut); such pieces do not count
+    // against the cap on event cuts.
+    var hs = tau_target - TAU;
+    for (var l = 0u; l < NL; l++) {
+        if (LMODE[l] == MODE_APPROACH) {
+            use_level(l);
+            hs = min(hs, onset_cut(since_onset(l, TAU), LV0[l], PER_CONTACT, tol));
         }
-        if (hs == tau_target - TAU) {
-            PIECES = PIECES + 1u;
-        }
-        if (SUBSTEPS > disp.max_substeps || PIECES > MAX_PIECES_PER_SUBSTEP) {
-            STATUS = STATUS_STEP_LIMIT;
-        } else {
-            var z0 = *z;
-            var trial: ZA;
-            rk4(seg, TAU, &z0, hs, &trial);
-            var znew: ZA;
-            TAU = TAU + accept(TAU, hs, &trial, seg, &z0, &znew);
-            *z = znew;
-            if (!finite(z)) {
-                STATUS = STATUS_NON_FINITE;
-            } else if (!(tau_target - TAU > tol)) {
-                end_substep(tau_target);
-            }
-        }
-    } else {
+    }
+    if (hs == tau_target - TAU) {
+        PIECES = PIECES + 1u;
+    }
+    if (SUBSTEPS > disp.max_substeps || PIECES > MAX_PIECES_PER_SUBSTEP) {
+        STATUS = STATUS_STEP_LIMIT;
+        return END_NONE;
+    }
+    *x = hs;
+    rk4(seg, TAU, z, hs, zx);
+    return trial_taken(hs, zx, z);
+}
+
+// The end of a piece that advanced to TAU with state z: ends its substep once at the target.
+fn end_piece(z: ptr<function, ZA>) {
+    let h = DT / real(CM);
+    var tau_target = DT;
+    if (CJ < CM) {
+        tau_target = real(CJ) * h;
+    }
+    let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
+    if (!finite(z)) {
+        STATUS = STATUS_NON_FINITE;
+    } else if (!(tau_target - TAU > tol)) {
         end_substep(tau_target);
     }
+}
+
+// One unit of work of the run from (TAU, z) (CJ == 0: the start of a record interval, else a
+// step of a substep's piece), then what it ends with: the buildings' and levels' tracking
+// over it, shared by every kind of unit, and the events' transitions.
+fn run_unit(seg: Seg, z: ptr<function, ZA>) {
+    var zx: ZA;
+    var x: real = DT;
+    var tau0: real = 0.0;
+    var ag0 = seg.a0;
+    var ag1 = seg.a1;
+    var end = END_NONE;
+    if (CJ == 0u) {
+        if (begin_interval(seg, z, &zx)) {
+            end = END_FREE;
+        }
+    } else {
+        end = substep_unit(seg, z, &zx, &x);
+        tau0 = TAU;
+        ag0 = seg_at(seg, TAU);
+        ag1 = seg_at(seg, TAU + x);
+    }
+    if (end == END_NONE) {
+        return;
+    }
+    track(tau0, x, z, &zx, ag0, ag1);
+    if (end == END_FREE) {
+        FREE_STEPS = FREE_STEPS + 1u;
+        *z = zx;
+        if (!finite(z)) {
+            STATUS = STATUS_NON_FINITE;
+        }
+        CI = CI + 1u;
+        return;
+    }
+    if (end == END_EVENT) {
+        transitions(TAU + x, &zx, z);
+        if (NS > 0u) {
+            storey_transitions(&zx);
+        }
+    } else {
+        // A level whose phase is not an event (the law's force does not depend on it).
+        for (var l = 0u; l < NL; l++) {
+            if (reapproaches(l, LMODE[l], &zx)) {
+                LMODE[l] = MODE_APPROACH;
+                ENDS_VALID = false;
+            }
+        }
+    }
+    LOC.phase = LOC_IDLE;
+    TAU = TAU + x;
+    *z = zx;
+    end_piece(z);
 }
 
 // Has the run ended? At the record's end, or with yielding storeys once it settled
@@ -990,6 +1123,28 @@ fn ended() -> bool {
         return CI >= INTERVALS;
     }
     return CI >= INTERVALS && (SETTLED != 0u || CI >= END);
+}
+
+// The run's event search from its blocks, and back.
+fn load_locator() {
+    let s = RS + S_LOCATE;
+    let c = RC + C_LOCATE;
+    LOC = Locator(rstate[s], rstate[s + 1u], rstate[s + 2u], rstate[s + 3u], rstate[s + 4u],
+        rstate[s + 5u], rcount[c], rcount[c + 1u], bitcast<i32>(rcount[c + 2u]));
+}
+
+fn store_locator() {
+    let s = RS + S_LOCATE;
+    let c = RC + C_LOCATE;
+    rstate[s] = LOC.a;
+    rstate[s + 1u] = LOC.fa;
+    rstate[s + 2u] = LOC.b;
+    rstate[s + 3u] = LOC.fb;
+    rstate[s + 4u] = LOC.tol;
+    rstate[s + 5u] = LOC.guard;
+    rcount[c] = LOC.phase;
+    rcount[c + 1u] = LOC.it;
+    rcount[c + 2u] = bitcast<u32>(LOC.last);
 }
 
 // One lane's work in a dispatch: at most disp.budget units of run run_ids[lane]; returns the
@@ -1033,7 +1188,9 @@ fn integrate_run(lane: u32) -> u32 {
     for (var l = 0u; l < NL; l++) {
         LMODE[l] = rcount[lci(l, LC_MODE)];
         LV0[l] = rstate[lsi(l, LS_V0)];
+        LFIRE[l] = rcount[lci(l, LC_FIRE)] != 0u;
     }
+    load_locator();
     CJ = rcount[RC + C_J];
     CM = rcount[RC + C_M];
     PIECES = rcount[RC + C_PIECES];
@@ -1046,7 +1203,8 @@ fn integrate_run(lane: u32) -> u32 {
     var budget = disp.budget;
     loop {
         // After the record, a run with yielding storeys ends once none can yield again.
-        if (NS > 0u && STATUS == STATUS_OK && CI >= INTERVALS && SETTLED == 0u && settles(&z)) {
+        if (NS > 0u && STATUS == STATUS_OK && CI >= INTERVALS && SETTLED == 0u
+            && LOC.phase == LOC_IDLE && settles(&z)) {
             SETTLED = 1u;
         }
         if (STATUS != STATUS_OK || ended() || budget == 0u) {
@@ -1058,18 +1216,16 @@ fn integrate_run(lane: u32) -> u32 {
             // The settling tail: free vibration, the ground at rest.
             seg = Seg(0.0, 0.0, DT);
         }
-        if (CJ == 0u) {
-            begin_interval(seg, &z);
-        } else {
-            piece(seg, &z);
-        }
+        run_unit(seg, &z);
     }
     for (var i = 0u; i < ZLEN; i++) { rstate[RS + i] = z[i]; }
     rstate[RS + S_TAU] = TAU;
     for (var l = 0u; l < NL; l++) {
         rcount[lci(l, LC_MODE)] = LMODE[l];
         rstate[lsi(l, LS_V0)] = LV0[l];
+        rcount[lci(l, LC_FIRE)] = u32(LFIRE[l]);
     }
+    store_locator();
     rcount[RC + C_STATUS] = STATUS;
     rcount[RC + C_I] = CI;
     rcount[RC + C_J] = CJ;

@@ -354,6 +354,7 @@ fn load_storeys(rm: u32) {
     SETTLED = rcount[RC + C_SETTLED];
     for (var s = 0u; s < NS; s++) {
         SM[s] = rcount[RC + C_STOREYS + SC_STRIDE * s + SC_MODE];
+        SFIRE[s] = rcount[RC + C_STOREYS + SC_STRIDE * s + SC_FIRE] != 0u;
     }
 }
 
@@ -361,5 +362,6 @@ fn store_storeys() {
     rcount[RC + C_SETTLED] = SETTLED;
     for (var s = 0u; s < NS; s++) {
         rcount[RC + C_STOREYS + SC_STRIDE * s + SC_MODE] = SM[s];
+        rcount[RC + C_STOREYS + SC_STRIDE * s + SC_FIRE] = u32(SFIRE[s]);
     }
 }

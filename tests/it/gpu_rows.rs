@@ -207,8 +207,8 @@ fn rows_too_large_for_the_software_loop_limit_are_refused() {
     }
     let row = Row::new(
         vec![
-            building(12, 1.2, Damping::Rayleigh(0.05)),
-            building(12, 1.0, Damping::Rayleigh(0.05)),
+            building(30, 3.0, Damping::Rayleigh(0.05)),
+            building(30, 2.7, Damping::Rayleigh(0.05)),
         ],
         vec![0.01],
         LawKind::Linear,
@@ -222,6 +222,43 @@ fn rows_too_large_for_the_software_loop_limit_are_refused() {
     packed.push(&m, &forcing(&accel), 0, &recs, &FastOptions::default());
     let err = run_rows(ctx, &recs, &packed, &GpuOptions::default()).unwrap_err();
     assert!(err.to_string().contains("loop limit"), "{err}");
+}
+
+/// Every shipped row config runs on the software adapter: a unit of work is one RK4 step (or
+/// a record step's start) and the tracking all units share, so its loop trips, summed over the
+/// branches a lockstep group of lanes runs, stay under lavapipe's loop limit even for
+/// `row-of-five.toml` (five buildings, 48 storeys, 28 contact levels). Before the event search
+/// was resumable ten of them were refused. The kernel's results on them are checked against
+/// the CPU twin on the same shapes (this file) and on shards of them (BENCHMARKS.md, "Rows on
+/// lavapipe").
+#[test]
+fn shipped_row_configs_fit_the_software_adapter() {
+    let Some(ctx) = ctx() else { return };
+    if !ctx.is_software() {
+        return;
+    }
+    let mut configs: Vec<_> = std::fs::read_dir("configs")
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    configs.sort();
+    let (mut rows, mut refused) = (0, Vec::new());
+    for cfg in configs {
+        let plan = pounding::plan::config::load(&cfg).unwrap();
+        let pounding::plan::Plan::Row(plan) = plan else {
+            continue;
+        };
+        rows += 1;
+        if let Err(e) = pounding::engine::gpu::row::check_fits(ctx, &plan) {
+            assert!(e.to_string().contains("loop limit"), "{e}");
+            refused.push(cfg.file_name().unwrap().to_string_lossy().into_owned());
+        }
+    }
+    assert!(rows >= 12, "{rows} row configs");
+    assert!(
+        refused.is_empty(),
+        "refused on the software adapter: {refused:?}"
+    );
 }
 
 /// The row kernel's source parses and validates (naga, f32 and f64) for shapes from single

@@ -22,7 +22,6 @@ use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{CoupledPropagator, Propagator};
 use crate::physics::row::{BuildingOutput, LevelOutput, RowOutput, StoreyOutput};
-use crate::physics::solver::fast::{LOCATE_BISECTIONS, LOCATE_ITERATIONS};
 use crate::physics::solver::row::yielding::settle_intervals;
 use crate::physics::solver::row::{simulate_row, BuildingModel, RowModel, RowScheme};
 use crate::physics::solver::FastOptions;
@@ -56,21 +55,29 @@ pub const C_J: usize = 3;
 pub const C_M: usize = 4;
 pub const C_PIECES: usize = 5;
 pub const C_FREE_STEPS: usize = 6;
-pub const C_LEVELS: usize = 7;
+/// The event search between units (`Locator` in `shaders/row.wgsl`): its phase, iterations,
+/// and last side (an i32's bits).
+pub const C_LOCATE: usize = 7;
+pub const C_LEVELS: usize = 10;
 pub const LC_MODE: usize = 0;
 pub const LC_IMPACTS: usize = 1;
 pub const LC_I_ONSET: usize = 2;
-pub const LC_STRIDE: usize = 3;
+/// Whether the level's event fires in the step being located.
+pub const LC_FIRE: usize = 3;
+pub const LC_STRIDE: usize = 4;
 pub const BC_DRIFT_STOREY: usize = 0;
 pub const BC_ACCEL_FLOOR: usize = 1;
 pub const BC_STRIDE: usize = 2;
 // Rows with yielding storeys add, after the buildings' counters: whether the run settled
 // (`RowModel::settled`), then per storey its spring state (`SM_*` in `shaders/yielding.wgsl`)
-// and whether it has yielded.
+// whether it has yielded, and whether its event fires in the step being located.
 pub const SC_MODE: usize = 0;
 pub const SC_YIELDED: usize = 1;
-pub const SC_STRIDE: usize = 2;
-// A run's state (reals): z, the local time, then each level's (LS_*), then each building's.
+pub const SC_FIRE: usize = 2;
+pub const SC_STRIDE: usize = 3;
+// A run's state (reals): z, the local time, the event search's reals (its bracket `a, f(a),
+// b, f(b)`, tolerance and guard probe), then each level's (LS_*), then each building's.
+pub const LOCATE_REALS: usize = 6;
 pub const LS_V0: usize = 0;
 pub const LS_TAU_ONSET: usize = 1;
 pub const LS_IMP_PEAK: usize = 2;
@@ -198,7 +205,7 @@ impl RowShape {
     }
 
     fn s_levels(&self) -> usize {
-        self.zlen() + 1
+        self.zlen() + 1 + LOCATE_REALS
     }
 
     fn s_buildings(&self) -> usize {
@@ -313,23 +320,27 @@ impl RowShape {
             ("C_M", C_M),
             ("C_PIECES", C_PIECES),
             ("C_FREE_STEPS", C_FREE_STEPS),
+            ("C_LOCATE", C_LOCATE),
             ("C_LEVELS", C_LEVELS),
             ("C_BUILDINGS", self.c_buildings()),
             ("C_SETTLED", self.c_settled()),
             ("C_STOREYS", self.c_storeys()),
             ("SC_MODE", SC_MODE),
             ("SC_YIELDED", SC_YIELDED),
+            ("SC_FIRE", SC_FIRE),
             ("SC_STRIDE", SC_STRIDE),
             ("STOREY_HEAD", STOREY_HEAD),
             ("C_STRIDE", self.c_stride()),
             ("LC_MODE", LC_MODE),
             ("LC_IMPACTS", LC_IMPACTS),
             ("LC_I_ONSET", LC_I_ONSET),
+            ("LC_FIRE", LC_FIRE),
             ("LC_STRIDE", LC_STRIDE),
             ("BC_DRIFT_STOREY", BC_DRIFT_STOREY),
             ("BC_ACCEL_FLOOR", BC_ACCEL_FLOOR),
             ("BC_STRIDE", BC_STRIDE),
             ("S_TAU", self.zlen()),
+            ("S_LOCATE", self.zlen() + 1),
             ("S_LEVELS", self.s_levels()),
             ("S_BUILDINGS", self.s_buildings()),
             ("S_STOREYS", self.s_storeys()),
@@ -392,8 +403,8 @@ impl RowShape {
         s
     }
 
-    /// An upper bound on the loop trips of one unit of work (a free interval, or an RK4 piece
-    /// with its event location and tracking), counted as the kernel's loops run.
+    /// An upper bound on the loop trips of one unit of work (a record interval's start with its
+    /// free step, or one RK4 step of a piece), counted as the kernel's loops run.
     pub fn loop_trips_per_unit(&self) -> u64 {
         let nm = self.modes() as u64;
         let nl = self.levels.len() as u64;
@@ -421,18 +432,21 @@ impl RowShape {
         let track = 5 * nm + 2 * forces + 2 * sq + nl + nm + nl * (3 * level);
         let track = track + 2 * (storeys + ns * nmax) + ns + 4 * sqc + 2 * nb_all * coupled;
         let transitions = nl * (3 * level) + storeys;
-        let locate = (2 * LOCATE_ITERATIONS + LOCATE_BISECTIONS) as u64 * (rk4 + event_max + 1);
-        let accept = 4 * event_max + nl * (2 * level) + rk4 + locate + track + transitions;
-        let accept = accept + storeys;
-        let piece = rk4 + accept + zlen;
-        let begin = nl + nm + nl * (6 * level + 2 * nmax) + track + zlen;
+        // A unit is one RK4 step of a piece (its trial, a probe of a hidden touch or of the
+        // event search, the step to its far end) or a record interval's start, then the
+        // tracking and transitions every kind of unit shares. A software adapter runs a group
+        // of lanes in SIMD lockstep through every branch any of them takes: the bound sums the
+        // branches.
+        let substep = nl + rk4 + 7 * event_max + nl * (2 * level) + storeys + 2;
+        let tail = track + transitions + storeys + nl * level + 3 * zlen;
+        let begin = nl + nm + nl * (6 * level + 2 * nmax) + zlen;
         let begin = begin + 3 * nm * (ns > 0) as u64 + 2 * storeys + ns * nmax;
         // The settling test with P-Delta: the static response and each storey's drift in it.
         let begin = begin + (2 * nm + ns + 2 * ns * nmax) * (ns > 0) as u64;
         // mode_bounds (with yielding storeys or coupled modes) and the coupled parts.
         let begin = begin + 3 * nm * ((ns > 0) as u64).max(coupled);
         let begin = begin + (8 * sqc + nb_all + nl * 4 * nmax * nmax) * coupled;
-        piece.max(begin) + 1
+        begin + substep + tail + 1
     }
 }
 

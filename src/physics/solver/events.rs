@@ -37,49 +37,112 @@ pub(crate) fn locate<S>(
     mut step: impl FnMut(f64) -> S,
     eval: impl Fn(&S) -> f64,
 ) -> (f64, S) {
-    let (mut a, mut fa) = (0.0, f0.min(0.0));
-    let (mut b, mut fb, mut zb) = (h, f1, z1);
-    let mut last = 0i8;
-    for it in 0..max_iter + LOCATE_BISECTIONS {
-        if b - a <= tol {
-            break;
+    let mut loc = Locator::new(h, f0, f1, tol, max_iter);
+    let mut zb = z1;
+    while let Some(x) = loc.next() {
+        let zx = step(x);
+        if loc.take(x, eval(&zx)) {
+            zb = zx;
         }
-        let mut x = if it < max_iter && fb != fa {
-            b - fb * (b - a) / (fb - fa)
+    }
+    (loc.end(), zb)
+}
+
+/// [`locate`] as a state machine, one probe at a time: the GPU row kernel (`Locator` in
+/// `shaders/row.wgsl`) keeps it between units of work, so a unit takes one RK4 step however
+/// long the search.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Locator {
+    /// The bracket: `f(a) <= 0 < f(b)`.
+    a: f64,
+    fa: f64,
+    b: f64,
+    fb: f64,
+    tol: f64,
+    /// The side the last estimate moved: 1 (b), -1 (a), 0 (none yet).
+    last: i8,
+    /// Iterations done (an estimate with its guard probe, or a bisection).
+    it: u32,
+    max_iter: u32,
+    /// The guard probe due after the last estimate.
+    guard: Option<f64>,
+}
+
+impl Locator {
+    pub(crate) fn new(h: f64, f0: f64, f1: f64, tol: f64, max_iter: u32) -> Self {
+        Locator {
+            a: 0.0,
+            fa: f0.min(0.0),
+            b: h,
+            fb: f1,
+            tol,
+            last: 0,
+            it: 0,
+            max_iter,
+            guard: None,
+        }
+    }
+
+    /// The length to probe next, or None once the bracket is closed.
+    pub(crate) fn next(&self) -> Option<f64> {
+        if let Some(g) = self.guard {
+            return Some(g);
+        }
+        let (a, b) = (self.a, self.b);
+        if self.it >= self.max_iter + LOCATE_BISECTIONS || b - a <= self.tol {
+            return None;
+        }
+        let mut x = if self.it < self.max_iter && self.fb != self.fa {
+            b - self.fb * (b - a) / (self.fb - self.fa)
         } else {
             0.5 * (a + b)
         };
         if !(x > a && x < b) {
             x = 0.5 * (a + b);
         }
-        let zx = step(x);
-        let fx = eval(&zx);
-        let g = if fx > 0.0 {
-            (b, fb, zb) = (x, fx, zx);
-            if last == 1 {
-                fa *= 0.5;
-            }
-            last = 1;
-            x - 0.5 * tol
-        } else {
-            (a, fa) = (x, fx);
-            if last == -1 {
-                fb *= 0.5;
-            }
-            last = -1;
-            x + 0.5 * tol
-        };
-        if it < max_iter && g > a && g < b {
-            let zg = step(g);
-            let fg = eval(&zg);
-            if fg > 0.0 {
-                (b, fb, zb) = (g, fg, zg);
-            } else {
-                (a, fa) = (g, fg);
-            }
-        }
+        Some(x)
     }
-    (b, zb)
+
+    /// The event value `fx` at the probe `x` [`Self::next`] gave; true where `x` became the
+    /// bracket's far end (its state is then the one to keep).
+    pub(crate) fn take(&mut self, x: f64, fx: f64) -> bool {
+        let fires = fx > 0.0;
+        if self.guard.take().is_some() {
+            if fires {
+                (self.b, self.fb) = (x, fx);
+            } else {
+                (self.a, self.fa) = (x, fx);
+            }
+            self.it += 1;
+            return fires;
+        }
+        let g = if fires {
+            (self.b, self.fb) = (x, fx);
+            if self.last == 1 {
+                self.fa *= 0.5;
+            }
+            self.last = 1;
+            x - 0.5 * self.tol
+        } else {
+            (self.a, self.fa) = (x, fx);
+            if self.last == -1 {
+                self.fb *= 0.5;
+            }
+            self.last = -1;
+            x + 0.5 * self.tol
+        };
+        if self.it < self.max_iter && g > self.a && g < self.b {
+            self.guard = Some(g);
+        } else {
+            self.it += 1;
+        }
+        fires
+    }
+
+    /// The far side of the event: where the search ends.
+    pub(crate) fn end(&self) -> f64 {
+        self.b
+    }
 }
 
 /// In free mode a step whose end is still apart can hide a brief, grazing touch. If the Hermite
@@ -262,5 +325,73 @@ pub(crate) fn reapproach(mode: Mode, z: &State) -> Mode {
         Mode::Approach
     } else {
         mode
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::solver::fast::LOCATE_ITERATIONS;
+
+    /// The search ends on the far side of the root, within its tolerance, for a function regula
+    /// falsi models well (a line), one it stalls on (a steep exponential-like rise) and one that
+    /// is 0 where the step starts (bisections close it).
+    #[test]
+    fn locate_ends_just_past_the_first_positive_instant() {
+        type Case = (f64, fn(f64) -> f64);
+        let cases: [Case; 3] = [
+            (0.3, |x| x - 0.3),
+            (0.7, |x| (x - 0.7) * (1.0 + 1e6 * (x - 0.7).max(0.0))),
+            (0.25, |x| if x <= 0.25 { 0.0 } else { x - 0.25 }),
+        ];
+        for (root, f) in cases {
+            let tol = 1e-9;
+            let (x, zx) = locate(
+                1.0,
+                f(0.0),
+                1.0,
+                f(1.0),
+                tol,
+                LOCATE_ITERATIONS,
+                |x| x,
+                |&x| f(x),
+            );
+            assert_eq!(x, zx);
+            assert!(f(x) > 0.0, "{root}: ends at {x}, f = {}", f(x));
+            assert!(x > root && x - root <= tol, "{root}: ends at {x}");
+        }
+    }
+
+    /// Driven one probe at a time, as the GPU kernel drives it between units of work, the
+    /// search probes exactly where `locate` does and ends at the same length.
+    #[test]
+    fn the_locator_one_probe_at_a_time_is_locate() {
+        let f = |x: f64| (x - 0.41) * (2.0 + x);
+        let mut probes = Vec::new();
+        let (x, _) = locate(
+            0.9,
+            f(0.0),
+            0.9,
+            f(0.9),
+            1e-10,
+            LOCATE_ITERATIONS,
+            |x| {
+                probes.push(x);
+                x
+            },
+            |&x| f(x),
+        );
+        let mut loc = Locator::new(0.9, f(0.0), f(0.9), 1e-10, LOCATE_ITERATIONS);
+        let mut resumed = Vec::new();
+        while let Some(p) = loc.next() {
+            // A copy, as the kernel stores and reloads it between dispatches.
+            let mut kept = loc;
+            kept.take(p, f(p));
+            loc = kept;
+            resumed.push(p);
+        }
+        assert!(!probes.is_empty());
+        assert_eq!(probes, resumed);
+        assert_eq!(loc.end(), x);
     }
 }
