@@ -153,6 +153,52 @@ fn row_kernel_matches_the_cpu_twin() {
     }
 }
 
+/// Two 12-storey buildings (refused on lavapipe before a unit of work was one RK4 step): f64
+/// on the device gives the CPU twin's impacts and substeps and its peaks within 1e-6, f32
+/// within 1e-3 where its impacts are the CPU's.
+#[test]
+fn a_twelve_storey_pair_on_the_gpu_is_the_cpu_twin() {
+    if ctx().is_none() {
+        return;
+    }
+    let models: Vec<RowModel> = [0.0, 0.004]
+        .iter()
+        .map(|&gap| {
+            RowModel::new(&Row::new(
+                vec![
+                    building(12, 1.2, Damping::Rayleigh(0.05)),
+                    building(12, 0.9, Damping::Modal(0.05)),
+                ],
+                vec![gap],
+                LawKind::LankaraniNikravesh,
+                2.75e9,
+                0.35,
+            ))
+        })
+        .collect();
+    let records: Vec<Vec<f64>> = (0..2).map(|s| record(70 + s, 2.0, 0.6)).collect();
+    let cpu = on_cpu_whole_row(&models, &records);
+    assert!(cpu.iter().all(|c| c.impacts > 0), "{cpu:?}");
+    for precision in [Precision::F64, Precision::F32] {
+        let opts = GpuOptions {
+            precision,
+            ..GpuOptions::default()
+        };
+        let gpu = on_gpu(&models, &records, &opts);
+        for (k, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+            let g = g.as_ref().expect("not handed back");
+            assert_eq!(g.status, Status::Ok, "{precision:?} run {k}");
+            let d = peak_diff(g, c);
+            if precision == Precision::F64 {
+                assert_eq!((g.impacts, g.substeps), (c.impacts, c.substeps), "run {k}");
+                assert!(d < 1e-6, "f64 run {k}: {d:e}");
+            } else if g.impacts == c.impacts {
+                assert!(d < 1e-3, "f32 run {k}: {d:e}");
+            }
+        }
+    }
+}
+
 /// A dispatch of one unit per run gives what a dispatch of many gives: the kernel's state
 /// carries everything between dispatches.
 #[test]
