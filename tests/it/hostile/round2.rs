@@ -323,14 +323,35 @@ fn refusals_leave_nothing_behind() {
     // with no `.partial` and no journal; the advised --backend cpu then runs.
     if let Some(ctx) = crate::support::gpu::ctx().filter(|c| c.is_software()) {
         let _ = ctx;
-        let o = pound(&[
-            "sweep",
-            "configs/row-of-five.toml",
-            "--backend",
-            "gpu",
-            "-o",
-            s(&x),
-        ]);
+        let tall = write(
+            d.path(),
+            "tall.toml",
+            r#"[[building]]
+storeys = 30
+storey_height_m = 3.0
+mass_kg = 3.0e5
+period_s = 3.0
+damping_ratio = 0.05
+
+[[building]]
+storeys = 30
+storey_height_m = 3.0
+mass_kg = 3.0e5
+period_s = 2.7
+damping_ratio = 0.05
+
+[contact]
+law = "lankarani_nikravesh"
+formula = "khatami"
+e = 0.6
+beta_n_per_m1_5 = 2.75e9
+gap_m = [0.01]
+
+[[record]]
+synthetic = { seed = 9, duration_s = 2.0, dt_s = 0.01, pga_g = 0.3 }
+"#,
+        );
+        let o = pound(&["sweep", s(&tall), "--backend", "gpu", "-o", s(&x)]);
         refused(&o, "too large for the software adapter");
         for p in [
             x.clone(),
