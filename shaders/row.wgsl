@@ -9,8 +9,8 @@
 // one invocation per run; resumable as fast.wgsl (at most `disp.budget` units of work per run
 // and dispatch: a record interval's start with its free step, or one RK4 step of a substep's
 // piece (its trial, a probe of a hidden touch or of the event search, the step to the event),
-// each followed by the tracking all units share, so that a unit's loop trips stay those of about
-// one RK4 step and one tracking, however long the event search).
+// the units that end a free step or a piece then tracking it in code they all share, so that a
+// unit's loop trips stay those of about one RK4 step and one tracking, however long the search).
 //
 // The host prepends the prelude, then the row's shape (src/engine/gpu/row.rs, `RowShape`): NB
 // buildings, NM modes in all, NL contact levels (NLA = max(NL, 1) sizes their arrays), ZLEN
