@@ -1016,12 +1016,8 @@ fn substep_unit(seg: Seg, z: ptr<function, ZA>, zx: ptr<function, ZA>, x: ptr<fu
         rk4(seg, TAU, z, *x, zx);
         return step_taken(*x, last, zx, z);
     }
-    let h = DT / real(CM);
-    var tau_target = DT;
-    if (CJ < CM) {
-        tau_target = real(CJ) * h;
-    }
-    let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
+    let tau_target = substep_target();
+    let tol = substep_tol();
     if (!(tau_target - TAU > tol)) {
         end_substep(tau_target);
         return END_NONE;
@@ -1048,17 +1044,25 @@ fn substep_unit(seg: Seg, z: ptr<function, ZA>, zx: ptr<function, ZA>, x: ptr<fu
     return trial_taken(hs, zx, z);
 }
 
+// The local time substep j of M ends at (the record step's end for the last).
+fn substep_target() -> real {
+    if (CJ < CM) {
+        return real(CJ) * (DT / real(CM));
+    }
+    return DT;
+}
+
+// How close to its target a substep counts as ended.
+fn substep_tol() -> real {
+    return max(LOCATE_TOL * (DT / real(CM)), 4.0 * EPS * DT);
+}
+
 // The end of a piece that advanced to TAU with state z: ends its substep once at the target.
 fn end_piece(z: ptr<function, ZA>) {
-    let h = DT / real(CM);
-    var tau_target = DT;
-    if (CJ < CM) {
-        tau_target = real(CJ) * h;
-    }
-    let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
+    let tau_target = substep_target();
     if (!finite(z)) {
         STATUS = STATUS_NON_FINITE;
-    } else if (!(tau_target - TAU > tol)) {
+    } else if (!(tau_target - TAU > substep_tol())) {
         end_substep(tau_target);
     }
 }

@@ -204,8 +204,13 @@ impl RowShape {
         M_MODELS + self.storeys.len() + self.yields()
     }
 
+    /// The event search's reals, after z and the local time.
+    fn s_locate(&self) -> usize {
+        self.zlen() + 1
+    }
+
     fn s_levels(&self) -> usize {
-        self.zlen() + 1 + LOCATE_REALS
+        self.s_locate() + LOCATE_REALS
     }
 
     fn s_buildings(&self) -> usize {
@@ -340,7 +345,7 @@ impl RowShape {
             ("BC_ACCEL_FLOOR", BC_ACCEL_FLOOR),
             ("BC_STRIDE", BC_STRIDE),
             ("S_TAU", self.zlen()),
-            ("S_LOCATE", self.zlen() + 1),
+            ("S_LOCATE", self.s_locate()),
             ("S_LEVELS", self.s_levels()),
             ("S_BUILDINGS", self.s_buildings()),
             ("S_STOREYS", self.s_storeys()),
