@@ -16,8 +16,12 @@
 // buildings, NM modes in all, NL contact levels (NLA = max(NL, 1) sizes their arrays), ZLEN
 // reals of state, MAXN the most storeys; each building's storeys and first mode (B_N, B_OFF);
 // each level's left building and floors (L_A, L_FA, L_FB); the offsets and strides of the
-// per-run blocks (P_*, M_*, S_*, C_*, LS_*, LC_*, BS_*, BC_*, MW). Then contact.wgsl and
-// hermite.wgsl. So a kernel carries exactly the loops its row needs.
+// per-run blocks (P_*, M_*, S_*, C_*, LS_*, LC_*, BS_*, BC_*, MW); then the functions that run
+// over the shape (the right-hand side `rhs`, each level's gap `delta` and rate `ddelta`, the
+// floors' `fill`, a storey's drift and the plastic loads), written out with constant indices
+// where the row is small (`RowShape::unrolled`: a lane's state stays in registers, where lavapipe
+// turns an index known only at run time into a loop over the lanes), else row_loops.wgsl's
+// loops. Then contact.wgsl and hermite.wgsl. So a kernel carries exactly the code its row needs.
 //
 // The state z is [q (NM), q' (NM), w (one per level), e_in, e_damp, then each yielding storey's
 // plastic drift and plastic work], as on the CPU; this kernel does not integrate the energy
@@ -168,25 +172,8 @@ fn fli(e: u32, q: u32, k: u32) -> u32 {
 
 // ---- row/mod.rs: LevelModel ----
 
-// phi . q of floor `f` of building `b`, from z at offset `at` (0: displacements, NM: velocities).
-fn floor_of(b: u32, f: u32, z: ptr<function, ZA>, at: u32) -> real {
-    var s: real = 0.0;
-    let o = at + B_OFF[b];
-    for (var i = 0u; i < B_N[b]; i++) {
-        s += shape_at(b, f, i) * (*z)[o + i];
-    }
-    return s;
-}
-
-fn delta(l: u32, z: ptr<function, ZA>) -> real {
-    let a = L_A[l];
-    return floor_of(a, L_FA[l], z, 0u) - floor_of(a + 1u, L_FB[l], z, 0u) - rp(P_GAPS + a);
-}
-
-fn ddelta(l: u32, z: ptr<function, ZA>) -> real {
-    let a = L_A[l];
-    return floor_of(a, L_FA[l], z, NM) - floor_of(a + 1u, L_FB[l], z, NM);
-}
+// delta(l, z) and ddelta(l, z), level l's gap and its rate, are written out per shape by the
+// host (RowShape::wgsl_unrolled).
 
 // The structural acceleration of floor f of building b (no ground, no contact).
 fn floor_accel(b: u32, f: u32, z: ptr<function, ZA>) -> real {
@@ -278,45 +265,8 @@ fn may_touch(l: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: 
     return hermite_range(d0, r0, d1, r1, h).hi > margin;
 }
 
-// row::rhs at ground acceleration ag, into `out`.
-fn rhs(ag: real, z: ptr<function, ZA>, out: ptr<function, ZA>) {
-    for (var i = 0u; i < NM; i++) {
-        let v = (*z)[NM + i];
-        (*out)[i] = v;
-        (*out)[NM + i] = -TXW[i] * v - W2[i] * (*z)[i] - PART[i] * ag;
-    }
-    if (COUPLED) {
-        for (var b = 0u; b < NB; b++) {
-            if (coupled(b)) {
-                for (var i = 0u; i < B_N[b]; i++) {
-                    (*out)[NM + B_OFF[b] + i] -= coupled_term(b, i, z, NM);
-                }
-            }
-        }
-    }
-    if (NS > 0u) {
-        plastic_rhs(z, out);
-    }
-    for (var l = 0u; l < NL; l++) {
-        if (LMODE[l] == MODE_FREE) {
-            (*out)[2u * NM + l] = 0.0;
-            continue;
-        }
-        let f = force(l, LMODE[l], LV0[l], z);
-        let a = L_A[l];
-        let oa = NM + B_OFF[a];
-        for (var i = 0u; i < B_N[a]; i++) {
-            (*out)[oa + i] -= shape_at(a, L_FA[l], i) * f;
-        }
-        let ob = NM + B_OFF[a + 1u];
-        for (var i = 0u; i < B_N[a + 1u]; i++) {
-            (*out)[ob + i] += shape_at(a + 1u, L_FB[l], i) * f;
-        }
-        (*out)[2u * NM + l] = f * ddelta(l, z);
-    }
-    (*out)[2u * NM + NL] = 0.0;
-    (*out)[2u * NM + NL + 1u] = 0.0;
-}
+// row::rhs (the force on each floor, the modes' accelerations) is written out per shape by
+// the host (RowShape::wgsl_unrolled), with load_shape_rows.
 
 // fast.rs `rk4`: classic RK4 over h from local time tau, into `out`.
 fn rk4(seg: Seg, tau: real, z: ptr<function, ZA>, h: real, out: ptr<function, ZA>) {
@@ -500,65 +450,8 @@ fn set_floor_forces(z: ptr<function, ZA>) {
     }
 }
 
-// Floors::fill of building b at end e from z at ground acceleration ag, with FF set.
-fn fill(b: u32, e: u32, z: ptr<function, ZA>, ag: real) {
-    let n = B_N[b];
-    let o = B_OFF[b];
-    var acc: array<real, MAXN>;
-    var jrk: array<real, MAXN>;
-    let yields = NS > 0u && B_S0[b] < NS;
-    if (yields) {
-        plastic_loads(b, z);
-    }
-    for (var i = 0u; i < n; i++) {
-        let k = o + i;
-        var a = -TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k];
-        if (yields) {
-            a += PLA[i];
-        }
-        acc[i] = a;
-        let qdd = a - PART[k] * ag;
-        jrk[i] = -TXW[k] * qdd - W2[k] * (*z)[NM + k];
-        if (yields) {
-            jrk[i] += PLJ[i];
-        }
-    }
-    // Damping that couples the modes: -E q' in the accelerations, -E q'' in the jerks (whose
-    // own damping term read the acceleration without it).
-    if (coupled(b)) {
-        for (var i = 0u; i < n; i++) {
-            let ev = coupled_term(b, i, z, NM);
-            acc[i] -= ev;
-            jrk[i] += TXW[o + i] * ev;
-        }
-        for (var i = 0u; i < n; i++) {
-            var eq: real = 0.0;
-            for (var k = 0u; k < n; k++) {
-                eq += cpl_e(b, i, k) * (acc[k] - PART[o + k] * ag);
-            }
-            jrk[i] -= eq;
-        }
-    }
-    for (var j = 0u; j < n; j++) {
-        var u: real = 0.0;
-        var v: real = 0.0;
-        var aa: real = 0.0;
-        var je: real = 0.0;
-        for (var i = 0u; i < n; i++) {
-            let s = shape_at(b, j, i);
-            u += s * (*z)[o + i];
-            v += s * (*z)[NM + o + i];
-            aa += s * acc[i];
-            je += s * jrk[i];
-        }
-        aa = aa + FF[o + j] / mass_at(b, j);
-        FL[fli(e, 0u, o + j)] = u;
-        FL[fli(e, 1u, o + j)] = v;
-        FL[fli(e, 2u, o + j)] = aa - ag;
-        FL[fli(e, 3u, o + j)] = aa;
-        FL[fli(e, 4u, o + j)] = je;
-    }
-}
+// Floors::fill of building b at end e from z at ground acceleration ag, with FF set, is
+// written out per shape by the host (RowShape::wgsl_unrolled).
 
 fn raise(free: bool, peak: real, y0: real, y1: real, d0: real, d1: real, a0: real, a1: real, h: real) -> real {
     if (free) {
@@ -583,9 +476,9 @@ fn track_buildings(z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1:
             touched[L_A[l] + 1u] = true;
         }
     }
+    for (var b = 0u; b < NB; b++) { fill(b, 1u, z1, ag1); }
     for (var b = 0u; b < NB; b++) {
         let free = !touched[b];
-        fill(b, 1u, z1, ag1);
         let n = B_N[b];
         let o = B_OFF[b];
         let sb = RS + S_BUILDINGS + BS_STRIDE * b;
@@ -1008,40 +901,46 @@ fn end_substep(tau_target: real) {
 }
 
 // One unit of substep j of the current interval (as fast.wgsl `piece`): a new piece's trial
-// or one of its later steps, from (TAU, z) into zx over *x; returns what it ends with.
+// or one of its later steps, from (TAU, z) into zx over *x; returns what it ends with. Both
+// take their RK4 step at one call, so that a SIMD group whose lanes take both (lavapipe runs
+// every branch any lane takes) runs RK4 once.
 fn substep_unit(seg: Seg, z: ptr<function, ZA>, zx: ptr<function, ZA>, x: ptr<function, real>) -> u32 {
-    if (LOC.phase != LOC_IDLE) {
-        var last: bool;
-        *x = step_length(&last);
-        rk4(seg, TAU, z, *x, zx);
-        return step_taken(*x, last, zx, z);
-    }
-    let tau_target = substep_target();
-    let tol = substep_tol();
-    if (!(tau_target - TAU > tol)) {
-        end_substep(tau_target);
-        return END_NONE;
-    }
-    SUBSTEPS = SUBSTEPS + 1u;
-    // Cut at the graded mesh after a touch (RowRun::onset_cut); such pieces do not count
-    // against the cap on event cuts.
-    var hs = tau_target - TAU;
-    for (var l = 0u; l < NL; l++) {
-        if (LMODE[l] == MODE_APPROACH) {
-            use_level(l);
-            hs = min(hs, onset_cut(since_onset(l, TAU), LV0[l], PER_CONTACT, tol));
+    let searching = LOC.phase != LOC_IDLE;
+    var last = false;
+    var h: real;
+    if (searching) {
+        h = step_length(&last);
+    } else {
+        let tau_target = substep_target();
+        let tol = substep_tol();
+        if (!(tau_target - TAU > tol)) {
+            end_substep(tau_target);
+            return END_NONE;
+        }
+        SUBSTEPS = SUBSTEPS + 1u;
+        // Cut at the graded mesh after a touch (RowRun::onset_cut); such pieces do not count
+        // against the cap on event cuts.
+        h = tau_target - TAU;
+        for (var l = 0u; l < NL; l++) {
+            if (LMODE[l] == MODE_APPROACH) {
+                use_level(l);
+                h = min(h, onset_cut(since_onset(l, TAU), LV0[l], PER_CONTACT, tol));
+            }
+        }
+        if (h == tau_target - TAU) {
+            PIECES = PIECES + 1u;
+        }
+        if (SUBSTEPS > disp.max_substeps || PIECES > MAX_PIECES_PER_SUBSTEP) {
+            STATUS = STATUS_STEP_LIMIT;
+            return END_NONE;
         }
     }
-    if (hs == tau_target - TAU) {
-        PIECES = PIECES + 1u;
+    *x = h;
+    rk4(seg, TAU, z, h, zx);
+    if (searching) {
+        return step_taken(h, last, zx, z);
     }
-    if (SUBSTEPS > disp.max_substeps || PIECES > MAX_PIECES_PER_SUBSTEP) {
-        STATUS = STATUS_STEP_LIMIT;
-        return END_NONE;
-    }
-    *x = hs;
-    rk4(seg, TAU, z, hs, zx);
-    return trial_taken(hs, zx, z);
+    return trial_taken(h, zx, z);
 }
 
 // The local time substep j of M ends at (the record step's end for the last).
@@ -1189,6 +1088,7 @@ fn integrate_run(lane: u32) -> u32 {
             PART[k] = models[mb + MW * i + 2u];
         }
     }
+    load_shape_rows();
     for (var l = 0u; l < NL; l++) {
         LMODE[l] = rcount[lci(l, LC_MODE)];
         LV0[l] = rstate[lsi(l, LS_V0)];

@@ -45,16 +45,8 @@ fn st_b(s: u32) -> real { return st_at(s, 2u); }
 fn st_geo(s: u32) -> real { return st_at(s, 3u); }
 fn st_row(s: u32, i: u32) -> real { return st_at(s, STOREY_HEAD + i); }
 
-// StoreyModel::drift: the drift (at 0) or its rate (at NM) in state z.
-fn storey_drift(s: u32, z: ptr<function, ZA>, at: u32) -> real {
-    let b = S_B[s];
-    let o = at + B_OFF[b];
-    var d: real = 0.0;
-    for (var i = 0u; i < B_N[b]; i++) {
-        d += st_row(s, i) * (*z)[o + i];
-    }
-    return d;
-}
+// StoreyModel::drift(s, z, at), the drift (at 0) or its rate (at NM) in state z, is written out
+// per shape by the host (RowShape::wgsl_unrolled), as is row::plastic_rhs.
 
 fn back_drift(s: u32, d: real, p: real) -> real {
     return d - p / (1.0 - st_b(s));
@@ -98,29 +90,6 @@ fn storey_firing_max(z: ptr<function, ZA>, m_in: real) -> real {
 fn storey_mark_firing(z: ptr<function, ZA>) {
     for (var s = 0u; s < NS; s++) {
         SFIRE[s] = storey_event(s, SM[s], storey_drift(s, z, 0u), storey_drift(s, z, NM), (*z)[PS0 + s]) > 0.0;
-    }
-}
-
-// row::plastic_rhs: each plastic load on the modal accelerations; while a storey yields, its
-// plastic drift rate (1 - b) d' and plastic work rate f p'.
-fn plastic_rhs(z: ptr<function, ZA>, out: ptr<function, ZA>) {
-    for (var s = 0u; s < NS; s++) {
-        let ps = PS0 + s;
-        (*out)[ps] = 0.0;
-        (*out)[ps + NS] = 0.0;
-        let p = (*z)[ps];
-        let k = st_k(s);
-        let kp = k * p;
-        let b = S_B[s];
-        let o = NM + B_OFF[b];
-        for (var i = 0u; i < B_N[b]; i++) {
-            (*out)[o + i] += st_row(s, i) * kp;
-        }
-        if (SM[s] != SM_ELASTIC) {
-            let dp = (1.0 - st_b(s)) * storey_drift(s, z, NM);
-            (*out)[ps] = dp;
-            (*out)[ps + NS] = k * (storey_drift(s, z, 0u) - p) * dp;
-        }
     }
 }
 

@@ -110,6 +110,10 @@ pub const F32_YIELD_SLACK: f64 = 1e-4;
 /// adapter are capped to stay below this many loop trips.
 const SOFTWARE_LOOP_TRIPS: u64 = 60_000;
 
+/// The most `sum n^2` over a row's buildings whose per-shape functions are written out
+/// ([`RowShape::unrolled`]).
+pub const UNROLL_MAX_SQUARES: usize = 65;
+
 /// What a row kernel is built for: each building's storeys, and each contact level's left
 /// building and floors (from 0).
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
@@ -269,15 +273,7 @@ impl RowShape {
         let nb = self.storeys.len();
         let nl = self.levels.len();
         let nla = nl.max(1);
-        let offs: Vec<usize> = self
-            .storeys
-            .iter()
-            .scan(0, |o, &n| {
-                let at = *o;
-                *o += n;
-                Some(at)
-            })
-            .collect();
+        let offs = self.mode_offsets();
         let pick = |k: usize| -> Vec<usize> {
             let v: Vec<usize> = self.levels.iter().map(|l| l[k]).collect();
             if v.is_empty() {
@@ -405,6 +401,312 @@ impl RowShape {
             "const COUPLED: bool = {};\n",
             self.coupled.iter().any(|&c| c)
         ));
+        if self.unrolled() {
+            s.push_str(&self.wgsl_unrolled());
+        } else {
+            s.push_str(super::shader::ROW_LOOPS_WGSL);
+        }
+        s
+    }
+
+    /// Is the row small enough to write its per-shape functions out (`wgsl_unrolled`)? The
+    /// written-out floors grow as the square of a building's storeys, and lavapipe's compile
+    /// time faster still; taller rows take `shaders/row_loops.wgsl`.
+    pub fn unrolled(&self) -> bool {
+        self.storeys.iter().map(|n| n * n).sum::<usize>() <= UNROLL_MAX_SQUARES
+    }
+
+    /// Where each building's modes start in the state (`B_OFF`).
+    fn mode_offsets(&self) -> Vec<usize> {
+        (self.storeys.iter())
+            .scan(0, |o, &n| {
+                let at = *o;
+                *o += n;
+                Some(at)
+            })
+            .collect()
+    }
+
+    /// The row's right-hand side (`row::rhs`) written out for this shape, with what it reads
+    /// per run cached where every index is a constant (each level's two floor rows of mode
+    /// shapes in `LSH`, each coupled building's `E` in `CPE`, loaded by `load_shape_rows`).
+    /// lavapipe turns a private array indexed at run time into a per-lane loop of loads and
+    /// stores; written out, the state's indices are constants and its reals stay in
+    /// registers. The operations and their order are those of the loops this replaces
+    /// (`floor_of`, `force`, `coupled_term`), so the values are the same.
+    fn wgsl_unrolled(&self) -> String {
+        let nm = self.modes();
+        let offs = self.mode_offsets();
+        let mut s = String::new();
+        // Each level's side rows: (building, floor) -> where its n reals start in LSH.
+        let mut rows: Vec<[usize; 2]> = Vec::new();
+        let mut load = String::new();
+        let mut at = 0;
+        for &[a, fa, fb] in &self.levels {
+            let mut pair = [0; 2];
+            for (side, (b, f)) in [(a, fa), (a + 1, fb)].into_iter().enumerate() {
+                let n = self.storeys[b];
+                pair[side] = at;
+                for i in 0..n {
+                    load.push_str(&format!(
+                        "    LSH[{}u] = models[MB[{b}u] + {}u];\n",
+                        at + i,
+                        MW * n + f * n + i
+                    ));
+                }
+                at += n;
+            }
+            rows.push(pair);
+        }
+        let nsh = at.max(1);
+        // Each building's mode shapes (floor-major) and floor masses, for `fill`.
+        let mut shp = Vec::new();
+        let mut nshp = 0;
+        for (b, &n) in self.storeys.iter().enumerate() {
+            shp.push(nshp);
+            for x in 0..n * n + n {
+                load.push_str(&format!(
+                    "    SHP[{}u] = models[MB[{b}u] + {}u];\n",
+                    nshp + x,
+                    MW * n + x
+                ));
+            }
+            nshp += n * n + n;
+        }
+        let mut cpe = Vec::new();
+        let mut ncpe = 0;
+        for (b, &n) in self.storeys.iter().enumerate() {
+            if self.coupled[b] {
+                cpe.push((b, ncpe));
+                for i in 0..n {
+                    for k in 0..n {
+                        load.push_str(&format!(
+                            "    CPE[{}u] = cpl_e({b}u, {i}u, {k}u);\n",
+                            ncpe + n * i + k
+                        ));
+                    }
+                }
+                ncpe += n * n;
+            }
+        }
+        // Each yielding storey's modal row (`st_row`), for its drift and plastic load.
+        let mut str_at = Vec::new();
+        let mut nstr = 0;
+        let mut st = 0;
+        for (b, (&n, &y)) in self.storeys.iter().zip(&self.yielding).enumerate() {
+            if !y {
+                continue;
+            }
+            for _ in 0..n {
+                str_at.push((b, nstr));
+                for i in 0..n {
+                    load.push_str(&format!("    STR[{}u] = st_row({st}u, {i}u);\n", nstr + i));
+                }
+                nstr += n;
+                st += 1;
+            }
+        }
+        s.push_str(&format!(
+            "var<private> STR: array<real, {}>;\n",
+            nstr.max(1)
+        ));
+        s.push_str(&format!(
+            "var<private> LSH: array<real, {nsh}>;\nvar<private> CPE: array<real, {}>;\nvar<private> SHP: array<real, {nshp}>;\n",
+            ncpe.max(1)
+        ));
+        s.push_str("fn load_shape_rows() {\n");
+        s.push_str(&load);
+        s.push_str("}\n");
+        // phi . q of a side row from offset `at` of z (floor_of).
+        let dot = |row: usize, b: usize, at: usize| -> String {
+            let mut e = String::from("0.0");
+            for i in 0..self.storeys[b] {
+                e.push_str(&format!(
+                    " + LSH[{}u] * (*z)[{}u]",
+                    row + i,
+                    at + offs[b] + i
+                ));
+            }
+            e
+        };
+        // Each level's gap and its rate (row/mod.rs LevelModel), a case per level.
+        for (name, at, gap) in [("delta", 0, true), ("ddelta", nm, false)] {
+            s.push_str(&format!(
+                "fn {name}(l: u32, z: ptr<function, ZA>) -> real {{\n    switch l {{\n"
+            ));
+            for (l, (&[a, _, _], &[ra, rb])) in self.levels.iter().zip(&rows).enumerate() {
+                let gap = if gap {
+                    format!(" - rp(P_GAPS + {a}u)")
+                } else {
+                    String::new()
+                };
+                s.push_str(&format!(
+                    "        case {l}u: {{ return ({}) - ({}){gap}; }}\n",
+                    dot(ra, a, at),
+                    dot(rb, a + 1, at)
+                ));
+            }
+            s.push_str("        default: { return 0.0; }\n    }\n}\n");
+        }
+        // (E q')_i of coupled building b whose E starts at c in CPE (row.wgsl's coupled_term).
+        let coupled_term = |b: usize, c: usize, i: usize| -> String {
+            let n = self.storeys[b];
+            let mut e = String::from("0.0");
+            for k in 0..n {
+                e.push_str(&format!(
+                    " + CPE[{}u] * (*z)[{}u]",
+                    c + n * i + k,
+                    nm + offs[b] + k
+                ));
+            }
+            e
+        };
+        // Floors::fill of building b at end e (row.wgsl's `fill`), a case per building.
+        s.push_str("fn fill(b: u32, e: u32, z: ptr<function, ZA>, ag: real) {\n    var acc: array<real, MAXN>;\n    var jrk: array<real, MAXN>;\n    switch b {\n");
+        let cpe_of = |b: usize| cpe.iter().find(|(x, _)| *x == b).map(|&(_, c)| c);
+        for (b, &n) in self.storeys.iter().enumerate() {
+            let o = offs[b];
+            s.push_str(&format!("        case {b}u: {{\n            let yields = NS > 0u && B_S0[{b}u] < NS;\n            if (yields) {{ plastic_loads({b}u, z); }}\n"));
+            for i in 0..n {
+                let k = o + i;
+                s.push_str(&format!(
+                    "            {{\n                var a = -TXW[{k}u] * (*z)[{v}u] - W2[{k}u] * (*z)[{k}u];\n                if (yields) {{ a += PLA[{i}u]; }}\n                acc[{i}u] = a;\n                let qdd = a - PART[{k}u] * ag;\n                jrk[{i}u] = -TXW[{k}u] * qdd - W2[{k}u] * (*z)[{v}u];\n                if (yields) {{ jrk[{i}u] += PLJ[{i}u]; }}\n            }}\n",
+                    v = nm + k
+                ));
+            }
+            if let Some(c) = cpe_of(b) {
+                s.push_str(&format!("            if (coupled({b}u)) {{\n"));
+                for i in 0..n {
+                    let e = coupled_term(b, c, i);
+                    s.push_str(&format!(
+                        "                {{\n                    let ev = {e};\n                    acc[{i}u] -= ev;\n                    jrk[{i}u] += TXW[{}u] * ev;\n                }}\n",
+                        o + i
+                    ));
+                }
+                for i in 0..n {
+                    let mut e = String::from("0.0");
+                    for k in 0..n {
+                        e.push_str(&format!(
+                            " + CPE[{}u] * (acc[{k}u] - PART[{}u] * ag)",
+                            c + n * i + k,
+                            o + k
+                        ));
+                    }
+                    s.push_str(&format!("                jrk[{i}u] -= {e};\n"));
+                }
+                s.push_str("            }\n");
+            }
+            let at = shp[b];
+            for j in 0..n {
+                let sum = |x: &dyn Fn(usize) -> String| -> String {
+                    let mut e = String::from("0.0");
+                    for i in 0..n {
+                        e.push_str(&format!(" + SHP[{}u] * {}", at + j * n + i, x(i)));
+                    }
+                    e
+                };
+                let k = o + j;
+                s.push_str(&format!(
+                    "            {{\n                let u = {};\n                let v = {};\n                let aa = ({}) + FF[{k}u] / SHP[{}u];\n                let je = {};\n                FL[fli(e, 0u, {k}u)] = u;\n                FL[fli(e, 1u, {k}u)] = v;\n                FL[fli(e, 2u, {k}u)] = aa - ag;\n                FL[fli(e, 3u, {k}u)] = aa;\n                FL[fli(e, 4u, {k}u)] = je;\n            }}\n",
+                    sum(&|i| format!("(*z)[{}u]", o + i)),
+                    sum(&|i| format!("(*z)[{}u]", nm + o + i)),
+                    sum(&|i| format!("acc[{i}u]")),
+                    at + n * n + j,
+                    sum(&|i| format!("jrk[{i}u]")),
+                ));
+            }
+            s.push_str("        }\n");
+        }
+        s.push_str("        default: {}\n    }\n}\n");
+        // Yielding storeys (yielding.wgsl): each one's drift or its rate (StoreyModel::drift),
+        // and their plastic loads in the right-hand side (row::plastic_rhs).
+        let ns = str_at.len();
+        if ns > 0 {
+            s.push_str("fn storey_drift(s: u32, z: ptr<function, ZA>, at: u32) -> real {\n    switch s {\n");
+            for (st, &(b, c)) in str_at.iter().enumerate() {
+                let mut e = String::from("0.0");
+                for i in 0..self.storeys[b] {
+                    e.push_str(&format!(" + STR[{}u] * (*z)[at + {}u]", c + i, offs[b] + i));
+                }
+                s.push_str(&format!("        case {st}u: {{ return {e}; }}\n"));
+            }
+            s.push_str("        default: { return 0.0; }\n    }\n}\n");
+            s.push_str("fn plastic_rhs(z: ptr<function, ZA>, out: ptr<function, ZA>) {\n");
+            for (st, &(b, c)) in str_at.iter().enumerate() {
+                let ps = self.plastic_slot0() + st;
+                s.push_str(&format!(
+                    "    {{\n        (*out)[{ps}u] = 0.0;\n        (*out)[{}u] = 0.0;\n        let p = (*z)[{ps}u];\n        let k = st_k({st}u);\n        let kp = k * p;\n",
+                    ps + ns
+                ));
+                for i in 0..self.storeys[b] {
+                    s.push_str(&format!(
+                        "        (*out)[{}u] += STR[{}u] * kp;\n",
+                        nm + offs[b] + i,
+                        c + i
+                    ));
+                }
+                s.push_str(&format!(
+                    "        if (SM[{st}u] != SM_ELASTIC) {{\n            let dp = (1.0 - st_b({st}u)) * storey_drift({st}u, z, NM);\n            (*out)[{ps}u] = dp;\n            (*out)[{}u] = k * (storey_drift({st}u, z, 0u) - p) * dp;\n        }}\n    }}\n",
+                    ps + ns
+                ));
+            }
+            s.push_str("}\n");
+        } else {
+            // An elastic row's kernel enters neither (`NS > 0` guards every call).
+            s.push_str("fn storey_drift(s: u32, z: ptr<function, ZA>, at: u32) -> real {\n    return 0.0;\n}\nfn plastic_rhs(z: ptr<function, ZA>, out: ptr<function, ZA>) {}\n");
+        }
+        s.push_str("fn rhs(ag: real, z: ptr<function, ZA>, out: ptr<function, ZA>) {\n");
+        for i in 0..nm {
+            s.push_str(&format!(
+                "    (*out)[{i}u] = (*z)[{v}u];\n    (*out)[{v}u] = -TXW[{i}u] * (*z)[{v}u] - W2[{i}u] * (*z)[{i}u] - PART[{i}u] * ag;\n",
+                v = nm + i
+            ));
+        }
+        for &(b, c) in &cpe {
+            let n = self.storeys[b];
+            s.push_str(&format!("    if (coupled({b}u)) {{\n"));
+            for i in 0..n {
+                let e = coupled_term(b, c, i);
+                s.push_str(&format!("        (*out)[{}u] -= {e};\n", nm + offs[b] + i));
+            }
+            s.push_str("    }\n");
+        }
+        s.push_str("    if (NS > 0u) {\n        plastic_rhs(z, out);\n    }\n");
+        for (l, (&[a, _, _], &[ra, rb])) in self.levels.iter().zip(&rows).enumerate() {
+            let w = 2 * nm + l;
+            s.push_str(&format!(
+                "    if (LMODE[{l}u] == MODE_FREE) {{\n        (*out)[{w}u] = 0.0;\n    }} else {{\n"
+            ));
+            s.push_str(&format!(
+                "        let d = ({}) - ({}) - rp(P_GAPS + {a}u);\n",
+                dot(ra, a, 0),
+                dot(rb, a + 1, 0)
+            ));
+            s.push_str(&format!(
+                "        let r = ({}) - ({});\n",
+                dot(ra, a, nm),
+                dot(rb, a + 1, nm)
+            ));
+            s.push_str(&format!(
+                "        use_level({l}u);\n        let f = contact_force(d, r, LV0[{l}u], LMODE[{l}u] == MODE_APPROACH);\n"
+            ));
+            for (row, b, sign) in [(ra, a, "-"), (rb, a + 1, "+")] {
+                for i in 0..self.storeys[b] {
+                    s.push_str(&format!(
+                        "        (*out)[{}u] {sign}= LSH[{}u] * f;\n",
+                        nm + offs[b] + i,
+                        row + i
+                    ));
+                }
+            }
+            s.push_str(&format!("        (*out)[{w}u] = f * r;\n    }}\n"));
+        }
+        let nl = self.levels.len();
+        s.push_str(&format!(
+            "    (*out)[{}u] = 0.0;\n    (*out)[{}u] = 0.0;\n}}\n",
+            2 * nm + nl,
+            2 * nm + nl + 1
+        ));
         s
     }
 
@@ -449,9 +751,11 @@ impl RowShape {
         // event search, the step to its far end) or a record interval's start, then the
         // tracking and transitions of the units that end a piece or a free step. A software
         // adapter runs a group of lanes in SIMD lockstep through every branch any of them
-        // takes: the bound sums the branches (a new piece's trial and a search's step are two
-        // RK4 steps).
-        let substep = nl + 2 * rk4 + 7 * event_max + 4 * d + nl + storeys + 2;
+        // takes: the bound sums the branches (a new piece's trial and a search's step share
+        // one RK4 call). The right-hand side, the gaps and the floors are written out
+        // (`wgsl_unrolled`), loop-free; they are still counted as loops here, which only
+        // over-counts.
+        let substep = nl + rk4 + 7 * event_max + 4 * d + nl + storeys + 2;
         let tail = track + transitions + storeys + d + nl + 3 * zlen;
         // begin: per level may_touch (gaps, rates, both sides' bounds), the touching level's
         // estimates (gaps, rates, structural accelerations), a contact level's.

@@ -51,6 +51,8 @@ pub const CONTACT_WGSL: &str = include_str!("../../../shaders/contact.wgsl");
 pub const HERMITE_WGSL: &str = include_str!("../../../shaders/hermite.wgsl");
 pub const FAST_WGSL: &str = include_str!("../../../shaders/fast.wgsl");
 pub const ROW_WGSL: &str = include_str!("../../../shaders/row.wgsl");
+/// The per-shape functions of `row.wgsl` as loops, for rows too tall to write them out.
+pub const ROW_LOOPS_WGSL: &str = include_str!("../../../shaders/row_loops.wgsl");
 pub const YIELDING_WGSL: &str = include_str!("../../../shaders/yielding.wgsl");
 pub const LANES_WGSL: &str = include_str!("../../../shaders/lanes.wgsl");
 pub const AGGREGATE_WGSL: &str = include_str!("../../../shaders/aggregate.wgsl");
