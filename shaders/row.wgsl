@@ -1,11 +1,10 @@
 // Rust twin: src/physics/solver/row/fast.rs (with row/mod.rs), function for function (same
 // names, same operation order), except that the CPU takes the contact substeps of buildings of
 // 4 or more storeys with Rayleigh damping in floor coordinates (the same motion, O(N) per
-// right-hand side) where this kernel stays in modes, and that the CPU bounds each mode's
-// |q''''| once per free step for every level's may_touch where this kernel bounds them per
-// level (the same values), and that the CPU lets the buildings no contact reaches stand still
-// through a step's substeps and steps them exactly at its end where this kernel substeps the
-// whole row (the CPU's `simulate_whole_row` is this kernel's twin step for step). The fast scheme on a row of shear buildings, in modal coordinates,
+// right-hand side) where this kernel stays in modes, and that the CPU lets the buildings no
+// contact reaches stand still through a step's substeps and steps them exactly at its end
+// where this kernel substeps the whole row (the CPU's `simulate_whole_row` is this kernel's
+// twin step for step). The fast scheme on a row of shear buildings, in modal coordinates,
 // one invocation per run; resumable as fast.wgsl (at most `disp.budget` units of work per run
 // and dispatch: a record interval's start with its free step, or one RK4 step of a substep's
 // piece (its trial, a probe of a hidden touch or of the event search, the step to the event),
@@ -175,26 +174,8 @@ fn fli(e: u32, q: u32, k: u32) -> u32 {
 // delta(l, z) and ddelta(l, z), level l's gap and its rate, are written out per shape by the
 // host (RowShape::wgsl_unrolled).
 
-// The structural acceleration of floor f of building b (no ground, no contact).
-fn floor_accel(b: u32, f: u32, z: ptr<function, ZA>) -> real {
-    var s: real = 0.0;
-    let o = B_OFF[b];
-    for (var i = 0u; i < B_N[b]; i++) {
-        let k = o + i;
-        s += shape_at(b, f, i) * (-TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k]);
-    }
-    if (coupled(b)) {
-        for (var i = 0u; i < B_N[b]; i++) {
-            s -= shape_at(b, f, i) * coupled_term(b, i, z, NM);
-        }
-    }
-    return s;
-}
-
-fn structural_rel_accel(l: u32, z: ptr<function, ZA>) -> real {
-    let a = L_A[l];
-    return floor_accel(a, L_FA[l], z) - floor_accel(a + 1u, L_FB[l], z);
-}
+// structural_rel_accel(l, z), the structural relative acceleration of level l's floors (no
+// ground, no contact), is written out per shape by the host (RowShape::wgsl_unrolled).
 
 fn force(l: u32, mode: u32, v0: real, z: ptr<function, ZA>) -> real {
     if (mode == MODE_FREE) {
@@ -228,23 +209,23 @@ fn reapproaches(l: u32, mode: u32, z: ptr<function, ZA>) -> bool {
     return mode == MODE_RESTITUTION && ddelta(l, z) > 0.0;
 }
 
-// The fourth-derivative bound of one side's floor, mode by mode.
-fn side_bound(b: u32, f: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>) -> real {
-    var s: real = 0.0;
-    let o = B_OFF[b];
-    for (var i = 0u; i < B_N[b]; i++) {
-        let k = o + i;
+// Each mode's fourth-derivative bound over the free step being tried (QB), which every
+// level's bound sums over its two floors (`level_bound`, written out per shape by the host):
+// once per mode, not per level and floor (the same values).
+var<private> QB: array<real, NM>;
+
+fn fill_mode_bounds(seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>) {
+    for (var k = 0u; k < NM; k++) {
         if (NS > 0u || COUPLED) {
             // mode_bounds: about the static response to the plastic loads, coupled modes'.
-            s += abs(shape_at(b, f, i)) * MBND[k];
+            QB[k] = MBND[k];
             continue;
         }
         let sk = Seg(seg.a0 * PART[k], seg.a1 * PART[k], seg.dt);
         let q = max(abs((*z0)[k]), abs((*z1)[k]));
         let qd = max(abs((*z0)[NM + k]), abs((*z1)[NM + k]));
-        s += abs(shape_at(b, f, i)) * fourth_derivative_bound(1.0, W2[k], TXW[k], q, qd, sk);
+        QB[k] = fourth_derivative_bound(1.0, W2[k], TXW[k], q, qd, sk);
     }
-    return s;
 }
 
 fn may_touch(l: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real, v0: real) -> bool {
@@ -252,8 +233,7 @@ fn may_touch(l: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: 
     let d1 = delta(l, z1);
     let r0 = ddelta(l, z0);
     let r1 = ddelta(l, z1);
-    let a = L_A[l];
-    let bound = side_bound(a, L_FA[l], seg, z0, z1) + side_bound(a + 1u, L_FB[l], seg, z0, z1);
+    let bound = level_bound(l);
     let margin = -error_margin(bound, h);
     if (cubic_max_bound(d0, r0, d1, r1, h) <= margin) {
         return false;
@@ -836,6 +816,7 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>, z1: ptr<function, ZA>) -> bool
         if (NS > 0u) {
             yielding = yield_watch(z, z1, dt);
         }
+        fill_mode_bounds(seg, z, z1);
         var touching = false;
         for (var l = 0u; l < NL; l++) {
             if (!may_touch(l, seg, z, z1, dt, LV0[l])) {

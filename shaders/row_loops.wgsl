@@ -160,3 +160,39 @@ fn plastic_rhs(z: ptr<function, ZA>, out: ptr<function, ZA>) {
         }
     }
 }
+
+// The structural acceleration of floor f of building b (no ground, no contact).
+fn floor_accel(b: u32, f: u32, z: ptr<function, ZA>) -> real {
+    var s: real = 0.0;
+    let o = B_OFF[b];
+    for (var i = 0u; i < B_N[b]; i++) {
+        let k = o + i;
+        s += shape_at(b, f, i) * (-TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k]);
+    }
+    if (coupled(b)) {
+        for (var i = 0u; i < B_N[b]; i++) {
+            s -= shape_at(b, f, i) * coupled_term(b, i, z, NM);
+        }
+    }
+    return s;
+}
+
+fn structural_rel_accel(l: u32, z: ptr<function, ZA>) -> real {
+    let a = L_A[l];
+    return floor_accel(a, L_FA[l], z) - floor_accel(a + 1u, L_FB[l], z);
+}
+
+// The fourth-derivative bound of one side's floor: its modes' bounds (QB) by its mode shape.
+fn side_bound(b: u32, f: u32) -> real {
+    var s: real = 0.0;
+    let o = B_OFF[b];
+    for (var i = 0u; i < B_N[b]; i++) {
+        s += abs(shape_at(b, f, i)) * QB[o + i];
+    }
+    return s;
+}
+
+fn level_bound(l: u32) -> real {
+    let a = L_A[l];
+    return side_bound(a, L_FA[l]) + side_bound(a + 1u, L_FB[l]);
+}

@@ -298,7 +298,8 @@ fn shipped_row_configs_fit_the_software_adapter() {
 }
 
 /// The row kernel's source parses and validates (naga, f32 and f64) for shapes from single
-/// storeys to a row of five and a row with no common floor level, elastic and yielding: the
+/// storeys to a row of five and a row with no common floor level, elastic and yielding, with
+/// the per-shape functions written out and as loops: the
 /// constants the host prepends make a complete module for every shape (P-Delta buildings whose
 /// damping couples their modes among them).
 #[test]
@@ -332,7 +333,16 @@ fn row_kernel_builds_for_every_shape() {
             yielding: vec![false, true, false],
             coupled: vec![true, true, false],
         },
+        // Too tall to write out: the loops of row_loops.wgsl, yielding and coupled.
+        RowShape {
+            storeys: vec![9, 4],
+            levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [0, 3, 3]],
+            yielding: vec![true, true],
+            coupled: vec![true, false],
+        },
     ];
+    // Both ways of writing the per-shape functions are among them.
+    assert!(shapes.iter().any(|s| s.unrolled()) && shapes.iter().any(|s| !s.unrolled()));
     for shape in &shapes {
         for precision in [Precision::F32, Precision::F64] {
             let src = row_source(precision, &shape.wgsl_constants());

@@ -561,9 +561,58 @@ impl RowShape {
             }
             e
         };
+        let cpe_of = |b: usize| cpe.iter().find(|(x, _)| *x == b).map(|&(_, c)| c);
+        // Each level's bound (its floors' mode shapes by the modes' bounds QB) and its floors'
+        // structural relative acceleration (row_loops.wgsl's level_bound, floor_accel).
+        s.push_str("fn level_bound(l: u32) -> real {\n    switch l {\n");
+        for (l, (&[a, _, _], &[ra, rb])) in self.levels.iter().zip(&rows).enumerate() {
+            let side = |row: usize, b: usize| -> String {
+                let mut e = String::from("0.0");
+                for i in 0..self.storeys[b] {
+                    e.push_str(&format!(" + abs(LSH[{}u]) * QB[{}u]", row + i, offs[b] + i));
+                }
+                e
+            };
+            s.push_str(&format!(
+                "        case {l}u: {{ return ({}) + ({}); }}\n",
+                side(ra, a),
+                side(rb, a + 1)
+            ));
+        }
+        s.push_str("        default: { return 0.0; }\n    }\n}\n");
+        s.push_str(
+            "fn structural_rel_accel(l: u32, z: ptr<function, ZA>) -> real {\n    switch l {\n",
+        );
+        for (l, (&[a, _, _], &[ra, rb])) in self.levels.iter().zip(&rows).enumerate() {
+            s.push_str(&format!("        case {l}u: {{\n"));
+            for (name, row, b) in [("sa", ra, a), ("sb", rb, a + 1)] {
+                let mut e = String::from("0.0");
+                for i in 0..self.storeys[b] {
+                    let k = offs[b] + i;
+                    e.push_str(&format!(
+                        " + LSH[{}u] * (-TXW[{k}u] * (*z)[{}u] - W2[{k}u] * (*z)[{k}u])",
+                        row + i,
+                        nm + k
+                    ));
+                }
+                s.push_str(&format!("            var {name} = {e};\n"));
+                if let Some(c) = cpe_of(b) {
+                    s.push_str(&format!("            if (coupled({b}u)) {{\n"));
+                    for i in 0..self.storeys[b] {
+                        s.push_str(&format!(
+                            "                {name} -= LSH[{}u] * ({});\n",
+                            row + i,
+                            coupled_term(b, c, i)
+                        ));
+                    }
+                    s.push_str("            }\n");
+                }
+            }
+            s.push_str("            return sa - sb;\n        }\n");
+        }
+        s.push_str("        default: { return 0.0; }\n    }\n}\n");
         // Floors::fill of building b at end e (row.wgsl's `fill`), a case per building.
         s.push_str("fn fill(b: u32, e: u32, z: ptr<function, ZA>, ag: real) {\n    var acc: array<real, MAXN>;\n    var jrk: array<real, MAXN>;\n    switch b {\n");
-        let cpe_of = |b: usize| cpe.iter().find(|(x, _)| *x == b).map(|&(_, c)| c);
         for (b, &n) in self.storeys.iter().enumerate() {
             let o = offs[b];
             s.push_str(&format!("        case {b}u: {{\n            let yields = NS > 0u && B_S0[{b}u] < NS;\n            if (yields) {{ plastic_loads({b}u, z); }}\n"));
@@ -757,9 +806,10 @@ impl RowShape {
         // over-counts.
         let substep = nl + rk4 + 7 * event_max + 4 * d + nl + storeys + 2;
         let tail = track + transitions + storeys + d + nl + 3 * zlen;
-        // begin: per level may_touch (gaps, rates, both sides' bounds), the touching level's
-        // estimates (gaps, rates, structural accelerations), a contact level's.
-        let begin = nl + nm + 11 * d + 3 * d * (1 + coupled) + 6 * nl + zlen;
+        // begin: the modes' bounds (`fill_mode_bounds`), per level may_touch (gaps, rates,
+        // both sides' bounds), the touching level's estimates (gaps, rates, structural
+        // accelerations), a contact level's.
+        let begin = nl + 2 * nm + 11 * d + 3 * d * (1 + coupled) + 6 * nl + zlen;
         let begin = begin + 3 * nm * yields + 2 * storeys + ns * nmax;
         // mode_bounds (with yielding storeys or coupled modes) and the coupled parts.
         let begin = begin + 3 * nm * yields.max(coupled);
