@@ -268,7 +268,18 @@ impl GpuContext {
             label: Some(&label),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         };
-        let module = d.create_shader_module(desc);
+        // Every loop in these shaders counts (a `for` that steps its counter, or a `loop` that
+        // spends a budget each pass: `shader::tests::every_loop_counts`), so naga's forced loop
+        // bounding (a second counter and exit test in every loop) is left out: on lavapipe it
+        // kept loops from unrolling and cost a third of a row sweep's time (BENCHMARKS.md,
+        // "Rows on lavapipe: the shape written out"). Bounds and division checks stay.
+        let checks = wgpu::ShaderRuntimeChecks {
+            force_loop_bounding: false,
+            ..wgpu::ShaderRuntimeChecks::checked()
+        };
+        // SAFETY: wgpu asks that a shader built without loop bounding never loops forever;
+        // every loop of ours ends after a count (above).
+        let module = unsafe { d.create_shader_module_trusted(desc, checks) };
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,

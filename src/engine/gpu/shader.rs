@@ -116,3 +116,55 @@ pub fn aggregate_source(precision: Precision) -> String {
         prelude(precision)
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every loop in the shaders ends after a count, as building them without naga's loop
+    /// bounding requires (context.rs): no `while`, every `for` has a step, every `loop` leaves
+    /// once its budget is spent and spends it each pass; the per-shape code the host writes
+    /// has no loop at all.
+    #[test]
+    fn every_loop_counts() {
+        let shape = super::super::row::RowShape::elastic(vec![3, 6], vec![[0, 0, 0], [0, 1, 1]]);
+        let written = shape.wgsl_constants();
+        let sources = [
+            ("types", TYPES_WGSL),
+            ("contact", CONTACT_WGSL),
+            ("hermite", HERMITE_WGSL),
+            ("fast", FAST_WGSL),
+            ("row", ROW_WGSL),
+            ("row_loops", ROW_LOOPS_WGSL),
+            ("yielding", YIELDING_WGSL),
+            ("lanes", LANES_WGSL),
+            ("aggregate", AGGREGATE_WGSL),
+            ("written out for 3 + 6 storeys", written.as_str()),
+        ];
+        let (mut fors, mut loops) = (0, 0);
+        for (name, src) in sources {
+            let code: Vec<&str> = src.lines().map(|l| l.split("//").next().unwrap()).collect();
+            for (i, line) in code.iter().enumerate() {
+                let at = format!("{name}.wgsl line {}: {line}", i + 1);
+                assert!(!line.contains("while"), "{at}");
+                if let Some(h) = line.find("for (") {
+                    let header = line[h..].split(") {").next().unwrap();
+                    let clauses: Vec<&str> = header.split(';').collect();
+                    assert_eq!(clauses.len(), 3, "{at}");
+                    assert!(!clauses[2].trim().is_empty(), "{at}");
+                    fors += 1;
+                }
+                if line.contains("loop {") {
+                    let body = code[i..(i + 12).min(code.len())].join("\n");
+                    assert!(body.contains("budget == 0u"), "{at}");
+                    assert!(body.contains("budget = budget - 1u"), "{at}");
+                    loops += 1;
+                }
+            }
+            if name.starts_with("written") {
+                assert!(!src.contains("for (") && !src.contains("loop {"));
+            }
+        }
+        assert!(fors > 20 && loops == 2, "{fors} for, {loops} loop");
+    }
+}
