@@ -16,8 +16,9 @@
 // reals of state, MAXN the most storeys; each building's storeys and first mode (B_N, B_OFF);
 // each level's left building and floors (L_A, L_FA, L_FB); the offsets and strides of the
 // per-run blocks (P_*, M_*, S_*, C_*, LS_*, LC_*, BS_*, BC_*, MW); then the functions that run
-// over the shape (the right-hand side `rhs`, each level's gap `delta` and rate `ddelta`, the
-// floors' `fill`, a storey's drift and the plastic loads), written out with constant indices
+// over the shape (the right-hand side `rhs`, each level's gap `delta`, rate `ddelta`, bound
+// `level_bound` and `structural_rel_accel`, the floors' `fill`, a storey's drift and the
+// plastic loads), written out with constant indices
 // where the row is small (`RowShape::unrolled`: a lane's state stays in registers, where lavapipe
 // turns an index known only at run time into a loop over the lanes), else row_loops.wgsl's
 // loops. Then contact.wgsl and hermite.wgsl. So a kernel carries exactly the code its row needs.

@@ -427,9 +427,11 @@ impl RowShape {
             .collect()
     }
 
-    /// The row's right-hand side (`row::rhs`) written out for this shape, with what it reads
-    /// per run cached where every index is a constant (each level's two floor rows of mode
-    /// shapes in `LSH`, each coupled building's `E` in `CPE`, loaded by `load_shape_rows`).
+    /// The row's per-shape functions (`row::rhs`, each level's gap, rate, bound and structural
+    /// acceleration, the floors' `fill`, a storey's drift, the plastic loads) written out for
+    /// this shape, with what they read per run cached where every index is a constant (each
+    /// building's mode shapes and masses in `SHP`, each coupled building's `E` in `CPE`, each
+    /// yielding storey's row in `STR`, loaded by `load_shape_rows`).
     /// lavapipe turns a private array indexed at run time into a per-lane loop of loads and
     /// stores; written out, the state's indices are constants and its reals stay in
     /// registers. The operations and their order are those of the loops this replaces
@@ -438,27 +440,7 @@ impl RowShape {
         let nm = self.modes();
         let offs = self.mode_offsets();
         let mut s = String::new();
-        // Each level's side rows: (building, floor) -> where its n reals start in LSH.
-        let mut rows: Vec<[usize; 2]> = Vec::new();
         let mut load = String::new();
-        let mut at = 0;
-        for &[a, fa, fb] in &self.levels {
-            let mut pair = [0; 2];
-            for (side, (b, f)) in [(a, fa), (a + 1, fb)].into_iter().enumerate() {
-                let n = self.storeys[b];
-                pair[side] = at;
-                for i in 0..n {
-                    load.push_str(&format!(
-                        "    LSH[{}u] = models[MB[{b}u] + {}u];\n",
-                        at + i,
-                        MW * n + f * n + i
-                    ));
-                }
-                at += n;
-            }
-            rows.push(pair);
-        }
-        let nsh = at.max(1);
         // Each building's mode shapes (floor-major) and floor masses, for `fill`.
         let mut shp = Vec::new();
         let mut nshp = 0;
@@ -473,6 +455,13 @@ impl RowShape {
             }
             nshp += n * n + n;
         }
+        // Each level's two floor rows of mode shapes: where their n reals start in SHP.
+        let rows: Vec<[usize; 2]> = (self.levels.iter())
+            .map(|&[a, fa, fb]| {
+                let row = |b: usize, f: usize| shp[b] + f * self.storeys[b];
+                [row(a, fa), row(a + 1, fb)]
+            })
+            .collect();
         let mut cpe = Vec::new();
         let mut ncpe = 0;
         for (b, &n) in self.storeys.iter().enumerate() {
@@ -511,7 +500,7 @@ impl RowShape {
             nstr.max(1)
         ));
         s.push_str(&format!(
-            "var<private> LSH: array<real, {nsh}>;\nvar<private> CPE: array<real, {}>;\nvar<private> SHP: array<real, {nshp}>;\n",
+            "var<private> CPE: array<real, {}>;\nvar<private> SHP: array<real, {nshp}>;\n",
             ncpe.max(1)
         ));
         s.push_str("fn load_shape_rows() {\n");
@@ -522,7 +511,7 @@ impl RowShape {
             let mut e = String::from("0.0");
             for i in 0..self.storeys[b] {
                 e.push_str(&format!(
-                    " + LSH[{}u] * (*z)[{}u]",
+                    " + SHP[{}u] * (*z)[{}u]",
                     row + i,
                     at + offs[b] + i
                 ));
@@ -569,7 +558,7 @@ impl RowShape {
             let side = |row: usize, b: usize| -> String {
                 let mut e = String::from("0.0");
                 for i in 0..self.storeys[b] {
-                    e.push_str(&format!(" + abs(LSH[{}u]) * QB[{}u]", row + i, offs[b] + i));
+                    e.push_str(&format!(" + abs(SHP[{}u]) * QB[{}u]", row + i, offs[b] + i));
                 }
                 e
             };
@@ -590,7 +579,7 @@ impl RowShape {
                 for i in 0..self.storeys[b] {
                     let k = offs[b] + i;
                     e.push_str(&format!(
-                        " + LSH[{}u] * (-TXW[{k}u] * (*z)[{}u] - W2[{k}u] * (*z)[{k}u])",
+                        " + SHP[{}u] * (-TXW[{k}u] * (*z)[{}u] - W2[{k}u] * (*z)[{k}u])",
                         row + i,
                         nm + k
                     ));
@@ -600,7 +589,7 @@ impl RowShape {
                     s.push_str(&format!("            if (coupled({b}u)) {{\n"));
                     for i in 0..self.storeys[b] {
                         s.push_str(&format!(
-                            "                {name} -= LSH[{}u] * ({});\n",
+                            "                {name} -= SHP[{}u] * ({});\n",
                             row + i,
                             coupled_term(b, c, i)
                         ));
@@ -727,22 +716,12 @@ impl RowShape {
                 "    if (LMODE[{l}u] == MODE_FREE) {{\n        (*out)[{w}u] = 0.0;\n    }} else {{\n"
             ));
             s.push_str(&format!(
-                "        let d = ({}) - ({}) - rp(P_GAPS + {a}u);\n",
-                dot(ra, a, 0),
-                dot(rb, a + 1, 0)
-            ));
-            s.push_str(&format!(
-                "        let r = ({}) - ({});\n",
-                dot(ra, a, nm),
-                dot(rb, a + 1, nm)
-            ));
-            s.push_str(&format!(
-                "        use_level({l}u);\n        let f = contact_force(d, r, LV0[{l}u], LMODE[{l}u] == MODE_APPROACH);\n"
+                "        let d = delta({l}u, z);\n        let r = ddelta({l}u, z);\n        use_level({l}u);\n        let f = contact_force(d, r, LV0[{l}u], LMODE[{l}u] == MODE_APPROACH);\n"
             ));
             for (row, b, sign) in [(ra, a, "-"), (rb, a + 1, "+")] {
                 for i in 0..self.storeys[b] {
                     s.push_str(&format!(
-                        "        (*out)[{}u] {sign}= LSH[{}u] * f;\n",
+                        "        (*out)[{}u] {sign}= SHP[{}u] * f;\n",
                         nm + offs[b] + i,
                         row + i
                     ));
@@ -801,9 +780,9 @@ impl RowShape {
         // tracking and transitions of the units that end a piece or a free step. A software
         // adapter runs a group of lanes in SIMD lockstep through every branch any of them
         // takes: the bound sums the branches (a new piece's trial and a search's step share
-        // one RK4 call). The right-hand side, the gaps and the floors are written out
-        // (`wgsl_unrolled`), loop-free; they are still counted as loops here, which only
-        // over-counts.
+        // one RK4 call). In a small row the right-hand side, the gaps and the floors are
+        // written out (`wgsl_unrolled`), loop-free; they are still counted as loops here,
+        // which only over-counts.
         let substep = nl + rk4 + 7 * event_max + 4 * d + nl + storeys + 2;
         let tail = track + transitions + storeys + d + nl + 3 * zlen;
         // begin: the modes' bounds (`fill_mode_bounds`), per level may_touch (gaps, rates,
