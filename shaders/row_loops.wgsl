@@ -196,3 +196,74 @@ fn level_bound(l: u32) -> real {
     let a = L_A[l];
     return side_bound(a, L_FA[l]) + side_bound(a + 1u, L_FB[l]);
 }
+
+// RowRun::track_buildings: each building's peaks over a piece from z0 to z1.
+fn track_buildings(z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1: real, h: real) {
+    if (ENDS_VALID) {
+        copy_floor_ends();
+    } else {
+        set_floor_forces(z0);
+        for (var b = 0u; b < NB; b++) { fill(b, 0u, z0, ag0); }
+    }
+    set_floor_forces(z1);
+    var touched: array<bool, NB>;
+    for (var l = 0u; l < NL; l++) {
+        if (LMODE[l] != MODE_FREE) {
+            touched[L_A[l]] = true;
+            touched[L_A[l] + 1u] = true;
+        }
+    }
+    for (var b = 0u; b < NB; b++) { fill(b, 1u, z1, ag1); }
+    for (var b = 0u; b < NB; b++) {
+        let free = !touched[b];
+        let n = B_N[b];
+        let o = B_OFF[b];
+        let sb = RS + S_BUILDINGS + BS_STRIDE * b;
+        let cb = RC + C_BUILDINGS + BC_STRIDE * b;
+        let top = o + n - 1u;
+        rstate[sb + BS_ROOF] = raise(free, rstate[sb + BS_ROOF],
+            FL[fli(0u, 0u, top)], FL[fli(1u, 0u, top)], FL[fli(0u, 1u, top)], FL[fli(1u, 1u, top)],
+            FL[fli(0u, 2u, top)], FL[fli(1u, 2u, top)], h);
+        var drift = rstate[sb + BS_DRIFT];
+        var accel = rstate[sb + BS_ACCEL];
+        for (var j = 0u; j < n; j++) {
+            let k = o + j;
+            // Floor 0 is the ground: it moves with the frame.
+            var bu0: real = 0.0; var bu1: real = 0.0; var bv0: real = 0.0; var bv1: real = 0.0;
+            var ba0: real = 0.0; var ba1: real = 0.0;
+            if (j > 0u) {
+                bu0 = FL[fli(0u, 0u, k - 1u)]; bu1 = FL[fli(1u, 0u, k - 1u)];
+                bv0 = FL[fli(0u, 1u, k - 1u)]; bv1 = FL[fli(1u, 1u, k - 1u)];
+                ba0 = FL[fli(0u, 2u, k - 1u)]; ba1 = FL[fli(1u, 2u, k - 1u)];
+            }
+            let inv_h = 1.0 / height_at(b, j);
+            let y0 = (FL[fli(0u, 0u, k)] - bu0) * inv_h;
+            let y1 = (FL[fli(1u, 0u, k)] - bu1) * inv_h;
+            let d0 = (FL[fli(0u, 1u, k)] - bv0) * inv_h;
+            let d1 = (FL[fli(1u, 1u, k)] - bv1) * inv_h;
+            let a0 = (FL[fli(0u, 2u, k)] - ba0) * inv_h;
+            let a1 = (FL[fli(1u, 2u, k)] - ba1) * inv_h;
+            let p = raise(free, drift, y0, y1, d0, d1, a0, a1, h);
+            if (p > drift) {
+                drift = p;
+                rcount[cb + BC_DRIFT_STOREY] = j + 1u;
+            }
+            if (NS > 0u) {
+                raise_storey(b, j, free, y0, y1, d0, d1, a0, a1, h);
+            }
+            var pa: real;
+            if (free) {
+                pa = raise_cubic_peak(accel, FL[fli(0u, 3u, k)], FL[fli(0u, 4u, k)],
+                    FL[fli(1u, 3u, k)], FL[fli(1u, 4u, k)], h);
+            } else {
+                pa = max(max(accel, abs(FL[fli(0u, 3u, k)])), abs(FL[fli(1u, 3u, k)]));
+            }
+            if (pa > accel) {
+                accel = pa;
+                rcount[cb + BC_ACCEL_FLOOR] = j + 1u;
+            }
+        }
+        rstate[sb + BS_DRIFT] = drift;
+        rstate[sb + BS_ACCEL] = accel;
+    }
+}

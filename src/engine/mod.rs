@@ -220,13 +220,45 @@ pub fn gpu_for(
             _ => Ok(None),
         };
     }
-    // Measured on an H100: the row kernel beats 16 CPU threads only for rows of one-storey
-    // buildings (2.4x); 0.59x at 3 storeys, 0.17x at 6 (BENCHMARKS.md).
-    if backend == Backend::Auto && Kernel::of(plan) == Kernel::Row && plan.max_storeys() > 1 {
-        note("notice: running on the CPU: the row kernel is slower than the CPU path for buildings of more than one storey (BENCHMARKS.md, \"Rows on the GPU\"); --backend gpu uses it".into());
-        return Ok(None);
+    if let (Backend::Auto, Plan::Row(rows)) = (backend, plan) {
+        if let Some(why) = row_stays_on_cpu(rows) {
+            note(format!("notice: running on the CPU: {why} (BENCHMARKS.md, \"Rows on an H200\"); --backend gpu uses it"));
+            return Ok(None);
+        }
     }
     Ok(backend.acquire("running on the CPU", note)?)
+}
+
+/// Runs a row sweep needs before `--backend auto` takes a hardware GPU for it: on an H200 the
+/// row kernel took about 5 s to build per shape, then ran 20,000-run sweeps of 3- and
+/// 4-storey pairs at 2.6-3.3x the rate of 16 CPU threads (5,228-7,942 runs/s against
+/// 2,040-2,752), so at 20,000 runs the GPU, build included, is about 1.2x the CPU and below
+/// it loses (180 runs of `configs/row-3-6.toml`: 5.7 s against 0.44 s).
+pub const ROW_GPU_MIN_RUNS: u64 = 20_000;
+
+/// Why `--backend auto` keeps a row sweep on the CPU though a hardware GPU may be there, if it
+/// does: whatever the row kernel was not measured faster at (BENCHMARKS.md, "Rows on an H200").
+pub fn row_stays_on_cpu(plan: &RowPlan) -> Option<String> {
+    if plan.len() < ROW_GPU_MIN_RUNS {
+        return Some(format!(
+            "a row sweep of fewer than {ROW_GPU_MIN_RUNS} runs is done sooner on the CPU than the GPU builds its kernel and runs it"
+        ));
+    }
+    if plan.buildings.iter().any(|b| b.p_delta.is_some()) {
+        return Some(
+            "the row kernel is not measured faster than the CPU path on P-Delta buildings".into(),
+        );
+    }
+    let shape = gpu::row::RowShape::of(&crate::physics::solver::row::RowModel::new(
+        &plan.row(&plan.run(0)),
+    ));
+    if !shape.unrolled() {
+        return Some(format!(
+            "the row kernel runs rows taller than two 5-storey buildings (storey counts whose squares sum past {}) as loops, slower than the CPU path",
+            gpu::row::UNROLL_MAX_SQUARES
+        ));
+    }
+    None
 }
 
 /// A chunk of finished runs, in run order, with the plan they belong to: a pair's or a row's.
@@ -536,6 +568,36 @@ mod tests {
             );
         }
         assert!(check_chunk(Some(MAX_CPU_CHUNK + 1), true).is_ok());
+    }
+
+    /// `--backend auto` takes the GPU for a row only where the row kernel was measured faster
+    /// than the CPU: enough runs, no P-Delta, a shape written out.
+    #[test]
+    fn auto_takes_the_gpu_for_rows_only_where_measured_faster() {
+        let row = |storeys: (usize, usize), runs: u64, extra: &str| {
+            let text = format!(
+                "[[building]]\nstoreys = {}\nstorey_height_m = 3.0\nmass_kg = 3e5\nperiod_s = 0.3\ndamping_ratio = 0.05\n{extra}\n\
+                 [[building]]\nstoreys = {}\nstorey_height_m = 3.0\nmass_kg = 3e5\nperiod_s = 0.5\ndamping_ratio = 0.05\n\
+                 [contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = {{ from = 0.0, to = 0.05, n = {runs} }}\n\
+                 [[record]]\nsynthetic = {{ seed = 1, duration_s = 2.0 }}\n",
+                storeys.0, storeys.1
+            );
+            crate::plan::config::load_row_text(&text, std::path::Path::new("auto.toml")).unwrap()
+        };
+        let n = ROW_GPU_MIN_RUNS;
+        assert_eq!(row_stays_on_cpu(&row((3, 4), n, "")), None);
+        assert_eq!(row_stays_on_cpu(&row((1, 1), n, "")), None);
+        // Two 4 + 7 storeys are the tallest written out (16 + 49 = 65).
+        assert_eq!(row_stays_on_cpu(&row((4, 7), n, "")), None);
+        let why = |r: &RowPlan| row_stays_on_cpu(r).unwrap_or_default();
+        assert!(why(&row((3, 4), n - 1, "")).contains("fewer than 20000 runs"));
+        assert!(why(&row((6, 6), n, "")).contains("as loops"));
+        assert!(why(&row((5, 7), n, "")).contains("as loops"));
+        let leaning = "yield_drift_ratio = 0.006\npost_yield_ratio = 0.02\np_delta = true";
+        assert!(why(&row((3, 4), n, leaning)).contains("P-Delta"));
+        // Yielding storeys without P-Delta were measured (2.6x on an H200).
+        let yielding = "yield_drift_ratio = 0.006\npost_yield_ratio = 0.02";
+        assert_eq!(row_stays_on_cpu(&row((3, 4), n, yielding)), None);
     }
 
     /// Without a GPU every scheme runs on the CPU, with its settings as given.

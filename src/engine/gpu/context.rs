@@ -71,8 +71,9 @@ enum Stage {
     Fast { energy: bool },
     /// `aggregate.wgsl`.
     Aggregate,
-    /// `row.wgsl` for one row shape (a hash of its WGSL constants).
-    Row(u64),
+    /// `row.wgsl` for one row shape (a hash of its WGSL constants); `loops`: the shape's
+    /// functions as loops (`shaders/row_loops.wgsl`), not written out.
+    Row { hash: u64, loops: bool },
 }
 
 type KernelKey = (Stage, Precision);
@@ -225,9 +226,11 @@ impl GpuContext {
         let constants = shape.wgsl_constants();
         let mut h = std::collections::hash_map::DefaultHasher::new();
         constants.hash(&mut h);
-        self.stage(Stage::Row(h.finish()), precision, || {
-            row_source(precision, &constants)
-        })
+        let stage = Stage::Row {
+            hash: h.finish(),
+            loops: !shape.unrolled(),
+        };
+        self.stage(stage, precision, || row_source(precision, &constants))
     }
 
     fn stage(
@@ -261,7 +264,7 @@ impl GpuContext {
         let name = match stage {
             Stage::Fast { .. } => "fast",
             Stage::Aggregate => "aggregate",
-            Stage::Row(_) => "row",
+            Stage::Row { .. } => "row",
         };
         let label = format!("{name}.wgsl {}", precision.key());
         let desc = wgpu::ShaderModuleDescriptor {
@@ -272,9 +275,13 @@ impl GpuContext {
         // spends a budget each pass: `shader::tests::every_loop_counts`), so naga's forced loop
         // bounding (a second counter and exit test in every loop) is left out: on lavapipe it
         // kept loops from unrolling and cost a third of a row sweep's time (BENCHMARKS.md,
-        // "Rows on lavapipe: the shape written out"). Bounds and division checks stay.
+        // "Rows on lavapipe: the shape written out"). Except for a row kernel whose shape runs
+        // as loops: without the bounding, a 6-storey pair did not finish one run in 50 s on an
+        // H200 where it had run with it (BENCHMARKS.md, "Rows on an H200"); on lavapipe the
+        // bounding leaves those rows' runs/s as they were, so every adapter builds it alike.
+        // Bounds and division checks stay.
         let checks = wgpu::ShaderRuntimeChecks {
-            force_loop_bounding: false,
+            force_loop_bounding: matches!(stage, Stage::Row { loops: true, .. }),
             ..wgpu::ShaderRuntimeChecks::checked()
         };
         // SAFETY: wgpu asks that a shader built without loop bounding never loops forever;
@@ -294,7 +301,7 @@ impl GpuContext {
         // Binding order as declared in each shader.
         let entries: Vec<wgpu::BindGroupLayoutEntry> = match stage {
             // row.wgsl binds as fast.wgsl, its building models (read only) at 9, no 10.
-            Stage::Fast { .. } | Stage::Row(_) => vec![
+            Stage::Fast { .. } | Stage::Row { .. } => vec![
                 entry(
                     0,
                     wgpu::BindingType::Buffer {
@@ -315,7 +322,7 @@ impl GpuContext {
                 entry(10, storage(true)),
             ]
             .into_iter()
-            .take(if matches!(stage, Stage::Row(_)) {
+            .take(if matches!(stage, Stage::Row { .. }) {
                 10
             } else {
                 11

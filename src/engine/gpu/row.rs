@@ -656,6 +656,56 @@ impl RowShape {
             s.push_str("        }\n");
         }
         s.push_str("        default: {}\n    }\n}\n");
+        // RowRun::track_buildings (row_loops.wgsl's), each building and storey written out.
+        s.push_str("fn track_buildings(z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1: real, h: real) {\n    if (ENDS_VALID) {\n        copy_floor_ends();\n    } else {\n        set_floor_forces(z0);\n");
+        for b in 0..self.storeys.len() {
+            s.push_str(&format!("        fill({b}u, 0u, z0, ag0);\n"));
+        }
+        s.push_str("    }\n    set_floor_forces(z1);\n");
+        for b in 0..self.storeys.len() {
+            s.push_str(&format!("    var touched{b} = false;\n"));
+        }
+        for (l, &[a, _, _]) in self.levels.iter().enumerate() {
+            s.push_str(&format!(
+                "    if (LMODE[{l}u] != MODE_FREE) {{\n        touched{a} = true;\n        touched{} = true;\n    }}\n",
+                a + 1
+            ));
+        }
+        for b in 0..self.storeys.len() {
+            s.push_str(&format!("    fill({b}u, 1u, z1, ag1);\n"));
+        }
+        let fl = |e: usize, q: usize, k: usize| format!("FL[{}u]", (5 * e + q) * nm + k);
+        for (b, &n) in self.storeys.iter().enumerate() {
+            let (o, top) = (offs[b], offs[b] + n - 1);
+            s.push_str(&format!(
+                "    {{\n        let free = !touched{b};\n        let sb = RS + S_BUILDINGS + BS_STRIDE * {b}u;\n        let cb = RC + C_BUILDINGS + BC_STRIDE * {b}u;\n        rstate[sb + BS_ROOF] = raise(free, rstate[sb + BS_ROOF], {}, {}, {}, {}, {}, {}, h);\n        var drift = rstate[sb + BS_DRIFT];\n        var accel = rstate[sb + BS_ACCEL];\n",
+                fl(0, 0, top), fl(1, 0, top), fl(0, 1, top), fl(1, 1, top), fl(0, 2, top), fl(1, 2, top)
+            ));
+            for j in 0..n {
+                let k = o + j;
+                // Floor 0 is the ground: it moves with the frame.
+                let rel = |e: usize, q: usize| {
+                    if j == 0 {
+                        format!("({} - 0.0)", fl(e, q, k))
+                    } else {
+                        format!("({} - {})", fl(e, q, k), fl(e, q, k - 1))
+                    }
+                };
+                s.push_str(&format!(
+                    "        {{\n            let inv_h = 1.0 / height_at({b}u, {j}u);\n            let y0 = {} * inv_h;\n            let y1 = {} * inv_h;\n            let d0 = {} * inv_h;\n            let d1 = {} * inv_h;\n            let a0 = {} * inv_h;\n            let a1 = {} * inv_h;\n            let p = raise(free, drift, y0, y1, d0, d1, a0, a1, h);\n            if (p > drift) {{\n                drift = p;\n                rcount[cb + BC_DRIFT_STOREY] = {}u;\n            }}\n",
+                    rel(0, 0), rel(1, 0), rel(0, 1), rel(1, 1), rel(0, 2), rel(1, 2), j + 1
+                ));
+                if self.yielding[b] {
+                    s.push_str(&format!("            if (NS > 0u) {{\n                raise_storey({b}u, {j}u, free, y0, y1, d0, d1, a0, a1, h);\n            }}\n"));
+                }
+                s.push_str(&format!(
+                    "            var pa: real;\n            if (free) {{\n                pa = raise_cubic_peak(accel, {}, {}, {}, {}, h);\n            }} else {{\n                pa = max(max(accel, abs({})), abs({}));\n            }}\n            if (pa > accel) {{\n                accel = pa;\n                rcount[cb + BC_ACCEL_FLOOR] = {}u;\n            }}\n        }}\n",
+                    fl(0, 3, k), fl(0, 4, k), fl(1, 3, k), fl(1, 4, k), fl(0, 3, k), fl(1, 3, k), j + 1
+                ));
+            }
+            s.push_str("        rstate[sb + BS_DRIFT] = drift;\n        rstate[sb + BS_ACCEL] = accel;\n    }\n");
+        }
+        s.push_str("}\n");
         // Yielding storeys (yielding.wgsl): each one's drift or its rate (StoreyModel::drift),
         // and their plastic loads in the right-hand side (row::plastic_rhs).
         let ns = str_at.len();
