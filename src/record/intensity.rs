@@ -17,6 +17,7 @@
 use super::Record;
 use crate::physics::model::Oscillator;
 use crate::physics::propagator::Propagator;
+use crate::physics::solver::hermite::quintic_max_bound;
 
 /// The damping ratio of a response spectrum unless stated.
 pub const DEFAULT_DAMPING: f64 = 0.05;
@@ -25,8 +26,17 @@ pub const DEFAULT_DAMPING: f64 = 0.05;
 /// substep, the velocity changes sign at most once in one for all but grazing extrema.
 const SUBSTEPS_PER_PERIOD: f64 = 32.0;
 
+/// Relative slack on the bound that lets an extremum below the peak skip its search.
+const SEARCH_SLACK: f64 = 1e-6;
+
 /// The oscillator's peak `|u|` (m) under `rec`, from rest, over the record (no free tail).
 pub fn peak_displacement(rec: &Record, period: f64, xi: f64) -> f64 {
+    peak_searched(rec, period, xi, false)
+}
+
+/// [`peak_displacement`], locating every extremum inside a substep where `every_extremum`
+/// (not only those whose bound reaches the peak so far): the same value, slower.
+fn peak_searched(rec: &Record, period: f64, xi: f64, every_extremum: bool) -> f64 {
     let o = Oscillator::from_period(1.0, period, xi);
     let parts = (rec.dt * SUBSTEPS_PER_PERIOD / period).ceil().max(1.0) as usize;
     let h = rec.dt / parts as f64;
@@ -42,9 +52,21 @@ pub fn peak_displacement(rec: &Record, period: f64, xi: f64) -> f64 {
                 a0 + (a1 - a0) * (k + 1) as f64 / parts as f64,
             );
             let (u1, v1) = step.step(u, v, b0, b1);
-            if v * v1 < 0.0 {
-                // An extremum inside: the root of v, from the linear guess, refined by Newton on
-                // the exact solution (v' = -w^2 u - c v - ag).
+            // An extremum inside, worth locating only where it may pass the peak: the quintic
+            // Hermite through both ends' u, v and u'' bounds |u| over the substep (the exact
+            // solution lies within (w h)^6 / 46080 of the amplitude of it, 1.2e-9 at T / 32;
+            // the slack covers it). Most extrema lie below the peak and skip the Newton steps
+            // below, each a propagator of its own (exponential, sine and cosine).
+            let may_pass = || {
+                if every_extremum {
+                    return true;
+                }
+                let acc = [-w2 * u - c * v - b0, -w2 * u1 - c * v1 - b1];
+                quintic_max_bound([u, u1], [v, v1], acc, h) * (1.0 + SEARCH_SLACK) >= peak
+            };
+            if v * v1 < 0.0 && may_pass() {
+                // The root of v, from the linear guess, refined by Newton on the exact
+                // solution (v' = -w^2 u - c v - ag).
                 let at = |tau: f64| {
                     let ag = b0 + (b1 - b0) * tau / h;
                     let (ut, vt) = Propagator::new(&o, tau).step(u, v, b0, ag);
@@ -247,6 +269,32 @@ mod tests {
                 "T {period}: {got} vs {peak}"
             );
         }
+    }
+
+    /// The bound that lets an extremum below the peak skip its search never skips one that
+    /// would raise it: the same peaks, bit for bit, as searching every extremum, over periods
+    /// from 0.02 to 6 s on a record of mixed frequencies with a pulse.
+    #[test]
+    fn skipped_extrema_never_raise_the_peak() {
+        let dt = 0.01;
+        let accel: Vec<f64> = (0..3000)
+            .map(|i| {
+                let t = i as f64 * dt;
+                (2.3 * t).sin() + 0.7 * (13.1 * t + 0.4).sin() - 0.4 * (31.0 * t).cos()
+                    + 3.0 * (-((t - 9.0) / 0.4).powi(2)).exp()
+            })
+            .collect();
+        let rec = record(dt, accel);
+        let mut searched = 0;
+        for period in log_periods(0.02, 6.0, 300) {
+            for xi in [0.02, 0.05, 0.2] {
+                let fast = peak_searched(&rec, period, xi, false);
+                let every = peak_searched(&rec, period, xi, true);
+                assert_eq!(fast.to_bits(), every.to_bits(), "T {period}, xi {xi}");
+                searched += 1;
+            }
+        }
+        assert_eq!(searched, 900);
     }
 
     #[test]

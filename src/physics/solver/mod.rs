@@ -20,7 +20,7 @@ pub mod calibration;
 pub mod collision;
 mod events;
 pub mod fast;
-mod hermite;
+pub(crate) mod hermite;
 pub mod reference;
 pub mod row;
 pub mod separation;
