@@ -1323,24 +1323,21 @@ pub fn sweep_rows<E: From<GpuError>>(
         let (outs, ct) = run_rows(ctx, &recs, &packed, opts)?;
         times.add_chunk(&ct);
         let t = Instant::now();
+        times.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
+        // The runs handed back, on every thread.
         let rows: Vec<(RowRunSpec, RowOutput)> = specs
-            .into_iter()
+            .into_par_iter()
             .zip(outs)
             .zip(&models)
             .map(|((s, o), m)| {
                 // The kernel has no collapse event: a run whose storey reached the limit is
                 // run again on the CPU, which ends it there.
-                let handed = o.is_none();
                 let o = o.filter(|o| {
                     o.buildings
                         .iter()
                         .all(|b| b.peak_drift_ratio < plan.collapse_drift_ratio)
                 });
                 let o = o.unwrap_or_else(|| simulate_row(m, &plan.forcing(&s), m.at_rest(), &cpu));
-                (s, o, handed)
-            })
-            .map(|(s, o, handed)| {
-                times.handed_off += handed as u64;
                 (s, o)
             })
             .collect();
