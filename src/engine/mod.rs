@@ -249,10 +249,7 @@ pub fn row_stays_on_cpu(plan: &RowPlan) -> Option<String> {
             "the row kernel is not measured faster than the CPU path on P-Delta buildings".into(),
         );
     }
-    let shape = gpu::row::RowShape::of(&crate::physics::solver::row::RowModel::new(
-        &plan.row(&plan.run(0)),
-    ));
-    if !shape.unrolled() {
+    if !gpu::row::RowShape::of_plan(plan).unrolled() {
         return Some(format!(
             "the row kernel runs rows taller than two 5-storey buildings (storey counts whose squares sum past {}) as loops, slower than the CPU path",
             gpu::row::UNROLL_MAX_SQUARES

@@ -375,8 +375,7 @@ pub fn run_storeys_gpu(
     opts: &crate::engine::gpu::GpuOptions,
 ) -> Result<StoreyRow, crate::engine::gpu::GpuError> {
     use crate::engine::gpu::row::{sweep_rows, RowShape};
-    use crate::physics::solver::row::RowModel;
-    let shape = RowShape::of(&RowModel::new(&plan.row(&plan.run(0))));
+    let shape = RowShape::of_plan(plan);
     ctx.row_kernel(opts.precision, &shape)?;
     let mut csv = 0.0;
     let (summary, times) = sweep_rows(

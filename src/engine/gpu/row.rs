@@ -129,6 +129,12 @@ pub struct RowShape {
 }
 
 impl RowShape {
+    /// The shape of every run of `plan` (storeys, levels, which buildings yield or may couple
+    /// their modes are the config's, not a run's), from its first run; `plan` has one.
+    pub fn of_plan(plan: &RowPlan) -> RowShape {
+        RowShape::of(&RowModel::new(&plan.row(&plan.run(0))))
+    }
+
     pub fn of(m: &RowModel) -> RowShape {
         RowShape {
             storeys: m.buildings.iter().map(|b| b.n()).collect(),
@@ -1094,7 +1100,7 @@ pub fn check_fits(ctx: &GpuContext, plan: &RowPlan) -> Result<(), GpuError> {
     if plan.is_empty() {
         return Ok(());
     }
-    let shape = RowShape::of(&RowModel::new(&plan.row(&plan.run(0))));
+    let shape = RowShape::of_plan(plan);
     software_cap(ctx, &shape).map(|_| ())
 }
 
@@ -1302,7 +1308,7 @@ pub fn sweep_rows<E: From<GpuError>>(
     let accels = plan.contact.accels();
     let recs = GpuRecords::upload(ctx, opts.precision, &accels)?;
     // Every per-run buffer of a chunk must fit one binding (tall rows carry large blocks).
-    let shape = RowShape::of(&RowModel::new(&plan.row(&plan.run(runs.start))));
+    let shape = RowShape::of_plan(plan);
     let chunk =
         (chunk.max(1) as u64).min(ctx.runs_fitting(shape.largest_block_bytes(opts.precision)));
     let cpu = RowScheme::Fast(opts.fast);
