@@ -218,7 +218,44 @@ fn since_onset(tau: real) -> real {
     return real(C.i - C.i_onset) * P.dt + (tau - S.tau_onset);
 }
 
-// Tracker::free_step: a free record step's peak displacements from the quintic Hermite.
+// tracker::free_accel_and_jerk: a free oscillator's absolute acceleration -(c v + k u) / m and
+// its rate -(c a + k v) / m (a the relative acceleration under ground acceleration ag).
+struct AJ { a: real, j: real }
+fn free_accel_and_jerk(m: real, c: real, k: real, u: real, v: real, ag: real) -> AJ {
+    let a = (-c * v - k * u) / m;
+    return AJ(a, (-c * (a - ag) - k * v) / m);
+}
+
+// hermite::raise_cubic_peak of an acceleration through both ends' values and rates.
+fn raise_accel_peak(peak: real, e0: AJ, e1: AJ, h: real) -> real {
+    let r = hermite_range(e0.a, e0.j, e1.a, e1.j, h);
+    return max(max(peak, abs(r.hi)), abs(r.lo));
+}
+
+// hermite::raise_hump_peak: the ends' |a|, and the cubic's largest |a| where |a| rises at the
+// start and falls at the end (a contact force's rate is unbounded at first touch).
+fn raise_accel_hump(peak: real, e0: AJ, e1: AJ, h: real) -> real {
+    var p = max(max(peak, abs(e0.a)), abs(e1.a));
+    if (e0.a * e0.j > 0.0 && e1.a * e1.j < 0.0 && e0.a * e1.a > 0.0) {
+        let r = hermite_range(e0.a, e0.j, e1.a, e1.j, h);
+        p = max(max(p, abs(r.hi)), abs(r.lo));
+    }
+    return p;
+}
+
+// tracker::accel_and_jerk in contact: building b's (1 or 2) absolute acceleration and its rate
+// at z, with the contact force f and its rate r on it (-f on building 1, +f on building 2).
+fn contact_accel_and_jerk(b: u32, z: Z, f: real, r: real, ag: real) -> AJ {
+    if (b == 1u) {
+        let a = (-P.c1 * z.v1 - P.k1 * z.u1 - f) / P.m1;
+        return AJ(a, (-P.c1 * (a - ag) - P.k1 * z.v1 - r) / P.m1);
+    }
+    let a = (-P.c2 * z.v2 - P.k2 * z.u2 + f) / P.m2;
+    return AJ(a, (-P.c2 * (a - ag) - P.k2 * z.v2 + r) / P.m2);
+}
+
+// Tracker::free_step: a free record step's peak displacements from the quintic Hermite, and in
+// the ACCEL variant its peak accelerations from the cubic with their rates (free_accel_peak).
 fn track_free_step(seg: Seg, z0: Z, z1: Z) {
     let a10 = (-P.c1 * z0.v1 - P.k1 * z0.u1) / P.m1 - seg.a0;
     let a11 = (-P.c1 * z1.v1 - P.k1 * z1.u1) / P.m1 - seg.a1;
@@ -226,18 +263,51 @@ fn track_free_step(seg: Seg, z0: Z, z1: Z) {
     let a20 = (-P.c2 * z0.v2 - P.k2 * z0.u2) / P.m2 - seg.a0;
     let a21 = (-P.c2 * z1.v2 - P.k2 * z1.u2) / P.m2 - seg.a1;
     S.peak_u2 = max(S.peak_u2, quintic_peak_abs(z0.u2, z1.u2, z0.v2, z1.v2, a20, a21, seg.dt));
+    if (ACCEL) {
+        S.peak_a1 = raise_accel_peak(S.peak_a1,
+            free_accel_and_jerk(P.m1, P.c1, P.k1, z0.u1, z0.v1, seg.a0),
+            free_accel_and_jerk(P.m1, P.c1, P.k1, z1.u1, z1.v1, seg.a1), seg.dt);
+        S.peak_a2 = raise_accel_peak(S.peak_a2,
+            free_accel_and_jerk(P.m2, P.c2, P.k2, z0.u2, z0.v2, seg.a0),
+            free_accel_and_jerk(P.m2, P.c2, P.k2, z1.u2, z1.v2, seg.a1), seg.dt);
+    }
     if (ENERGY) {
         S.e_peak = max(S.e_peak, z1.ein);
     }
 }
 
-fn track_step(mode: u32, h: real, z0: Z, z1: Z) {
+// Tracker::step: a piece tau -> tau + h of the record interval seg, spent in mode.
+fn track_step(mode: u32, h: real, z0: Z, z1: Z, seg: Seg, tau: real) {
     let r1 = hermite_range(z0.u1, z0.v1, z1.u1, z1.v1, h);
     S.peak_u1 = max(max(S.peak_u1, abs(r1.hi)), abs(r1.lo));
     let r2 = hermite_range(z0.u2, z0.v2, z1.u2, z1.v2, h);
     S.peak_u2 = max(max(S.peak_u2, abs(r2.hi)), abs(r2.lo));
     if (ENERGY) {
         S.e_peak = max(S.e_peak, z1.ein);
+    }
+    if (ACCEL) {
+        let slope = (seg.a1 - seg.a0) / seg.dt;
+        let ag0 = seg.a0 + slope * tau;
+        let ag1 = seg.a0 + slope * (tau + h);
+        if (mode == MODE_FREE) {
+            // In free flight the cubic Hermite with the accelerations' rates.
+            S.peak_a1 = raise_accel_peak(S.peak_a1,
+                free_accel_and_jerk(P.m1, P.c1, P.k1, z0.u1, z0.v1, ag0),
+                free_accel_and_jerk(P.m1, P.c1, P.k1, z1.u1, z1.v1, ag1), h);
+            S.peak_a2 = raise_accel_peak(S.peak_a2,
+                free_accel_and_jerk(P.m2, P.c2, P.k2, z0.u2, z0.v2, ag0),
+                free_accel_and_jerk(P.m2, P.c2, P.k2, z1.u2, z1.v2, ag1), h);
+        } else {
+            // In contact with the force and its rate, where the acceleration peaks inside.
+            let fa = force(mode, S.v0, z0);
+            let ra = force_rate(mode, S.v0, z0, fa);
+            let fb = force(mode, S.v0, z1);
+            let rb = force_rate(mode, S.v0, z1, fb);
+            S.peak_a1 = raise_accel_hump(S.peak_a1, contact_accel_and_jerk(1u, z0, fa, ra, ag0),
+                contact_accel_and_jerk(1u, z1, fb, rb, ag1), h);
+            S.peak_a2 = raise_accel_hump(S.peak_a2, contact_accel_and_jerk(2u, z0, fa, ra, ag0),
+                contact_accel_and_jerk(2u, z1, fb, rb, ag1), h);
+        }
     }
     if (mode != MODE_FREE) {
         S.contact_time = S.contact_time + h;
@@ -325,12 +395,12 @@ fn accept(tau: real, h_in: real, trial_in: Z, seg: Seg, z0: Z, out: ptr<function
         let f0 = event_value(mode, v0, z0);
         let tol = max(LOCATE_TOL * h, 4.0 * EPS * P.dt);
         let l = locate(h, f0, trial, f1, tol, mode, v0, seg, tau, z0);
-        track_step(mode, l.x, z0, l.z);
+        track_step(mode, l.x, z0, l.z, seg, tau);
         C.mode = transition(mode, tau + l.x, l.z, z0);
         *out = l.z;
         return l.x;
     }
-    track_step(mode, h, z0, trial);
+    track_step(mode, h, z0, trial, seg, tau);
     *out = trial;
     C.mode = reapproach(mode, trial);
     return h;
@@ -391,11 +461,18 @@ fn shared_settled(bound1: real, bound2: real, d: Dist) -> bool {
         && bound2 + responses[h + 5u] * d.r2 < S.peak_u2;
 }
 
-// FreeResponse::can_end at checkpoint sample i, for a run at distance d.
+// FreeResponse::can_end at checkpoint sample i, for a run at distance d (in the ACCEL variant
+// the accelerations' bounds too: table entries 7 and 8, their growth in header entries 6, 7).
 fn shared_can_end(i: u32, d: Dist) -> bool {
-    let c = M.response + SH_HEADER + SH_CHECK * (i / SH_EVERY);
+    let h = M.response;
+    let c = h + SH_HEADER + SH_CHECK * (i / SH_EVERY);
+    var accel_settled = true;
+    if (ACCEL) {
+        accel_settled = responses[c + 7u] + responses[h + 6u] * d.r1 < S.peak_a1
+            && responses[c + 8u] + responses[h + 7u] * d.r2 < S.peak_a2;
+    }
     return shared_clear(responses[c + 4u], d)
-        && shared_settled(responses[c + 5u], responses[c + 6u], d);
+        && shared_settled(responses[c + 5u], responses[c + 6u], d) && accel_settled;
 }
 
 // The start of the current record interval (fast.rs `run`, loop body): take it with the exact

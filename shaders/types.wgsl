@@ -31,6 +31,7 @@ struct State {
     contact_time: real,
     dissipated: real,
     e_in: real, e_damp: real, e_peak: real,
+    peak_a1: real, peak_a2: real,
 }
 
 struct Meta {

@@ -5,8 +5,10 @@
 use crate::engine::Summary;
 use crate::physics::model::{Initial, RunOutput};
 use crate::physics::row::RowOutput;
-use crate::physics::solver::row::{simulate_row, RowModel};
-use crate::physics::solver::{simulate, simulate_shared, FreeResponse, Scheme};
+use crate::physics::solver::row::{near_collapse, simulate_row, RowModel, RowScheme};
+use crate::physics::solver::{
+    simulate, simulate_shared, simulate_tracking_accel, FastOptions, FreeResponse, Scheme,
+};
 use crate::plan::row::{RowPlan, RowRunSpec};
 use crate::plan::{PairPlan, RunSpec};
 use rayon::prelude::*;
@@ -71,6 +73,46 @@ pub fn run_many(plan: &PairPlan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunO
     out
 }
 
+/// Run the runs `specs` of a row plan that runs as a pair ([`RowPlan::runs_as_pair`]) on the
+/// pair's kernel, in order, each tracking its buildings' accelerations, sharing free responses
+/// as [`run_many`] does; outputs in the row's form ([`RowOutput::of_pair`]). A run that comes
+/// near the plan's collapse limit ([`near_collapse`]) is run again on the row's kernel, which
+/// models collapse.
+pub fn run_row_pairs(plan: &RowPlan, specs: &[RowRunSpec], o: &FastOptions) -> Vec<RowOutput> {
+    let pairs: Vec<RunSpec> = specs.iter().map(|s| plan.pair_run(s)).collect();
+    let mut out = Vec::with_capacity(specs.len());
+    for ks in free_motion_stretches(&pairs) {
+        let group = &pairs[ks.clone()];
+        let forcing = plan.forcing(&specs[ks.start]);
+        let pair = group[0].pair();
+        let shared = (group.len() >= MIN_SHARED_RUNS)
+            .then(|| FreeResponse::with_accel(&pair.b1, &pair.b2, &forcing));
+        out.extend(group.iter().zip(&specs[ks]).map(|(s, spec)| {
+            let run = simulate_tracking_accel(&s.pair(), &forcing, o, shared.as_ref(), None);
+            row_of_pair(plan, spec, &run, o)
+        }));
+    }
+    out
+}
+
+/// Run `spec` of a row plan that runs as a pair in the row's form, from `run`, its pair run:
+/// run again on the row's kernel where it nears the collapse limit ([`near_collapse`]).
+pub(crate) fn row_of_pair(
+    plan: &RowPlan,
+    spec: &RowRunSpec,
+    run: &RunOutput,
+    o: &FastOptions,
+) -> RowOutput {
+    let h = plan.first_storey_heights();
+    let row = RowOutput::of_pair(run, [h[0], h[1]]);
+    if near_collapse(&row, plan.collapse_drift_ratio) {
+        let model = RowModel::new(&plan.row(spec));
+        let forcing = plan.forcing(spec);
+        return simulate_row(&model, &forcing, model.at_rest(), &RowScheme::Fast(*o));
+    }
+    row
+}
+
 /// Run the runs `runs` of `plan` with `scheme`, `chunk` runs per task, on the current rayon pool;
 /// `sink` gets each chunk's results in run order, `progress` the number of runs done so far.
 pub fn run_range<E>(
@@ -100,7 +142,16 @@ pub fn run_rows<E>(
     progress: impl FnMut(u64),
 ) -> Result<Summary, E> {
     let scheme = plan.scheme();
+    let as_pair = match scheme {
+        RowScheme::Fast(o) if plan.runs_as_pair() => Some(o),
+        _ => None,
+    };
     let solve = |ids: std::ops::Range<u64>| {
+        if let Some(o) = &as_pair {
+            let specs: Vec<RowRunSpec> = ids.map(|i| plan.run(i)).collect();
+            let outs = run_row_pairs(plan, &specs, o);
+            return specs.into_iter().zip(outs).collect();
+        }
         ids.map(|i| {
             let spec = plan.run(i);
             let model = RowModel::new(&plan.row(&spec));

@@ -58,6 +58,8 @@ impl Summary {
     /// Count one finished run of a row.
     pub(crate) fn count_row(&mut self, o: &crate::physics::row::RowOutput) {
         self.count_work(o.status, o.impacts, o.free_steps, o.substeps);
+        self.shared_steps += o.shared_steps;
+        self.runs_sharing += (o.shared_steps > 0) as u64;
     }
 
     fn count_work(&mut self, status: Status, impacts: u32, free_steps: u64, substeps: u64) {
@@ -148,8 +150,9 @@ impl Backend {
 /// that choice is made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Kernel {
-    /// Two elastic one-storey buildings: the specialised pair kernels (CPU `solver::fast` with
-    /// the shared free response, `shaders/fast.wgsl`).
+    /// Two elastic one-storey buildings, written as a pair or as a row of two
+    /// ([`RowPlan::runs_as_pair`]; the fast scheme): the specialised pair kernels (CPU
+    /// `solver::fast` with the shared free response, `shaders/fast.wgsl`).
     Pair,
     /// A row of shear buildings: the row kernels (CPU `solver::row`, `shaders/row.wgsl`).
     Row,
@@ -159,6 +162,7 @@ impl Kernel {
     pub fn of(plan: &Plan) -> Kernel {
         match plan {
             Plan::Pair(_) => Kernel::Pair,
+            Plan::Row(r) if r.runs_as_pair() => Kernel::Pair,
             Plan::Row(_) => Kernel::Row,
         }
     }
@@ -220,7 +224,7 @@ pub fn gpu_for(
             _ => Ok(None),
         };
     }
-    if let (Backend::Auto, Plan::Row(rows)) = (backend, plan) {
+    if let (Backend::Auto, Plan::Row(rows), Kernel::Row) = (backend, plan, Kernel::of(plan)) {
         if let Some(why) = row_stays_on_cpu(rows) {
             note(format!("notice: running on the CPU: {why} (BENCHMARKS.md, \"Rows on an H200\"); --backend gpu uses it"));
             return Ok(None);
@@ -412,7 +416,9 @@ impl<'c> Engine<'c> {
     /// software adapter's loop limit).
     pub fn check(&self, plan: &Plan) -> Result<(), GpuError> {
         match (self, plan) {
-            (Engine::Gpu { ctx, .. }, Plan::Row(r)) => gpu::row::check_fits(ctx, r),
+            (Engine::Gpu { ctx, .. }, Plan::Row(r)) if Kernel::of(plan) == Kernel::Row => {
+                gpu::row::check_fits(ctx, r)
+            }
             _ => Ok(()),
         }
     }
@@ -439,6 +445,9 @@ impl<'c> Engine<'c> {
                 debug_assert_eq!(*scheme, plan.scheme(), "the engine runs the plan's scheme");
                 let summary = cpu::run_rows(row, runs, *chunk, sink, progress)?;
                 (summary, GpuTimes::default())
+            }
+            Engine::Gpu { ctx, opts, chunk } if Kernel::of(plan) == Kernel::Pair => {
+                gpu::sweep::run_row_pairs(row, runs, ctx, opts, *chunk, sink, progress)?
             }
             Engine::Gpu { ctx, opts, chunk } => {
                 gpu::row::sweep_rows(ctx, row, runs, *chunk, opts, sink, progress)?

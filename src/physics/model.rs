@@ -162,6 +162,10 @@ pub struct RunOutput {
     pub peak_u1: f64,
     /// max |u2|, m
     pub peak_u2: f64,
+    /// max |absolute acceleration| of building 1 and 2 (relative plus the ground's), m/s^2,
+    /// where the run tracked it (a row of two one-storey buildings reports it,
+    /// [`crate::physics::solver::simulate_tracking_accel`]); 0 otherwise.
+    pub peak_accel: [f64; 2],
     /// Approach speed `v0` of the impact with the largest peak force, m/s (0 if none).
     pub impact_velocity: f64,
     /// Onset time of the first impact, s (None if no impact).

@@ -8,7 +8,7 @@
 //! mass of the two colliding floors, `m_eff = m_A m_B / (m_A + m_B)`.
 
 use crate::physics::contact::{Contact, LawKind};
-use crate::physics::model::{EnergyBalance, Status};
+use crate::physics::model::{EnergyBalance, RunOutput, Status};
 use crate::physics::shear::ShearBuilding;
 
 /// Two floors of neighbouring buildings are at the same level when their elevations differ by
@@ -206,6 +206,9 @@ pub struct RowOutput {
     pub substeps: u64,
     /// Record steps taken whole by the exact modal propagators.
     pub free_steps: u64,
+    /// Record steps settled by a shared free response instead (a row that runs on the pair's
+    /// kernels, [`RowOutput::of_pair`]).
+    pub shared_steps: u64,
     pub energy: Option<EnergyBalance>,
     /// Every yielding storey, building by building, bottom to top (none in an elastic row).
     pub storeys: Vec<StoreyOutput>,
@@ -238,6 +241,45 @@ pub struct LevelClosing {
 }
 
 impl RowOutput {
+    /// What a row of two one-storey buildings of storey heights `heights` reports, from the run
+    /// of the same pair of oscillators (tracking their accelerations,
+    /// [`crate::physics::solver::simulate_tracking_accel`]): its one level is the pair's contact;
+    /// a storey's drift is its floor's displacement.
+    pub fn of_pair(out: &RunOutput, heights: [f64; 2]) -> RowOutput {
+        let level = LevelOutput {
+            impacts: out.impacts,
+            peak_force: out.peak_force,
+            peak_penetration: out.peak_penetration,
+            impact_velocity: out.impact_velocity,
+            first_impact: out.first_impact,
+            contact_time: out.contact_time,
+            dissipated_energy: out.dissipated_energy,
+        };
+        let building = |u: f64, a: f64, h: f64| BuildingOutput {
+            peak_roof: u,
+            peak_drift_ratio: u / h,
+            drift_storey: (u > 0.0) as u32,
+            peak_accel: a,
+            accel_floor: (a > 0.0) as u32,
+            inelastic: None,
+        };
+        let mut row = RowOutput {
+            status: out.status,
+            levels: vec![level],
+            buildings: vec![
+                building(out.peak_u1, out.peak_accel[0], heights[0]),
+                building(out.peak_u2, out.peak_accel[1], heights[1]),
+            ],
+            substeps: out.substeps,
+            free_steps: out.free_steps,
+            shared_steps: out.shared_steps,
+            energy: out.energy,
+            ..RowOutput::default()
+        };
+        row.gather();
+        row
+    }
+
     /// Each yielding building's outputs from its storeys in `self.storeys` (`spans`: each
     /// building's storeys there, None where it is elastic); the residual drifts are known only
     /// where the run `settled` (else NaN, not a guess). The CPU schemes and the GPU row

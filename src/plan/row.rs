@@ -19,7 +19,8 @@ use crate::plan::config::{
 };
 use crate::plan::sample::refused_draw;
 use crate::plan::{
-    check_axis, config, Check, ContactPlan, ContactRun, DAMPING, GAP, MASS, PERIOD, POSITIVE,
+    check_axis, config, Check, ContactPlan, ContactRun, RunSpec, DAMPING, GAP, MASS, PERIOD,
+    POSITIVE,
 };
 use serde::Deserialize;
 use std::path::Path;
@@ -864,6 +865,48 @@ impl RowPlan {
             opt(out.energy.map(|e| e.residual)),
         ]);
         c
+    }
+
+    /// Is every run of this plan two elastic one-storey buildings whose floors meet (one contact
+    /// level), without P-Delta, run by the fast scheme? Then the pair's kernels run it
+    /// ([`crate::engine::Kernel::of`], [`RowPlan::pair_run`]) and its output keeps this plan's
+    /// columns ([`RowOutput::of_pair`]); a run that nears the collapse limit goes back to the
+    /// row's kernel ([`crate::physics::solver::row::near_collapse`]).
+    pub fn runs_as_pair(&self) -> bool {
+        self.buildings.len() == 2
+            && self
+                .buildings
+                .iter()
+                .all(|b| b.storeys() == 1 && b.p_delta.is_none())
+            && self.yielding.iter().all(Option::is_none)
+            && matches!(self.contact.spec.scheme, Scheme::Fast(_))
+            && self.level_names().len() == 1
+    }
+
+    /// `run` as the pair's run of the same buildings (floor mass, period, damping ratio), gap,
+    /// contact and forcing: for a plan that [`RowPlan::runs_as_pair`].
+    pub fn pair_run(&self, run: &RowRunSpec) -> RunSpec {
+        debug_assert!(self.runs_as_pair());
+        let mass = |b: usize| match (&self.buildings[b].floor_masses, run.mass[b]) {
+            (Some(m), _) => m[0],
+            (None, m) => m.expect("a swept mass"),
+        };
+        RunSpec {
+            contact: run.contact,
+            m1: mass(0),
+            t1: run.period[0],
+            xi1: run.damping[0],
+            m2: mass(1),
+            t2: run.period[1],
+            xi2: run.damping[1],
+            gap: run.gaps[0],
+            sample: run.sample,
+        }
+    }
+
+    /// Each building's storey height (the first storey's), for [`RowOutput::of_pair`].
+    pub fn first_storey_heights(&self) -> Vec<f64> {
+        self.buildings.iter().map(|b| b.heights[0]).collect()
     }
 
     /// The row scheme of the plan's scheme.

@@ -6,11 +6,18 @@
 //! the trace integrates the run alone, which gives the same output (`solver::simulate_shared`).
 //! A row's trace runs as the sweep does, buildings that no contact can reach standing still;
 //! such a building is sampled at its exact motion without changing the run, so the output is
-//! the sweep's to the last digit (`solver::row::simulate_row_observed`).
+//! the sweep's to the last digit (`solver::row::simulate_row_observed`). A row of two
+//! one-storey buildings that the sweep runs on the pair's kernel is traced there too (its
+//! samples in the row's form), unless it nears the collapse limit, where the sweep runs it on
+//! the row's.
 
-use crate::physics::solver::row::{simulate_row_observed, RowModel, RowSample, StoreySample};
-use crate::physics::solver::{simulate_observed, Mode, Sample};
-use crate::plan::row::RowPlan;
+use crate::physics::model::Pair;
+use crate::physics::row::RowOutput;
+use crate::physics::solver::row::{
+    near_collapse, simulate_row_observed, RowModel, RowSample, RowScheme, StoreySample,
+};
+use crate::physics::solver::{simulate_observed, simulate_tracking_accel, Mode, Sample};
+use crate::plan::row::{RowPlan, RowRunSpec};
 use crate::plan::{PairPlan, Plan, RunSpec};
 use crate::studies::plot::{Panel, Series};
 
@@ -84,15 +91,18 @@ fn trace_pair(pair: &PairPlan, run: u64) -> Trace {
 
 fn trace_row(plan: &RowPlan, run: u64) -> Trace {
     let spec = plan.run(run);
-    let model = RowModel::new(&plan.row(&spec));
-    let mut samples = Vec::new();
-    let output = simulate_row_observed(
-        &model,
-        &plan.forcing(&spec),
-        model.at_rest(),
-        &plan.scheme(),
-        &mut |s: &RowSample| samples.push(s.clone()),
-    );
+    let (output, samples) = on_the_pair_kernel(plan, &spec).unwrap_or_else(|| {
+        let model = RowModel::new(&plan.row(&spec));
+        let mut samples = Vec::new();
+        let output = simulate_row_observed(
+            &model,
+            &plan.forcing(&spec),
+            model.at_rest(),
+            &plan.scheme(),
+            &mut |s: &RowSample| samples.push(s.clone()),
+        );
+        (output, samples)
+    });
     Trace {
         header: plan.header(),
         row: plan.cells(&spec, &output),
@@ -101,6 +111,37 @@ fn trace_row(plan: &RowPlan, run: u64) -> Trace {
             levels: plan.level_names(),
             samples,
         },
+    }
+}
+
+/// Run `spec` observed on the pair's kernel where the sweep runs it there (a row of two
+/// one-storey buildings that does not near the collapse limit): its output and samples.
+fn on_the_pair_kernel(plan: &RowPlan, spec: &RowRunSpec) -> Option<(RowOutput, Vec<RowSample>)> {
+    let RowScheme::Fast(o) = plan.scheme() else {
+        return None;
+    };
+    if !plan.runs_as_pair() {
+        return None;
+    }
+    let pair = plan.pair_run(spec).pair();
+    let mut samples = Vec::new();
+    let mut observe = |s: &Sample| samples.push(row_sample(&pair, s));
+    let forcing = plan.forcing(spec);
+    let out = simulate_tracking_accel(&pair, &forcing, &o, None, Some(&mut observe));
+    let h = plan.first_storey_heights();
+    let output = RowOutput::of_pair(&out, [h[0], h[1]]);
+    (!near_collapse(&output, plan.collapse_drift_ratio)).then_some((output, samples))
+}
+
+/// A pair's sample as the row of its two one-storey buildings gives it.
+fn row_sample(pair: &Pair, s: &Sample) -> RowSample {
+    RowSample {
+        t: s.t,
+        floors: vec![vec![s.z[0]], vec![s.z[2]]],
+        penetrations: vec![(s.z[0] - s.z[2] - pair.gap).max(0.0)],
+        forces: vec![s.force],
+        modes: vec![s.mode],
+        storeys: Vec::new(),
     }
 }
 

@@ -4,7 +4,7 @@ use pounding::engine::gpu::layout::{self, Layout};
 use pounding::engine::gpu::shader::{aggregate_source, fast_source, Precision};
 
 fn parse(precision: Precision) -> naga::Module {
-    parse_source(&fast_source(precision, true))
+    parse_source(&fast_source(precision, true, true))
 }
 
 pub fn parse_source(src: &str) -> naga::Module {
@@ -62,6 +62,13 @@ fn shared_structs_match_the_shader_in_both_precisions() {
     }
     let m = parse_source(&aggregate_source(Precision::F64));
     check::<layout::State64>(&m, size_of::<layout::State64>());
+    // Every variant of the fast stage (energy balance, peak accelerations) is valid WGSL.
+    for p in [Precision::F64, Precision::F32] {
+        for (energy, accel) in [(false, false), (false, true), (true, false), (true, true)] {
+            let m = parse_source(&fast_source(p, energy, accel));
+            check::<layout::Counters>(&m, size_of::<layout::Counters>());
+        }
+    }
 }
 
 /// The value of the shader's `const name` (a literal).

@@ -1,5 +1,6 @@
 //! Integration tests: one binary, one module per area.
 
+mod accelerations;
 mod accuracy;
 mod cli;
 mod collapse;

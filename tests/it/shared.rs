@@ -5,7 +5,8 @@
 use crate::support::{collect, records_dir, without_work};
 use pounding::physics::model::{Initial, RunOutput};
 use pounding::physics::solver::{
-    simulate, simulate_observed, simulate_shared, FastOptions, FreeResponse, Scheme,
+    simulate, simulate_observed, simulate_shared, simulate_tracking_accel, FastOptions,
+    FreeResponse, Scheme,
 };
 use pounding::plan::{config, PairPlan};
 use std::path::Path;
@@ -71,6 +72,18 @@ fn assert_same_but_work(label: &str, stepped: &RunOutput, shared: &RunOutput) {
 /// first touch and the early end are decided by slack there).
 #[test]
 fn shortcuts_change_nothing_but_the_work() {
+    shortcuts_change_nothing(false);
+}
+
+/// The same with each building's peak acceleration tracked (a row of two one-storey buildings
+/// runs so): the response keeps the accelerations' peaks and bounds, the runs' accelerations
+/// are the ones they step to, and tracking them changes no other output.
+#[test]
+fn shortcuts_change_nothing_with_accelerations_tracked() {
+    shortcuts_change_nothing(true);
+}
+
+fn shortcuts_change_nothing(accel: bool) {
     let plan = plan(SCENES);
     let scheme = Scheme::Fast(FastOptions::default());
     let (mut runs, mut started_late, mut ended_early, mut shared, mut all) = (0, 0, 0, 0u64, 0u64);
@@ -84,7 +97,11 @@ fn shortcuts_change_nothing_but_the_work() {
     for specs in groups.values() {
         let forcing = plan.forcing(&specs[0]);
         let pair = specs[0].pair();
-        let response = FreeResponse::new(&pair.b1, &pair.b2, &forcing);
+        let response = if accel {
+            FreeResponse::with_accel(&pair.b1, &pair.b2, &forcing)
+        } else {
+            FreeResponse::new(&pair.b1, &pair.b2, &forcing)
+        };
         // The free response's largest u1 - u2, from a run that cannot touch.
         let mut far = pair;
         far.gap = 1e9;
@@ -96,9 +113,21 @@ fn shortcuts_change_nothing_but_the_work() {
         for gap in gaps {
             let mut p = pair;
             p.gap = gap;
-            let stepped = simulate(&p, &forcing, &Initial::default(), &scheme);
-            let fast = simulate_shared(&p, &forcing, &Initial::default(), &scheme, &response);
             let label = format!("{:?} gap {gap:e}", specs[0]);
+            let (stepped, fast) = if accel {
+                let o = FastOptions::default();
+                let stepped = simulate_tracking_accel(&p, &forcing, &o, None, None);
+                let fast = simulate_tracking_accel(&p, &forcing, &o, Some(&response), None);
+                assert!(stepped.peak_accel.iter().all(|&a| a > 0.0), "{label}");
+                let mut untracked = simulate(&p, &forcing, &Initial::default(), &scheme);
+                untracked.peak_accel = stepped.peak_accel;
+                assert_eq!(untracked, stepped, "{label}: tracking changes nothing else");
+                (stepped, fast)
+            } else {
+                let stepped = simulate(&p, &forcing, &Initial::default(), &scheme);
+                let fast = simulate_shared(&p, &forcing, &Initial::default(), &scheme, &response);
+                (stepped, fast)
+            };
             assert_same_but_work(&label, &stepped, &fast);
             let first = response.first_possible_contact(gap) as u64;
             runs += 1;

@@ -295,3 +295,55 @@ fn a_yielding_row_trace_ends_at_its_sweep_rows_storey_outputs() {
     }
     assert!(yielded >= 3, "{yielded} runs yielded");
 }
+
+/// A row of two one-storey buildings, which the sweep runs on the pair's kernel: its trace is
+/// that kernel's run too, its row the sweep's byte for byte, its samples in the row's form
+/// within the row's peaks; a run the sweep gives the row kernel (it nears the collapse limit)
+/// is traced there.
+#[test]
+fn a_row_of_two_traces_on_the_pair_kernel_as_its_sweep_runs() {
+    let dir = tempdir();
+    let text = std::fs::read_to_string("configs/row-of-two.toml")
+        .unwrap()
+        .replace("n = 30 }", "n = 3 }")
+        .replace("to = 0.6, n = 40 }", "to = 1.2, n = 3 }")
+        .replace("[[building]]\nstoreys = 1\nstorey_height_m = 3.5\nmass_kg = 4.0e5", "[run]\ncollapse_drift_ratio = 0.02\n\n[[building]]\nstoreys = 1\nstorey_height_m = 3.5\nmass_kg = 4.0e5");
+    let cfg = dir.path().join("row-of-two.toml");
+    std::fs::write(&cfg, &text).unwrap();
+    let sweep_text = sweep(dir.path(), &cfg);
+    let lines: Vec<&str> = sweep_text.lines().collect();
+    assert_eq!(lines.len(), 10);
+    let mut statuses = std::collections::BTreeSet::new();
+    for i in 1..lines.len() {
+        let run = i - 1;
+        let (said, trace) = trace(dir.path(), &cfg, run);
+        let said: Vec<&str> = said.lines().collect();
+        assert_eq!(said, [lines[0], lines[i]], "run {run}: the sweep's row");
+        statuses.insert(cell(lines[0], lines[i], "status").to_string());
+        let mut rows = trace.lines();
+        let th: Vec<&str> = rows.next().unwrap().split(',').collect();
+        let samples: Vec<Vec<&str>> = rows.map(|r| r.split(',').collect()).collect();
+        for b in [1, 2] {
+            let col = th
+                .iter()
+                .position(|c| *c == format!("b{b}_f1_u_m"))
+                .unwrap();
+            let sampled = samples
+                .iter()
+                .map(|c| c[col].parse::<f64>().unwrap().abs())
+                .fold(0.0, f64::max);
+            let peak: f64 = cell(lines[0], lines[i], &format!("b{b}_peak_roof_m"))
+                .parse()
+                .unwrap();
+            assert!(
+                sampled <= peak * (1.0 + 1e-12) && sampled > 0.9 * peak,
+                "run {run}, building {b}: {sampled} against {peak}"
+            );
+        }
+    }
+    assert_eq!(
+        statuses.into_iter().collect::<Vec<_>>(),
+        ["collapsed", "ok"],
+        "runs on both kernels"
+    );
+}

@@ -67,8 +67,8 @@ pub struct Kernel {
 /// A compiled stage and variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Stage {
-    /// `fast.wgsl`, with or without the energy balance.
-    Fast { energy: bool },
+    /// `fast.wgsl`, with or without the energy balance and the peak accelerations.
+    Fast { energy: bool, accel: bool },
     /// `aggregate.wgsl`.
     Aggregate,
     /// `row.wgsl` for one row shape (a hash of its WGSL constants); `loops`: the shape's
@@ -203,11 +203,16 @@ impl GpuContext {
         });
     }
 
-    /// The fast-scheme kernel in `precision`, with or without the energy balance, compiled on
-    /// first use.
-    pub fn kernel(&self, precision: Precision, energy: bool) -> Result<Arc<Kernel>, GpuError> {
-        self.stage(Stage::Fast { energy }, precision, || {
-            fast_source(precision, energy)
+    /// The fast-scheme kernel in `precision`, with or without the energy balance and the
+    /// buildings' peak accelerations, compiled on first use.
+    pub fn kernel(
+        &self,
+        precision: Precision,
+        energy: bool,
+        accel: bool,
+    ) -> Result<Arc<Kernel>, GpuError> {
+        self.stage(Stage::Fast { energy, accel }, precision, || {
+            fast_source(precision, energy, accel)
         })
     }
 

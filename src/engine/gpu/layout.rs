@@ -102,6 +102,9 @@ real_structs! {
         /// Input and structural damping work so far, and the largest input reached, J (the
         /// energy balance: `cpu::State` and `Tracker`).
         e_in, e_damp, e_peak,
+        /// Each building's peak absolute acceleration, where the run tracks it (the `ACCEL`
+        /// variant: a row of two one-storey buildings).
+        peak_a1, peak_a2,
     }
 }
 

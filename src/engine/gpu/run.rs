@@ -149,6 +149,8 @@ pub struct Packed {
 pub struct PackedChunk {
     pub runs: Vec<Packed>,
     pub shared: Vec<f64>,
+    /// The runs track their buildings' peak accelerations (the kernel's `ACCEL` variant).
+    pub accel: bool,
 }
 
 /// Pack one run: `record` is the index of its record in the [`GpuRecords`] it will run with.
@@ -223,7 +225,13 @@ pub fn pack(
 /// A run's results from its final state (what `Tracker::finish` and `Tracker::energy` do on
 /// the CPU; GPU runs start at rest, or on their shared free response); None for a run handed
 /// back to the host (`STATUS_HANDOFF`).
-pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<RunOutput> {
+pub fn output(
+    s: &State64,
+    c: &Counters,
+    p: &Params64,
+    energy: bool,
+    accel: bool,
+) -> Option<RunOutput> {
     if c.status == STATUS_HANDOFF {
         return None;
     }
@@ -243,6 +251,11 @@ pub fn output(s: &State64, c: &Counters, p: &Params64, energy: bool) -> Option<R
         peak_penetration: s.peak_penetration,
         peak_u1: s.peak_u1,
         peak_u2: s.peak_u2,
+        peak_accel: if accel {
+            [s.peak_a1, s.peak_a2]
+        } else {
+            [0.0; 2]
+        },
         impact_velocity,
         first_impact: (c.impacts > 0).then_some(s.first_impact),
         contact_time: s.contact_time,
@@ -408,7 +421,7 @@ pub fn run_chunk(
     }
     let (done, mut times) = integrate(ctx, recs, chunk, opts)?;
     let t = Instant::now();
-    let out = read_outputs(ctx, &done, runs, opts)?;
+    let out = read_outputs(ctx, &done, runs, opts, chunk.accel)?;
     times.readback = t.elapsed();
     Ok((out, times))
 }
@@ -430,7 +443,7 @@ pub fn integrate(
 ) -> Result<(Integrated, ChunkTimes), GpuError> {
     let runs = &chunk.runs[..];
     let mut times = ChunkTimes::default();
-    let kernel = ctx.kernel(opts.precision, opts.fast.energy)?;
+    let kernel = ctx.kernel(opts.precision, opts.fast.energy, chunk.accel)?;
     let n = runs.len();
     let t = Instant::now();
     let params: Vec<u8> = match opts.precision {
@@ -665,6 +678,8 @@ fn initial_states(runs: &[Packed], precision: Precision) -> (Vec<u8>, Vec<Counte
                     v2: s.state[3],
                     peak_u1: s.peaks[0],
                     peak_u2: s.peaks[1],
+                    peak_a1: s.peaks[2],
+                    peak_a2: s.peaks[3],
                     ..Default::default()
                 },
                 Counters {
@@ -685,12 +700,14 @@ fn initial_states(runs: &[Packed], precision: Precision) -> (Vec<u8>, Vec<Counte
     (bytes, counters)
 }
 
-/// Each run's results from its final state, in input order (None: handed back).
+/// Each run's results from its final state, in input order (None: handed back); `accel`: the
+/// runs tracked their peak accelerations.
 pub fn read_outputs(
     ctx: &GpuContext,
     done: &Integrated,
     runs: &[Packed],
     opts: &GpuOptions,
+    accel: bool,
 ) -> Result<Vec<Option<RunOutput>>, GpuError> {
     let energy = opts.fast.energy;
     let sbytes = read(ctx, &done.states)?;
@@ -702,7 +719,7 @@ pub fn read_outputs(
             ss.iter()
                 .zip(cs)
                 .zip(runs)
-                .map(|((s, c), r)| output(s, c, &r.params, energy))
+                .map(|((s, c), r)| output(s, c, &r.params, energy, accel))
                 .collect()
         }
         Precision::F32 => {
@@ -710,7 +727,7 @@ pub fn read_outputs(
             ss.iter()
                 .zip(cs)
                 .zip(runs)
-                .map(|((s, c), r)| output(&s.to_f64(), c, &r.params, energy))
+                .map(|((s, c), r)| output(&s.to_f64(), c, &r.params, energy, accel))
                 .collect()
         }
     };

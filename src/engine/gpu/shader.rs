@@ -72,14 +72,18 @@ fn prelude(precision: Precision) -> String {
 /// variants rather than a uniform branch, because lavapipe compiled the untaken energy code
 /// into the free step and lost 30 % of its runs/s (measured with `pound bench`).
 /// The shared free response's table layout and slack come from `shared` and the physics.
-pub fn fast_source(precision: Precision, energy: bool) -> String {
+/// `ACCEL`: whether this variant tracks each building's peak absolute acceleration (a row of
+/// two one-storey buildings reports it; a pair does not, and its kernel carries none of it).
+pub fn fast_source(precision: Precision, energy: bool, accel: bool) -> String {
     use super::layout::NO_RESPONSE;
-    use super::shared::{CHECK_EVERY, HEADER, PER_CHECK};
+    use super::shared::{header_reals, reals_per_check, CHECK_EVERY};
     use crate::physics::solver::shared::REACH_SLACK;
+    let (header, per_check) = (header_reals(accel), reals_per_check(accel));
     format!(
         "{}const FORMS: u32 = {FORMS_PER_RUN}u;\nconst ENERGY: bool = {energy};\n\
-         const NO_RESPONSE: u32 = {NO_RESPONSE}u;\nconst SH_HEADER: u32 = {HEADER}u;\n\
-         const SH_CHECK: u32 = {PER_CHECK}u;\nconst SH_EVERY: u32 = {CHECK_EVERY}u;\nconst REACH_SLACK: real = {REACH_SLACK:e};\n{CONTACT_WGSL}{HERMITE_WGSL}{FAST_WGSL}{LANES_WGSL}",
+         const ACCEL: bool = {accel};\n\
+         const NO_RESPONSE: u32 = {NO_RESPONSE}u;\nconst SH_HEADER: u32 = {header}u;\n\
+         const SH_CHECK: u32 = {per_check}u;\nconst SH_EVERY: u32 = {CHECK_EVERY}u;\nconst REACH_SLACK: real = {REACH_SLACK:e};\n{CONTACT_WGSL}{HERMITE_WGSL}{FAST_WGSL}{LANES_WGSL}",
         prelude(precision)
     )
 }

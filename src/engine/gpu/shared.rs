@@ -11,46 +11,62 @@
 //! 2.0 s with).
 //!
 //! A response's table at `responses[Meta::response..]`, in reals:
-//! - [`HEADER`]: `omega`, reach growth and peak growth, each for building 1 then 2
-//!   (`FreeResponse::rates`);
-//! - [`PER_CHECK`] per checkpoint, the samples `i = CHECK_EVERY * c < intervals`: the state
-//!   `[u1, v1, u2, v2]` there and the largest reach and peak bounds over steps `i..`.
+//! - [`header_reals`]: `omega`, reach growth and peak growth, each for building 1 then 2
+//!   (`FreeResponse::rates`), then, where the runs track their accelerations (`accel`), the
+//!   acceleration bounds' growth;
+//! - [`reals_per_check`] per checkpoint, the samples `i = CHECK_EVERY * c < intervals`: the
+//!   state `[u1, v1, u2, v2]` there and the largest reach and peak bounds over steps `i..`
+//!   (then the acceleration bounds' with `accel`).
 //!
 //! A run takes its distance `R` from the shared motion only at checkpoints, where it checks for
 //! an early end, so one state per `CHECK_EVERY` steps is all the kernel reads.
 
 use super::layout::NO_RESPONSE;
 use super::run::Packed;
+use super::sweep::PairRuns;
 use crate::engine::cpu::{free_motion_stretches, same_free_motion, MIN_SHARED_RUNS};
 use crate::physics::solver::FreeResponse;
-use crate::plan::{PairPlan, RunSpec};
+use crate::plan::RunSpec;
 use rayon::prelude::*;
 
-pub const HEADER: usize = 6;
-pub const PER_CHECK: usize = 7;
+/// Reals of a table's header, and per checkpoint (see the module's notes).
+pub const fn header_reals(accel: bool) -> usize {
+    6 + 2 * accel as usize
+}
+pub const fn reals_per_check(accel: bool) -> usize {
+    7 + 2 * accel as usize
+}
 /// Record steps between checkpoints: a run may end early, or learn its distance again after a
 /// contact, at these samples (the CPU checks for an early end as often, `fast::END_CHECK_EVERY`).
 pub const CHECK_EVERY: usize = 8;
 
 /// Reals of one response's table over `intervals` record steps.
-pub fn table_reals(intervals: usize) -> usize {
-    HEADER + PER_CHECK * intervals.div_ceil(CHECK_EVERY)
+pub fn table_reals(intervals: usize, accel: bool) -> usize {
+    header_reals(accel) + reals_per_check(accel) * intervals.div_ceil(CHECK_EVERY)
 }
 
 /// Write a response's table (see the module's notes) into `out`, `table_reals` long.
 pub fn fill_table(r: &FreeResponse, out: &mut [f64]) {
     let n = r.intervals();
-    let (head, checks) = out.split_at_mut(HEADER);
+    let accel = r.accel();
+    let (head, checks) = out.split_at_mut(header_reals(accel));
     for (k, pair) in r.rates().iter().enumerate() {
         head[2 * k..2 * k + 2].copy_from_slice(pair);
     }
-    debug_assert_eq!(checks.len(), PER_CHECK * n.div_ceil(CHECK_EVERY));
-    for (c, t) in checks.chunks_exact_mut(PER_CHECK).enumerate() {
+    if accel {
+        head[6..].copy_from_slice(&r.accel_growth());
+    }
+    let per = reals_per_check(accel);
+    debug_assert_eq!(checks.len(), per * n.div_ceil(CHECK_EVERY));
+    for (c, t) in checks.chunks_exact_mut(per).enumerate() {
         let i = c * CHECK_EVERY;
         let (z, _) = r.at(i);
         let (reach, bound) = r.maxima_after(i);
         t[..4].copy_from_slice(&z[..4]);
-        t[4..].copy_from_slice(&[reach, bound[0], bound[1]]);
+        t[4..7].copy_from_slice(&[reach, bound[0], bound[1]]);
+        if accel {
+            t[7..].copy_from_slice(&r.accel_bounds_after(i));
+        }
     }
 }
 
@@ -60,20 +76,21 @@ pub fn fill_table(r: &FreeResponse, out: &mut [f64]) {
 pub struct Start {
     pub i: u32,
     pub state: [f64; 4],
-    pub peaks: [f64; 2],
+    /// `[u1, u2, a1, a2]` (the accelerations' 0 where the runs do not track them).
+    pub peaks: [f64; 4],
 }
 
 /// Does `spec` lie in a stretch of at least [`MIN_SHARED_RUNS`] consecutive runs of `plan` with
 /// its free motion? Decided on the plan, not the chunk, so that whether a run shares (which
 /// moves an f32 result by rounding: the response is stepped in f64) does not depend on where
 /// chunks end or how a chunk is ordered.
-fn in_long_stretch(plan: &PairPlan, spec: &RunSpec) -> bool {
+fn in_long_stretch(plan: &dyn PairRuns, spec: &RunSpec) -> bool {
     let same = |j: u64| same_free_motion(spec, &plan.run(j));
     let (mut lo, mut hi) = (spec.index, spec.index);
     while ((hi - lo + 1) as usize) < MIN_SHARED_RUNS && lo > 0 && same(lo - 1) {
         lo -= 1;
     }
-    while ((hi - lo + 1) as usize) < MIN_SHARED_RUNS && hi + 1 < plan.len() && same(hi + 1) {
+    while ((hi - lo + 1) as usize) < MIN_SHARED_RUNS && hi + 1 < plan.runs() && same(hi + 1) {
         hi += 1;
     }
     (hi - lo + 1) as usize >= MIN_SHARED_RUNS
@@ -85,7 +102,7 @@ fn in_long_stretch(plan: &PairPlan, spec: &RunSpec) -> bool {
 /// `meta.response` and `start` of those runs, and returns the responses' tables, one after
 /// another. Stretches past `max_reals` in all step their whole records.
 pub fn share(
-    plan: &PairPlan,
+    plan: &dyn PairRuns,
     specs: &[&RunSpec],
     packed: &mut [Packed],
     max_reals: usize,
@@ -108,7 +125,7 @@ pub fn share(
     let mut total = 0;
     let mut placed = Vec::new();
     for ks in stretches {
-        let len = table_reals(plan.forcing(specs[ks[0]]).intervals());
+        let len = table_reals(plan.forcing(specs[ks[0]]).intervals(), plan.accel());
         if total + len > max_reals {
             break;
         }
@@ -129,7 +146,11 @@ pub fn share(
         .map(|((ks, _, _), slot)| {
             let forcing = plan.forcing(specs[ks[0]]);
             let pair = specs[ks[0]].pair();
-            let r = FreeResponse::new(&pair.b1, &pair.b2, &forcing);
+            let r = if plan.accel() {
+                FreeResponse::with_accel(&pair.b1, &pair.b2, &forcing)
+            } else {
+                FreeResponse::new(&pair.b1, &pair.b2, &forcing)
+            };
             fill_table(&r, slot);
             ks.iter()
                 .map(|&k| {

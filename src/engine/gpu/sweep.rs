@@ -2,11 +2,73 @@
 //! the previous chunk, read back, the runs the kernel hands back finished on the CPU in f64.
 
 use crate::engine::Summary;
-use crate::physics::model::RunOutput;
-use crate::physics::solver::Scheme;
+use crate::physics::model::{Forcing, RunOutput};
+use crate::physics::row::RowOutput;
+use crate::physics::solver::{simulate_tracking_accel, FastOptions, Scheme};
+use crate::plan::contact::ContactPlan;
+use crate::plan::row::{RowPlan, RowRunSpec as RowSpec};
 use crate::plan::{PairPlan, RunSpec};
 use rayon::prelude::*;
 use std::time::Instant;
+
+/// The runs a GPU sweep of the pair kernel integrates: a pair's plan, or a row plan that runs as
+/// a pair ([`RowPairs`]).
+pub trait PairRuns: Sync {
+    /// Runs in all (the shared responses look past a chunk's ends, up to here).
+    fn runs(&self) -> u64;
+    /// Run `index`, as a pair's run (its `index` is `index`).
+    fn run(&self, index: u64) -> RunSpec;
+    /// The laws, records, intensities and scheme.
+    fn contact(&self) -> &ContactPlan;
+    /// Do its runs track their buildings' peak accelerations (a row's output has them)?
+    fn accel(&self) -> bool;
+
+    fn forcing(&self, spec: &RunSpec) -> Forcing<'_> {
+        self.contact().forcing(&spec.contact)
+    }
+
+    /// Run `spec` on the CPU in f64 (a run the kernel handed back).
+    fn run_on_cpu(&self, spec: &RunSpec, fast: &FastOptions) -> RunOutput;
+}
+
+impl PairRuns for PairPlan {
+    fn runs(&self) -> u64 {
+        self.len()
+    }
+    fn run(&self, index: u64) -> RunSpec {
+        PairPlan::run(self, index)
+    }
+    fn contact(&self) -> &ContactPlan {
+        &self.contact
+    }
+    fn accel(&self) -> bool {
+        false
+    }
+    fn run_on_cpu(&self, spec: &RunSpec, fast: &FastOptions) -> RunOutput {
+        crate::engine::cpu::run_one(self, spec, &Scheme::Fast(*fast))
+    }
+}
+
+/// A row plan that runs as a pair ([`RowPlan::runs_as_pair`]), seen as the pair's runs.
+pub struct RowPairs<'a>(pub &'a RowPlan);
+
+impl PairRuns for RowPairs<'_> {
+    fn runs(&self) -> u64 {
+        self.0.len()
+    }
+    fn run(&self, index: u64) -> RunSpec {
+        self.0.pair_run(&self.0.run(index))
+    }
+    fn contact(&self) -> &ContactPlan {
+        &self.0.contact
+    }
+    fn accel(&self) -> bool {
+        true
+    }
+    fn run_on_cpu(&self, spec: &RunSpec, fast: &FastOptions) -> RunOutput {
+        simulate_tracking_accel(&spec.pair(), &self.forcing(spec), fast, None, None)
+    }
+}
 
 /// Where a GPU sweep spent its time, s (packing is host work; upload, kernel and readback are
 /// timed around the GPU calls that wait for completion).
@@ -52,18 +114,17 @@ impl GpuTimes {
     /// in f64 (`spec(k)` is the run of `outs[k]`).
     pub(crate) fn finish<'a>(
         &mut self,
-        plan: &PairPlan,
+        plan: &dyn PairRuns,
         fast: &crate::physics::solver::FastOptions,
         outs: Vec<Option<RunOutput>>,
         spec: impl Fn(usize) -> &'a RunSpec + Sync,
     ) -> Vec<RunOutput> {
         let t = Instant::now();
-        let cpu = Scheme::Fast(*fast);
         self.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
         let done = outs
             .into_par_iter()
             .enumerate()
-            .map(|(k, o)| o.unwrap_or_else(|| crate::engine::cpu::run_one(plan, spec(k), &cpu)))
+            .map(|(k, o)| o.unwrap_or_else(|| plan.run_on_cpu(spec(k), fast)))
             .collect();
         self.handoff += t.elapsed().as_secs_f64();
         done
@@ -73,12 +134,12 @@ impl GpuTimes {
 /// The plan's records on the device, and `chunk` capped by what one chunk's buffers may hold:
 /// what every GPU sweep of `plan` starts with.
 pub(crate) fn upload_records(
-    plan: &PairPlan,
+    plan: &dyn PairRuns,
     ctx: &super::GpuContext,
     opts: &super::GpuOptions,
     chunk: usize,
 ) -> Result<(super::GpuRecords, u64), super::GpuError> {
-    let accels = plan.contact.accels();
+    let accels = plan.contact().accels();
     let recs = super::GpuRecords::upload(ctx, opts.precision, &accels)?;
     let chunk = (chunk.max(1) as u64).min(ctx.max_runs_per_chunk(opts.precision));
     Ok((recs, chunk))
@@ -86,7 +147,7 @@ pub(crate) fn upload_records(
 
 /// Pack run `spec` of `plan` for the kernel.
 pub(crate) fn pack_run(
-    plan: &PairPlan,
+    plan: &dyn PairRuns,
     spec: &RunSpec,
     recs: &super::GpuRecords,
     opts: &super::GpuOptions,
@@ -104,7 +165,7 @@ pub(crate) fn pack_run(
 /// response ([`super::shared::share`]) get one, unless `opts` says not to or asks for the energy
 /// balance (the shortcuts skip its integrals).
 pub(crate) fn pack_chunk(
-    plan: &PairPlan,
+    plan: &dyn PairRuns,
     specs: &[&RunSpec],
     ctx: &super::GpuContext,
     recs: &super::GpuRecords,
@@ -120,7 +181,52 @@ pub(crate) fn pack_chunk(
     } else {
         Vec::new()
     };
-    super::PackedChunk { runs, shared }
+    super::PackedChunk {
+        runs,
+        shared,
+        accel: plan.accel(),
+    }
+}
+
+/// Run the runs `runs` of a row plan that runs as a pair ([`RowPlan::runs_as_pair`]) on the pair
+/// kernel, tracking the buildings' accelerations ([`run_range`] of [`RowPairs`]); `sink` gets
+/// each chunk in the row's form, a run that nears the collapse limit run again on the CPU's row
+/// kernel (`cpu::row_of_pair`).
+pub fn run_row_pairs<E: From<super::GpuError>>(
+    plan: &RowPlan,
+    runs: std::ops::Range<u64>,
+    ctx: &super::GpuContext,
+    opts: &super::GpuOptions,
+    chunk: usize,
+    mut sink: impl FnMut(&[(RowSpec, RowOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), E> {
+    let mut summary = Summary::default();
+    let pairs = RowPairs(plan);
+    let (s, times) = run_range(
+        &pairs,
+        runs,
+        ctx,
+        opts,
+        chunk,
+        |done: &[(RunSpec, RunOutput)]| {
+            let rows: Vec<(RowSpec, RowOutput)> = done
+                .par_iter()
+                .map(|(p, o)| {
+                    let spec = plan.run(p.index);
+                    let out = crate::engine::cpu::row_of_pair(plan, &spec, o, &opts.fast);
+                    (spec, out)
+                })
+                .collect();
+            for (_, o) in &rows {
+                summary.count_row(o);
+            }
+            sink(&rows)
+        },
+        progress,
+    )?;
+    summary.seconds = s.seconds;
+    Ok((summary, times))
 }
 
 /// Run the runs `runs` of `plan` on the GPU, `chunk` runs per chunk (capped by the device's limits);
@@ -129,7 +235,7 @@ pub(crate) fn pack_chunk(
 /// path in f64. Rows already handed to `sink` stay there if a later chunk fails (device loss,
 /// out of memory).
 pub fn run_range<E: From<super::GpuError>>(
-    plan: &PairPlan,
+    plan: &dyn PairRuns,
     runs: std::ops::Range<u64>,
     ctx: &super::GpuContext,
     opts: &super::GpuOptions,

@@ -72,7 +72,15 @@ pub fn single_collision_observed(
         separated = s.mode == Mode::Free;
         observer(s);
     };
-    let out = reference::run(&pair, &forcing, &init, &opts, Some(&mut obs), Some(1));
+    let out = reference::run(
+        &pair,
+        &forcing,
+        &init,
+        &opts,
+        Some(&mut obs),
+        Some(1),
+        false,
+    );
     if out.status != Status::Ok {
         return Collision {
             e: f64::NAN,

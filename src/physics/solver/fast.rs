@@ -125,6 +125,7 @@ pub(crate) fn cut_tolerance(t: f64, h: f64) -> f64 {
 /// many record steps: the check costs about a tenth of a free step.
 const END_CHECK_EVERY: usize = 8;
 
+/// One run; `accel`: track each building's peak absolute acceleration too.
 pub(crate) fn run(
     pair: &Pair,
     forcing: &Forcing,
@@ -132,10 +133,12 @@ pub(crate) fn run(
     o: &FastOptions,
     shared: Option<&FreeResponse>,
     observer: Option<&mut dyn FnMut(&Sample)>,
+    accel: bool,
 ) -> RunOutput {
     // The shortcuts keep every output but the energy integrals and the observer's samples.
-    let shared =
-        shared.filter(|s| !o.energy && observer.is_none() && s.serves(pair, forcing, init));
+    let shared = shared.filter(|s| {
+        !o.energy && observer.is_none() && s.serves(pair, forcing, init) && s.accel() == accel
+    });
     let dt = forcing.dt;
     let (p1, p2) = (Propagator::new(&pair.b1, dt), Propagator::new(&pair.b2, dt));
     let forms = o.energy.then(|| {
@@ -146,6 +149,7 @@ pub(crate) fn run(
     });
     let mut run = Integration::start(pair, init, forcing.t0, observer);
     run.energy = o.energy;
+    run.tr.accel = accel;
     let mut substeps: u32 = 0;
     let n = forcing.intervals();
     let mut first = 0;
@@ -159,7 +163,8 @@ pub(crate) fn run(
     // (`FreeResponse::distance`); None after any other step.
     let mut distance: Option<[f64; 2]> = None;
     for i in first..n {
-        let peaks = [run.tr.out.peak_u1, run.tr.out.peak_u2];
+        let pa = run.tr.out.peak_accel;
+        let peaks = [run.tr.out.peak_u1, run.tr.out.peak_u2, pa[0], pa[1]];
         if let Some(sh) = shared.filter(|_| run.mode == Mode::Free) {
             if distance.is_none() || i % END_CHECK_EVERY == 0 {
                 let r = sh.distance(i, &run.z);
@@ -182,7 +187,7 @@ pub(crate) fn run(
                 (Some(sh), Some(r)) if sh.clears(i, r, pair.gap) => {
                     (true, sh.peaks_settled(i, r, peaks))
                 }
-                _ => (false, [false; 2]),
+                _ => (false, [false; 4]),
             };
             if clear || !may_touch(pair, &seg, &z, &z1, dt, run.tr.v0) {
                 if let Some((f1, f2)) = &forms {
@@ -259,7 +264,8 @@ pub(crate) fn run(
                 }
                 let (z0, mode, v0) = (run.z, run.mode, run.tr.v0);
                 let step = |x: f64| rk4(pair, mode, v0, &seg, t, &z0, x);
-                t += run.accept(t, hs, step(hs), LOCATE_TOLERANCE, LOCATE_ITERATIONS, step);
+                let (tol, iters) = (LOCATE_TOLERANCE, LOCATE_ITERATIONS);
+                t += run.accept(&seg, t, hs, step(hs), tol, iters, step);
                 if !finite(&run.z) {
                     return run.finish(Status::NonFinite, substeps as u64);
                 }

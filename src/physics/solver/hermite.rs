@@ -59,16 +59,37 @@ pub(crate) fn cubic_max_bound(y0: f64, d0: f64, y1: f64, d1: f64, h: f64) -> f64
     top + (top.abs() + m) * (BOUND_SLACK - 1.0)
 }
 
+/// Upper bound on `|y|` of the cubic Hermite through `(y0, y0')`, `(y1, y1')` over `[0, h]`
+/// (without the rounding slack [`raise_cubic_peak`] adds).
+#[inline]
+pub(crate) fn cubic_abs_bound(y0: f64, d0: f64, y1: f64, d1: f64, h: f64) -> f64 {
+    y0.abs().max(y1.abs()) + CUBIC_SLOPE_WEIGHT * h * (d0.abs() + d1.abs())
+}
+
 /// `peak` raised to the largest `|y|` of the cubic Hermite over `[0, h]` (the search skipped
 /// when the cubic cannot reach `peak`).
 #[inline]
 pub(crate) fn raise_cubic_peak(peak: f64, y0: f64, d0: f64, y1: f64, d1: f64, h: f64) -> f64 {
-    let m = CUBIC_SLOPE_WEIGHT * h * (d0.abs() + d1.abs());
-    if (y0.abs().max(y1.abs()) + m) * BOUND_SLACK <= peak {
+    if cubic_abs_bound(y0, d0, y1, d1, h) * BOUND_SLACK <= peak {
         return peak;
     }
     let (lo, hi) = hermite_range(y0, d0, y1, d1, h);
     peak.max(hi.abs()).max(lo.abs())
+}
+
+/// `peak` raised to `|y|` at both ends of a piece and, where `|y|` rises at its start and falls
+/// at its end (a hump inside, on one side of 0), to the largest `|y|` of the cubic Hermite
+/// through both ends' values and rates. As `tracker::raise_force_peak`, for a quantity whose
+/// rate may be unbounded at an end where nothing peaks (a contact force's at first touch).
+#[inline]
+pub(crate) fn raise_hump_peak(peak: f64, y0: f64, d0: f64, y1: f64, d1: f64, h: f64) -> f64 {
+    let peak = peak.max(y0.abs()).max(y1.abs());
+    if y0 * d0 > 0.0 && y1 * d1 < 0.0 && y0 * y1 > 0.0 {
+        let (lo, hi) = hermite_range(y0, d0, y1, d1, h);
+        peak.max(hi.abs()).max(lo.abs())
+    } else {
+        peak
+    }
 }
 
 /// Upper bound on `|y|` of the quintic Hermite through `(y, y', y'')` at both ends over `[0, h]`.
@@ -169,7 +190,22 @@ pub(crate) fn quintic_signed_bounds(y: [f64; 2], d: [f64; 2], a: [f64; 2], h: f6
 
 #[cfg(test)]
 mod tests {
-    use super::quintic_peak_abs;
+    use super::{quintic_peak_abs, raise_hump_peak};
+
+    /// A hump inside a piece, on either side of 0, is the cubic's (exact for a quadratic); a
+    /// piece that rises throughout, however steeply at its start (a force's rate at first
+    /// touch), raises the peak only to its ends.
+    #[test]
+    fn a_hump_is_searched_only_where_it_rises_then_falls() {
+        let f = |t: f64| 2.0 - (t - 0.3) * (t - 0.3);
+        let r = |t: f64| -2.0 * (t - 0.3);
+        let p = raise_hump_peak(0.0, f(0.0), r(0.0), f(1.0), r(1.0), 1.0);
+        assert!((p - 2.0).abs() < 1e-15, "{p}");
+        let p = raise_hump_peak(0.0, -f(0.0), -r(0.0), -f(1.0), -r(1.0), 1.0);
+        assert!((p - 2.0).abs() < 1e-15, "{p}");
+        assert_eq!(raise_hump_peak(0.5, 0.0, 1e12, 1.0, 0.5, 1.0), 1.0);
+        assert_eq!(raise_hump_peak(3.0, 1.0, 1.0, 2.0, -1.0, 1.0), 3.0);
+    }
 
     /// Exact for a quintic, and within its error bound `(omega h)^6 / 46080` for a sine whose
     /// crest lies inside the step (where the cubic Hermite is off by up to `(omega h)^4 / 384`).

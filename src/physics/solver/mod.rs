@@ -89,8 +89,8 @@ pub fn simulate_observed(
     observer: Option<&mut dyn FnMut(&Sample)>,
 ) -> RunOutput {
     match scheme {
-        Scheme::Fast(o) => fast::run(pair, forcing, init, o, None, observer),
-        Scheme::Reference(o) => reference::run(pair, forcing, init, o, observer, None),
+        Scheme::Fast(o) => fast::run(pair, forcing, init, o, None, observer, false),
+        Scheme::Reference(o) => reference::run(pair, forcing, init, o, observer, None, false),
     }
 }
 
@@ -106,9 +106,42 @@ pub fn simulate_shared(
     shared: &FreeResponse,
 ) -> RunOutput {
     match scheme {
-        Scheme::Fast(o) => fast::run(pair, forcing, init, o, Some(shared), None),
-        Scheme::Reference(o) => reference::run(pair, forcing, init, o, None, None),
+        Scheme::Fast(o) => fast::run(pair, forcing, init, o, Some(shared), None, false),
+        Scheme::Reference(o) => reference::run(pair, forcing, init, o, None, None, false),
     }
+}
+
+/// A run of the fast scheme from rest that also tracks each building's peak absolute
+/// acceleration ([`RunOutput::peak_accel`]), as a row's buildings report it: how a row of two
+/// one-storey elastic buildings runs on the pair's kernel. `shared`: a free response of its
+/// buildings built [`FreeResponse::with_accel`] (one that does not serve it, or a run with an
+/// `observer`, steps the whole record instead: the same output).
+pub fn simulate_tracking_accel(
+    pair: &Pair,
+    forcing: &Forcing,
+    o: &FastOptions,
+    shared: Option<&FreeResponse>,
+    observer: Option<&mut dyn FnMut(&Sample)>,
+) -> RunOutput {
+    fast::run(
+        pair,
+        forcing,
+        &Initial::default(),
+        o,
+        shared,
+        observer,
+        true,
+    )
+}
+
+/// As [`simulate_tracking_accel`], under the reference scheme (the truth its accelerations are
+/// checked against).
+pub fn simulate_reference_tracking_accel(
+    pair: &Pair,
+    forcing: &Forcing,
+    o: &ReferenceOptions,
+) -> RunOutput {
+    reference::run(pair, forcing, &Initial::default(), o, None, None, true)
 }
 
 /// Ground acceleration over one record interval: linear from `a0` at `t0` to `a1` at `t0 + dt`.
@@ -188,6 +221,17 @@ pub(crate) fn rhs(p: &Pair, mode: Mode, v0: f64, ag: f64, inv_m: [f64; 2], z: &S
         f * ddelta(z),
         -ag * (b1.m * z[1] + b2.m * z[3]),
         b1.c * z[1] * z[1] + b2.c * z[3] * z[3],
+    ]
+}
+
+/// Each building's absolute acceleration (relative plus the ground's) at `z` under contact
+/// force `f`: `-(c v + k u + f) / m1` and `-(c v + k u - f) / m2`.
+#[inline]
+pub(crate) fn structural_accel(p: &Pair, z: &State, f: f64) -> [f64; 2] {
+    let (b1, b2) = (&p.b1, &p.b2);
+    [
+        (-b1.c * z[1] - b1.k * z[0] - f) / b1.m,
+        (-b2.c * z[3] - b2.k * z[2] + f) / b2.m,
     ]
 }
 

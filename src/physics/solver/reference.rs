@@ -198,8 +198,10 @@ pub(crate) fn run(
     o: &ReferenceOptions,
     observer: Option<&mut dyn FnMut(&Sample)>,
     stop_after_impacts: Option<u32>,
+    accel: bool,
 ) -> RunOutput {
     let mut run = Integration::start(pair, init, forcing.t0, observer);
+    run.tr.accel = accel;
     let mut steps: u64 = 0;
     let mut h = forcing.dt / 8.0;
     for i in 0..forcing.intervals() {
@@ -241,7 +243,7 @@ pub(crate) fn run(
                 }
             }
             let step = |x: f64| dopri(pair, mode, v0, &seg, t, &z0, x, o.rtol, &cs).0;
-            t += run.accept(t, hs, trial, 1e-13, 100, step);
+            t += run.accept(&seg, t, hs, trial, 1e-13, 100, step);
             if stop_after_impacts.is_some_and(|n| run.tr.impacts_ended() >= n) {
                 return run.finish(Status::Ok, steps);
             }

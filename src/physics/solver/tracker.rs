@@ -2,13 +2,18 @@
 //! being integrated, shared by both schemes.
 
 use super::events::{event_value, hidden_touch, locate, reapproach, transition};
-use super::hermite::{cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak};
+use super::hermite::{
+    cubic_max_bound, hermite_range, raise_cubic_peak, raise_hump_peak, raise_quintic_peak,
+};
+use super::structural_accel;
 use super::{ddelta, delta, force, force_rate, Mode, Sample, Segment, State};
 use crate::physics::model::{EnergyBalance, Initial, Oscillator, Pair, RunOutput, Status};
 
 /// Peaks and impact bookkeeping shared by both schemes.
 pub(crate) struct Tracker {
     pub out: RunOutput,
+    /// Track each building's peak absolute acceleration (`out.peak_accel`).
+    pub accel: bool,
     /// Approach speed of the current impact.
     pub v0: f64,
     imp_peak: f64,
@@ -53,6 +58,7 @@ impl Tracker {
     pub fn new() -> Tracker {
         Tracker {
             out: RunOutput::default(),
+            accel: false,
             v0: 0.0,
             imp_peak: 0.0,
             e_initial: 0.0,
@@ -72,8 +78,9 @@ impl Tracker {
     }
 
     /// Account for a free record step over `seg`, from `z0` to `z1`: peak displacements from
-    /// the quintic Hermite (both ends' accelerations are known in free flight). A building whose
-    /// peak is `settled` (it cannot be raised over this step) skips the search.
+    /// the quintic Hermite (both ends' accelerations are known in free flight), peak
+    /// accelerations (where tracked) from the cubic Hermite with their rates. A peak that is
+    /// `settled` (`[u1, u2, a1, a2]`: it cannot be raised over this step) skips the search.
     #[inline]
     pub fn free_step(
         &mut self,
@@ -81,7 +88,7 @@ impl Tracker {
         seg: &Segment,
         z0: &State,
         z1: &State,
-        settled: [bool; 2],
+        settled: [bool; 4],
     ) {
         let o = &mut self.out;
         o.free_steps += 1;
@@ -91,22 +98,67 @@ impl Tracker {
         if !settled[1] {
             o.peak_u2 = free_peak(&p.b2, o.peak_u2, seg, [z0[2], z0[3]], [z1[2], z1[3]]);
         }
+        if self.accel {
+            let pa = &mut o.peak_accel;
+            if !settled[2] {
+                pa[0] = free_accel_peak(&p.b1, pa[0], seg, [z0[0], z0[1]], [z1[0], z1[1]]);
+            }
+            if !settled[3] {
+                pa[1] = free_accel_peak(&p.b2, pa[1], seg, [z0[2], z0[3]], [z1[2], z1[3]]);
+            }
+        }
         self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
     }
 
     /// Start from a free state reached by the shared free response ([`super::shared`]):
-    /// `steps` record steps taken there, with these peak displacements.
-    pub fn resume_free(&mut self, steps: u64, peaks: [f64; 2]) {
+    /// `steps` record steps taken there, with these peaks (`[u1, u2, a1, a2]`).
+    pub fn resume_free(&mut self, steps: u64, peaks: [f64; 4]) {
         self.out.shared_steps += steps;
-        [self.out.peak_u1, self.out.peak_u2] = peaks;
+        [self.out.peak_u1, self.out.peak_u2] = [peaks[0], peaks[1]];
+        if self.accel {
+            self.out.peak_accel = [peaks[2], peaks[3]];
+        }
     }
 
-    /// Account for a step `t0 -> t0 + h` spent in `mode`, from `z0` to `z1`.
+    /// Account for a step `t0 -> t0 + h` spent in `mode`, from `z0` to `z1` (inside the record
+    /// step `seg`). Peak accelerations, where tracked, from the cubic Hermite through both
+    /// ends' accelerations and rates: in free flight over the piece; in contact, with the
+    /// force and its rate, where the acceleration peaks inside the piece (`raise_hump_peak`:
+    /// a force's rate is unbounded at first touch under the nonlinear viscoelastic law).
+    /// Events end pieces at the force's kinks, so inside a piece the acceleration is as smooth
+    /// as the force, whose peak the same cubic finds: `O(h^4)`; the ends' values alone were
+    /// `O(h^2)`, 2e-3 from the reference at the default setting in tests/it/scenes.rs.
     #[inline]
-    pub fn step(&mut self, p: &Pair, mode: Mode, h: f64, z0: &State, z1: &State) {
+    #[allow(clippy::too_many_arguments)] // the piece: its mode, ends, length and place
+    pub fn step(
+        &mut self,
+        p: &Pair,
+        mode: Mode,
+        h: f64,
+        z0: &State,
+        z1: &State,
+        seg: &Segment,
+        t0: f64,
+    ) {
         let o = &mut self.out;
         o.peak_u1 = raise_cubic_peak(o.peak_u1, z0[0], z0[1], z1[0], z1[1], h);
         o.peak_u2 = raise_cubic_peak(o.peak_u2, z0[2], z0[3], z1[2], z1[3], h);
+        if self.accel {
+            let ag = (seg.at(t0), seg.at(t0 + h));
+            let ends = [
+                accel_and_jerk(p, mode, self.v0, z0, ag.0),
+                accel_and_jerk(p, mode, self.v0, z1, ag.1),
+            ];
+            let pa = &mut o.peak_accel;
+            for (b, peak) in pa.iter_mut().enumerate() {
+                let ([a0, j0], [a1, j1]) = (ends[0][b], ends[1][b]);
+                *peak = if mode == Mode::Free {
+                    raise_cubic_peak(*peak, a0, j0, a1, j1, h)
+                } else {
+                    raise_hump_peak(*peak, a0, j0, a1, j1, h)
+                };
+            }
+        }
         self.e_peak = self.e_peak.max(self.e_initial + z1[5]);
         if mode != Mode::Free {
             o.contact_time += h;
@@ -166,6 +218,51 @@ impl Tracker {
 #[inline]
 pub(crate) fn free_accel(o: &Oscillator, u: f64, v: f64, ag: f64) -> f64 {
     (-o.c * v - o.k * u) / o.m - ag
+}
+
+/// Absolute acceleration `-(c v + k u) / m` of a free oscillator at `(u, v)` and its rate
+/// `-(c a + k v) / m` (`a` the relative acceleration under ground acceleration `ag`).
+#[inline]
+pub(crate) fn free_accel_and_jerk(o: &Oscillator, u: f64, v: f64, ag: f64) -> (f64, f64) {
+    let a_abs = (-o.c * v - o.k * u) / o.m;
+    (a_abs, (-o.c * (a_abs - ag) - o.k * v) / o.m)
+}
+
+/// Each building's absolute acceleration and its rate at `z` in `mode` (ground acceleration
+/// `ag`): `-(c v + k u -+ F) / m` and `-(c a + k v -+ F') / m`, `a` the relative acceleration
+/// and `F'` the force's rate. Free: [`free_accel_and_jerk`] of each.
+#[inline]
+pub(crate) fn accel_and_jerk(p: &Pair, mode: Mode, v0: f64, z: &State, ag: f64) -> [[f64; 2]; 2] {
+    if mode == Mode::Free {
+        let (a1, j1) = free_accel_and_jerk(&p.b1, z[0], z[1], ag);
+        let (a2, j2) = free_accel_and_jerk(&p.b2, z[2], z[3], ag);
+        return [[a1, j1], [a2, j2]];
+    }
+    let f = force(p, mode, v0, z);
+    let r = force_rate(p, mode, v0, z, f);
+    let a = structural_accel(p, z, f);
+    let (b1, b2) = (&p.b1, &p.b2);
+    [
+        [a[0], (-b1.c * (a[0] - ag) - b1.k * z[1] - r) / b1.m],
+        [a[1], (-b2.c * (a[1] - ag) - b2.k * z[3] + r) / b2.m],
+    ]
+}
+
+/// `peak` raised to the largest `|a|` of one oscillator's absolute acceleration over the free
+/// record step `seg` from `(u, v)` = `s0` to `s1`: the cubic Hermite through its values and
+/// rates at both ends (as a row's building's). The run and the shared free response both call
+/// it, so their peaks agree to the bit.
+#[inline]
+pub(crate) fn free_accel_peak(
+    o: &Oscillator,
+    peak: f64,
+    seg: &Segment,
+    s0: [f64; 2],
+    s1: [f64; 2],
+) -> f64 {
+    let (a0, j0) = free_accel_and_jerk(o, s0[0], s0[1], seg.a0);
+    let (a1, j1) = free_accel_and_jerk(o, s1[0], s1[1], seg.a1);
+    raise_cubic_peak(peak, a0, j0, a1, j1, seg.dt)
 }
 
 /// `peak` raised to the largest `|u|` of one oscillator's quintic Hermite over the free record
@@ -243,7 +340,7 @@ impl<'a, 'o> Integration<'a, 'o> {
 
     /// The free record step over `seg` to `z1`, with no possible contact (already checked by the
     /// caller); `settled`: the buildings whose peaks this step cannot raise.
-    pub fn free_step(&mut self, seg: &Segment, z1: State, settled: [bool; 2]) {
+    pub fn free_step(&mut self, seg: &Segment, z1: State, settled: [bool; 4]) {
         self.tr.free_step(self.pair, seg, &self.z, &z1, settled);
         self.z = z1;
         self.emit(seg.t1());
@@ -253,8 +350,10 @@ impl<'a, 'o> Integration<'a, 'o> {
     /// length `x`. A touch hidden inside a free step and any event inside the step are located
     /// (to `tol_rel * h`, at most `max_iter` iterations); the step then ends there. Updates peaks
     /// and mode and returns the length advanced.
+    #[allow(clippy::too_many_arguments)] // the step, its trial, and how to locate events in it
     pub fn accept(
         &mut self,
+        seg: &Segment,
         t: f64,
         h: f64,
         trial: State,
@@ -279,12 +378,12 @@ impl<'a, 'o> Integration<'a, 'o> {
             let tol = (tol_rel * h).max(4.0 * f64::EPSILON * t.abs());
             let eval = |s: &State| event_value(p, mode, v0, s);
             let (x, zb) = locate(h, f0, trial, f1, tol, max_iter, &mut step, eval);
-            self.tr.step(p, mode, x, &z0, &zb);
+            self.tr.step(p, mode, x, &z0, &zb, seg, t);
             self.mode = transition(p, mode, t + x, &zb, &z0, &mut self.tr);
             self.z = zb;
             x
         } else {
-            self.tr.step(p, mode, h, &z0, &trial);
+            self.tr.step(p, mode, h, &z0, &trial, seg, t);
             self.z = trial;
             self.mode = reapproach(mode, &self.z);
             h

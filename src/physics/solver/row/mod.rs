@@ -69,6 +69,14 @@ pub enum RowScheme {
 /// buildings). The levels' gaps must be beyond reach ([`UNCOUPLED_GAP_M`]). The fast scheme
 /// moves every building in every substep here, so that both floors of a level share each
 /// piece.
+/// Would the row kernel watch this run for collapse under `collapse_limit` (a building's peak
+/// drift ratio reached [`run::COLLAPSE_WATCH`] of it)? Such a run of a row that ran on the
+/// pair's kernel, which does not model collapse, is run again on the row's.
+pub fn near_collapse(out: &RowOutput, collapse_limit: f64) -> bool {
+    let watch = run::COLLAPSE_WATCH * collapse_limit;
+    out.buildings.iter().any(|b| b.peak_drift_ratio >= watch)
+}
+
 pub fn simulate_uncoupled(m: &RowModel, forcing: &Forcing, scheme: &RowScheme) -> RowOutput {
     match scheme {
         RowScheme::Fast(o) => fast::run_uncoupled(m, forcing, o),
