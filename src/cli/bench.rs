@@ -35,7 +35,9 @@ pub struct Args {
     /// Instead, the multi-storey suite: rows of two buildings of each of these storey counts
     /// (e.g. 1,3,6,12,20), about `--storey-runs` runs each on the CPU and `--storey-gpu-runs`
     /// on the GPU adapter found, a software one too (in `--precision`; its runs/s and the
-    /// share of its lanes busy; rows the adapter cannot run are named and left out).
+    /// share of its lanes busy, its host packing and kernel seconds; rows the adapter cannot
+    /// run are named and left out). Each runs on the kernels a sweep of it takes: elastic
+    /// one-storey rows on the pair's.
     #[arg(long, value_delimiter = ',', value_name = "N")]
     storeys: Option<Vec<usize>>,
     /// Runs per sweep of the multi-storey suite.

@@ -328,6 +328,9 @@ pub struct StoreyRow {
     pub csv: f64,
     /// On the GPU: the share of the lane trips the kernel held that did work.
     pub lane_utilisation: Option<f64>,
+    /// On the GPU: the host's packing (overlapping the device's previous chunk) and the
+    /// kernel's dispatches, s (inside `summary.seconds`).
+    pub pack_and_kernel: Option<(f64, f64)>,
 }
 
 /// Seconds to format a chunk of row results as CSV (the text is thrown away).
@@ -363,6 +366,7 @@ pub fn run_storeys(storeys: usize, plan: &RowPlan) -> StoreyRow {
         summary,
         csv,
         lane_utilisation: None,
+        pack_and_kernel: None,
     }
 }
 
@@ -375,21 +379,22 @@ pub fn run_storeys_gpu(
     opts: &crate::engine::gpu::GpuOptions,
 ) -> Result<StoreyRow, crate::engine::gpu::GpuError> {
     use crate::engine::gpu::row::{sweep_rows, RowShape};
-    let shape = RowShape::of_plan(plan);
-    ctx.row_kernel(opts.precision, &shape)?;
+    use crate::engine::gpu::sweep::run_row_pairs;
     let mut csv = 0.0;
-    let (summary, times) = sweep_rows(
-        ctx,
-        plan,
-        0..plan.len(),
-        crate::engine::GPU_CHUNK,
-        opts,
-        |rows| -> Result<(), crate::engine::gpu::GpuError> {
-            csv += csv_seconds(plan, rows);
-            Ok(())
-        },
-        |_| {},
-    )?;
+    let sink = |rows: &[_]| -> Result<(), crate::engine::gpu::GpuError> {
+        csv += csv_seconds(plan, rows);
+        Ok(())
+    };
+    let (runs, chunk) = (0..plan.len(), crate::engine::GPU_CHUNK);
+    // The kernels a sweep of this plan takes (`engine::Kernel::of`): a row of two one-storey
+    // buildings runs on the pair's.
+    let (summary, times) = if plan.runs_as_pair() {
+        ctx.kernel(opts.precision, opts.fast.energy, true)?;
+        run_row_pairs(plan, runs, ctx, opts, chunk, sink, |_| {})?
+    } else {
+        ctx.row_kernel(opts.precision, &RowShape::of_plan(plan))?;
+        sweep_rows(ctx, plan, runs, chunk, opts, sink, |_| {})?
+    };
     Ok(StoreyRow {
         storeys,
         yielding: plan.yielding.iter().any(Option::is_some),
@@ -397,19 +402,20 @@ pub fn run_storeys_gpu(
         summary,
         csv,
         lane_utilisation: times.lane_utilisation(),
+        pack_and_kernel: Some((times.pack, times.kernel)),
     })
 }
 
 /// A markdown table of the multi-storey suite.
 pub fn storey_table(rows: &[StoreyRow]) -> String {
     let mut s = String::from(
-        "| storeys per building | runs | backend | total s | runs/s | storeys x runs/s | free steps/s | RK4 substeps/s | csv s | impacts | lanes busy |\n|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| storeys per building | runs | backend | total s | runs/s | storeys x runs/s | free steps/s | RK4 substeps/s | csv s | pack s | kernel s | impacts | lanes busy |\n|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
         let m = &r.summary;
         let per_s = |x: u64| x as f64 / m.seconds.max(1e-12);
         s.push_str(&format!(
-            "| {}{} | {} | {} | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} | {} |\n",
+            "| {}{} | {} | {} | {:.3} | {:.0} | {:.0} | {:.3e} | {:.3e} | {:.3} | {} | {} | {} | {} |\n",
             r.storeys,
             if r.yielding { ", yielding" } else { "" },
             m.runs,
@@ -420,6 +426,10 @@ pub fn storey_table(rows: &[StoreyRow]) -> String {
             per_s(m.free_steps),
             per_s(m.substeps),
             r.csv,
+            r.pack_and_kernel
+                .map_or("-".to_string(), |(p, _)| format!("{p:.3}")),
+            r.pack_and_kernel
+                .map_or("-".to_string(), |(_, k)| format!("{k:.3}")),
             m.impacts,
             r.lane_utilisation
                 .map_or("-".to_string(), |u| format!("{:.1} %", 100.0 * u))

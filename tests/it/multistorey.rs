@@ -673,13 +673,23 @@ fn bench_storeys_suite_times_each_storey_count() {
     let out = crate::support::pound(&["bench", "--storeys", "1,4", "--storey-runs", "20"]);
     let table = crate::support::ok(&out);
     let stderr = String::from_utf8_lossy(&out.stderr);
+    let head: Vec<&str> = table
+        .lines()
+        .find(|l| l.starts_with("| storeys per building"))
+        .expect("the table's header")
+        .split('|')
+        .map(str::trim)
+        .collect();
+    let col = |name: &str| head.iter().position(|c| *c == name).expect(name);
     let lines: Vec<&str> = table.lines().filter(|l| l.contains("cpu (")).collect();
     assert_eq!(lines.len(), 2, "{table}");
     for (line, n) in lines.iter().zip(["1", "4"]) {
         let cells: Vec<&str> = line.split('|').map(str::trim).collect();
         assert_eq!((cells[1], cells[2]), (n, "20"), "{line}");
-        assert!(cells[5].parse::<f64>().unwrap() > 0.0, "{line}");
-        assert_eq!(cells[11], "-", "no lanes on the CPU: {line}");
+        assert!(cells[col("runs/s")].parse::<f64>().unwrap() > 0.0, "{line}");
+        for c in ["lanes busy", "pack s", "kernel s"] {
+            assert_eq!(cells[col(c)], "-", "no {c} on the CPU: {line}");
+        }
     }
     if crate::support::gpu::ctx().is_some() {
         let gpu: Vec<&str> = table.lines().filter(|l| l.contains("| gpu ")).collect();
@@ -689,8 +699,14 @@ fn bench_storeys_suite_times_each_storey_count() {
             .expect("1-storey rows on the GPU");
         let cells: Vec<&str> = one.split('|').map(str::trim).collect();
         assert_eq!(cells[2], "20", "{one}");
-        let busy: f64 = cells[11].trim_end_matches(" %").parse().unwrap();
+        let busy: f64 = cells[col("lanes busy")]
+            .trim_end_matches(" %")
+            .parse()
+            .unwrap();
         assert!(busy > 0.0 && busy <= 100.0, "{one}");
+        let total: f64 = cells[col("total s")].parse().unwrap();
+        let kernel: f64 = cells[col("kernel s")].parse().unwrap();
+        assert!(kernel > 0.0 && kernel <= total, "{one}");
         assert!(
             gpu.iter().any(|l| l.starts_with("| 4 |")) || stderr.contains("4-storey rows on"),
             "the 4-storey rows are run or named: {table}\n{stderr}"

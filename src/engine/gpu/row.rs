@@ -952,6 +952,21 @@ impl PackedRows {
         recs: &GpuRecords,
         fast: &FastOptions,
     ) {
+        let blocks = model_blocks(m, forcing.dt);
+        self.push_with_blocks(m, forcing, record, recs, fast, blocks);
+    }
+
+    /// [`PackedRows::push`] with the run's model blocks already computed ([`model_blocks`]:
+    /// every mode's propagator, the part of packing worth doing on every thread).
+    fn push_with_blocks(
+        &mut self,
+        m: &RowModel,
+        forcing: &Forcing,
+        record: usize,
+        recs: &GpuRecords,
+        fast: &FastOptions,
+        blocks: Vec<Vec<f64>>,
+    ) {
         assert_eq!(
             RowShape::of(m),
             self.shape,
@@ -985,7 +1000,7 @@ impl PackedRows {
             len,
             forcing.intervals() as u32,
         ]);
-        for block in model_blocks(m, dt) {
+        for block in blocks {
             let at = self.models.add(block);
             self.meta.push(at);
         }
@@ -1313,20 +1328,39 @@ pub fn sweep_rows<E: From<GpuError>>(
         (chunk.max(1) as u64).min(ctx.runs_fitting(shape.largest_block_bytes(opts.precision)));
     let cpu = RowScheme::Fast(opts.fast);
     let mut summary = Summary::default();
-    let mut first = runs.start;
-    while first < runs.end {
+    // A chunk's host work: its runs, their models (a Jacobi decomposition per building) and
+    // model blocks (a propagator per mode) on every thread, then packed in run order. The next
+    // chunk's is done while the device integrates this one, as for pairs.
+    let prep = |first: u64| {
+        let t = Instant::now();
         let end = (first + chunk).min(runs.end);
-        let specs: Vec<RowRunSpec> = (first..end).map(|i| plan.run(i)).collect();
-        // Modes (a Jacobi decomposition per building) on every thread.
-        let models: Vec<RowModel> = specs
+        let specs: Vec<RowRunSpec> = (first..end).into_par_iter().map(|i| plan.run(i)).collect();
+        let (models, blocks): (Vec<RowModel>, Vec<Vec<Vec<f64>>>) = specs
             .par_iter()
-            .map(|s| RowModel::new(&plan.row(s)))
-            .collect();
+            .map(|s| {
+                let m = RowModel::new(&plan.row(s));
+                let b = model_blocks(&m, plan.forcing(s).dt);
+                (m, b)
+            })
+            .unzip();
         let mut packed = PackedRows::new(shape.clone());
-        for (s, m) in specs.iter().zip(&models) {
-            packed.push(m, &plan.forcing(s), s.contact.record, &recs, &opts.fast);
+        for ((s, m), b) in specs.iter().zip(&models).zip(blocks) {
+            let forcing = plan.forcing(s);
+            packed.push_with_blocks(m, &forcing, s.contact.record, &recs, &opts.fast, b);
         }
-        let (outs, ct) = run_rows(ctx, &recs, &packed, opts)?;
+        (specs, models, packed, t.elapsed().as_secs_f64())
+    };
+    let mut first = runs.start;
+    let mut next = Some(prep(first));
+    while let Some((specs, models, packed, pack_s)) = next.take() {
+        let end = first + specs.len() as u64;
+        times.pack += pack_s;
+        let (done, upcoming) = rayon::join(
+            || run_rows(ctx, &recs, &packed, opts),
+            || (end < runs.end).then(|| prep(end)),
+        );
+        next = upcoming;
+        let (outs, ct) = done?;
         times.add_chunk(&ct);
         let t = Instant::now();
         times.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;

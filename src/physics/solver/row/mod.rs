@@ -64,11 +64,6 @@ pub enum RowScheme {
     Reference(super::ReferenceOptions),
 }
 
-/// Simulate `m`'s buildings from rest as if no contact could ever act, tracking each level's
-/// closing and its floors' peaks ([`RowOutput::closings`]; the separation of yielding
-/// buildings). The levels' gaps must be beyond reach ([`UNCOUPLED_GAP_M`]). The fast scheme
-/// moves every building in every substep here, so that both floors of a level share each
-/// piece.
 /// Would the row kernel watch this run for collapse under `collapse_limit` (a building's peak
 /// drift ratio reached [`run::COLLAPSE_WATCH`] of it)? Such a run of a row that ran on the
 /// pair's kernel, which does not model collapse, is run again on the row's.
@@ -77,6 +72,11 @@ pub fn near_collapse(out: &RowOutput, collapse_limit: f64) -> bool {
     out.buildings.iter().any(|b| b.peak_drift_ratio >= watch)
 }
 
+/// Simulate `m`'s buildings from rest as if no contact could ever act, tracking each level's
+/// closing and its floors' peaks ([`RowOutput::closings`]; the separation of yielding
+/// buildings). The levels' gaps must be beyond reach ([`UNCOUPLED_GAP_M`]). The fast scheme
+/// moves every building in every substep here, so that both floors of a level share each
+/// piece.
 pub fn simulate_uncoupled(m: &RowModel, forcing: &Forcing, scheme: &RowScheme) -> RowOutput {
     match scheme {
         RowScheme::Fast(o) => fast::run_uncoupled(m, forcing, o),
