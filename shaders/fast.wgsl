@@ -301,8 +301,10 @@ fn track_step(mode: u32, h: real, z0: Z, z1: Z, seg: Seg, tau: real) {
             // In contact with the force and its rate, where the acceleration peaks inside.
             let fa = force(mode, S.v0, z0);
             let ra = force_rate(mode, S.v0, z0, fa);
-            let fb = force(mode, S.v0, z1);
-            let rb = force_rate(mode, S.v0, z1, fb);
+            // tracker.rs: the end in the mode the run goes on in (reapproach).
+            let mb = reapproach(mode, z1);
+            let fb = force(mb, S.v0, z1);
+            let rb = force_rate(mb, S.v0, z1, fb);
             S.peak_a1 = raise_accel_hump(S.peak_a1, contact_accel_and_jerk(1u, z0, fa, ra, ag0),
                 contact_accel_and_jerk(1u, z1, fb, rb, ag1), h);
             S.peak_a2 = raise_accel_hump(S.peak_a2, contact_accel_and_jerk(2u, z0, fa, ra, ag0),

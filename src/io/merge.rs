@@ -100,6 +100,21 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, SidecarError> {
             "the inputs hold different columns (--columns)".into(),
         ));
     }
+    // One plan's runs from two kernels (shards written by pounds that chose differently, e.g.
+    // a row of two one-storey buildings before and after it took the pair's kernels).
+    if let Some((p, m)) = parts
+        .iter()
+        .find(|(_, m)| m.kernel.is_some() && first.kernel.is_some() && m.kernel != first.kernel)
+    {
+        return Err(fail(
+            p,
+            format!(
+                "its runs took the {} kernel, another input's the {}: rerun the shards with one pound",
+                m.kernel.as_deref().unwrap_or("?"),
+                first.kernel.as_deref().unwrap_or("?")
+            ),
+        ));
+    }
     let header = crate::io::csv::header_for(first.columns.as_deref());
     let header_line = crate::io::csv::header_line(&header);
     for (p, m) in &parts {

@@ -233,6 +233,12 @@ impl SweepOutput {
             if p.meta.backend != meta.backend {
                 return Err(cannot("the backend (--backend, --precision)"));
             }
+            // Kernels chosen from the scene by another pound (recorded since it was).
+            if p.meta.kernel.is_some() && p.meta.kernel != meta.kernel {
+                return Err(cannot(
+                    "the kernel the scene takes (a pound of another version wrote it)",
+                ));
+            }
             if p.meta.columns != meta.columns {
                 return Err(cannot("the columns (--columns)"));
             }

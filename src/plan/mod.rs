@@ -92,7 +92,9 @@ impl Plan {
     pub fn suite(&self) -> crate::physics::solver::calibration::Suite {
         use crate::physics::solver::calibration::Suite;
         match self {
+            // A row of two one-storey buildings runs on the pair's kernels.
             Plan::Pair(_) => Suite::Pairs,
+            Plan::Row(r) if r.runs_as_pair() => Suite::Pairs,
             Plan::Row(_) if self.yields() => Suite::YieldingRows,
             Plan::Row(_) => Suite::Rows,
         }

@@ -29,9 +29,18 @@ const SETTINGS: [f64; 7] = [8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0];
 /// from the reference's here.
 const FLOOR: f64 = 1e-7;
 /// The most a run's error may be at 128 and at 512 substeps per contact (the ends' values
-/// alone in contact, `O(h^2)`, left 3e-5 at 128).
-const AT_128: f64 = 1e-6;
+/// alone in contact, `O(h^2)`, left 3e-5 at 128; a contact that closes again while
+/// restituting, which the pair's scheme does not locate, 1.6e-6).
+const AT_128: f64 = 2e-6;
 const AT_512: f64 = 2e-7;
+
+/// The fast scheme at `s` substeps per contact.
+fn at(s: f64) -> FastOptions {
+    FastOptions {
+        substeps_per_contact: s,
+        ..FastOptions::default()
+    }
+}
 
 /// A run's worst relative error against the reference `t`: each building's peak acceleration
 /// and roof displacement, and the peak force where it pounds.
@@ -80,11 +89,7 @@ fn every_runs_accelerations_converge() {
             let errs: Vec<(f64, f64)> = SETTINGS
                 .iter()
                 .map(|&s| {
-                    let o = FastOptions {
-                        substeps_per_contact: s,
-                        ..FastOptions::default()
-                    };
-                    let out = simulate_tracking_accel(&p, &forcing, &o, None, None);
+                    let out = simulate_tracking_accel(&p, &forcing, &at(s), None, None);
                     assert_eq!(out.status, Status::Ok, "{name} at {s}");
                     if s >= 16.0 && out.impacts != t.impacts {
                         bad.push(format!(
@@ -95,26 +100,81 @@ fn every_runs_accelerations_converge() {
                     (s, run_error(&out, &t))
                 })
                 .collect();
-            let line: Vec<String> = errs.iter().map(|(s, e)| format!("{s}: {e:.1e}")).collect();
-            eprintln!("{name}: {}", line.join(", "));
-            for &(s, e) in &errs {
-                if (s == 128.0 && e > AT_128) || (s == 512.0 && e > AT_512) {
-                    bad.push(format!("{name}: error {e:.2e} at {s}"));
-                }
-            }
-            let before: Vec<(f64, Vec<Option<f64>>)> =
-                errs.iter().map(|&(s, e)| (s, vec![Some(e)])).collect();
-            for k in 1..errs.len() {
-                for r in rises(&before[..k], &[Some(errs[k].1)], FLOOR) {
-                    bad.push(format!(
-                        "{name}: not converging, error {:.2e} at {} after {:.2e} at {}",
-                        errs[k].1, errs[k].0, r.previous_error, r.previous_setting
-                    ));
-                }
-            }
+            judge(&name, &errs, &mut bad);
         }
     }
+    // A contact that closes again while restituting (found in review): the run goes back to
+    // approach after the piece (unlocated), whose end is read in approach (its damping force
+    // in); read in restitution, the acceleration was 2.9e-3 off at 16 and 4.9e-3 at 32.
+    let plan = pounding::plan::config::load_text(CLOSES_AGAIN, std::path::Path::new("again.toml"))
+        .unwrap();
+    let Plan::Row(row) = &plan else {
+        panic!("a row's plan")
+    };
+    let spec = row.run(0);
+    let (p, forcing) = (row.pair_run(&spec).pair(), row.forcing(&spec));
+    let t = simulate_reference_tracking_accel(&p, &forcing, &reference);
+    let errs: Vec<(f64, f64)> = SETTINGS
+        .iter()
+        .map(|&s| {
+            let out = simulate_tracking_accel(&p, &forcing, &at(s), None, None);
+            (s, run_error(&out, &t))
+        })
+        .collect();
+    judge("closes again", &errs, &mut bad);
     assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
+/// Two one-storey buildings whose contact closes again while restituting.
+const CLOSES_AGAIN: &str = r#"
+[[building]]
+storeys = 1
+storey_height_m = 3.5
+mass_kg = 570897.7852582119
+period_s = 0.6
+damping_ratio = 0.034293247008335345
+gap_right_m = 0.007134073136369329
+
+[[building]]
+storeys = 1
+storey_height_m = 3.5
+mass_kg = 2.0e5
+period_s = 0.24245516627059194
+damping_ratio = 0.05
+
+[contact]
+law = "nonlinear_viscoelastic"
+formula = "ebrahimi"
+e = 0.65
+beta_n_per_m1_5 = 1406401172.1794302
+
+[[record]]
+synthetic = { seed = 11, duration_s = 6.0, dt_s = 0.01, pga_g = 0.35 }
+
+[intensity]
+pga_g = 0.5
+"#;
+
+/// `pound accuracy`'s rule over one run's errors at the settings, and the most it may be at
+/// 128 and 512; failures into `bad`.
+fn judge(name: &str, errs: &[(f64, f64)], bad: &mut Vec<String>) {
+    let line: Vec<String> = errs.iter().map(|(s, e)| format!("{s}: {e:.1e}")).collect();
+    eprintln!("{name}: {}", line.join(", "));
+    for &(s, e) in errs {
+        if (s == 128.0 && e > AT_128) || (s == 512.0 && e > AT_512) {
+            bad.push(format!("{name}: error {e:.2e} at {s}"));
+        }
+    }
+    let before: Vec<(f64, Vec<Option<f64>>)> =
+        errs.iter().map(|&(s, e)| (s, vec![Some(e)])).collect();
+    for k in 1..errs.len() {
+        for r in rises(&before[..k], &[Some(errs[k].1)], FLOOR) {
+            bad.push(format!(
+                "{name}: not converging, error {:.2e} at {} after {:.2e} at {}",
+                errs[k].1, errs[k].0, r.previous_error, r.previous_setting
+            ));
+        }
+    }
 }
 
 /// A row of two one-storey buildings across laws, gaps and intensities, with a collapse limit
@@ -173,6 +233,9 @@ fn a_row_of_two_runs_on_the_pair_kernels_on_both_backends() {
     let plan =
         pounding::plan::config::load_text(ROW, std::path::Path::new("row-of-two.toml")).unwrap();
     assert_eq!(Kernel::of(&plan), Kernel::Pair);
+    // `--target-error` reads the calibration of the kernels that run it.
+    use pounding::physics::solver::calibration::Suite;
+    assert_eq!(plan.suite(), Suite::Pairs);
     let Plan::Row(row) = &plan else {
         panic!("a row's plan")
     };

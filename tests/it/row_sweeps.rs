@@ -415,3 +415,48 @@ fn auto_runs_multistorey_rows_on_the_cpu() {
     let meta = std::fs::read_to_string(pounding::io::provenance::meta_path(&out)).unwrap();
     assert!(meta.contains("backend = \"cpu\""), "{meta}");
 }
+
+/// One plan's runs from two kernels never meet in one file: shards, or a cut-off sweep, written
+/// by a pound that chose another kernel for the scene (a row of two one-storey buildings took
+/// the row kernel before it took the pair's) are refused by `pound merge` and `--resume`.
+#[test]
+fn outputs_of_another_kernel_are_not_merged_or_resumed() {
+    let dir = tempdir();
+    let cfg = dir.path().join("two.toml");
+    let text = std::fs::read_to_string("configs/row-of-two.toml")
+        .unwrap()
+        .replace("n = 30 }", "n = 6 }");
+    std::fs::write(&cfg, text).unwrap();
+    let as_row = |meta: &Path| {
+        let t = std::fs::read_to_string(meta).unwrap();
+        assert!(t.contains("kernel = \"pair\""), "{t}");
+        std::fs::write(meta, t.replace("kernel = \"pair\"", "kernel = \"row\"")).unwrap();
+    };
+    let parts: Vec<_> = (0..2)
+        .map(|i| {
+            let p = dir.path().join(format!("s{i}.csv"));
+            ok(&sweep(&cfg, &p, &["--shard", &format!("{i}/2")]));
+            p
+        })
+        .collect();
+    as_row(&pounding::io::atomic::sibling(&parts[1], ".meta.toml"));
+    let merged = dir.path().join("merged.csv");
+    let r = pound(&["merge", s(&parts[0]), s(&parts[1]), "-o", s(&merged)]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success() && err.contains("row kernel"), "{err}");
+    assert!(!merged.exists());
+
+    let full = dir.path().join("full.csv");
+    ok(&sweep(&cfg, &full, &[]));
+    let cut = dir.path().join("cut.csv");
+    interrupt(
+        &cfg,
+        std::fs::metadata(&full).unwrap().len() as usize,
+        &cut,
+        0.5,
+    );
+    as_row(&pounding::io::provenance::progress_path(&cut));
+    let r = sweep(&cfg, &cut, &["--resume"]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success() && err.contains("kernel"), "{err}");
+}
