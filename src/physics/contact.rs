@@ -166,6 +166,9 @@ pub struct Contact {
     pub damping_ratio: f64,
     /// `m1 m2 / (m1 + m2)`, kg.
     pub m_eff: f64,
+    /// [`Contact::tc_coef`], computed once: its `powf` on every step sizing was 1.3 % of a
+    /// row sweep's CPU time.
+    tc: f64,
 }
 
 impl Contact {
@@ -179,12 +182,18 @@ impl Contact {
             2.0 * damping_ratio * (stiffness * m_eff).sqrt()
         };
         let damping_ratio = if kind.is_damped() { damping_ratio } else { 0.0 };
+        let tc = if kind.is_hertzian() {
+            HERTZ_TC * (1.25 * m_eff / stiffness).powf(0.4)
+        } else {
+            std::f64::consts::PI * (m_eff / stiffness).sqrt()
+        };
         Contact {
             kind,
             stiffness,
             damping,
             damping_ratio,
             m_eff,
+            tc,
         }
     }
 
@@ -343,11 +352,7 @@ impl Contact {
     /// linear laws; for Hertz-type laws, from `delta_max = (5 m_eff v^2 / (4 beta))^(2/5)`,
     /// `HERTZ_TC (1.25 m_eff / beta)^(2/5)`.
     pub fn tc_coef(&self) -> f64 {
-        if self.kind.is_hertzian() {
-            HERTZ_TC * (1.25 * self.m_eff / self.stiffness).powf(0.4)
-        } else {
-            std::f64::consts::PI * (self.m_eff / self.stiffness).sqrt()
-        }
+        self.tc
     }
 }
 

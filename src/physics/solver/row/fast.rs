@@ -312,19 +312,22 @@ fn run_with<'a>(
     let mut storey_modes = Vec::with_capacity(m.storeys.len());
     let mut yield_watch = vec![false; m.buildings.len()];
     let mut i = 0;
+    // The step's start, in a buffer kept from step to step (as `z1`, its end).
+    let mut z_start = Vec::with_capacity(len);
     while let Some(seg) = super::yielding::next_segment(m, forcing, i, &mut run) {
         i += 1;
         // A building near collapse moves in substeps, where its storeys' collapse is an event.
         let watched = !m.drifts.is_empty() && run.refresh_watch();
-        let z = run.z.clone();
+        z_start.clone_from(&run.z);
+        let z = &z_start;
         // The exact free step of every mode: the step itself when no level may touch, and the
         // buildings' that stand still through a step of substeps (none in a row of two).
         let any_contact = run.any_contact();
-        z1.copy_from_slice(&z);
+        z1.copy_from_slice(z);
         work.clear();
         if can_stand || !any_contact {
             if yields {
-                m.static_offsets(&z, &mut q_static);
+                m.static_offsets(z, &mut q_static);
             }
             for k in 0..n {
                 if in_coupled[k] {
@@ -348,7 +351,7 @@ fn run_with<'a>(
             for c in coupled.iter_mut() {
                 let qs = yields.then_some(&q_static[..]);
                 let w = forms.is_some().then_some(&mut work[..]);
-                c.step(m, &z, qs, (seg.a0, seg.a1), &mut z1, w);
+                c.step(m, z, qs, (seg.a0, seg.a1), &mut z1, w);
                 if forms.is_some() {
                     let b = &m.buildings[c.building()];
                     for (i, &w) in work.iter().enumerate().skip(b.off).take(b.n()) {
@@ -362,9 +365,9 @@ fn run_with<'a>(
         // A storey that yields, or may in the exact free step, moves its building in substeps.
         let mut yielding = false;
         if yields && (can_stand || !any_contact) {
-            m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
+            m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
             bounded = true;
-            yielding = m.yield_watch(&run.storey_modes, (&z, &z1), &bounds, dt, &mut yield_watch);
+            yielding = m.yield_watch(&run.storey_modes, (z, &z1), &bounds, dt, &mut yield_watch);
         }
         if watched {
             if !yields {
@@ -373,10 +376,10 @@ fn run_with<'a>(
             if can_stand || !any_contact {
                 // Near collapse: in substeps while a storey may reach the limit in the step.
                 if !bounded {
-                    m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
+                    m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
                     bounded = true;
                 }
-                yielding |= run.collapse_watch((&z, &z1), &bounds, dt, &mut yield_watch);
+                yielding |= run.collapse_watch((z, &z1), &bounds, dt, &mut yield_watch);
             } else {
                 for (y, w) in yield_watch.iter_mut().zip(&run.watch) {
                     *y |= *w;
@@ -386,7 +389,7 @@ fn run_with<'a>(
         }
         if !any_contact {
             if !bounded {
-                m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
+                m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
                 bounded = true;
             }
             // The floors at both ends are needed for the peaks if the step is free; the levels
@@ -395,7 +398,7 @@ fn run_with<'a>(
             let mut touching = false;
             if prepare_ends {
                 m.coarse_floor_bounds(&bounds, &mut coarse);
-                run.prepare_free_ends(&z, &z1, (seg.a0, seg.a1));
+                run.prepare_free_ends(z, &z1, (seg.a0, seg.a1));
                 for (l, ((lm, ls), may)) in m
                     .levels
                     .iter()
@@ -417,7 +420,7 @@ fn run_with<'a>(
                 }
             } else {
                 for ((lm, ls), may) in m.levels.iter().zip(&run.levels).zip(may_touch.iter_mut()) {
-                    let t = lm.may_touch_bounded(n, &bounds, &z, &z1, dt, ls.v0);
+                    let t = lm.may_touch_bounded(n, &bounds, z, &z1, dt, ls.v0);
                     *may = Some(t);
                     touching |= t;
                 }
@@ -425,7 +428,7 @@ fn run_with<'a>(
             if touching || yielding {
                 run.drop_free_ends();
             } else {
-                run.free_step(&seg, z1.clone());
+                run.free_step(&seg, &mut z1);
                 if !run.z.iter().all(|x| x.is_finite()) {
                     return finish(run, Status::NonFinite, substeps, tally);
                 }
@@ -460,18 +463,17 @@ fn run_with<'a>(
                 if active[a] && active[b] {
                     continue;
                 }
-                let (d, r) = (lm.delta(&z), lm.ddelta(n, &z));
+                let (d, r) = (lm.delta(z), lm.ddelta(n, z));
                 let mut close = standing == Standing::Grown
                     && active[a] != active[b]
                     && d + 2.0 * r.max(0.0) * dt > 0.0;
                 if !close {
                     if !bounded {
-                        m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
+                        m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
                         bounded = true;
                     }
-                    close = *may_touch[l].get_or_insert_with(|| {
-                        lm.may_touch_bounded(n, &bounds, &z, &z1, dt, ls.v0)
-                    });
+                    close = *may_touch[l]
+                        .get_or_insert_with(|| lm.may_touch_bounded(n, &bounds, z, &z1, dt, ls.v0));
                 }
                 if close {
                     (active[a], active[b]) = (true, true);
@@ -496,10 +498,10 @@ fn run_with<'a>(
                 if *may != Some(true) {
                     continue;
                 }
-                let v_est = 1.5 * lm.ddelta(n, &z).abs().max(lm.ddelta(n, &z1).abs());
-                let d_est = lm.delta(&z).max(lm.delta(&z1));
+                let v_est = 1.5 * lm.ddelta(n, z).abs().max(lm.ddelta(n, &z1).abs());
+                let d_est = lm.delta(z).max(lm.delta(&z1));
                 let a_est = lm
-                    .structural_rel_accel(m, &z)
+                    .structural_rel_accel(m, z)
                     .abs()
                     .max(lm.structural_rel_accel(m, &z1).abs());
                 let c = &lm.contact;
@@ -514,8 +516,8 @@ fn run_with<'a>(
                     continue;
                 }
                 let c = &lm.contact;
-                let (d, r) = (lm.delta(&z), lm.ddelta(n, &z));
-                let a = lm.structural_rel_accel(m, &z).abs();
+                let (d, r) = (lm.delta(z), lm.ddelta(n, z));
+                let a = lm.structural_rel_accel(m, z).abs();
                 if ls.mode == Mode::Free {
                     // A free level beside a contact: size for its touch if it could close within
                     // the step at its present rate.
@@ -547,12 +549,12 @@ fn run_with<'a>(
         lookouts.clear();
         if any_still {
             if !bounded {
-                m.fourth_derivative_bounds(&seg, &z, &z1, &mut bounds);
+                m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
             }
             for (l, lm) in m.levels.iter().enumerate() {
                 let (a, b) = lm.buildings;
                 if active[a] != active[b] {
-                    lookouts.push(Lookout::new(m, l, active[a], &bounds, &z, &z1, dt));
+                    lookouts.push(Lookout::new(m, l, active[a], &bounds, z, &z1, dt));
                 }
             }
         }
@@ -611,7 +613,7 @@ fn run_with<'a>(
                     for (l, lm) in m.levels.iter().enumerate() {
                         let (a, b) = lm.buildings;
                         if (a == k || b == k) && run.active[a] != run.active[b] {
-                            lookouts.push(Lookout::new(m, l, a == k, &bounds, &z, &z1, dt));
+                            lookouts.push(Lookout::new(m, l, a == k, &bounds, z, &z1, dt));
                         }
                     }
                 };
@@ -642,7 +644,7 @@ fn run_with<'a>(
         }
         run.leave_substeps();
         if any_still {
-            run.finish_still(&seg, &z, &z1, &work);
+            run.finish_still(&seg, z, &z1, &work);
         }
     }
     finish(run, Status::Ok, substeps, tally)
