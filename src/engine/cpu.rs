@@ -103,8 +103,7 @@ pub(crate) fn row_of_pair(
     run: &RunOutput,
     o: &FastOptions,
 ) -> RowOutput {
-    let h = plan.first_storey_heights();
-    let row = RowOutput::of_pair(run, [h[0], h[1]]);
+    let row = RowOutput::of_pair(run, plan.pair_heights());
     if near_collapse(&row, plan.collapse_drift_ratio) {
         let model = RowModel::new(&plan.row(spec));
         let forcing = plan.forcing(spec);

@@ -904,9 +904,10 @@ impl RowPlan {
         }
     }
 
-    /// Each building's storey height (the first storey's), for [`RowOutput::of_pair`].
-    pub fn first_storey_heights(&self) -> Vec<f64> {
-        self.buildings.iter().map(|b| b.heights[0]).collect()
+    /// The two buildings' storey heights, for [`RowOutput::of_pair`] (a plan that
+    /// [`RowPlan::runs_as_pair`]).
+    pub fn pair_heights(&self) -> [f64; 2] {
+        [self.buildings[0].heights[0], self.buildings[1].heights[0]]
     }
 
     /// The row scheme of the plan's scheme.

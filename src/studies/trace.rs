@@ -128,8 +128,7 @@ fn on_the_pair_kernel(plan: &RowPlan, spec: &RowRunSpec) -> Option<(RowOutput, V
     let mut observe = |s: &Sample| samples.push(row_sample(&pair, s));
     let forcing = plan.forcing(spec);
     let out = simulate_tracking_accel(&pair, &forcing, &o, None, Some(&mut observe));
-    let h = plan.first_storey_heights();
-    let output = RowOutput::of_pair(&out, [h[0], h[1]]);
+    let output = RowOutput::of_pair(&out, plan.pair_heights());
     (!near_collapse(&output, plan.collapse_drift_ratio)).then_some((output, samples))
 }
 
