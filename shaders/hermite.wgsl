@@ -185,3 +185,14 @@ fn raise_force_peak(peak: real, f0: real, r0: real, f1: real, r1: real, h: real)
     }
     return p;
 }
+
+// hermite::raise_hump_peak: the ends' |y|, and the cubic's largest |y| where |y| rises at the
+// start and falls at the end (a hump inside, on one side of 0).
+fn raise_hump_peak(peak: real, y0: real, d0: real, y1: real, d1: real, h: real) -> real {
+    var p = max(peak, max(abs(y0), abs(y1)));
+    if (y0 * d0 > 0.0 && y1 * d1 < 0.0 && y0 * y1 > 0.0) {
+        let r = hermite_range(y0, d0, y1, d1, h);
+        p = max(p, max(abs(r.hi), abs(r.lo)));
+    }
+    return p;
+}

@@ -418,6 +418,29 @@ fn mode_bounds(seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>) {
 
 // ---- row/mod.rs: RowRun ----
 
+// physics/row.rs LevelSide::at: quantity q at end e (FL) of a level's side on building b,
+// floor f (from 0), weight w: the floor's, or on a column its storey's floors' by their shares
+// (the ground's 0).
+fn side_fl(e: u32, q: u32, b: u32, f: u32, w: real) -> real {
+    let top = FL[fli(e, q, B_OFF[b] + f)];
+    if (w == 1.0) {
+        return top;
+    }
+    var below: real = 0.0;
+    if (f > 0u) {
+        below = FL[fli(e, q, B_OFF[b] + f - 1u)];
+    }
+    return w * top + (1.0 - w) * below;
+}
+
+// A force on a column's point reaches its storey's floors by the same shares (LevelSide::shares).
+fn spread_on_column(b: u32, f: u32, w: real, force: real) {
+    if (f > 0u) {
+        FF[B_OFF[b] + f - 1u] += (1.0 - w) * force;
+    }
+    FF[B_OFF[b] + f] += w * force;
+}
+
 fn set_floor_forces(z: ptr<function, ZA>) {
     for (var k = 0u; k < NM; k++) { FF[k] = 0.0; }
     for (var l = 0u; l < NL; l++) {
@@ -426,6 +449,11 @@ fn set_floor_forces(z: ptr<function, ZA>) {
         }
         let f = force(l, LMODE[l], LV0[l], z);
         let a = L_A[l];
+        if (HAS_COLUMNS && L_CS[l] < 2u) {
+            spread_on_column(a, L_FA[l], L_WA[l], -f);
+            spread_on_column(a + 1u, L_FB[l], L_WB[l], f);
+            continue;
+        }
         FF[B_OFF[a] + L_FA[l]] -= f;
         FF[B_OFF[a + 1u] + L_FB[l]] += f;
     }
@@ -477,20 +505,101 @@ fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0:
         // The force's rates from the floors' relative accelerations at both ends (FL, with
         // the contact forces of these modes).
         let a = L_A[l];
-        let ka = B_OFF[a] + L_FA[l];
-        let kb = B_OFF[a + 1u] + L_FB[l];
+        let accel0 = side_fl(0u, 2u, a, L_FA[l], L_WA[l]) - side_fl(0u, 2u, a + 1u, L_FB[l], L_WB[l]);
+        let accel1 = side_fl(1u, 2u, a, L_FA[l], L_WA[l]) - side_fl(1u, 2u, a + 1u, L_FB[l], L_WB[l]);
         let approaching = mode == MODE_APPROACH;
         let v0 = LV0[l];
         let f = force(l, mode, v0, z1);
-        let r1 = contact_force_rate(y1, d1, FL[fli(1u, 2u, ka)] - FL[fli(1u, 2u, kb)], v0, approaching);
+        let r1 = contact_force_rate(y1, d1, accel1, v0, approaching);
         var f0: real = 0.0;
         var r0: real = 0.0;
         if (r1 < 0.0) {
             f0 = force(l, mode, v0, z0);
-            r0 = contact_force_rate(y0, d0, FL[fli(0u, 2u, ka)] - FL[fli(0u, 2u, kb)], v0, approaching);
+            r0 = contact_force_rate(y0, d0, accel0, v0, approaching);
         }
         rstate[lsi(l, LS_IMP_PEAK)] = raise_force_peak(rstate[lsi(l, LS_IMP_PEAK)], f0, r0, f, r1, h);
+        if (HAS_COLUMNS && L_CS[l] < 2u) {
+            track_column(l, mode, y0, d0, y1, d1, accel0, f, r1, z0, z1, h);
+        }
     }
+}
+
+// row/outputs.rs raise_column_peak: `peak` raised to the largest |V + share F| over a contact
+// piece, the ends and the hump's cubic held within max |V| + |share| max F.
+fn raise_column_peak(peak: real, v0: real, vr0: real, v1: real, vr1: real, f0: real, r0: real, f1: real, r1: real, share: real, touches: bool, h: real) -> real {
+    let y0 = v0 + share * f0;
+    let y1 = v1 + share * f1;
+    let ends = max(peak, max(abs(y0), abs(y1)));
+    if (touches) {
+        return ends;
+    }
+    let hump = raise_hump_peak(ends, y0, vr0 + share * r0, y1, vr1 + share * r1, h);
+    if (hump <= ends) {
+        return ends;
+    }
+    var f_max = max(abs(f0), abs(f1));
+    if (r1 < 0.0 && r0 > 0.0) {
+        f_max = max(f_max, hermite_range(f0, r0, f1, r1, h).hi);
+    }
+    let bound = raise_cubic_peak(0.0, v0, vr0, v1, vr1, h) + abs(share) * f_max;
+    return max(ends, min(hump, bound));
+}
+
+// RowRun::track's struck column (row/outputs.rs): the largest shear of the struck storey's two
+// column segments over a contact piece, its spring force `V` with the share of the force on
+// the struck building each segment carries to its floor (`V - s F` above the point,
+// `V + (1 - s) F` below), by the hump's cubic, or at the piece's ends alone where it begins at
+// the touch or ends at the separation (the force's rate unbounded there).
+fn track_column(l: u32, mode: u32, y0: real, d0: real, y1: real, d1: real, accel0: real, f1: real, r1: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) {
+    let side = L_CS[l];
+    let b = L_A[l] + side;
+    var j = L_FA[l];
+    var w = L_WA[l];
+    var on_struck: real = -1.0;
+    if (side == 1u) {
+        j = L_FB[l];
+        w = L_WB[l];
+        on_struck = 1.0;
+    }
+    let v0 = LV0[l];
+    let f0 = force(l, mode, v0, z0);
+    let r0 = contact_force_rate(y0, d0, accel0, v0, mode == MODE_APPROACH);
+    let k = rp(P_COLUMNS + L_CI[l]);
+    let o = B_OFF[b];
+    var drift: array<real, 2>;
+    var rate: array<real, 2>;
+    for (var e = 0u; e < 2u; e++) {
+        drift[e] = FL[fli(e, 0u, o + j)];
+        rate[e] = FL[fli(e, 1u, o + j)];
+        if (j > 0u) {
+            drift[e] -= FL[fli(e, 0u, o + j - 1u)];
+            rate[e] -= FL[fli(e, 1u, o + j - 1u)];
+        }
+    }
+    var spring = array<real, 2>(k * drift[0], k * drift[1]);
+    var spring_rate = array<real, 2>(k * rate[0], k * rate[1]);
+    if (NS > 0u && B_S0[b] < NS) {
+        let s = B_S0[b] + j;
+        var pv = array<real, 2>(0.0, 0.0);
+        if (SM[s] != SM_ELASTIC) {
+            pv[0] = (1.0 - st_b(s)) * rate[0];
+            pv[1] = (1.0 - st_b(s)) * rate[1];
+        }
+        spring[0] = k * (drift[0] - (*z0)[PS0 + s]);
+        spring[1] = k * (drift[1] - (*z1)[PS0 + s]);
+        spring_rate[0] = k * (rate[0] - pv[0]);
+        spring_rate[1] = k * (rate[1] - pv[1]);
+    }
+    let touches = y0 <= 0.0 || y1 <= 0.0;
+    var peak = rstate[lsi(l, LS_COLUMN_SHEAR)];
+    for (var x = 0u; x < 2u; x++) {
+        var share = -w;
+        if (x == 1u) {
+            share = 1.0 - w;
+        }
+        peak = raise_column_peak(peak, spring[0], spring_rate[0], spring[1], spring_rate[1], f0, r0, f1, r1, on_struck * share, touches, h);
+    }
+    rstate[lsi(l, LS_COLUMN_SHEAR)] = peak;
 }
 
 fn onset(l: u32, tau: real, v0: real, f: real) {

@@ -7,24 +7,37 @@
 // Nothing to cache: these read the shapes from `models` as they go.
 fn load_shape_rows() {}
 
-// phi . q of floor `f` of building `b`, from z at offset `at` (0: displacements, NM: velocities).
-fn floor_of(b: u32, f: u32, z: ptr<function, ZA>, at: u32) -> real {
+// A level side's mode-shape row at mode i (BuildingModel::point_row): floor f's, or on a
+// column its storey's floors' by their shares.
+fn side_shape(b: u32, f: u32, w: real, i: u32) -> real {
+    if (w == 1.0) {
+        return shape_at(b, f, i);
+    }
+    var s: real = 0.0;
+    if (f > 0u) {
+        s = (1.0 - w) * shape_at(b, f - 1u, i);
+    }
+    return s + w * shape_at(b, f, i);
+}
+
+// row . q of a level side, from z at offset `at` (0: displacements, NM: velocities).
+fn side_of(b: u32, f: u32, w: real, z: ptr<function, ZA>, at: u32) -> real {
     var s: real = 0.0;
     let o = at + B_OFF[b];
     for (var i = 0u; i < B_N[b]; i++) {
-        s += shape_at(b, f, i) * (*z)[o + i];
+        s += side_shape(b, f, w, i) * (*z)[o + i];
     }
     return s;
 }
 
 fn delta(l: u32, z: ptr<function, ZA>) -> real {
     let a = L_A[l];
-    return floor_of(a, L_FA[l], z, 0u) - floor_of(a + 1u, L_FB[l], z, 0u) - rp(P_GAPS + a);
+    return side_of(a, L_FA[l], L_WA[l], z, 0u) - side_of(a + 1u, L_FB[l], L_WB[l], z, 0u) - rp(P_GAPS + a);
 }
 
 fn ddelta(l: u32, z: ptr<function, ZA>) -> real {
     let a = L_A[l];
-    return floor_of(a, L_FA[l], z, NM) - floor_of(a + 1u, L_FB[l], z, NM);
+    return side_of(a, L_FA[l], L_WA[l], z, NM) - side_of(a + 1u, L_FB[l], L_WB[l], z, NM);
 }
 
 // row::rhs at ground acceleration ag, into `out`.
@@ -55,11 +68,11 @@ fn rhs(ag: real, z: ptr<function, ZA>, out: ptr<function, ZA>) {
         let a = L_A[l];
         let oa = NM + B_OFF[a];
         for (var i = 0u; i < B_N[a]; i++) {
-            (*out)[oa + i] -= shape_at(a, L_FA[l], i) * f;
+            (*out)[oa + i] -= side_shape(a, L_FA[l], L_WA[l], i) * f;
         }
         let ob = NM + B_OFF[a + 1u];
         for (var i = 0u; i < B_N[a + 1u]; i++) {
-            (*out)[ob + i] += shape_at(a + 1u, L_FB[l], i) * f;
+            (*out)[ob + i] += side_shape(a + 1u, L_FB[l], L_WB[l], i) * f;
         }
         (*out)[2u * NM + l] = f * ddelta(l, z);
     }
@@ -161,17 +174,18 @@ fn plastic_rhs(z: ptr<function, ZA>, out: ptr<function, ZA>) {
     }
 }
 
-// The structural acceleration of floor f of building b (no ground, no contact).
-fn floor_accel(b: u32, f: u32, z: ptr<function, ZA>) -> real {
+// The structural acceleration of a level side (floor f of building b, weight w) (no ground,
+// no contact).
+fn floor_accel(b: u32, f: u32, w: real, z: ptr<function, ZA>) -> real {
     var s: real = 0.0;
     let o = B_OFF[b];
     for (var i = 0u; i < B_N[b]; i++) {
         let k = o + i;
-        s += shape_at(b, f, i) * (-TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k]);
+        s += side_shape(b, f, w, i) * (-TXW[k] * (*z)[NM + k] - W2[k] * (*z)[k]);
     }
     if (coupled(b)) {
         for (var i = 0u; i < B_N[b]; i++) {
-            s -= shape_at(b, f, i) * coupled_term(b, i, z, NM);
+            s -= side_shape(b, f, w, i) * coupled_term(b, i, z, NM);
         }
     }
     return s;
@@ -179,22 +193,22 @@ fn floor_accel(b: u32, f: u32, z: ptr<function, ZA>) -> real {
 
 fn structural_rel_accel(l: u32, z: ptr<function, ZA>) -> real {
     let a = L_A[l];
-    return floor_accel(a, L_FA[l], z) - floor_accel(a + 1u, L_FB[l], z);
+    return floor_accel(a, L_FA[l], L_WA[l], z) - floor_accel(a + 1u, L_FB[l], L_WB[l], z);
 }
 
-// The fourth-derivative bound of one side's floor: its modes' bounds (QB) by its mode shape.
-fn side_bound(b: u32, f: u32) -> real {
+// The fourth-derivative bound of one level side: its modes' bounds (QB) by its row.
+fn side_bound(b: u32, f: u32, w: real) -> real {
     var s: real = 0.0;
     let o = B_OFF[b];
     for (var i = 0u; i < B_N[b]; i++) {
-        s += abs(shape_at(b, f, i)) * QB[o + i];
+        s += abs(side_shape(b, f, w, i)) * QB[o + i];
     }
     return s;
 }
 
 fn level_bound(l: u32) -> real {
     let a = L_A[l];
-    return side_bound(a, L_FA[l]) + side_bound(a + 1u, L_FB[l]);
+    return side_bound(a, L_FA[l], L_WA[l]) + side_bound(a + 1u, L_FB[l], L_WB[l]);
 }
 
 // RowRun::track_buildings: each building's peaks over a piece from z0 to z1.

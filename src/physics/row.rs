@@ -1,30 +1,129 @@
-//! A row of multi-storey buildings, left to right, that may pound floor against floor: the
-//! scene of a multi-storey run, and what such a run reports.
+//! A row of multi-storey buildings, left to right, that may pound: the scene of a multi-storey
+//! run, and what such a run reports.
 //!
-//! Adjacent buildings `a` and `a + 1` stand `gaps[a]` apart. They can touch at every floor level
-//! both have at the same elevation (within [`LEVEL_TOLERANCE_M`]); floors at different heights
-//! never touch floor to floor (mid-column pounding is not modelled). Each such contact level
-//! has its own contact element: the run's law, stiffness and damping ratio, with the effective
-//! mass of the two colliding floors, `m_eff = m_A m_B / (m_A + m_B)`.
+//! Adjacent buildings `a` and `a + 1` stand `gaps[a]` apart. They touch at contact levels:
+//! floor against floor where both have a floor at the same elevation (within
+//! [`LevelRule::same_level_m`]), and floor against column where a floor faces the neighbour's
+//! storey between its floors (physics.md section 11; [`LevelRule::floor_column`] turns these
+//! off). A storey's columns deflect as fixed-fixed members, `u(xi) = u_(j-1) + (u_j - u_(j-1))
+//! s(xi)` with `s = 3 xi^2 - 2 xi^3`, and the force reaches the storey's two floors as
+//! `(1 - s) F` and `s F` ([`LevelSide`]). Each level has its own contact element: the run's law,
+//! stiffness and damping ratio, with the effective mass of the two colliding points,
+//! `m_eff = m_A m_B / (m_A + m_B)`, a column's point mass being `1 / ((1 - s)^2 / m_(j-1) + s^2
+//! / m_j)` (the ground's term 0).
 
 use crate::physics::contact::{Contact, LawKind};
 use crate::physics::model::{EnergyBalance, RunOutput, Status};
 use crate::physics::shear::ShearBuilding;
 
-/// Two floors of neighbouring buildings are at the same level when their elevations differ by
-/// at most this, m.
+/// Two floors of neighbouring buildings are at the same level, by default, when their
+/// elevations differ by at most this, m.
 pub const LEVEL_TOLERANCE_M: f64 = 0.01;
 
-/// A contact level: floor `floor_left` of building `left` against floor `floor_right` of
-/// building `left + 1` (floors counted from 1, the lowest above the ground).
+/// Which contact levels a row has.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelRule {
+    /// Floors whose elevations differ by at most this are one floor/floor level, m.
+    pub same_level_m: f64,
+    /// A floor that faces the neighbour's storey between its floors strikes its columns.
+    pub floor_column: bool,
+}
+
+impl Default for LevelRule {
+    fn default() -> LevelRule {
+        LevelRule {
+            same_level_m: LEVEL_TOLERANCE_M,
+            floor_column: true,
+        }
+    }
+}
+
+/// Where a level meets one of its buildings: a floor, or the columns of a storey at a height
+/// between its floors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelSide {
+    /// The floor (from 1); on a column, the floor at the top of the struck storey (the
+    /// storey's number).
+    pub floor: usize,
+    /// The share of the point's motion and force on `floor`: 1 on a floor; on a column
+    /// `s = 3 xi^2 - 2 xi^3` at `xi` up the storey, the rest `1 - s` on the floor below (none on
+    /// the ground).
+    pub weight: f64,
+}
+
+impl LevelSide {
+    pub fn floor(floor: usize) -> LevelSide {
+        LevelSide { floor, weight: 1.0 }
+    }
+
+    /// The column of storey `storey` (from 1) at `xi` up it (`0 < xi < 1`).
+    pub fn column(storey: usize, xi: f64) -> LevelSide {
+        LevelSide {
+            floor: storey,
+            weight: xi * xi * (3.0 - 2.0 * xi),
+        }
+    }
+
+    pub fn on_column(&self) -> bool {
+        self.weight != 1.0
+    }
+
+    /// The point's value (displacement, velocity, acceleration) from its building's floors'
+    /// `x` (the lowest floor first). On a floor exactly `x[floor - 1]`.
+    #[inline]
+    pub fn at(&self, x: &[f64]) -> f64 {
+        let top = x[self.floor - 1];
+        if self.weight == 1.0 {
+            return top;
+        }
+        let below = if self.floor >= 2 {
+            x[self.floor - 2]
+        } else {
+            0.0
+        };
+        self.weight * top + (1.0 - self.weight) * below
+    }
+
+    /// Each floor (from 0) the point moves with, and its share: the transpose of
+    /// [`LevelSide::at`], so a force `F` at the point does the work `F u(xi)`.
+    pub fn shares(&self) -> impl Iterator<Item = (usize, f64)> {
+        let f = self.floor - 1;
+        let below = (self.weight != 1.0 && f >= 1).then(|| (f - 1, 1.0 - self.weight));
+        below.into_iter().chain(std::iter::once((f, self.weight)))
+    }
+
+    /// The point's mass under a force there: `1 / sum share^2 / m` over its floors (the
+    /// ground takes no share of the motion).
+    pub fn point_mass(&self, masses: &[f64]) -> f64 {
+        if self.weight == 1.0 {
+            return masses[self.floor - 1];
+        }
+        1.0 / self.shares().map(|(f, w)| w * w / masses[f]).sum::<f64>()
+    }
+
+    /// Its name in a level's column prefix: `f3` for floor 3, `c3` for storey 3's column.
+    pub fn name(&self) -> String {
+        let kind = if self.on_column() { 'c' } else { 'f' };
+        format!("{kind}{}", self.floor)
+    }
+}
+
+/// A contact level: a point of building `left` against a point of building `left + 1`, at
+/// least one of them a floor.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Level {
     pub left: usize,
-    pub floor_left: usize,
-    pub floor_right: usize,
-    /// Elevation of the level (the left floor's), m.
+    pub sides: [LevelSide; 2],
+    /// Elevation of the level (the striking floor's), m.
     pub elevation: f64,
     pub contact: Contact,
+}
+
+impl Level {
+    /// Does a floor strike a column here?
+    pub fn floor_column(&self) -> bool {
+        self.sides.iter().any(LevelSide::on_column)
+    }
 }
 
 /// Buildings left to right, the gap between each adjacent two, and the contact levels.
@@ -41,8 +140,9 @@ pub struct Row {
 }
 
 impl Row {
-    /// A row whose contact levels all use `law` with `stiffness` and dimensionless damping
-    /// `damping_ratio` (see [`Contact::new`]). Panics unless there is one gap per adjacent pair.
+    /// A row whose contact levels ([`LevelRule::default`]) all use `law` with `stiffness` and
+    /// dimensionless damping `damping_ratio` (see [`Contact::new`]). Panics unless there is
+    /// one gap per adjacent pair.
     pub fn new(
         buildings: Vec<ShearBuilding>,
         gaps: Vec<f64>,
@@ -50,17 +150,30 @@ impl Row {
         stiffness: f64,
         damping_ratio: f64,
     ) -> Row {
+        let rule = LevelRule::default();
+        Row::with_levels(buildings, gaps, law, stiffness, damping_ratio, rule)
+    }
+
+    /// [`Row::new`] with the levels `rule` gives.
+    pub fn with_levels(
+        buildings: Vec<ShearBuilding>,
+        gaps: Vec<f64>,
+        law: LawKind,
+        stiffness: f64,
+        damping_ratio: f64,
+        rule: LevelRule,
+    ) -> Row {
         assert_eq!(gaps.len() + 1, buildings.len(), "one gap per adjacent pair");
         let mut levels = Vec::new();
         for (a, pair) in buildings.windows(2).enumerate() {
-            for (fa, fb, elevation) in common_levels(&pair[0], &pair[1]) {
-                let (ma, mb) = (pair[0].masses[fa - 1], pair[1].masses[fb - 1]);
+            for point in contact_points(&pair[0], &pair[1], rule) {
+                let [ma, mb] = [0, 1].map(|k| point.sides[k].point_mass(&pair[k].masses));
+                let (k, m_eff) = (point.share * stiffness, point.share * ma * mb / (ma + mb));
                 levels.push(Level {
                     left: a,
-                    floor_left: fa,
-                    floor_right: fb,
-                    elevation,
-                    contact: Contact::new(law, stiffness, damping_ratio, ma * mb / (ma + mb)),
+                    sides: point.sides,
+                    elevation: point.elevation,
+                    contact: Contact::new(law, k, damping_ratio, m_eff),
                 });
             }
         }
@@ -82,6 +195,104 @@ impl Row {
     pub fn storeys(&self) -> usize {
         self.buildings.iter().map(|b| b.storeys()).sum()
     }
+}
+
+/// A contact point of two neighbours ([`contact_points`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactPoint {
+    pub sides: [LevelSide; 2],
+    /// m
+    pub elevation: f64,
+    /// The share of the contact's stiffness and mass the point takes: 1, but from 1/2 to 1
+    /// over `same_level_m` to `2 same_level_m` where its partner lies as close ([`contact_points`]).
+    pub share: f64,
+}
+
+/// The contact points of `left` and `right`, lowest first: every two floors at the same
+/// elevation (within `rule.same_level_m`), and with `rule.floor_column` every other floor of
+/// either against the neighbour's storey at its height (none above the neighbour's roof).
+///
+/// Two floors `d` apart just beyond the tolerance give two floor/column points that both move
+/// almost as the one floor/floor level they become within it: each takes a share of the
+/// contact that rises smoothly from 1/2 at `d = same_level_m` to 1 at twice that, so the
+/// motion does not jump where two points become one.
+pub fn contact_points(
+    left: &ShearBuilding,
+    right: &ShearBuilding,
+    rule: LevelRule,
+) -> Vec<ContactPoint> {
+    let tol = rule.same_level_m;
+    let z = [left.elevations(), right.elevations()];
+    let mut points: Vec<ContactPoint> = Vec::new();
+    // Per point on a column: the striking side, and the struck storey's nearer floor.
+    let mut struck: Vec<Option<(usize, usize, f64)>> = Vec::new();
+    for (fa, &ea) in z[0].iter().enumerate() {
+        if let Some(fb) = z[1].iter().position(|&eb| (ea - eb).abs() <= tol) {
+            points.push(ContactPoint {
+                sides: [LevelSide::floor(fa + 1), LevelSide::floor(fb + 1)],
+                elevation: ea,
+                share: 1.0,
+            });
+            struck.push(None);
+        }
+    }
+    if rule.floor_column {
+        for k in 0..2 {
+            let other = 1 - k;
+            for (f, &e) in z[k].iter().enumerate() {
+                if z[other].iter().any(|&o| (e - o).abs() <= tol) {
+                    continue;
+                }
+                // The neighbour's storey at `e`: the first floor above it.
+                let Some(j) = z[other].iter().position(|&o| o > e) else {
+                    continue;
+                };
+                let bottom = if j == 0 { 0.0 } else { z[other][j - 1] };
+                let xi = (e - bottom) / (z[other][j] - bottom);
+                let mut sides = [LevelSide::floor(f + 1); 2];
+                sides[other] = LevelSide::column(j + 1, xi);
+                points.push(ContactPoint {
+                    sides,
+                    elevation: e,
+                    share: 1.0,
+                });
+                // The nearer of the struck storey's floors (the ground has no partner).
+                let near = if xi >= 0.5 {
+                    Some((j, z[other][j]))
+                } else {
+                    j.checked_sub(1).map(|b| (b, bottom))
+                };
+                struck.push(near.map(|(floor, zn)| (k, floor, (e - zn).abs())));
+            }
+        }
+        // Partners: the point where the struck storey's nearer floor strikes this floor's
+        // storey, as close to this one.
+        let shares: Vec<f64> = (0..points.len())
+            .map(|i| {
+                let Some((k, near, d)) = struck[i] else {
+                    return 1.0;
+                };
+                let striking = points[i].sides[k].floor - 1;
+                let partner = (0..points.len()).any(|p| match struck[p] {
+                    Some((kp, near_p, _)) => {
+                        kp != k && points[p].sides[kp].floor - 1 == near && near_p == striking
+                    }
+                    None => false,
+                });
+                if partner {
+                    let r = ((d - tol) / tol).clamp(0.0, 1.0);
+                    0.5 + 0.5 * r * r * (3.0 - 2.0 * r)
+                } else {
+                    1.0
+                }
+            })
+            .collect();
+        for (p, s) in points.iter_mut().zip(shares) {
+            p.share = s;
+        }
+    }
+    points.sort_by(|a, b| a.elevation.total_cmp(&b.elevation));
+    points
 }
 
 /// The floors of `left` and `right` at the same elevation (within [`LEVEL_TOLERANCE_M`]),
@@ -114,6 +325,12 @@ pub struct LevelOutput {
     pub contact_time: f64,
     /// Net work of the contact force on the relative motion, J.
     pub dissipated_energy: f64,
+    /// Where a floor strikes a column: the struck storey's largest column shear while in
+    /// contact, N (the storey's spring force with the share of the contact force each
+    /// segment of the column carries: `max(|V - s F|, |V + (1 - s) F|)`); 0 elsewhere.
+    pub column_shear: f64,
+    /// That shear over the storey's yield force, where it yields (0 elsewhere).
+    pub column_shear_ratio: f64,
 }
 
 /// What one building reports. Peaks are over the whole simulated time.
@@ -254,6 +471,7 @@ impl RowOutput {
             first_impact: out.first_impact,
             contact_time: out.contact_time,
             dissipated_energy: out.dissipated_energy,
+            ..LevelOutput::default()
         };
         let building = |u: f64, a: f64, h: f64| BuildingOutput {
             peak_roof: u,
@@ -358,7 +576,8 @@ mod tests {
         let got: Vec<(usize, usize, usize)> = row
             .levels
             .iter()
-            .map(|l| (l.left, l.floor_left, l.floor_right))
+            .filter(|l| !l.floor_column())
+            .map(|l| (l.left, l.sides[0].floor, l.sides[1].floor))
             .collect();
         assert_eq!(
             got,
@@ -370,13 +589,109 @@ mod tests {
     }
 
     #[test]
-    fn floors_at_different_heights_never_touch() {
-        let row = Row::new(
+    fn floors_at_different_heights_strike_columns() {
+        // 3 storeys of 3.5 m against 4 of 3 m: floors at 3.5, 7, 10.5 against 3, 6, 9, 12.
+        let (a, b) = (building(3, 3.5, 2e5), building(4, 3.0, 3e5));
+        let row = Row::new(vec![a, b], vec![0.02], LawKind::Linear, 1e9, 0.0);
+        let got: Vec<(String, String, f64)> = (row.levels.iter())
+            .map(|l| (l.sides[0].name(), l.sides[1].name(), l.elevation))
+            .collect();
+        let want = [
+            ("c1", "f1", 3.0),
+            ("f1", "c2", 3.5),
+            ("c2", "f2", 6.0),
+            ("f2", "c3", 7.0),
+            ("c3", "f3", 9.0),
+            ("f3", "c4", 10.5),
+        ];
+        assert_eq!(got.len(), want.len(), "{got:?}");
+        for ((l, r, z), (wl, wr, wz)) in got.iter().zip(want) {
+            assert_eq!((l.as_str(), r.as_str()), (wl, wr));
+            assert!((z - wz).abs() < 1e-12);
+        }
+        // Floor 1 of the left building (3.5 m) is a sixth of the way up the right's storey 2
+        // (3-6 m): s = 3 / 36 - 2 / 216.
+        let side = row.levels[1].sides[1];
+        let s = 3.0 / 36.0 - 2.0 / 216.0;
+        assert!((side.weight - s).abs() < 1e-15);
+        assert!((side.at(&[2.0, 4.0, 0.0, 0.0]) - (2.0 + 2.0 * s)).abs() < 1e-12);
+        // Storey 1's column shares its point with the ground: only floor 1 moves it.
+        let low = row.levels[0].sides[0];
+        let xi: f64 = 3.0 / 3.5;
+        assert!((low.weight - xi * xi * (3.0 - 2.0 * xi)).abs() < 1e-15);
+        assert_eq!(low.shares().collect::<Vec<_>>(), vec![(0, low.weight)]);
+        assert!((low.point_mass(&[2e5; 3]) - 2e5 / (low.weight * low.weight)).abs() < 1e-6);
+        // The point's mass: 1 / ((1 - s)^2 / m_1 + s^2 / m_2), and the effective mass with it.
+        let mp = 1.0 / ((1.0 - s) * (1.0 - s) / 3e5 + s * s / 3e5);
+        let want = 2e5 * mp / (2e5 + mp);
+        assert!((row.levels[1].contact.m_eff - want).abs() < 1e-9 * want);
+        // Turned off: only common floors (none here).
+        let rule = LevelRule {
+            floor_column: false,
+            ..LevelRule::default()
+        };
+        let (a, b) = (building(3, 3.5, 2e5), building(4, 3.0, 3e5));
+        let off = Row::with_levels(vec![a, b], vec![0.02], LawKind::Linear, 1e9, 0.0, rule);
+        assert!(off.levels.is_empty());
+    }
+
+    /// A force at a column's point does the work of its shares on the floors: the split is the
+    /// transpose of how the point moves, so any floor motion gives `F u(xi)` both ways.
+    #[test]
+    fn a_column_point_splits_its_force_by_virtual_work() {
+        for (storey, xi) in [(1, 0.3), (2, 0.3), (3, 0.77)] {
+            let side = LevelSide::column(storey, xi);
+            let u = [0.013, -0.007, 0.021];
+            let f = 2.5e5;
+            let work: f64 = side.shares().map(|(k, w)| w * f * u[k]).sum();
+            assert!((work - f * side.at(&u)).abs() < 1e-12 * f);
+            // Statically the shares carry the whole force, except what the ground takes.
+            let carried: f64 = side.shares().map(|(_, w)| w).sum();
+            let want = if storey == 1 { side.weight } else { 1.0 };
+            assert!((carried - want).abs() < 1e-15);
+        }
+    }
+
+    /// Two floors just beyond the tolerance apart give two floor/column points that each take a
+    /// half share, rising to whole ones at twice the tolerance: where they become one level,
+    /// the contact's stiffness does not jump.
+    #[test]
+    fn points_that_become_one_level_share_the_contact() {
+        let shares = |h: f64| -> Vec<f64> {
+            let (a, b) = (building(3, 3.0, 2e5), building(3, h, 2e5));
+            contact_points(&a, &b, LevelRule::default())
+                .iter()
+                .map(|p| p.share)
+                .collect()
+        };
+        assert_eq!(shares(3.0), vec![1.0; 3]);
+        // Floor 1 at 3.0 against 3.005: one level.
+        assert_eq!(shares(3.005).len(), 3);
+        // Just past 0.01 m: floor 1's two points take half shares (the higher floors are
+        // farther apart; the right's roof is above the left's).
+        let near = shares(3.0101);
+        assert_eq!(near.len(), 5);
+        assert!(
+            near.iter().take(2).all(|&s| (s - 0.5).abs() < 1e-3),
+            "{near:?}"
+        );
+        let far = shares(3.3);
+        assert!(far.iter().all(|&s| s == 1.0), "{far:?}");
+    }
+
+    #[test]
+    fn floors_at_different_heights_never_touch_without_columns() {
+        let rule = LevelRule {
+            floor_column: false,
+            ..LevelRule::default()
+        };
+        let row = Row::with_levels(
             vec![building(3, 3.0, 2e5), building(3, 3.2, 2e5)],
             vec![0.02],
             LawKind::Linear,
             1e9,
             0.0,
+            rule,
         );
         assert!(row.levels.is_empty());
     }

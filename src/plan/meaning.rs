@@ -266,7 +266,7 @@ const PER_BUILDING: [(&str, &str, &str, &str); 19] = [
 ];
 
 /// Per contact level: suffix, unit, short name, meaning.
-const PER_LEVEL: [(&str, &str, &str, &str); 4] = [
+const PER_LEVEL: [(&str, &str, &str, &str); 6] = [
     ("impacts", "-", "impacts, {level}", "impacts at {level}"),
     (
         "peak_force_n",
@@ -285,6 +285,18 @@ const PER_LEVEL: [(&str, &str, &str, &str); 4] = [
         "m/s",
         "impact velocity, {level}",
         "approach speed of the largest impact at {level}",
+    ),
+    (
+        "column_shear_n",
+        "N",
+        "column shear, {level}",
+        "largest shear in the struck storey's columns while in contact at {level}: the storey's spring force with the share of the contact force each column segment carries, max(|V - s F|, |V + (1 - s) F|), s = 3 xi^2 - 2 xi^3 at the height xi up the storey (0 if never in contact)",
+    ),
+    (
+        "column_shear_ratio",
+        "-",
+        "column shear / yield force, {level}",
+        "that largest column shear at {level} over the struck storey's yield force (storeys that yield)",
     ),
 ];
 
@@ -332,23 +344,37 @@ pub fn meaning(column: &str) -> Option<Meaning> {
             }
         }
     }
-    // level_bIfJ_bKfL_<output>
+    // level_bIfJ_bKfL_<output>, or a floor against a storey's columns: bKcL
     if let Some(rest) = column.strip_prefix("level_") {
         let parts: Vec<&str> = rest.splitn(3, '_').collect();
         if let [left, right, output] = parts[..] {
-            let floor = |p: &str| -> Option<(usize, usize)> {
-                let (b, f) = p.strip_prefix('b')?.split_once('f')?;
-                Some((number(b)?, number(f)?))
+            // (building, floor or storey, on a column)
+            let side = |p: &str| -> Option<(usize, usize, bool)> {
+                let p = p.strip_prefix('b')?;
+                let (b, f, column) = match p.split_once('f') {
+                    Some((b, f)) => (b, f, false),
+                    None => p.split_once('c').map(|(b, c)| (b, c, true))?,
+                };
+                Some((number(b)?, number(f)?, column))
             };
-            if let (Some(l), Some(r), Some(m)) = (
-                floor(left),
-                floor(right),
-                PER_LEVEL.iter().find(|m| m.0 == output),
-            ) {
-                let level = format!(
-                    "the level where floor {} of building {} meets floor {} of building {}",
-                    l.1, l.0, r.1, r.0
-                );
+            let sides = (side(left), side(right));
+            if let ((Some(l), Some(r)), Some(m)) = (sides, PER_LEVEL.iter().find(|m| m.0 == output))
+            {
+                let level = match (l.2, r.2) {
+                    (false, false) => format!(
+                        "the level where floor {} of building {} meets floor {} of building {}",
+                        l.1, l.0, r.1, r.0
+                    ),
+                    (false, true) => format!(
+                        "the level where floor {} of building {} strikes the columns of storey {} of building {}",
+                        l.1, l.0, r.1, r.0
+                    ),
+                    (true, false) => format!(
+                        "the level where floor {} of building {} strikes the columns of storey {} of building {}",
+                        r.1, r.0, l.1, l.0
+                    ),
+                    (true, true) => return None,
+                };
                 return Some(Meaning {
                     unit: m.1,
                     label: m.2.replace("{level}", &format!("level {left}-{right}")),
@@ -420,6 +446,10 @@ mod tests {
         assert!(m
             .text
             .contains("floor 3 of building 1 meets floor 2 of building 2"));
+        let m = meaning("level_b1c2_b2f1_impacts").unwrap();
+        assert!(m
+            .text
+            .contains("floor 1 of building 2 strikes the columns of storey 2 of building 1"));
         assert_eq!(meaning("b12_peak_drift_ratio").unwrap().unit, "m/m");
         for c in crate::plan::row::BUILDING_OUTPUTS
             .iter()
@@ -446,6 +476,7 @@ mod tests {
             "b_peak_roof_m",
             "gap_a_2_m",
             "level_b1f3_peak_force_n",
+            "level_b1c3_b2c2_peak_force_n",
             "nope",
             "b1_nope",
         ] {

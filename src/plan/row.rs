@@ -8,7 +8,7 @@
 //! last gap innermost.
 
 use crate::physics::model::Forcing;
-use crate::physics::row::{Row, RowOutput, StoreyOutput};
+use crate::physics::row::{Level, LevelRule, LevelSide, Row, RowOutput, StoreyOutput};
 use crate::physics::shear::{Damping, ShearBuilding, Yielding, MAX_STOREYS};
 use crate::physics::solver::row::RowScheme;
 use crate::physics::solver::Scheme;
@@ -48,14 +48,30 @@ config::forms!(PerStorey, "a number (every storey) or a list of numbers (one per
 });
 
 /// The column prefix of a contact level: `level_b1f3_b2f3` for floor 3 of building 1 (`left`
-/// = 0, buildings from 0 here) against floor 3 of building 2 (floors from 1).
-pub fn level_name(left: usize, floor_left: usize, floor_right: usize) -> String {
+/// = 0, buildings from 0 here) against floor 3 of building 2 (floors from 1);
+/// `level_b1f3_b2c4` where floor 3 of building 1 strikes the columns of building 2's storey 4.
+pub fn level_name(left: usize, sides: &[LevelSide; 2]) -> String {
     format!(
-        "level_b{}f{floor_left}_b{}f{floor_right}",
+        "level_b{}{}_b{}{}",
         left + 1,
-        left + 2
+        sides[0].name(),
+        left + 2,
+        sides[1].name()
     )
 }
+
+/// `[levels]` as written: which contact levels a row has.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawLevels {
+    /// Floors this close are one floor/floor level, m (default 0.01).
+    pub same_level_m: Option<f64>,
+    /// A floor that faces a neighbour's storey strikes its columns (default true).
+    pub floor_column: Option<bool>,
+}
+
+/// The largest `[levels] same_level_m`: the depth of a thick slab, m.
+pub const MAX_SAME_LEVEL_M: f64 = 0.5;
 
 /// One `[[building]]` as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -205,6 +221,8 @@ pub struct RawRowConfig {
     #[serde(default)]
     pub intensity: RawIntensity,
     pub sample: Option<RawSample>,
+    #[serde(default)]
+    pub levels: RawLevels,
 }
 
 /// One building's axes.
@@ -326,6 +344,11 @@ pub struct RowPlan {
     pub contact: ContactPlan,
     /// A run collapses when any storey's drift ratio reaches this (infinite: never).
     pub collapse_drift_ratio: f64,
+    /// Which contact levels the rows have (`[levels]`).
+    pub level_rule: LevelRule,
+    /// Per contact level where a floor strikes a column: whether the struck storey yields
+    /// (None for a floor/floor level). Set once the plan is made ([`RowPlan::struck_columns`]).
+    struck: Vec<Option<bool>>,
     pub buildings: Vec<ShearAxes>,
     /// m, per adjacent pair.
     pub gaps: Vec<Vec<f64>>,
@@ -508,9 +531,10 @@ impl RowPlan {
         w
     }
 
-    /// Each adjacent pair with no floor at a common elevation, and why: they never touch floor
-    /// to floor (mid-column pounding is not modelled), so no run checks them for contact.
-    /// Heights are not swept, so this holds for every run of the plan.
+    /// Each adjacent pair with no contact level, and why: no floor at a common elevation, and
+    /// floors that strike columns turned off (`[levels] floor_column = false`), so no run
+    /// checks them for contact. Heights are not swept, so this holds for every run of the
+    /// plan.
     pub fn pairs_without_levels(&self) -> Vec<String> {
         let row = self.row(&self.run(0));
         let elevations = |b: &ShearBuilding| -> Vec<String> {
@@ -520,12 +544,12 @@ impl RowPlan {
             .filter(|&a| !row.levels.iter().any(|l| l.left == a))
             .map(|a| {
                 format!(
-                    "buildings {} and {} share no floor level (floors at {} m against {} m; levels meet within {} m): floors at different heights are not modelled as touching (mid-column pounding), so this pair is never checked for contact and has no level columns",
+                    "buildings {} and {} share no floor level (floors at {} m against {} m; levels meet within {} m) and [levels] floor_column = false: floors that strike columns are turned off, so this pair is never checked for contact and has no level columns",
                     a + 1,
                     a + 2,
                     elevations(&row.buildings[a]).join(", "),
                     elevations(&row.buildings[a + 1]).join(", "),
-                    crate::physics::row::LEVEL_TOLERANCE_M
+                    self.level_rule.same_level_m
                 )
             })
             .collect()
@@ -630,24 +654,53 @@ impl RowPlan {
             })
             .collect();
         let s = &run.contact;
-        Row::new(buildings, run.gaps.clone(), s.law, s.stiffness, s.damping)
-            .with_collapse(self.collapse_drift_ratio)
+        let rule = self.level_rule;
+        Row::with_levels(
+            buildings,
+            run.gaps.clone(),
+            s.law,
+            s.stiffness,
+            s.damping,
+            rule,
+        )
+        .with_collapse(self.collapse_drift_ratio)
     }
 
     pub fn forcing(&self, run: &RowRunSpec) -> Forcing<'_> {
         self.contact.forcing(&run.contact)
     }
 
-    /// The contact levels' column prefixes, `level_b1f3_b2f3` for floor 3 of building 1
-    /// against floor 3 of building 2 (buildings and floors from 1). They depend only on storeys
-    /// and heights, which no axis sweeps, so every run of the plan has the same levels.
+    /// The contact levels of every run (with the first run's contact elements): they depend
+    /// only on storeys and heights, which no axis sweeps, so every run of the plan has the
+    /// same levels.
+    pub fn levels(&self) -> Vec<Level> {
+        self.row(&self.run(0)).levels
+    }
+
+    /// The contact levels' column prefixes ([`level_name`]).
     pub fn level_names(&self) -> Vec<String> {
-        let first = self.run(0);
-        self.row(&first)
-            .levels
-            .iter()
-            .map(|l| level_name(l.left, l.floor_left, l.floor_right))
+        (self.levels().iter())
+            .map(|l| level_name(l.left, &l.sides))
             .collect()
+    }
+
+    /// Per contact level where a floor strikes a column, whether the struck storey yields
+    /// (None for a floor/floor level).
+    fn struck_columns(&self) -> Vec<Option<bool>> {
+        if self.is_empty() {
+            return Vec::new();
+        }
+        (self.levels().iter())
+            .map(|l| {
+                let side = (0..2).find(|&k| l.sides[k].on_column())?;
+                Some(self.yielding[l.left + side].is_some())
+            })
+            .collect()
+    }
+
+    /// Does a floor strike a neighbour's columns in this plan's rows?
+    pub fn has_floor_column(&self) -> bool {
+        self.levels().iter().any(Level::floor_column)
     }
 
     /// Every column, in file order: the contact and motion columns of the pair, each
@@ -713,9 +766,15 @@ impl RowPlan {
                 }
             }
         }
-        for l in self.level_names() {
+        for (l, struck) in self.level_names().iter().zip(&self.struck) {
             for c in LEVEL_OUTPUTS {
                 h.push(format!("{l}_{c}"));
+            }
+            if let Some(yields) = struck {
+                h.push(format!("{l}_column_shear_n"));
+                if *yields {
+                    h.push(format!("{l}_column_shear_ratio"));
+                }
             }
         }
         for c in ["input_energy_j", "damping_energy_j", "energy_residual"] {
@@ -851,13 +910,19 @@ impl RowPlan {
                 }
             }
         }
-        for l in &out.levels {
+        for (l, struck) in out.levels.iter().zip(&self.struck) {
             c.extend([
                 l.impacts.to_string(),
                 num(l.peak_force),
                 num(l.peak_penetration),
                 num(l.impact_velocity),
             ]);
+            if let Some(yields) = struck {
+                c.push(num(l.column_shear));
+                if *yields {
+                    c.push(num(l.column_shear_ratio));
+                }
+            }
         }
         c.extend([
             opt(out.energy.map(|e| e.input)),
@@ -880,7 +945,7 @@ impl RowPlan {
                 .all(|b| b.storeys() == 1 && b.p_delta.is_none())
             && self.yielding.iter().all(Option::is_none)
             && matches!(self.contact.spec.scheme, Scheme::Fast(_))
-            && self.level_names().len() == 1
+            && matches!(&self.levels()[..], [l] if !l.floor_column())
     }
 
     /// `run` as the pair's run of the same buildings (floor mass, period, damping ratio), gap,
@@ -1298,9 +1363,11 @@ pub fn parse_row(
                 ),
             )
         })?;
-    Ok(RowPlan {
+    let level_rule = level_rule(&raw.levels).map_err(|(k, m)| invalid(k, m))?;
+    let mut plan = RowPlan {
         contact,
         collapse_drift_ratio,
+        level_rule,
         buildings,
         gaps,
         samples,
@@ -1312,7 +1379,31 @@ pub fn parse_row(
         yielding,
         yield_dim,
         storey_columns: false,
-    })
+        struck: Vec::new(),
+    };
+    plan.struck = plan.struck_columns();
+    Ok(plan)
+}
+
+/// `[levels]` as the rows' rule. Err: the key and why.
+fn level_rule(raw: &RawLevels) -> Result<LevelRule, (&'static str, String)> {
+    let mut rule = LevelRule::default();
+    if let Some(x) = raw.same_level_m {
+        if !(0.0..=MAX_SAME_LEVEL_M).contains(&x) {
+            return Err((
+                "levels.same_level_m",
+                format!(
+                    "{}: expected a height in m >= 0 and <= {MAX_SAME_LEVEL_M} (floors this close are one level)",
+                    crate::show(x)
+                ),
+            ));
+        }
+        rule.same_level_m = x;
+    }
+    if let Some(on) = raw.floor_column {
+        rule.floor_column = on;
+    }
+    Ok(rule)
 }
 
 /// Every P-Delta building stable under gravity alone at every period it takes (`taken`): each

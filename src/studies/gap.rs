@@ -11,10 +11,11 @@
 //! response ([`yielding_separation`]).
 
 use crate::physics::model::Oscillator;
+use crate::physics::row::LevelRule;
 use crate::physics::separation::{cqc_rho, Rule};
 use crate::physics::shear::ShearBuilding;
 use crate::physics::solver::separation::{
-    separation, yielding_separation, LevelSeparation, Separation,
+    separation_with, yielding_separation, LevelSeparation, Separation,
 };
 use crate::plan::columns::{at, contact_and_motion, num, RECORD_IMS};
 use crate::plan::intensity::TARGET_COLUMNS;
@@ -156,15 +157,29 @@ impl Scenes<'_> {
             Plan::Row(plan) if self.0.yields() => {
                 let run = plan.motion_run(m);
                 let buildings = plan.row(&run).buildings;
-                yielding_separation(&buildings, &plan.forcing(&run), &plan.scheme())
+                yielding_separation(
+                    &buildings,
+                    &plan.forcing(&run),
+                    &plan.scheme(),
+                    plan.level_rule,
+                )
             }
             _ => {
                 let spec = &self.base().spec;
-                Ok(separation(
+                Ok(separation_with(
                     &self.buildings(m),
                     &spec.records[record].forcing(1.0, spec.tail),
+                    self.level_rule(),
                 ))
             }
+        }
+    }
+
+    /// Which contact levels the scene has (a pair's one floor level is the default's).
+    fn level_rule(&self) -> LevelRule {
+        match self.0 {
+            Plan::Row(plan) => plan.level_rule,
+            Plan::Pair(_) => LevelRule::default(),
         }
     }
 
@@ -266,7 +281,7 @@ impl<'a> GapStudy<'a> {
         let level_names = first.map_or(Vec::new(), |s| {
             s.levels
                 .iter()
-                .map(|l| level_name(l.pair, l.floor_left, l.floor_right))
+                .map(|l| level_name(l.pair, &l.sides))
                 .collect()
         });
         let level_pairs = first.map_or(Vec::new(), |s| s.levels.iter().map(|l| l.pair).collect());

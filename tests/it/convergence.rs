@@ -32,7 +32,7 @@ use pounding::record::{read_record, ReadOptions};
 use pounding::studies::accuracy::rises;
 
 /// The settings tried, substeps per contact.
-const SETTINGS: [f64; 7] = [8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0];
+pub(crate) const SETTINGS: [f64; 7] = [8.0, 16.0, 32.0, 64.0, 128.0, 256.0, 512.0];
 /// The error below which settings are not told apart: the reference (tolerance 1e-10) and the
 /// peaks of free record steps (a quintic Hermite over each, the same at every setting) agree
 /// with the exact motion to about 1e-7 here.
@@ -66,7 +66,7 @@ impl Scene {
 }
 
 /// `building` with every storey yielding at drift ratio `theta`, post-yield ratio `b`.
-fn yielding(mut s: ShearBuilding, theta: f64, b: f64) -> ShearBuilding {
+pub(crate) fn yielding(mut s: ShearBuilding, theta: f64, b: f64) -> ShearBuilding {
     let n = s.storeys();
     s.yielding = Some(Yielding::from_drift_ratio(
         &s.stiffness,
@@ -388,24 +388,32 @@ fn judge(
                 Err(why) => bad.push(format!("{at}: {why}")),
             }
         }
-        let line: Vec<String> = errs.iter().map(|(s, e)| format!("{s}: {e:.1e}")).collect();
-        eprintln!("{path}, {}: {}", scene.name, line.join(", "));
-        // `pound accuracy`'s rule, over the settings this run was compared at.
-        let before: Vec<(f64, Vec<Option<f64>>)> =
-            errs.iter().map(|&(s, e)| (s, vec![Some(e)])).collect();
-        for k in 1..errs.len() {
-            let (s1, e1) = errs[k];
-            for r in rises(&before[..k], &[Some(e1)], FLOOR) {
-                bad.push(format!(
-                    "{path}, {}: not converging, error {e1:.2e} at {s1} after {:.2e} at {}",
-                    scene.name, r.previous_error, r.previous_setting
-                ));
-            }
+        bad.extend(failures(&format!("{path}, {}", scene.name), &errs));
+    }
+    bad
+}
+
+/// One run's errors `(setting, error)` judged (see the module's text): printed, then each
+/// setting whose error rises by `pound accuracy`'s rule over the settings before it, and an
+/// error above `AT_128` at 128 or above `FLOOR` at 512.
+pub(crate) fn failures(name: &str, errs: &[(f64, f64)]) -> Vec<String> {
+    let mut bad = Vec::new();
+    let line: Vec<String> = errs.iter().map(|(s, e)| format!("{s}: {e:.1e}")).collect();
+    eprintln!("{name}: {}", line.join(", "));
+    let before: Vec<(f64, Vec<Option<f64>>)> =
+        errs.iter().map(|&(s, e)| (s, vec![Some(e)])).collect();
+    for k in 1..errs.len() {
+        let (s1, e1) = errs[k];
+        for r in rises(&before[..k], &[Some(e1)], FLOOR) {
+            bad.push(format!(
+                "{name}: not converging, error {e1:.2e} at {s1} after {:.2e} at {}",
+                r.previous_error, r.previous_setting
+            ));
         }
-        for &(s, e) in &errs {
-            if (s == 128.0 && e > AT_128) || (s == 512.0 && e > FLOOR) {
-                bad.push(format!("{path}, {}: error {e:.2e} at {s}", scene.name));
-            }
+    }
+    for &(s, e) in errs {
+        if (s == 128.0 && e > AT_128) || (s == 512.0 && e > FLOOR) {
+            bad.push(format!("{name}: error {e:.2e} at {s}"));
         }
     }
     bad

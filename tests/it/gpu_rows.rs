@@ -50,11 +50,13 @@ fn on_cpu_whole_row(models: &[RowModel], records: &[Vec<f64>]) -> Vec<RowOutput>
 }
 
 /// Largest relative difference of the peaks of two results of one run (force, every level's
-/// force, roofs, drifts, floor accelerations).
+/// force and struck column's shear, roofs, drifts, floor accelerations).
 fn peak_diff(a: &RowOutput, b: &RowOutput) -> f64 {
     let mut d = rel(a.peak_force, b.peak_force);
     for (x, y) in a.levels.iter().zip(&b.levels) {
-        d = d.max(rel(x.peak_force, y.peak_force));
+        d = d
+            .max(rel(x.peak_force, y.peak_force))
+            .max(rel(x.column_shear, y.column_shear));
     }
     for (x, y) in a.buildings.iter().zip(&b.buildings) {
         d = d
@@ -121,7 +123,7 @@ fn row_kernel_matches_the_cpu_twin() {
         // of three (44 impacts), whose events the kernel locates in time local to the record
         // step (the CPU in absolute time): 1e-9 s apart at first, grown through the impact
         // sequence. f32: up to 4e-5.
-        assert_gpu_is_the_twin(&models, &records, &cpu, 1e-5);
+        assert_gpu_is_the_twin(&models, &records, &cpu, 1e-5, 0);
     }
 }
 
@@ -133,6 +135,7 @@ fn assert_gpu_is_the_twin(
     records: &[Vec<f64>],
     cpu: &[RowOutput],
     f64_peaks: f64,
+    substep_slack: u64,
 ) {
     for precision in [Precision::F64, Precision::F32] {
         let opts = GpuOptions {
@@ -145,7 +148,14 @@ fn assert_gpu_is_the_twin(
             let d = peak_diff(g, c);
             assert_eq!(g.status, Status::Ok, "{precision:?} run {k}");
             if precision == Precision::F64 {
-                assert_eq!((g.impacts, g.substeps), (c.impacts, c.substeps), "run {k}");
+                assert_eq!(g.impacts, c.impacts, "run {k}");
+                assert!(
+                    g.substeps.abs_diff(c.substeps) <= substep_slack,
+                    "run {k}: {} substeps, the CPU's {}",
+                    g.substeps,
+                    c.substeps
+                );
+                eprintln!("f64 run {k}: peaks {d:.1e} apart");
                 assert!(d < f64_peaks, "f64 run {k}: {d:e}\n{g:?}\n{c:?}");
                 let places = |o: &RowOutput| {
                     (o.buildings.iter())
@@ -186,7 +196,7 @@ fn a_twelve_storey_pair_on_the_gpu_is_the_cpu_twin() {
     let records: Vec<Vec<f64>> = (0..2).map(|s| record(70 + s, 2.0, 0.6)).collect();
     let cpu = on_cpu_whole_row(&models, &records);
     assert!(cpu.iter().all(|c| c.impacts > 0), "{cpu:?}");
-    assert_gpu_is_the_twin(&models, &records, &cpu, 1e-6);
+    assert_gpu_is_the_twin(&models, &records, &cpu, 1e-6, 0);
 }
 
 /// A dispatch of one unit per run gives what a dispatch of many gives: the kernel's state
@@ -361,12 +371,14 @@ fn row_kernel_builds_for_every_shape() {
             levels: vec![[0, 0, 0]],
             yielding: vec![true, true],
             coupled: vec![false, false],
+            columns: vec![],
         },
         RowShape {
             storeys: vec![3, 6, 2],
             levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [1, 0, 0], [1, 1, 1]],
             yielding: vec![false, true, true],
             coupled: vec![false, false, false],
+            columns: vec![],
         },
         // P-Delta buildings whose damping may couple their modes, elastic and yielding.
         RowShape {
@@ -374,6 +386,7 @@ fn row_kernel_builds_for_every_shape() {
             levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [1, 0, 0], [1, 1, 1]],
             yielding: vec![false, true, false],
             coupled: vec![true, true, false],
+            columns: vec![],
         },
         // Too tall to write out: the loops of row_loops.wgsl, yielding and coupled.
         RowShape {
@@ -381,6 +394,27 @@ fn row_kernel_builds_for_every_shape() {
             levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [0, 3, 3]],
             yielding: vec![true, true],
             coupled: vec![true, false],
+            columns: vec![],
+        },
+        // Floors that strike columns, written out and as loops (one in a first storey, whose
+        // column shares its point with the ground).
+        RowShape {
+            storeys: vec![3, 4],
+            levels: vec![[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 2]],
+            yielding: vec![false, true],
+            coupled: vec![false, false],
+            columns: vec![
+                (0, 0, 0.9f64.to_bits()),
+                (1, 1, 0.07f64.to_bits()),
+                (3, 1, 0.5f64.to_bits()),
+            ],
+        },
+        RowShape {
+            storeys: vec![9, 4],
+            levels: vec![[0, 0, 0], [0, 0, 1], [0, 1, 1]],
+            yielding: vec![true, false],
+            coupled: vec![false, false],
+            columns: vec![(0, 0, 0.9f64.to_bits()), (1, 1, 0.07f64.to_bits())],
         },
     ];
     // Both ways of writing the per-shape functions are among them.
@@ -624,5 +658,68 @@ fn row_kernel_yields_as_the_cpu_twin() {
                 }
             }
         }
+    }
+}
+
+/// Floors that strike columns (issue 50) on the device: a 3-storey of 3.5 m storeys beside a
+/// 4-storey of 3 m storeys (every level floor against column; written out), elastic and
+/// yielding, at two gaps, and a 9-storey of 3.2 m storeys beside it (the loops): f64 gives the
+/// CPU twin's impacts, substeps and peaks (the struck columns' shear among them).
+#[test]
+fn floors_that_strike_columns_on_the_gpu_are_the_cpu_twin() {
+    if ctx().is_none() {
+        return;
+    }
+    let frame = |n: usize, h: f64, period: f64| {
+        ShearBuilding::from_period(
+            vec![2.5e5; n],
+            &vec![1.0; n],
+            vec![h; n],
+            period,
+            Damping::Modal(0.05),
+        )
+    };
+    let yielding = |mut b: ShearBuilding| {
+        let n = b.storeys();
+        b.yielding = Some(Yielding::from_drift_ratio(
+            &b.stiffness,
+            &b.heights,
+            &vec![0.005; n],
+            vec![0.05; n],
+        ));
+        b
+    };
+    let row = |left: ShearBuilding, right: ShearBuilding, gap: f64| {
+        RowModel::new(&Row::new(
+            vec![left, right],
+            vec![gap],
+            LawKind::NonlinearViscoelastic,
+            2.75e9,
+            0.35,
+        ))
+    };
+    for (left, right) in [
+        (frame(3, 3.5, 0.45), frame(4, 3.0, 0.55)),
+        (frame(3, 3.5, 0.45), yielding(frame(4, 3.0, 0.55))),
+        (frame(9, 3.2, 0.9), frame(4, 3.0, 0.55)),
+    ] {
+        let models: Vec<RowModel> = [0.0, 0.004]
+            .iter()
+            .map(|&gap| row(left.clone(), right.clone(), gap))
+            .collect();
+        let shape = RowShape::of(&models[0]);
+        assert!(!shape.columns.is_empty());
+        let records: Vec<Vec<f64>> = (0..2).map(|s| record(80 + s, 3.0, 0.5)).collect();
+        let cpu = on_cpu_whole_row(&models, &records);
+        assert!(
+            cpu.iter()
+                .all(|c| c.levels.iter().any(|l| l.column_shear > 0.0)),
+            "a floor strikes a column: {cpu:?}"
+        );
+        // The CPU's free steps read a column's point from its floors (`w u_j + (1 - w)
+        // u_(j-1)`), the kernel from its row of mode shapes (the same motion, rounded
+        // differently): a check of a free step that rounds the other way takes a piece more
+        // or less.
+        assert_gpu_is_the_twin(&models, &records, &cpu, 1e-6, 4);
     }
 }

@@ -13,6 +13,7 @@ mod damage_states;
 mod fast_vs_reference;
 mod fidelity;
 mod figures;
+mod floor_column;
 mod gap;
 mod gpu;
 mod gpu_rows;

@@ -525,12 +525,16 @@ fn row_config_sweeps_to_csv_matching_the_library() {
     let header: Vec<String> = rd.headers().unwrap().iter().map(String::from).collect();
     assert_eq!(header, plan.header());
     // Levels: building 1's floors 1, 2 meet building 2's (3 m, 6 m); building 2's floors at 3
-    // and 6 m meet building 3's floors 1 and 2, its 9.5 m and 13 m floors meet nothing.
+    // and 6 m meet building 3's floors 1 and 2, building 3's roof (9 m) strikes building 2's
+    // third storey's columns (6 to 9.5 m), and building 2's 9.5 m and 13 m floors, above
+    // building 3's roof, meet nothing.
     for name in [
         "level_b1f1_b2f1_peak_force_n",
         "level_b1f2_b2f2_peak_force_n",
         "level_b2f1_b3f1_peak_force_n",
         "level_b2f2_b3f2_peak_force_n",
+        "level_b2c3_b3f3_peak_force_n",
+        "level_b2c3_b3f3_column_shear_n",
         "b2_peak_drift_ratio",
         "gap_2_3_m",
     ] {
@@ -541,7 +545,7 @@ fn row_config_sweeps_to_csv_matching_the_library() {
             .iter()
             .filter(|h| h.starts_with("level_") && h.ends_with("_peak_force_n"))
             .count(),
-        4
+        5
     );
     let rows: Vec<Vec<String>> = rd
         .records()

@@ -116,8 +116,8 @@ fn row_sweeps_resume_shard_merge_and_write_parquet() {
             }
         }
     }
-    // run, impacts, substeps, 3 storeys, 3 x 2 storey and floor numbers, 4 levels' impacts.
-    assert_eq!(ints, rows.len() * 16);
+    // run, impacts, substeps, 3 storeys, 3 x 2 storey and floor numbers, 5 levels' impacts.
+    assert_eq!(ints, rows.len() * 17);
 }
 
 /// `--aggregate` of a row sweep: per group of a building's parameter, the run counts, the

@@ -87,7 +87,9 @@ pub const LS_PENETRATION: usize = 5;
 pub const LS_FIRST_IMPACT: usize = 6;
 pub const LS_CONTACT_TIME: usize = 7;
 pub const LS_DISSIPATED: usize = 8;
-pub const LS_STRIDE: usize = 9;
+/// The struck column's largest shear, where a floor strikes a column.
+pub const LS_COLUMN_SHEAR: usize = 9;
+pub const LS_STRIDE: usize = 10;
 pub const BS_ROOF: usize = 0;
 pub const BS_DRIFT: usize = 1;
 pub const BS_ACCEL: usize = 2;
@@ -126,6 +128,10 @@ pub struct RowShape {
     /// `K0`, several storeys)? Its block then carries the coupling and the exact step of its
     /// modes together (zeros and the per-mode step where a run's storeys lean alike).
     pub coupled: Vec<bool>,
+    /// The levels where a floor strikes a column: the level, the struck side (0 left, 1
+    /// right) and its weight's bits (`LevelSide::weight`, the share on the storey's top
+    /// floor). Empty where every level is floor against floor.
+    pub columns: Vec<(usize, usize, u64)>,
 }
 
 impl RowShape {
@@ -141,7 +147,13 @@ impl RowShape {
             levels: m
                 .levels
                 .iter()
-                .map(|l| [l.buildings.0, l.floors.0, l.floors.1])
+                .map(|l| [l.buildings.0, l.sides[0].floor - 1, l.sides[1].floor - 1])
+                .collect(),
+            columns: (m.levels.iter().enumerate())
+                .filter_map(|(l, lm)| {
+                    let side = (0..2).find(|&k| lm.sides[k].on_column())?;
+                    Some((l, side, lm.sides[side].weight.to_bits()))
+                })
                 .collect(),
             yielding: m
                 .buildings
@@ -161,7 +173,24 @@ impl RowShape {
             levels,
             yielding,
             coupled,
+            columns: Vec::new(),
         }
+    }
+
+    /// Where a floor strikes a yielding storey's column at level `l`: that storey's index
+    /// among the run's yielding storeys.
+    fn struck_storey(&self, l: usize) -> Option<usize> {
+        let &(_, side, _) = self.columns.iter().find(|c| c.0 == l)?;
+        let [a, fa, fb] = self.levels[l];
+        let storey = if side == 0 { fa } else { fb };
+        self.first_storeys()[a + side].map(|first| first + storey)
+    }
+
+    /// Level `l`'s weight on side `side` (1 on a floor).
+    fn weight(&self, l: usize, side: usize) -> f64 {
+        (self.columns.iter())
+            .find(|c| c.0 == l && c.1 == side)
+            .map_or(1.0, |c| f64::from_bits(c.2))
     }
 
     /// The yielding storeys (every storey of each yielding building).
@@ -207,6 +236,12 @@ impl RowShape {
     }
 
     fn p_stride(&self) -> usize {
+        self.p_columns() + self.columns.len()
+    }
+
+    /// Where the struck storeys' stiffnesses start in a run's parameters (one per level where
+    /// a floor strikes a column), after each level's contact.
+    fn p_columns(&self) -> usize {
         P_GAPS + self.storeys.len() - 1 + 3 * self.levels.len()
     }
 
@@ -312,6 +347,7 @@ impl RowShape {
             ("P_RATE", P_RATE),
             ("P_GAPS", P_GAPS),
             ("P_LEVELS", P_GAPS + nb - 1),
+            ("P_COLUMNS", self.p_columns()),
             ("P_STRIDE", self.p_stride()),
             ("M_LAW", M_LAW),
             ("M_REC_OFFSET", M_REC_OFFSET),
@@ -361,6 +397,7 @@ impl RowShape {
             ("LS_FIRST_IMPACT", LS_FIRST_IMPACT),
             ("LS_CONTACT_TIME", LS_CONTACT_TIME),
             ("LS_DISSIPATED", LS_DISSIPATED),
+            ("LS_COLUMN_SHEAR", LS_COLUMN_SHEAR),
             ("LS_STRIDE", LS_STRIDE),
             ("BS_ROOF", BS_ROOF),
             ("BS_DRIFT", BS_DRIFT),
@@ -381,6 +418,24 @@ impl RowShape {
         a("L_A", "NLA", &pick(0));
         a("L_FA", "NLA", &pick(1));
         a("L_FB", "NLA", &pick(2));
+        // Where floors strike columns: each level's struck side (2: none) and its index among
+        // such levels, each side's weight (1 on a floor).
+        let (mut struck, mut index) = (vec![2; nla], vec![0; nla]);
+        for (i, &(l, side, _)) in self.columns.iter().enumerate() {
+            (struck[l], index[l]) = (side, i);
+        }
+        a("L_CS", "NLA", &struck);
+        a("L_CI", "NLA", &index);
+        let mut weights = String::new();
+        for (name, side) in [("L_WA", 0), ("L_WB", 1)] {
+            let w: Vec<String> = (0..nla)
+                .map(|l| format!("{:?}", self.weight(l, side)))
+                .collect();
+            weights.push_str(&format!(
+                "var<private> {name}: array<real, NLA> = array<real, NLA>({});\n",
+                w.join(", ")
+            ));
+        }
         // The yielding storeys: each one's building and storey, each building's first (NS
         // where it is elastic).
         let firsts = self.first_storeys();
@@ -403,9 +458,11 @@ impl RowShape {
             .map(|((&n, &y), &c)| if c { Self::model_head_len(n, y) } else { 0 })
             .collect();
         a("B_CP", "NB", &cp);
+        s.push_str(&weights);
         s.push_str(&format!(
-            "const COUPLED: bool = {};\n",
-            self.coupled.iter().any(|&c| c)
+            "const COUPLED: bool = {};\nconst HAS_COLUMNS: bool = {};\n",
+            self.coupled.iter().any(|&c| c),
+            !self.columns.is_empty()
         ));
         if self.unrolled() {
             s.push_str(&self.wgsl_unrolled());
@@ -441,7 +498,7 @@ impl RowShape {
     /// lavapipe turns a private array indexed at run time into a per-lane loop of loads and
     /// stores; written out, the state's indices are constants and its reals stay in
     /// registers. The operations and their order are those of the loops this replaces
-    /// (`floor_of`, `force`, `coupled_term`), so the values are the same.
+    /// (`side_of`, `force`, `coupled_term`), so the values are the same.
     fn wgsl_unrolled(&self) -> String {
         let nm = self.modes();
         let offs = self.mode_offsets();
@@ -461,13 +518,34 @@ impl RowShape {
             }
             nshp += n * n + n;
         }
-        // Each level's two floor rows of mode shapes: where their n reals start in SHP.
-        let rows: Vec<[usize; 2]> = (self.levels.iter())
-            .map(|&[a, fa, fb]| {
-                let row = |b: usize, f: usize| shp[b] + f * self.storeys[b];
-                [row(a, fa), row(a + 1, fb)]
-            })
-            .collect();
+        // Each level's two sides' rows of mode shapes: where their n reals start in SHP (a
+        // floor's row, or on a column its storey's floors' rows by their shares, as
+        // `BuildingModel::point_row`).
+        let mut rows: Vec<[usize; 2]> = Vec::new();
+        for (l, &[a, fa, fb]) in self.levels.iter().enumerate() {
+            let mut pair = [0; 2];
+            for (side, (b, f)) in [(a, fa), (a + 1, fb)].into_iter().enumerate() {
+                let n = self.storeys[b];
+                let row = |f: usize| shp[b] + f * n;
+                let w = self.weight(l, side);
+                if w == 1.0 {
+                    pair[side] = row(f);
+                    continue;
+                }
+                pair[side] = nshp;
+                for i in 0..n {
+                    let top = format!("{:?} * SHP[{}u]", w, row(f) + i);
+                    let x = if f == 0 {
+                        top
+                    } else {
+                        format!("{:?} * SHP[{}u] + {top}", 1.0 - w, row(f - 1) + i)
+                    };
+                    load.push_str(&format!("    SHP[{}u] = {x};\n", nshp + i));
+                }
+                nshp += n;
+            }
+            rows.push(pair);
+        }
         let mut cpe = Vec::new();
         let mut ncpe = 0;
         for (b, &n) in self.storeys.iter().enumerate() {
@@ -512,7 +590,7 @@ impl RowShape {
         s.push_str("fn load_shape_rows() {\n");
         s.push_str(&load);
         s.push_str("}\n");
-        // phi . q of a side row from offset `at` of z (floor_of).
+        // phi . q of a side row from offset `at` of z (side_of).
         let dot = |row: usize, b: usize, at: usize| -> String {
             let mut e = String::from("0.0");
             for i in 0..self.storeys[b] {
@@ -884,6 +962,8 @@ struct StoreyReadout {
     index: usize,
     height: f64,
     d_y: f64,
+    /// Its yield force `k d_y`, N.
+    yield_force: f64,
     leaning: Option<(usize, Vec<f64>)>,
 }
 
@@ -894,6 +974,7 @@ impl StoreyReadout {
             index: s,
             height: sm.height,
             d_y: sm.d_y,
+            yield_force: sm.k * sm.d_y,
             leaning: (sm.geometric != 0.0).then(|| m.residual_row(s)),
         }
     }
@@ -992,6 +1073,9 @@ impl PackedRows {
             let c = &l.contact;
             self.params.extend([c.damping, c.m_eff, c.tc_coef()]);
         }
+        // Each struck storey's stiffness, where a floor strikes a column.
+        self.params
+            .extend(m.levels.iter().filter_map(|l| l.column.map(|c| c.k)));
         let (offset, len) = recs.record(record);
         debug_assert_eq!(forcing.accel.len(), len as usize);
         self.meta.extend([
@@ -1252,6 +1336,10 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> 
                 first_impact: (lc[LC_IMPACTS] > 0).then_some(ls[LS_FIRST_IMPACT]),
                 contact_time: ls[LS_CONTACT_TIME],
                 dissipated_energy: ls[LS_DISSIPATED],
+                column_shear: ls[LS_COLUMN_SHEAR],
+                column_shear_ratio: shape
+                    .struck_storey(l)
+                    .map_or(0.0, |st| ls[LS_COLUMN_SHEAR] / storeys[st].yield_force),
             }
         })
         .collect();

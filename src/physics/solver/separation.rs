@@ -25,7 +25,7 @@ use super::Segment;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::Propagator;
-use crate::physics::row::{common_levels, Row};
+use crate::physics::row::{contact_points, LevelRule, LevelSide, Row};
 use crate::physics::shear::{Modes, ShearBuilding};
 
 /// Most parts a refined step is cut into: 2, 4, 8 or 16, the fewest that bring the parts'
@@ -40,9 +40,8 @@ const PART_COUNTS: [usize; 4] = [2, 4, 8, 16];
 pub struct LevelSeparation {
     /// The left building of the pair (the right one is `pair + 1`).
     pub pair: usize,
-    /// Floors counted from 1.
-    pub floor_left: usize,
-    pub floor_right: usize,
+    /// Where it meets the two buildings: a floor, or a storey's columns (floors from 1).
+    pub sides: [LevelSide; 2],
     /// m
     pub elevation: f64,
     /// `max(0, max_t (u_left - u_right))`, m: the smallest gap at which this level never
@@ -146,10 +145,21 @@ impl Stepped {
         }
     }
 
-    /// Displacement, velocity and acceleration (relative to the ground) of floor `f` (from 0).
+    /// The mode-shape row of a level's point: its floors' rows by their shares.
+    fn point_row(&self, side: &LevelSide) -> Vec<f64> {
+        let mut row = vec![0.0; self.modes.count()];
+        for (f, w) in side.shares() {
+            for (r, p) in row.iter_mut().zip(&self.modes.shape[f]) {
+                *r += w * p;
+            }
+        }
+        row
+    }
+
+    /// Displacement, velocity and acceleration (relative to the ground) of the point whose
+    /// mode-shape row is `shape`.
     #[inline]
-    fn floor(&self, m: &Modal, f: usize, ag: f64) -> [f64; 3] {
-        let shape = &self.modes.shape[f];
+    fn floor(&self, m: &Modal, shape: &[f64], ag: f64) -> [f64; 3] {
         let (mut u, mut v, mut a) = (0.0, 0.0, 0.0);
         for (i, o) in self.osc.iter().enumerate() {
             let qdd = -o.c * m.qd[i] - o.k * m.q[i] - self.modes.participation[i] * ag;
@@ -345,26 +355,52 @@ pub const TOLERANCE: f64 = 1e-8;
 /// The watched floors' `[u, u', u'']` at one instant, into `out`.
 fn floors_at(
     stepped: &[Stepped],
-    watched: &[(usize, usize)],
+    watched: &[Watched],
     state: &[Modal],
     ag: f64,
     out: &mut [[f64; 3]],
 ) {
-    for (o, &(b, f)) in out.iter_mut().zip(watched) {
-        *o = stepped[b].floor(&state[b], f, ag);
+    for (o, w) in out.iter_mut().zip(watched) {
+        *o = stepped[w.building].floor(&state[w.building], &w.row, ag);
     }
 }
 
-/// The separation `buildings` (left to right, on one ground) need under `forcing`, from rest.
+/// A point whose motion a separation watches: a floor, or a storey's columns at a height.
+struct Watched {
+    building: usize,
+    side: LevelSide,
+    /// Its mode-shape row.
+    row: Vec<f64>,
+}
+
+/// The separation `buildings` (left to right, on one ground) need under `forcing`, from rest,
+/// at the contact levels of [`LevelRule::default`].
 pub fn separation(buildings: &[ShearBuilding], forcing: &Forcing) -> Separation {
+    separation_with(buildings, forcing, LevelRule::default())
+}
+
+/// [`separation`] at the contact levels `rule` gives.
+pub fn separation_with(
+    buildings: &[ShearBuilding],
+    forcing: &Forcing,
+    rule: LevelRule,
+) -> Separation {
     let dt = forcing.dt;
     let stepped: Vec<Stepped> = buildings.iter().map(|b| Stepped::new(b, dt)).collect();
-    // The floors to watch, as (building, floor from 0), each once.
-    let mut watched: Vec<(usize, usize)> = Vec::new();
-    let mut watch = |b: usize, f: usize| match watched.iter().position(|&w| w == (b, f)) {
+    // The points to watch, each once.
+    let mut watched: Vec<Watched> = Vec::new();
+    let mut watch = |b: usize, side: LevelSide| match watched
+        .iter()
+        .position(|w| w.building == b && w.side == side)
+    {
         Some(i) => i,
         None => {
-            watched.push((b, f));
+            let row = stepped[b].point_row(&side);
+            watched.push(Watched {
+                building: b,
+                side,
+                row,
+            });
             watched.len() - 1
         }
     };
@@ -372,20 +408,20 @@ pub fn separation(buildings: &[ShearBuilding], forcing: &Forcing) -> Separation 
     // Per level: the closing, then the two floors.
     let mut tracked = Vec::new();
     for (a, pair) in buildings.windows(2).enumerate() {
-        for (fl, fr, elevation) in common_levels(&pair[0], &pair[1]) {
-            let (l, r) = (watch(a, fl - 1), watch(a + 1, fr - 1));
+        for point in contact_points(&pair[0], &pair[1], rule) {
+            let [sl, sr] = point.sides;
+            let (l, r) = (watch(a, sl), watch(a + 1, sr));
             levels.push(LevelSeparation {
                 pair: a,
-                floor_left: fl,
-                floor_right: fr,
-                elevation,
+                sides: point.sides,
+                elevation: point.elevation,
                 required: 0.0,
                 time: None,
                 peak_left: 0.0,
                 peak_right: 0.0,
             });
             let closing = Tracked {
-                zero: pair[0] == pair[1] && fl == fr,
+                zero: pair[0] == pair[1] && sl == sr,
                 ..Tracked::new(l, Some(r))
             };
             tracked.push([closing, Tracked::new(l, None), Tracked::new(r, None)]);
@@ -418,12 +454,11 @@ pub fn separation(buildings: &[ShearBuilding], forcing: &Forcing) -> Separation 
             s.sixth_bounds(&z0[b], seg.a0, seg.a1, 1.0 / dt, &mut sixth[b]);
         }
         floors_at(&stepped, &watched, &z1, seg.a1, &mut ends1);
-        for (e, &(b, f)) in floor_error.iter_mut().zip(&watched) {
-            let shape = &stepped[b].modes.shape[f];
+        for (e, w) in floor_error.iter_mut().zip(&watched) {
             *e = weight
-                * shape
+                * w.row
                     .iter()
-                    .zip(&sixth[b])
+                    .zip(&sixth[w.building])
                     .map(|(p, s)| p.abs() * s)
                     .sum::<f64>();
         }
@@ -525,17 +560,18 @@ pub fn separation(buildings: &[ShearBuilding], forcing: &Forcing) -> Separation 
 }
 
 /// The separation `buildings` (left to right, on one ground; storeys may yield) need under
-/// `forcing`, from rest, by the row `scheme` with every level out of reach
+/// `forcing`, from rest, at the contact levels `rule` gives, by the row `scheme` with every level out of reach
 /// ([`simulate_uncoupled`]). The fundamental modes are the initial stiffness's (as the
 /// buildings' damping). Err: why the run did not end.
 pub fn yielding_separation(
     buildings: &[ShearBuilding],
     forcing: &Forcing,
     scheme: &RowScheme,
+    rule: LevelRule,
 ) -> Result<Separation, String> {
     let gaps = vec![UNCOUPLED_GAP_M; buildings.len() - 1];
     // The contact law is never reached; it only has to be valid.
-    let row = Row::new(buildings.to_vec(), gaps, LawKind::Linear, 1.0, 0.0);
+    let row = Row::with_levels(buildings.to_vec(), gaps, LawKind::Linear, 1.0, 0.0, rule);
     let model = RowModel::new(&row);
     let out = simulate_uncoupled(&model, forcing, scheme);
     if out.status != Status::Ok {
@@ -550,8 +586,7 @@ pub fn yielding_separation(
         .zip(&out.closings)
         .map(|(l, c)| LevelSeparation {
             pair: l.left,
-            floor_left: l.floor_left,
-            floor_right: l.floor_right,
+            sides: l.sides,
             elevation: l.elevation,
             required: c.closing.max(0.0),
             time: c.time,
@@ -675,15 +710,12 @@ mod tests {
             let exact = separation(&row, &f);
             let strong: Vec<ShearBuilding> =
                 row.iter().map(|b| yielding(b.clone(), 1.0, 0.0)).collect();
-            let s = yielding_separation(&strong, &f, &fast()).unwrap();
+            let s = yielding_separation(&strong, &f, &fast(), LevelRule::default()).unwrap();
             assert_eq!(s.levels.len(), exact.levels.len());
             assert_eq!(s.substeps, 0, "nothing yields: every step is exact");
             assert_eq!(s.fundamental, exact.fundamental);
             for (a, b) in s.levels.iter().zip(&exact.levels) {
-                assert_eq!(
-                    (a.pair, a.floor_left, a.floor_right),
-                    (b.pair, b.floor_left, b.floor_right)
-                );
+                assert_eq!((a.pair, a.sides), (b.pair, b.sides));
                 assert!(relative(a.required, b.required) < 1e-6);
                 assert!(relative(a.peak_left, b.peak_left) < 1e-6);
                 assert!(relative(a.peak_right, b.peak_right) < 1e-6);
@@ -704,7 +736,7 @@ mod tests {
             yielding(single(0.45, 0.05), 0.004, 0.0),
             yielding(single(0.3, 0.05), 0.003, 0.05),
         ];
-        let s = yielding_separation(&buildings, &f, &fast()).unwrap();
+        let s = yielding_separation(&buildings, &f, &fast(), LevelRule::default()).unwrap();
         let l = s.levels[0];
         assert!(s.substeps > 0, "the storeys yield");
         let run = |gap: f64| {
@@ -749,8 +781,8 @@ mod tests {
         ] {
             let row: Vec<ShearBuilding> =
                 row.into_iter().map(|b| yielding(b, 0.004, 0.03)).collect();
-            let s = yielding_separation(&row, &f, &fast()).unwrap();
-            let r = yielding_separation(&row, &f, &reference).unwrap();
+            let s = yielding_separation(&row, &f, &fast(), LevelRule::default()).unwrap();
+            let r = yielding_separation(&row, &f, &reference, LevelRule::default()).unwrap();
             assert!(s.substeps > 0, "the storeys yield");
             for (a, b) in s.levels.iter().zip(&r.levels) {
                 let what = format!("{a:?} against {b:?}");

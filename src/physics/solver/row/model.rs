@@ -4,7 +4,7 @@
 
 use super::yielding::StoreyModel;
 use crate::physics::contact::Contact;
-use crate::physics::row::Row;
+use crate::physics::row::{LevelSide, Row};
 use crate::physics::shear::{storey_drift_row, Modes};
 use crate::physics::solver::events::fourth_derivative_bound;
 use crate::physics::solver::Segment;
@@ -91,6 +91,33 @@ impl BuildingModel {
         self.modes.count()
     }
 
+    /// The mode-shape row of a level's point on this building: `u = row . q`, the shares of
+    /// its floors' rows.
+    fn point_row(&self, side: &LevelSide) -> Vec<f64> {
+        let mut row = vec![0.0; self.n()];
+        for (f, w) in side.shares() {
+            if w == 1.0 {
+                row.clone_from(&self.modes.shape[f]);
+            } else {
+                for (r, p) in row.iter_mut().zip(&self.modes.shape[f]) {
+                    *r += w * p;
+                }
+            }
+        }
+        row
+    }
+
+    /// A level's point on this building in floor coordinates: the offset and length of its
+    /// floors in the state, the row its motion reads (the shares) and the one its force
+    /// enters the floors' accelerations by (share over mass).
+    fn point_in_floors(&self, side: &LevelSide) -> ((usize, usize), Vec<f64>, Vec<f64>) {
+        let shares: Vec<(usize, f64)> = side.shares().collect();
+        let first = shares[0].0;
+        let phi = shares.iter().map(|&(_, w)| w).collect();
+        let psi = shares.iter().map(|&(f, w)| w / self.masses[f]).collect();
+        ((self.off + first, shares.len()), phi, psi)
+    }
+
     /// Storey `j`'s drift in this building's current coordinates (`modal_row` in its modes):
     /// the offset in the state and the row, `d = row . z[off..]`.
     pub(crate) fn drift_row(&self, j: usize, modal_row: &[f64]) -> (usize, Vec<f64>) {
@@ -108,10 +135,10 @@ pub(crate) struct LevelModel {
     /// Offset and length of the left and right buildings' modes in `q`.
     pub a: (usize, usize),
     pub b: (usize, usize),
-    /// Buildings and floors (from 0) of the level.
+    /// Buildings of the level, and where it meets each.
     pub buildings: (usize, usize),
-    pub floors: (usize, usize),
-    /// Mode-shape rows of the two floors: `u_left = phi_a . q[a]`.
+    pub sides: [LevelSide; 2],
+    /// Mode-shape rows of the two points: `u_left = phi_a . q[a]`.
     pub phi_a: Vec<f64>,
     pub phi_b: Vec<f64>,
     /// How the level's force enters the two buildings' accelerations: the mode-shape rows
@@ -120,6 +147,24 @@ pub(crate) struct LevelModel {
     pub psi_b: Vec<f64>,
     pub gap: f64,
     pub contact: Contact,
+    /// Where a floor strikes a column: the struck storey, whose shear the level reports.
+    pub column: Option<StruckColumn>,
+}
+
+/// The storey a floor strikes between its floors (physics.md section 11).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StruckColumn {
+    /// Which side of the level it is on (0 left, 1 right), its building and storey (from 0:
+    /// storey 0 joins the ground and floor 0).
+    pub side: usize,
+    pub building: usize,
+    pub storey: usize,
+    /// The share `s` of the force on the floor above (`1 - s` on the floor below).
+    pub weight: f64,
+    /// The storey's initial stiffness, N/m.
+    pub k: f64,
+    /// Its index in [`RowModel::storeys`] where it yields.
+    pub yielding: Option<usize>,
 }
 
 /// A row resolved for integration: modes of every building and the levels in modal terms.
@@ -235,18 +280,30 @@ impl RowModel {
             .iter()
             .map(|l| {
                 let (ba, bb) = (&buildings[l.left], &buildings[l.left + 1]);
-                let (fa, fb) = (l.floor_left - 1, l.floor_right - 1);
+                let [phi_a, phi_b] = [(ba, 0), (bb, 1)].map(|(bm, k)| bm.point_row(&l.sides[k]));
                 LevelModel {
                     a: (ba.off, ba.n()),
                     b: (bb.off, bb.n()),
                     buildings: (l.left, l.left + 1),
-                    floors: (fa, fb),
-                    phi_a: ba.modes.shape[fa].clone(),
-                    phi_b: bb.modes.shape[fb].clone(),
-                    psi_a: ba.modes.shape[fa].clone(),
-                    psi_b: bb.modes.shape[fb].clone(),
+                    sides: l.sides,
+                    psi_a: phi_a.clone(),
+                    psi_b: phi_b.clone(),
+                    phi_a,
+                    phi_b,
                     gap: row.gaps[l.left],
                     contact: l.contact,
+                    column: (0..2).find(|&k| l.sides[k].on_column()).map(|side| {
+                        let building = l.left + side;
+                        let storey = l.sides[side].floor - 1;
+                        StruckColumn {
+                            side,
+                            building,
+                            storey,
+                            weight: l.sides[side].weight,
+                            k: row.buildings[building].stiffness[storey],
+                            yielding: buildings[building].first_storey.map(|f| f + storey),
+                        }
+                    }),
                 }
             })
             .collect();
@@ -303,14 +360,10 @@ impl RowModel {
         for l in m.levels.iter_mut() {
             let (ba, bb) = (&m.buildings[l.buildings.0], &m.buildings[l.buildings.1]);
             if ba.in_floors {
-                l.a = (ba.off + l.floors.0, 1);
-                l.phi_a = vec![1.0];
-                l.psi_a = vec![1.0 / ba.masses[l.floors.0]];
+                (l.a, l.phi_a, l.psi_a) = ba.point_in_floors(&l.sides[0]);
             }
             if bb.in_floors {
-                l.b = (bb.off + l.floors.1, 1);
-                l.phi_b = vec![1.0];
-                l.psi_b = vec![1.0 / bb.masses[l.floors.1]];
+                (l.b, l.phi_b, l.psi_b) = bb.point_in_floors(&l.sides[1]);
             }
         }
         m.storeys_to_coordinates();

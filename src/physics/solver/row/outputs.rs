@@ -1,11 +1,12 @@
 //! What a row run reports: its time history to an observer ([`RowSample`]), the peaks tracked
 //! between samples (floors, levels, closings), and the run's output at its end.
 
+use super::yielding::StoreyMode;
 use super::{step_still, BuildingModel, RowRun};
 use crate::physics::model::{EnergyBalance, Status};
 use crate::physics::row::{RowOutput, StoreyOutput};
 use crate::physics::solver::hermite::{
-    cubic_max_bound, hermite_range, raise_cubic_peak, raise_quintic_peak,
+    cubic_max_bound, hermite_range, raise_cubic_peak, raise_hump_peak, raise_quintic_peak,
 };
 use crate::physics::solver::tracker::raise_force_peak;
 use crate::physics::solver::{Mode, Segment};
@@ -54,8 +55,18 @@ impl<'m> RowRun<'m> {
                 continue;
             }
             let fl = lm.force(n, ls.mode, ls.v0, z);
-            self.floors[lm.buildings.0][end].force[lm.floors.0] -= fl;
-            self.floors[lm.buildings.1][end].force[lm.floors.1] += fl;
+            let [a, b] = &lm.sides;
+            if !a.on_column() && !b.on_column() {
+                self.floors[lm.buildings.0][end].force[a.floor - 1] -= fl;
+                self.floors[lm.buildings.1][end].force[b.floor - 1] += fl;
+                continue;
+            }
+            for (f, w) in a.shares() {
+                self.floors[lm.buildings.0][end].force[f] -= w * fl;
+            }
+            for (f, w) in b.shares() {
+                self.floors[lm.buildings.1][end].force[f] += w * fl;
+            }
         }
     }
 
@@ -139,14 +150,14 @@ impl<'m> RowRun<'m> {
     /// [`LevelModel::delta`] from the modes).
     pub fn level_ends(&self, l: usize) -> [f64; 4] {
         let lm = &self.m.levels[l];
-        let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+        let ((a, b), [sa, sb]) = (lm.buildings, &lm.sides);
         let [a0, a1] = &self.floors[a];
         let [b0, b1] = &self.floors[b];
         [
-            a0.u[fa] - b0.u[fb] - lm.gap,
-            a0.v[fa] - b0.v[fb],
-            a1.u[fa] - b1.u[fb] - lm.gap,
-            a1.v[fa] - b1.v[fb],
+            sa.at(&a0.u) - sb.at(&b0.u) - lm.gap,
+            sa.at(&a0.v) - sb.at(&b0.v),
+            sa.at(&a1.u) - sb.at(&b1.u) - lm.gap,
+            sa.at(&a1.v) - sb.at(&b1.v),
         ]
     }
 
@@ -244,11 +255,51 @@ impl<'m> RowRun<'m> {
             o.dissipated_energy = z1[2 * n + l];
             // The force's rates from the floors' accelerations at both ends (with the contact
             // forces of these modes: the ends are recomputed where a mode changes).
-            let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
-            let accel = |e: usize| self.floors[a][e].a_rel[fa] - self.floors[b][e].a_rel[fb];
+            let ((a, b), [sa, sb]) = (lm.buildings, &lm.sides);
+            let accel =
+                |e: usize| sa.at(&self.floors[a][e].a_rel) - sb.at(&self.floors[b][e].a_rel);
             let approaching = ls.mode == Mode::Approach;
             let f = lm.force(n, ls.mode, ls.v0, z1);
             let r1 = lm.contact.force_rate(y1, d1, accel(1), ls.v0, approaching);
+            if let Some(c) = &lm.column {
+                // The struck storey's two column segments: the storey's spring force `V` and
+                // the share of the force on the struck building each carries to its floor.
+                let f0 = lm.force(n, ls.mode, ls.v0, z0);
+                let r0 = lm.contact.force_rate(y0, d0, accel(0), ls.v0, approaching);
+                let on_struck = if c.side == 0 { -1.0 } else { 1.0 };
+                let fl = &self.floors[c.building];
+                let j = c.storey;
+                let drift = |x: &[f64]| x[j] - if j > 0 { x[j - 1] } else { 0.0 };
+                let spring = |e: usize, z: &[f64]| -> (f64, f64) {
+                    let (d, dv) = (drift(&fl[e].u), drift(&fl[e].v));
+                    match c.yielding {
+                        Some(s) => {
+                            let sm = &m.storeys[s];
+                            let p = z[m.plastic_slot(s)];
+                            let pv = match self.storey_modes[s] {
+                                StoreyMode::Yielding(_) => (1.0 - sm.b) * dv,
+                                StoreyMode::Elastic => 0.0,
+                            };
+                            (c.k * (d - p), c.k * (dv - pv))
+                        }
+                        None => (c.k * d, c.k * dv),
+                    }
+                };
+                let ((v0, vr0), (v1, vr1)) = (spring(0, z0), spring(1, z1));
+                let mut peak = ls.out.column_shear;
+                for share in [-c.weight, 1.0 - c.weight] {
+                    let share = on_struck * share;
+                    peak = raise_column_peak(
+                        peak,
+                        [v0, vr0, v1, vr1],
+                        [f0, r0, f, r1],
+                        share,
+                        y0 <= 0.0 || y1 <= 0.0,
+                        h,
+                    );
+                }
+                ls.out.column_shear = peak;
+            }
             ls.imp_peak = raise_force_peak(ls.imp_peak, f, r1, h, || {
                 let f0 = lm.force(n, ls.mode, ls.v0, z0);
                 (
@@ -286,8 +337,8 @@ impl<'m> RowRun<'m> {
                 .levels
                 .iter()
                 .map(|lm| {
-                    let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
-                    (floors[a][fa] - floors[b][fb] - lm.gap).max(0.0)
+                    let ((a, b), [sa, sb]) = (lm.buildings, &lm.sides);
+                    (sa.at(&floors[a]) - sb.at(&floors[b]) - lm.gap).max(0.0)
                 })
                 .collect(),
             forces: (m.levels.iter().zip(&self.levels).zip(&self.level_on))
@@ -350,9 +401,13 @@ impl<'m> RowRun<'m> {
                 self.e_peak,
             )
         });
-        for ls in self.levels.iter_mut() {
+        for (ls, lm) in self.levels.iter_mut().zip(&m.levels) {
             if ls.mode != Mode::Free {
                 ls.end_impact();
+            }
+            if let Some(s) = lm.column.and_then(|c| c.yielding) {
+                let sm = &m.storeys[s];
+                ls.out.column_shear_ratio = ls.out.column_shear / (sm.k * sm.d_y);
             }
         }
         // At rest a storey's drift is its plastic drift, but with P-Delta gravity leans on it:
@@ -400,4 +455,40 @@ impl<'m> RowRun<'m> {
         out.gather();
         out
     }
+}
+
+/// `peak` raised to the largest `|V + share F|` over a contact piece of length `h`: a struck
+/// column segment's shear, from the storey's spring force `V` and the contact force `F` (with
+/// their rates) at both ends, `spring = [V0, V0', V1, V1']`, `force = [F0, F0', F1, F1']`.
+/// The ends, and where `|V + share F|` humps inside, the cubic Hermite's largest value, held
+/// within `max |V| + |share| max F` (the cubic of `V`, the force's own peak as
+/// `tracker::raise_force_peak` takes it): the force's rate grows without bound as the
+/// penetration nears 0 (the nonlinear viscoelastic law's `delta^(1/4)` damping), where the
+/// cubic would overshoot. A piece that begins at the touch or ends at the separation
+/// (`touches`) takes its ends alone.
+pub(super) fn raise_column_peak(
+    peak: f64,
+    spring: [f64; 4],
+    force: [f64; 4],
+    share: f64,
+    touches: bool,
+    h: f64,
+) -> f64 {
+    let [v0, vr0, v1, vr1] = spring;
+    let [f0, r0, f1, r1] = force;
+    let (y0, y1) = (v0 + share * f0, v1 + share * f1);
+    let ends = peak.max(y0.abs()).max(y1.abs());
+    if touches {
+        return ends;
+    }
+    let hump = raise_hump_peak(ends, y0, vr0 + share * r0, y1, vr1 + share * r1, h);
+    if hump <= ends {
+        return ends;
+    }
+    let mut f_max = f0.abs().max(f1.abs());
+    if r1 < 0.0 && r0 > 0.0 {
+        f_max = f_max.max(hermite_range(f0, r0, f1, r1, h).1);
+    }
+    let bound = raise_cubic_peak(0.0, v0, vr0, v1, vr1, h) + share.abs() * f_max;
+    ends.max(hump.min(bound))
 }

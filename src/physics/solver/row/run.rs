@@ -316,31 +316,29 @@ impl<'m> RowRun<'m> {
             return;
         };
         for (c, lm) in closings.iter_mut().zip(&self.m.levels) {
-            let ((a, b), (fa, fb)) = (lm.buildings, lm.floors);
+            let ((a, b), [sa, sb]) = (lm.buildings, &lm.sides);
             let ([a0, a1], [b0, b1]) = (&self.floors[a], &self.floors[b]);
-            let y = [a0.u[fa] - b0.u[fb], a1.u[fa] - b1.u[fb]];
-            let d = [a0.v[fa] - b0.v[fb], a1.v[fa] - b1.v[fb]];
-            let acc = [a0.a_rel[fa] - b0.a_rel[fb], a1.a_rel[fa] - b1.a_rel[fb]];
+            let (ua, va, aa) = (
+                [sa.at(&a0.u), sa.at(&a1.u)],
+                [sa.at(&a0.v), sa.at(&a1.v)],
+                [sa.at(&a0.a_rel), sa.at(&a1.a_rel)],
+            );
+            let (ub, vb, ab) = (
+                [sb.at(&b0.u), sb.at(&b1.u)],
+                [sb.at(&b0.v), sb.at(&b1.v)],
+                [sb.at(&b0.a_rel), sb.at(&b1.a_rel)],
+            );
+            let y = [ua[0] - ub[0], ua[1] - ub[1]];
+            let d = [va[0] - vb[0], va[1] - vb[1]];
+            let acc = [aa[0] - ab[0], aa[1] - ab[1]];
             if quintic_max_bound(y, d, acc, h) > c.closing {
                 let (hi, s) = quintic_range(y, d, acc, h)[1];
                 if hi > c.closing {
                     (c.closing, c.time) = (hi, Some(t0 + s * h));
                 }
             }
-            c.peak_left = raise_quintic_peak(
-                c.peak_left,
-                [a0.u[fa], a1.u[fa]],
-                [a0.v[fa], a1.v[fa]],
-                [a0.a_rel[fa], a1.a_rel[fa]],
-                h,
-            );
-            c.peak_right = raise_quintic_peak(
-                c.peak_right,
-                [b0.u[fb], b1.u[fb]],
-                [b0.v[fb], b1.v[fb]],
-                [b0.a_rel[fb], b1.a_rel[fb]],
-                h,
-            );
+            c.peak_left = raise_quintic_peak(c.peak_left, ua, va, aa, h);
+            c.peak_right = raise_quintic_peak(c.peak_right, ub, vb, ab, h);
         }
     }
 
