@@ -138,8 +138,8 @@ fn rp(k: u32) -> real {
 
 // The contact element of level l into K (contact.wgsl).
 fn use_level(l: u32) {
-    let b = RP + P_LEVELS + 3u * l;
-    K = Law(LAW, rp(P_STIFFNESS), rparams[b], rp(P_RATIO), rparams[b + 1u], rparams[b + 2u]);
+    let b = RP + P_LEVELS + LEVEL_PARAMS * l;
+    K = Law(LAW, rparams[b], rparams[b + 1u], rp(P_RATIO), rparams[b + 2u], rparams[b + 3u]);
 }
 
 fn shape_at(b: u32, j: u32, i: u32) -> real {

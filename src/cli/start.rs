@@ -74,13 +74,25 @@ pub fn init(a: InitArgs) -> Result<()> {
 }
 
 pub fn columns(a: ColumnsArgs) -> Result<()> {
-    let names = match &a.config {
-        Some(path) => config::columns_of(&config::read_text(path)?, path)?,
+    let plan = match &a.config {
+        Some(path) => Some(config::load_text(&config::read_text(path)?, path)?),
+        None => None,
+    };
+    let names = match &plan {
+        Some(plan) => plan.header(),
         None => pounding::plan::columns::header()
             .into_iter()
             .map(String::from)
             .collect(),
     };
-    std::io::stdout().write_all(meaning::table(&names).as_bytes())?;
+    let mut out = meaning::table(&names);
+    // A row's contact levels: where each is and what meets there.
+    if let Some(pounding::plan::Plan::Row(row)) = &plan {
+        if !row.is_empty() && !row.level_names().is_empty() {
+            out.push('\n');
+            out.push_str(&row.level_table());
+        }
+    }
+    std::io::stdout().write_all(out.as_bytes())?;
     Ok(())
 }

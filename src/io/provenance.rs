@@ -108,6 +108,10 @@ impl Fingerprint {
         if plan.yielding.iter().any(Option::is_some) {
             text.push_str(&format!("|{:?}", plan.yielding));
         }
+        // Rows at the default contact levels hash as they did before `[levels]`.
+        if plan.level_rule != crate::physics::row::LevelRule::default() {
+            text.push_str(&format!("|{:?}", plan.level_rule));
+        }
         Fingerprint {
             plan: hex(Sha256::digest(text.as_bytes())),
             ..base

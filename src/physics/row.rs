@@ -226,21 +226,35 @@ pub fn contact_points(
     let mut points: Vec<ContactPoint> = Vec::new();
     // Per point on a column: the striking side, and the struck storey's nearer floor.
     let mut struck: Vec<Option<(usize, usize, f64)>> = Vec::new();
+    // Each floor's nearest floor of the other building within the tolerance; two floors are
+    // one level where each is the other's nearest (so the pairs do not depend on which
+    // building is on the left).
+    let nearest = |k: usize, e: f64| -> Option<usize> {
+        (z[1 - k].iter().enumerate())
+            .filter(|(_, &o)| (e - o).abs() <= tol)
+            .min_by(|a, b| (e - a.1).abs().total_cmp(&(e - b.1).abs()))
+            .map(|(f, _)| f)
+    };
+    let paired = |k: usize, f: usize| -> bool {
+        nearest(k, z[k][f]).is_some_and(|g| nearest(1 - k, z[1 - k][g]) == Some(f))
+    };
     for (fa, &ea) in z[0].iter().enumerate() {
-        if let Some(fb) = z[1].iter().position(|&eb| (ea - eb).abs() <= tol) {
-            points.push(ContactPoint {
-                sides: [LevelSide::floor(fa + 1), LevelSide::floor(fb + 1)],
-                elevation: ea,
-                share: 1.0,
-            });
-            struck.push(None);
+        if !paired(0, fa) {
+            continue;
         }
+        let fb = nearest(0, ea).expect("a paired floor");
+        points.push(ContactPoint {
+            sides: [LevelSide::floor(fa + 1), LevelSide::floor(fb + 1)],
+            elevation: ea,
+            share: 1.0,
+        });
+        struck.push(None);
     }
     if rule.floor_column {
         for k in 0..2 {
             let other = 1 - k;
             for (f, &e) in z[k].iter().enumerate() {
-                if z[other].iter().any(|&o| (e - o).abs() <= tol) {
+                if paired(k, f) {
                     continue;
                 }
                 // The neighbour's storey at `e`: the first floor above it.
@@ -677,6 +691,54 @@ mod tests {
         );
         let far = shares(3.3);
         assert!(far.iter().all(|&s| s == 1.0), "{far:?}");
+    }
+
+    /// Floors pair by mutual nearness: with a wide tolerance, A's floors at 3.4 and 6.4 m
+    /// against B's at 3.0, 3.7 and 6.7 m give the same points whichever is on the left (before,
+    /// a floor paired with the first within the tolerance, and one within it of a paired floor
+    /// was left out).
+    #[test]
+    fn the_points_do_not_depend_on_which_building_is_left() {
+        let a = ShearBuilding::from_period(
+            vec![2e5; 2],
+            &[1.0; 2],
+            vec![3.4, 3.0],
+            0.3,
+            Damping::Modal(0.05),
+        );
+        let b = ShearBuilding::from_period(
+            vec![2e5; 3],
+            &[1.0; 3],
+            vec![3.0, 0.7, 3.0],
+            0.3,
+            Damping::Modal(0.05),
+        );
+        let rule = LevelRule {
+            same_level_m: 0.5,
+            floor_column: true,
+        };
+        let key = |p: &ContactPoint, flip: bool| {
+            let [l, r] = p.sides;
+            let (l, r) = if flip { (r, l) } else { (l, r) };
+            (l.name(), r.name())
+        };
+        let ab: Vec<_> = (contact_points(&a, &b, rule).iter())
+            .map(|p| key(p, false))
+            .collect();
+        let mut ba: Vec<_> = (contact_points(&b, &a, rule).iter())
+            .map(|p| key(p, true))
+            .collect();
+        let mut sorted = ab.clone();
+        sorted.sort();
+        ba.sort();
+        assert_eq!(sorted, ba);
+        // 3.4 pairs with 3.7 (each the other's nearest), 6.4 with 6.7; B's 3.0 m floor, whose
+        // nearest (3.4) is paired, strikes A's first storey.
+        let want: Vec<(String, String)> = [("c1", "f1"), ("f1", "f2"), ("f2", "f3")]
+            .iter()
+            .map(|(l, r)| (l.to_string(), r.to_string()))
+            .collect();
+        assert_eq!(ab, want);
     }
 
     #[test]

@@ -152,11 +152,17 @@ impl Plan {
                         r.buildings[0].storeys()
                     );
                 }
+                let levels = r.levels();
+                let columns = levels.iter().filter(|l| l.floor_column()).count();
+                let columns = match columns {
+                    0 => String::new(),
+                    c => format!(", {c} of them floor against column"),
+                };
                 format!(
-                    "a row of {} buildings ({} storeys, {} contact levels{tail})",
+                    "a row of {} buildings ({} storeys, {} contact levels{columns}{tail})",
                     r.buildings.len(),
                     r.buildings.iter().map(|b| b.storeys()).sum::<usize>(),
-                    r.row(&r.run(0)).levels.len(),
+                    levels.len(),
                 )
             }
         }

@@ -72,6 +72,10 @@ pub struct RawLevels {
 
 /// The largest `[levels] same_level_m`: the depth of a thick slab, m.
 pub const MAX_SAME_LEVEL_M: f64 = 0.5;
+/// The smallest, m: two floors just beyond it apart share the contact up to twice it
+/// ([`crate::physics::row::contact_points`]), so at 0 floors a rounding apart would be two
+/// whole points.
+pub const MIN_SAME_LEVEL_M: f64 = 0.001;
 
 /// One `[[building]]` as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -538,7 +542,13 @@ impl RowPlan {
     pub fn pairs_without_levels(&self) -> Vec<String> {
         let row = self.row(&self.run(0));
         let elevations = |b: &ShearBuilding| -> Vec<String> {
-            b.elevations().iter().map(|z| format!("{z}")).collect()
+            // To the micrometre: a sum of storey heights shows its rounding past that.
+            (b.elevations().iter())
+                .map(|z| {
+                    let t = format!("{z:.6}");
+                    t.trim_end_matches('0').trim_end_matches('.').to_string()
+                })
+                .collect()
         };
         (0..self.buildings.len() - 1)
             .filter(|&a| !row.levels.iter().any(|l| l.left == a))
@@ -696,6 +706,34 @@ impl RowPlan {
                 Some(self.yielding[l.left + side].is_some())
             })
             .collect()
+    }
+
+    /// The contact levels as a Markdown table: each one's column prefix, kind (floor/floor or
+    /// floor/column), elevation and, on a column, the struck storey's height fraction `xi` and
+    /// the share `s` of the force on its top floor (`pound columns CONFIG`).
+    pub fn level_table(&self) -> String {
+        let mut t = String::from(
+            "| level | kind | elevation m | struck storey: xi | share on its top floor s |\n|---|---|---:|---:|---:|\n",
+        );
+        for (l, name) in self.levels().iter().zip(self.level_names()) {
+            let column = (0..2).find(|&k| l.sides[k].on_column());
+            let (kind, xi, s) = match column {
+                None => ("floor/floor", String::new(), String::new()),
+                Some(k) => {
+                    let b = &self.row(&self.run(0)).buildings[l.left + k];
+                    let j = l.sides[k].floor;
+                    let below: f64 = b.heights[..j - 1].iter().sum();
+                    let xi = (l.elevation - below) / b.heights[j - 1];
+                    let s = l.sides[k].weight;
+                    ("floor/column", format!("{xi:.3}"), format!("{s:.3}"))
+                }
+            };
+            t.push_str(&format!(
+                "| `{name}` | {kind} | {} | {xi} | {s} |\n",
+                crate::show(l.elevation)
+            ));
+        }
+        t
     }
 
     /// Does a floor strike a neighbour's columns in this plan's rows?
@@ -1389,11 +1427,11 @@ pub fn parse_row(
 fn level_rule(raw: &RawLevels) -> Result<LevelRule, (&'static str, String)> {
     let mut rule = LevelRule::default();
     if let Some(x) = raw.same_level_m {
-        if !(0.0..=MAX_SAME_LEVEL_M).contains(&x) {
+        if !(MIN_SAME_LEVEL_M..=MAX_SAME_LEVEL_M).contains(&x) {
             return Err((
                 "levels.same_level_m",
                 format!(
-                    "{}: expected a height in m >= 0 and <= {MAX_SAME_LEVEL_M} (floors this close are one level)",
+                    "{}: expected a height in m >= {MIN_SAME_LEVEL_M} and <= {MAX_SAME_LEVEL_M} (floors this close are one level; two floors just farther apart share the contact up to twice it, so it cannot be 0)",
                     crate::show(x)
                 ),
             ));

@@ -226,6 +226,19 @@ impl PairGap {
     }
 }
 
+/// The least conservative code rule whose gap covers `required`, the exact gap of a level
+/// whose points' peaks are `peak_left`, `peak_right` (DDC asks for the least, ABS for the
+/// most): `ddc`, `srss` or `abs`; `none` where none does; empty where the floors never close.
+pub fn covering_rule(required: f64, peak_left: f64, peak_right: f64, rho: f64) -> &'static str {
+    if required <= 0.0 {
+        return "";
+    }
+    [Rule::Ddc, Rule::Srss, Rule::Abs]
+        .into_iter()
+        .find(|r| r.gap(peak_left, peak_right, rho) >= required)
+        .map_or("none", Rule::key)
+}
+
 /// One run of the study.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GapRun {
@@ -453,6 +466,7 @@ impl<'a> GapStudy<'a> {
                 for r in Rule::ALL {
                     h.push(format!("{l}_{}_m", r.key()));
                 }
+                h.push(format!("{l}_rule"));
             }
         }
         h.push("error_bound_m".into());
@@ -486,6 +500,7 @@ impl<'a> GapStudy<'a> {
                 let rho = run.pairs[l.pair].expect("a level's pair shares it").rho;
                 c.extend([l.required, l.peak_left, l.peak_right].map(num));
                 c.extend(Rule::ALL.map(|r| num(r.gap(l.peak_left, l.peak_right, rho))));
+                c.push(covering_rule(l.required, l.peak_left, l.peak_right, rho).into());
             }
         }
         c.push(opt(run.separation.error_bound));
@@ -925,6 +940,23 @@ fn round_step(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Peaks 3 and 4 cm: DDC asks for sqrt(25 - 24 rho) cm, SRSS 5, ABS 7.
+    #[test]
+    fn the_covering_rule_is_the_least_conservative_that_covers() {
+        let rho = 0.5; // DDC: sqrt(13) = 3.606 cm
+        for (required, want) in [
+            (0.0, ""),
+            (0.03, "ddc"),
+            (0.036, "ddc"),
+            (0.0361, "srss"),
+            (0.05, "srss"),
+            (0.06, "abs"),
+            (0.0701, "none"),
+        ] {
+            assert_eq!(covering_rule(required, 0.03, 0.04, rho), want, "{required}");
+        }
+    }
 
     /// In the probability-of-pounding panel each intensity's points and its fitted curve share
     /// one style, and intensities differ; a failed fit is named on its points.

@@ -322,10 +322,34 @@ fn the_levels_section_sets_the_contact_levels() {
     assert!(wide.contains(&"level_b2f3_b3f3".to_string()), "{wide:?}");
     for (extra, needle) in [
         ("[levels]\nsame_level_m = -0.1\n", "levels.same_level_m"),
+        ("[levels]\nsame_level_m = 0\n", "levels.same_level_m"),
         ("[levels]\nsame_level_m = 0.6\n", "levels.same_level_m"),
         ("[levels]\nfloor_colum = false\n", "floor_colum"),
     ] {
         let e = load(extra).unwrap_err().to_string();
         assert!(e.contains(needle), "{extra}: {e}");
     }
+}
+
+/// `[levels]` is part of a plan's fingerprint, so `--resume` and `pound merge` refuse to join
+/// outputs made with other contact levels; the default rule hashes as a config without
+/// `[levels]` (whose sweeps before it keep their fingerprint).
+#[test]
+fn the_levels_section_is_in_the_fingerprint() {
+    use pounding::io::provenance::Fingerprint;
+    let dir = crate::support::tempdir();
+    let cfg = dir.path().join("levels.toml");
+    let base = crate::multistorey::ROW_CONFIG;
+    let print = |extra: &str| {
+        let plan =
+            pounding::plan::config::load_row_text(&format!("{base}\n{extra}"), &cfg).unwrap();
+        Fingerprint::of_row(&plan).plan
+    };
+    let plain = print("");
+    assert_eq!(
+        plain,
+        print("[levels]\nsame_level_m = 0.01\nfloor_column = true\n")
+    );
+    assert_ne!(plain, print("[levels]\nsame_level_m = 0.015\n"));
+    assert_ne!(plain, print("[levels]\nfloor_column = false\n"));
 }

@@ -35,11 +35,13 @@ pub const P_DT: usize = 0;
 pub const P_T0: usize = 1;
 pub const P_SCALE: usize = 2;
 pub const P_PER_CONTACT: usize = 3;
+/// The first level's stiffness (each level reads its own, `LEVEL_PARAMS`).
 pub const P_STIFFNESS: usize = 4;
 pub const P_RATIO: usize = 5;
 /// The row's structural rate (`RowModel::structural_rate`).
 pub const P_RATE: usize = 6;
-/// Then one gap per adjacent pair, then per level: contact damping, `m_eff`, `tc_coef`.
+/// Then one gap per adjacent pair, then per level its contact (`LEVEL_PARAMS`), then each struck
+/// storey's stiffness (`RowShape::p_columns`).
 pub const P_GAPS: usize = 7;
 // A run's meta block (u32), then each building's model block offset.
 pub const M_LAW: usize = 0;
@@ -87,6 +89,9 @@ pub const LS_PENETRATION: usize = 5;
 pub const LS_FIRST_IMPACT: usize = 6;
 pub const LS_CONTACT_TIME: usize = 7;
 pub const LS_DISSIPATED: usize = 8;
+/// Reals per contact level in a run's parameters: its stiffness, damping, effective mass and
+/// contact-time coefficient.
+pub const LEVEL_PARAMS: usize = 4;
 /// The struck column's largest shear, where a floor strikes a column.
 pub const LS_COLUMN_SHEAR: usize = 9;
 pub const LS_STRIDE: usize = 10;
@@ -242,7 +247,7 @@ impl RowShape {
     /// Where the struck storeys' stiffnesses start in a run's parameters (one per level where
     /// a floor strikes a column), after each level's contact.
     fn p_columns(&self) -> usize {
-        P_GAPS + self.storeys.len() - 1 + 3 * self.levels.len()
+        P_GAPS + self.storeys.len() - 1 + LEVEL_PARAMS * self.levels.len()
     }
 
     fn m_stride(&self) -> usize {
@@ -347,6 +352,7 @@ impl RowShape {
             ("P_RATE", P_RATE),
             ("P_GAPS", P_GAPS),
             ("P_LEVELS", P_GAPS + nb - 1),
+            ("LEVEL_PARAMS", LEVEL_PARAMS),
             ("P_COLUMNS", self.p_columns()),
             ("P_STRIDE", self.p_stride()),
             ("M_LAW", M_LAW),
@@ -1069,9 +1075,11 @@ impl PackedRows {
             gaps[l.buildings.0] = l.gap;
         }
         self.params.extend(gaps);
+        // Each level's own stiffness: two points about to become one level take shares of it.
         for l in &m.levels {
             let c = &l.contact;
-            self.params.extend([c.damping, c.m_eff, c.tc_coef()]);
+            self.params
+                .extend([c.stiffness, c.damping, c.m_eff, c.tc_coef()]);
         }
         // Each struck storey's stiffness, where a floor strikes a column.
         self.params
