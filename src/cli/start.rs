@@ -85,14 +85,13 @@ pub fn columns(a: ColumnsArgs) -> Result<()> {
             .map(String::from)
             .collect(),
     };
-    let mut out = meaning::table(&names);
-    // A row's contact levels: where each is and what meets there.
+    std::io::stdout().write_all(meaning::table(&names).as_bytes())?;
+    // A row's contact levels, where each is and what meets there, on stderr: standard output
+    // holds the one table of columns.
     if let Some(pounding::plan::Plan::Row(row)) = &plan {
         if !row.is_empty() && !row.level_names().is_empty() {
-            out.push('\n');
-            out.push_str(&row.level_table());
+            note!("\ncontact levels:\n{}", row.level_table().trim_end());
         }
     }
-    std::io::stdout().write_all(out.as_bytes())?;
     Ok(())
 }

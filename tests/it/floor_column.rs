@@ -353,3 +353,53 @@ fn the_levels_section_is_in_the_fingerprint() {
     assert_ne!(plain, print("[levels]\nsame_level_m = 0.015\n"));
     assert_ne!(plain, print("[levels]\nfloor_column = false\n"));
 }
+
+/// Floors at equal heights: the same levels and the same output to the bit with floor/column
+/// contact on or off (the CSVs of the shipped rows with equal floors were compared byte for
+/// byte before and after the change: docs/floor-column.md).
+#[test]
+fn equal_floors_are_unchanged_by_floor_column_contact() {
+    let accel = record(7, 6.0, 0.5);
+    let f = forcing(&accel);
+    let off = LevelRule {
+        floor_column: false,
+        ..LevelRule::default()
+    };
+    for (buildings, gaps) in [
+        (
+            vec![tall(0.55), building(6, 0.8, Damping::Rayleigh(0.05))],
+            vec![0.005],
+        ),
+        (
+            vec![
+                building(2, 0.3, Damping::Modal(0.05)),
+                yielding(building(5, 0.7, Damping::Rayleigh(0.05)), 0.005, 0.03),
+                building(3, 0.4, Damping::Modal(0.05)),
+            ],
+            vec![0.004, 0.0],
+        ),
+    ] {
+        let at = |rule: LevelRule| {
+            Row::with_levels(
+                buildings.clone(),
+                gaps.clone(),
+                LawKind::NonlinearViscoelastic,
+                2.75e9,
+                0.5,
+                rule,
+            )
+        };
+        let (with, without) = (at(LevelRule::default()), at(off));
+        assert_eq!(with.levels, without.levels);
+        assert!(with.levels.iter().all(|l| !l.floor_column()));
+        for scheme in [fast(16.0), reference()] {
+            let run = |r: &Row| {
+                let m = RowModel::new(r);
+                simulate_row(&m, &f, m.at_rest(), &scheme)
+            };
+            let (a, b) = (run(&with), run(&without));
+            assert!(a.impacts > 0);
+            assert_eq!(format!("{a:?}"), format!("{b:?}"));
+        }
+    }
+}
