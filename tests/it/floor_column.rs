@@ -403,3 +403,68 @@ fn equal_floors_are_unchanged_by_floor_column_contact() {
         }
     }
 }
+
+/// docs/floor-column.md's worked example states what its first command gives: each row of its
+/// table, rebuilt from `pound sweep configs/floor-column.toml --aggregate ...` now.
+#[test]
+fn the_worked_example_states_what_its_command_gives() {
+    use crate::support::{ok, pound, table};
+    let dir = crate::support::tempdir();
+    let out = dir.path().join("floor-column.csv");
+    let level = "level_b1f3_b2c4";
+    let exceed = [
+        "impacts=0".to_string(),
+        format!("{level}_impacts=0"),
+        format!("{level}_column_shear_ratio=1"),
+    ];
+    let mut args = vec![
+        "sweep",
+        "configs/floor-column.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--aggregate",
+        "target_sa_g,gap_1_2_m",
+    ];
+    for e in &exceed {
+        args.extend(["--exceed", e]);
+    }
+    ok(&pound(&args));
+    let doc = std::fs::read_to_string("docs/floor-column.md").unwrap();
+    let rows = table(&out);
+    assert_eq!(rows.len(), 16);
+    let mut stated = 0;
+    for r in &rows {
+        let num = |c: &str| r[c].parse::<f64>().unwrap();
+        let sa = format!("{} g", num("target_sa_g"));
+        let gap = match num("gap_1_2_m") {
+            0.0 => "0".to_string(),
+            g => format!("{} mm", (g * 1e3).round()),
+        };
+        let force = match num(&format!("{level}_peak_force_n_max")) {
+            0.0 => "0".to_string(),
+            f => format!("{:.2} MN", f / 1e6),
+        };
+        let ratio = |c: &str| match num(&format!("{level}_column_shear_ratio_{c}")) {
+            0.0 => "0".to_string(),
+            x => format!("{x:.2}"),
+        };
+        let line = format!(
+            "| {sa} | {gap} | {} / {} | {} | {} | {force} | {} | {} |",
+            r["exceed_impacts>0"],
+            r["runs"],
+            r[&format!("exceed_{level}_impacts>0")],
+            r[&format!("exceed_{level}_column_shear_ratio>1")],
+            ratio("max"),
+            ratio("p50"),
+        );
+        let prefix = format!("| {sa} | {gap} |");
+        if doc.contains(&prefix) {
+            assert!(
+                doc.contains(&line),
+                "docs/floor-column.md does not say `{line}`"
+            );
+            stated += 1;
+        }
+    }
+    assert_eq!(stated, 10, "the table's rows");
+}
