@@ -511,15 +511,17 @@ fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0:
         let v0 = LV0[l];
         let f = force(l, mode, v0, z1);
         let r1 = contact_force_rate(y1, d1, accel1, v0, approaching);
+        // The start's force and rate where the force's peak or a struck column needs them.
+        let column = HAS_COLUMNS && L_CS[l] < 2u;
         var f0: real = 0.0;
         var r0: real = 0.0;
-        if (r1 < 0.0) {
+        if (r1 < 0.0 || column) {
             f0 = force(l, mode, v0, z0);
             r0 = contact_force_rate(y0, d0, accel0, v0, approaching);
         }
         rstate[lsi(l, LS_IMP_PEAK)] = raise_force_peak(rstate[lsi(l, LS_IMP_PEAK)], f0, r0, f, r1, h);
-        if (HAS_COLUMNS && L_CS[l] < 2u) {
-            track_column(l, mode, y0, d0, y1, d1, accel0, f, r1, z0, z1, h);
+        if (column) {
+            track_column(l, y0, y1, f0, r0, f, r1, z0, z1, h);
         }
     }
 }
@@ -550,7 +552,7 @@ fn raise_column_peak(peak: real, v0: real, vr0: real, v1: real, vr1: real, f0: r
 // the struck building each segment carries to its floor (`V - s F` above the point,
 // `V + (1 - s) F` below), by the hump's cubic, or at the piece's ends alone where it begins at
 // the touch or ends at the separation (the force's rate unbounded there).
-fn track_column(l: u32, mode: u32, y0: real, d0: real, y1: real, d1: real, accel0: real, f1: real, r1: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) {
+fn track_column(l: u32, y0: real, y1: real, f0: real, r0: real, f1: real, r1: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) {
     let side = L_CS[l];
     let b = L_A[l] + side;
     var j = L_FA[l];
@@ -561,9 +563,6 @@ fn track_column(l: u32, mode: u32, y0: real, d0: real, y1: real, d1: real, accel
         w = L_WB[l];
         on_struck = 1.0;
     }
-    let v0 = LV0[l];
-    let f0 = force(l, mode, v0, z0);
-    let r0 = contact_force_rate(y0, d0, accel0, v0, mode == MODE_APPROACH);
     let k = rp(P_COLUMNS + L_CI[l]);
     let o = B_OFF[b];
     var drift: array<real, 2>;

@@ -92,6 +92,22 @@ impl LevelSide {
         below.into_iter().chain(std::iter::once((f, self.weight)))
     }
 
+    /// The point's row of mode shapes, `u = row . q`, from its building's (`shape[f]`: floor
+    /// `f`'s, from 0): its floors' rows by their shares (a floor's own row on a floor).
+    pub fn mode_row(&self, shape: &[Vec<f64>]) -> Vec<f64> {
+        let f = self.floor - 1;
+        if self.weight == 1.0 {
+            return shape[f].clone();
+        }
+        let mut row = vec![0.0; shape[f].len()];
+        for (f, w) in self.shares() {
+            for (r, p) in row.iter_mut().zip(&shape[f]) {
+                *r += w * p;
+            }
+        }
+        row
+    }
+
     /// The point's mass under a force there: `1 / sum share^2 / m` over its floors (the
     /// ground takes no share of the motion).
     pub fn point_mass(&self, masses: &[f64]) -> f64 {
@@ -122,8 +138,13 @@ pub struct Level {
 impl Level {
     /// Does a floor strike a column here?
     pub fn floor_column(&self) -> bool {
-        self.sides.iter().any(LevelSide::on_column)
+        struck_side(&self.sides).is_some()
     }
+}
+
+/// Which side of a level (0 left, 1 right) is a struck column, if one is.
+pub fn struck_side(sides: &[LevelSide; 2]) -> Option<usize> {
+    (0..2).find(|&k| sides[k].on_column())
 }
 
 /// Buildings left to right, the gap between each adjacent two, and the contact levels.
@@ -307,20 +328,6 @@ pub fn contact_points(
     }
     points.sort_by(|a, b| a.elevation.total_cmp(&b.elevation));
     points
-}
-
-/// The floors of `left` and `right` at the same elevation (within [`LEVEL_TOLERANCE_M`]),
-/// lowest first: `(floor of left, floor of right, elevation)`, floors counted from 1.
-pub fn common_levels(left: &ShearBuilding, right: &ShearBuilding) -> Vec<(usize, usize, f64)> {
-    let (za, zb) = (left.elevations(), right.elevations());
-    za.iter()
-        .enumerate()
-        .filter_map(|(fa, &ea)| {
-            zb.iter()
-                .position(|&eb| (ea - eb).abs() <= LEVEL_TOLERANCE_M)
-                .map(|fb| (fa + 1, fb + 1, ea))
-        })
-        .collect()
 }
 
 /// What one contact level reports. Peaks are over the whole simulated time.

@@ -8,7 +8,7 @@
 //! last gap innermost.
 
 use crate::physics::model::Forcing;
-use crate::physics::row::{Level, LevelRule, LevelSide, Row, RowOutput, StoreyOutput};
+use crate::physics::row::{struck_side, Level, LevelRule, LevelSide, Row, RowOutput, StoreyOutput};
 use crate::physics::shear::{Damping, ShearBuilding, Yielding, MAX_STOREYS};
 use crate::physics::solver::row::RowScheme;
 use crate::physics::solver::Scheme;
@@ -702,7 +702,7 @@ impl RowPlan {
         }
         (self.levels().iter())
             .map(|l| {
-                let side = (0..2).find(|&k| l.sides[k].on_column())?;
+                let side = struck_side(&l.sides)?;
                 Some(self.yielding[l.left + side].is_some())
             })
             .collect()
@@ -715,12 +715,12 @@ impl RowPlan {
         let mut t = String::from(
             "| level | kind | elevation m | struck storey: xi | share on its top floor s |\n|---|---|---:|---:|---:|\n",
         );
-        for (l, name) in self.levels().iter().zip(self.level_names()) {
-            let column = (0..2).find(|&k| l.sides[k].on_column());
-            let (kind, xi, s) = match column {
+        let row = self.row(&self.run(0));
+        for (l, name) in row.levels.iter().zip(self.level_names()) {
+            let (kind, xi, s) = match struck_side(&l.sides) {
                 None => ("floor/floor", String::new(), String::new()),
                 Some(k) => {
-                    let b = &self.row(&self.run(0)).buildings[l.left + k];
+                    let b = &row.buildings[l.left + k];
                     let j = l.sides[k].floor;
                     let below: f64 = b.heights[..j - 1].iter().sum();
                     let xi = (l.elevation - below) / b.heights[j - 1];
@@ -734,11 +734,6 @@ impl RowPlan {
             ));
         }
         t
-    }
-
-    /// Does a floor strike a neighbour's columns in this plan's rows?
-    pub fn has_floor_column(&self) -> bool {
-        self.levels().iter().any(Level::floor_column)
     }
 
     /// Every column, in file order: the contact and motion columns of the pair, each

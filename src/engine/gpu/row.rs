@@ -21,7 +21,7 @@ use crate::engine::Summary;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{CoupledPropagator, Propagator};
-use crate::physics::row::{BuildingOutput, LevelOutput, RowOutput, StoreyOutput};
+use crate::physics::row::{struck_side, BuildingOutput, LevelOutput, RowOutput, StoreyOutput};
 use crate::physics::solver::row::yielding::settle_intervals;
 use crate::physics::solver::row::{simulate_row, BuildingModel, RowModel, RowScheme};
 use crate::physics::solver::FastOptions;
@@ -156,7 +156,7 @@ impl RowShape {
                 .collect(),
             columns: (m.levels.iter().enumerate())
                 .filter_map(|(l, lm)| {
-                    let side = (0..2).find(|&k| lm.sides[k].on_column())?;
+                    let side = struck_side(&lm.sides)?;
                     Some((l, side, lm.sides[side].weight.to_bits()))
                 })
                 .collect(),
@@ -187,8 +187,14 @@ impl RowShape {
     fn struck_storey(&self, l: usize) -> Option<usize> {
         let &(_, side, _) = self.columns.iter().find(|c| c.0 == l)?;
         let [a, fa, fb] = self.levels[l];
-        let storey = if side == 0 { fa } else { fb };
-        self.first_storeys()[a + side].map(|first| first + storey)
+        let (b, storey) = (a + side, if side == 0 { fa } else { fb });
+        // The yielding storeys of the buildings before it come first (`first_storeys`, without
+        // its vector: this runs per run at readback).
+        let before = (self.storeys[..b].iter().zip(&self.yielding))
+            .filter(|(_, &y)| y)
+            .map(|(n, _)| n)
+            .sum::<usize>();
+        self.yielding[b].then_some(before + storey)
     }
 
     /// Level `l`'s weight on side `side` (1 on a floor).

@@ -145,17 +145,6 @@ impl Stepped {
         }
     }
 
-    /// The mode-shape row of a level's point: its floors' rows by their shares.
-    fn point_row(&self, side: &LevelSide) -> Vec<f64> {
-        let mut row = vec![0.0; self.modes.count()];
-        for (f, w) in side.shares() {
-            for (r, p) in row.iter_mut().zip(&self.modes.shape[f]) {
-                *r += w * p;
-            }
-        }
-        row
-    }
-
     /// Displacement, velocity and acceleration (relative to the ground) of the point whose
     /// mode-shape row is `shape`.
     #[inline]
@@ -395,7 +384,7 @@ pub fn separation_with(
     {
         Some(i) => i,
         None => {
-            let row = stepped[b].point_row(&side);
+            let row = side.mode_row(&stepped[b].modes.shape);
             watched.push(Watched {
                 building: b,
                 side,

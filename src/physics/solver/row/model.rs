@@ -4,7 +4,7 @@
 
 use super::yielding::StoreyModel;
 use crate::physics::contact::Contact;
-use crate::physics::row::{LevelSide, Row};
+use crate::physics::row::{struck_side, LevelSide, Row};
 use crate::physics::shear::{storey_drift_row, Modes};
 use crate::physics::solver::events::fourth_derivative_bound;
 use crate::physics::solver::Segment;
@@ -89,22 +89,6 @@ impl FloorForm {
 impl BuildingModel {
     pub fn n(&self) -> usize {
         self.modes.count()
-    }
-
-    /// The mode-shape row of a level's point on this building: `u = row . q`, the shares of
-    /// its floors' rows.
-    fn point_row(&self, side: &LevelSide) -> Vec<f64> {
-        let mut row = vec![0.0; self.n()];
-        for (f, w) in side.shares() {
-            if w == 1.0 {
-                row.clone_from(&self.modes.shape[f]);
-            } else {
-                for (r, p) in row.iter_mut().zip(&self.modes.shape[f]) {
-                    *r += w * p;
-                }
-            }
-        }
-        row
     }
 
     /// A level's point on this building in floor coordinates: the offset and length of its
@@ -280,7 +264,8 @@ impl RowModel {
             .iter()
             .map(|l| {
                 let (ba, bb) = (&buildings[l.left], &buildings[l.left + 1]);
-                let [phi_a, phi_b] = [(ba, 0), (bb, 1)].map(|(bm, k)| bm.point_row(&l.sides[k]));
+                let [phi_a, phi_b] =
+                    [(ba, 0), (bb, 1)].map(|(bm, k)| l.sides[k].mode_row(&bm.modes.shape));
                 LevelModel {
                     a: (ba.off, ba.n()),
                     b: (bb.off, bb.n()),
@@ -292,7 +277,7 @@ impl RowModel {
                     phi_b,
                     gap: row.gaps[l.left],
                     contact: l.contact,
-                    column: (0..2).find(|&k| l.sides[k].on_column()).map(|side| {
+                    column: struck_side(&l.sides).map(|side| {
                         let building = l.left + side;
                         let storey = l.sides[side].floor - 1;
                         StruckColumn {

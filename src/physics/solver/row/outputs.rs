@@ -54,17 +54,12 @@ impl<'m> RowRun<'m> {
             if ls.mode == Mode::Free {
                 continue;
             }
+            // On a floor its one share is 1: the whole force, to the bit.
             let fl = lm.force(n, ls.mode, ls.v0, z);
-            let [a, b] = &lm.sides;
-            if !a.on_column() && !b.on_column() {
-                self.floors[lm.buildings.0][end].force[a.floor - 1] -= fl;
-                self.floors[lm.buildings.1][end].force[b.floor - 1] += fl;
-                continue;
-            }
-            for (f, w) in a.shares() {
+            for (f, w) in lm.sides[0].shares() {
                 self.floors[lm.buildings.0][end].force[f] -= w * fl;
             }
-            for (f, w) in b.shares() {
+            for (f, w) in lm.sides[1].shares() {
                 self.floors[lm.buildings.1][end].force[f] += w * fl;
             }
         }
@@ -261,11 +256,20 @@ impl<'m> RowRun<'m> {
             let approaching = ls.mode == Mode::Approach;
             let f = lm.force(n, ls.mode, ls.v0, z1);
             let r1 = lm.contact.force_rate(y1, d1, accel(1), ls.v0, approaching);
+            let start = || {
+                let f0 = lm.force(n, ls.mode, ls.v0, z0);
+                (
+                    f0,
+                    lm.contact.force_rate(y0, d0, accel(0), ls.v0, approaching),
+                )
+            };
+            // The start's force and rate, where a struck column needs them too.
+            let mut known = None;
             if let Some(c) = &lm.column {
                 // The struck storey's two column segments: the storey's spring force `V` and
                 // the share of the force on the struck building each carries to its floor.
-                let f0 = lm.force(n, ls.mode, ls.v0, z0);
-                let r0 = lm.contact.force_rate(y0, d0, accel(0), ls.v0, approaching);
+                let (f0, r0) = start();
+                known = Some((f0, r0));
                 let on_struck = if c.side == 0 { -1.0 } else { 1.0 };
                 let fl = &self.floors[c.building];
                 let j = c.storey;
@@ -300,13 +304,7 @@ impl<'m> RowRun<'m> {
                 }
                 ls.out.column_shear = peak;
             }
-            ls.imp_peak = raise_force_peak(ls.imp_peak, f, r1, h, || {
-                let f0 = lm.force(n, ls.mode, ls.v0, z0);
-                (
-                    f0,
-                    lm.contact.force_rate(y0, d0, accel(0), ls.v0, approaching),
-                )
-            });
+            ls.imp_peak = raise_force_peak(ls.imp_peak, f, r1, h, || known.unwrap_or_else(start));
         }
     }
 
