@@ -52,22 +52,8 @@ pub fn run(a: Args) -> Result<()> {
     let gaps = a.gaps.as_deref().map(parse_gaps).transpose()?;
     let threads = a.threads.map(super::sweep::check_threads).transpose()?;
     let plan = config::load_text(&text, &a.config)?;
-    if let pounding::plan::Plan::Row(r) = &plan {
-        if r.buildings.len() == 1 {
-            bail!(
-                "{}: one building stands alone: a separation gap is between neighbours; give a row of two or more [[building]] entries",
-                a.config.display()
-            );
-        }
-    }
-    // A pair that cannot touch floor to floor has no required gap to give.
-    let apart = plan.pairs_without_levels();
-    if !apart.is_empty() {
-        bail!(
-            "{}: {}: no required gap can be computed for such a pair",
-            a.config.display(),
-            apart.join("; ")
-        );
+    if let Some(why) = GapStudy::refusal(&plan) {
+        bail!("{}: {why}", a.config.display());
     }
     super::warn_all(&a.config, plan.input_warnings());
     let mut pool = rayon::ThreadPoolBuilder::new();

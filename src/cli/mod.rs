@@ -556,26 +556,7 @@ pub fn target_error_in(
     suite: pounding::physics::solver::calibration::Suite,
     target: f64,
 ) -> Result<pounding::physics::solver::calibration::Choice> {
-    use pounding::physics::solver::calibration::for_target_in;
-    if !(target > 0.0 && target.is_finite()) {
-        bail!(
-            "--target-error {target}: expected a relative error above 0, e.g. 1e-2 ({})",
-            suite.measure()
-        );
-    }
-    let c = for_target_in(suite, target).map_err(|best| {
-        anyhow::anyhow!(
-            "--target-error {target:e}: below what the fast scheme is calibrated for on {} (its smallest {} is {best:.1e}); use a larger target, or the reference scheme (pound sweep --scheme reference)",
-            suite.config(),
-            suite.measure()
-        )
-    })?;
-    note!(
-        "--target-error {target:e}: {} RK4 substeps per contact ({} {:.1e} on {}, measured by pound accuracy)",
-        c.substeps_per_contact,
-        suite.measure(),
-        c.calibrated_p99,
-        suite.config()
-    );
+    let (c, said) = pounding::plan::settings::target_error_in(suite, target)?;
+    note!("{said}");
     Ok(c)
 }

@@ -198,26 +198,19 @@ fn spectrum(
     plot: Option<&std::path::Path>,
     figure: &super::FigureArgs,
 ) -> Result<()> {
-    use rayon::prelude::*;
-    let rows: Vec<(f64, f64)> = periods
-        .par_iter()
-        .map(|&t| (t, intensity::peak_displacement(rec, t, damping)))
-        .collect();
     let mut csv = String::from("period_s,sa_g,sa_m_s2,sd_m\n");
     let mut points = Vec::new();
-    for &(t, sd) in &rows {
-        let w = 2.0 * std::f64::consts::PI / t;
-        let sa = w * w * sd;
+    for o in intensity::spectrum(rec, periods, damping) {
         // Shortest round trip, in exponent form beyond ordinary magnitudes (never 300 digits).
         let show = pounding::show;
         csv.push_str(&format!(
             "{},{},{},{}\n",
-            show(t),
-            show(sa / G),
-            show(sa),
-            show(sd)
+            show(o.period_s),
+            show(o.sa_m_s2 / G),
+            show(o.sa_m_s2),
+            show(o.sd_m)
         ));
-        points.push((t, sa / G));
+        points.push((o.period_s, o.sa_m_s2 / G));
     }
     let (pgv, pgd) = intensity::pgv_pgd(rec);
     let peak = points

@@ -8,7 +8,7 @@ use pounding::engine::aggregate::Aggregator;
 use pounding::engine::{Backend, Chunk, Engine, Kernel};
 use pounding::io::provenance::{Fingerprint, Meta};
 use pounding::io::sweep_output::{Format, Opened, SweepOutput};
-use pounding::physics::solver::{FastOptions, ReferenceOptions, Scheme};
+use pounding::plan::settings::{picked_columns, sweep_warnings, SchemeKind, SchemeSettings};
 use pounding::plan::shard::Shard;
 use pounding::plan::{config, Plan};
 use std::io::IsTerminal;
@@ -89,40 +89,6 @@ fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
     Shard::parse(s).ok_or_else(|| format!("`{s}`: expected I/N with 0 <= I < N, e.g. 3/16"))
 }
 
-/// The scheme as run: the config's, or `--scheme` (keeping the config's settings when it names
-/// the same scheme), with `--energy` added to the fast scheme.
-fn scheme_as_run(configured: Scheme, asked: Option<SchemeArg>, energy: bool) -> Scheme {
-    let scheme = match asked {
-        None => configured,
-        Some(SchemeArg::Fast) => Scheme::Fast(match configured {
-            Scheme::Fast(o) => o,
-            _ => FastOptions::default(),
-        }),
-        Some(SchemeArg::Reference) => Scheme::Reference(match configured {
-            Scheme::Reference(o) => o,
-            _ => ReferenceOptions::default(),
-        }),
-    };
-    match scheme {
-        Scheme::Fast(o) => Scheme::Fast(FastOptions {
-            energy: o.energy || energy,
-            ..o
-        }),
-        reference => reference,
-    }
-}
-
-/// Say that `--target-error` replaces a `run.substeps_per_contact` the config gives.
-fn overrides_configured(config_text: &str, chosen: f64) {
-    let given = config_text
-        .parse::<toml::Table>()
-        .ok()
-        .and_then(|t| t.get("run")?.get("substeps_per_contact").cloned());
-    if let Some(v) = given {
-        note!("notice: --target-error overrides the config's run.substeps_per_contact = {v} with {chosen}");
-    }
-}
-
 /// `--threads`, checked.
 pub fn check_threads(t: usize) -> Result<usize> {
     use pounding::plan::limits::{MAX_THREADS, WHY_THREADS};
@@ -195,21 +161,8 @@ pub fn run(a: Args) -> Result<()> {
     // (or the fingerprint), so the output is not put in place.
     let changed = config::changed_records(&config_text, &flags.config, &plan);
     let (path, what) = finish_unless_changed(*out, &changed)?;
-    if absurd > 0 {
-        note!("warning: {absurd} runs have a building whose peak displacement exceeds its height ({}): check the record's units and the intensity", plan.height_basis());
-    }
-    if past_drift > 0 {
-        note!(
-            "warning: {past_drift} runs have a storey past a drift ratio of {} without collapsing (where collapse studies call a building collapsed): {}, so these buildings stand where real ones may have fallen; read them as collapsed, or as outside the model's range",
-            pounding::plan::limits::WARN_DRIFT_RATIO,
-            match &plan {
-                pounding::plan::Plan::Row(r) if r.collapse_drift_ratio.is_finite() => format!(
-                    "the collapse limit is a drift ratio of {} ([run] collapse_drift_ratio)",
-                    pounding::show(r.collapse_drift_ratio)
-                ),
-                _ => "the collapse criterion is off ([run] collapse_drift_ratio = \"none\")".into(),
-            }
-        );
+    for w in sweep_warnings(&plan, absurd, past_drift) {
+        note!("warning: {w}");
     }
     finished(&summary, &path, &format!(" ({what})"));
     Ok(())
@@ -315,50 +268,26 @@ impl Flags {
         plan: &mut Plan,
         config_text: &str,
     ) -> Result<Option<pounding::physics::solver::calibration::Choice>> {
-        let mut scheme = scheme_as_run(plan.scheme(), self.scheme, self.energy);
-        let chosen = match (self.target_error, &mut scheme) {
-            (None, _) => None,
-            (Some(_), Scheme::Reference(_)) => bail!(
-                "--target-error chooses the fast scheme's setting; the reference scheme is controlled by its tolerance (run.tol)"
-            ),
-            (Some(e), Scheme::Fast(o)) => {
-                let c = super::target_error_in(plan.suite(), e)?;
-                overrides_configured(config_text, c.substeps_per_contact);
-                o.substeps_per_contact = c.substeps_per_contact;
-                Some(c)
-            }
-        };
-        plan.set_scheme(scheme);
-        let spc = match scheme {
-            Scheme::Fast(o) => o.substeps_per_contact,
-            Scheme::Reference(_) => FastOptions::default().substeps_per_contact,
-        };
-        super::warn_all(&self.config, plan.warnings(spc));
-        Ok(chosen)
+        let settled = SchemeSettings {
+            scheme: self.scheme.map(|s| match s {
+                SchemeArg::Fast => SchemeKind::Fast,
+                SchemeArg::Reference => SchemeKind::Reference,
+            }),
+            energy: self.energy,
+            target_error: self.target_error,
+        }
+        .settle(plan, config_text)?;
+        for n in &settled.notices {
+            note!("{n}");
+        }
+        super::warn_all(&self.config, settled.warnings);
+        Ok(settled.chosen)
     }
 
     /// How runs are written ([`Columns`]).
     fn output_columns(&self, plan: &Plan) -> Result<Columns> {
         let header = plan.header();
-        if let Some(twice) = self
-            .columns
-            .as_deref()
-            .and_then(pounding::plan::config::name_given_twice)
-        {
-            bail!("--columns: `{twice}` is given twice: give each column once");
-        }
-        let picked = self
-            .columns
-            .as_ref()
-            .map(|c| pounding::plan::columns::select_in(&header, c))
-            .transpose()
-            .map_err(|bad| {
-                anyhow::anyhow!(
-                    "--columns: `{bad}` is not a column of this sweep ({}); its columns are: {}",
-                    plan.scene(),
-                    header.join(", ")
-                )
-            })?;
+        let picked = picked_columns(plan, self.columns.as_deref())?;
         let summary = self
             .aggregate
             .as_ref()

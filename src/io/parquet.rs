@@ -18,8 +18,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+/// A column's type in typed outputs (Parquet, the Python package's Arrow tables).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
+pub enum Kind {
     Int,
     Text,
     Real,
@@ -28,7 +29,7 @@ enum Kind {
 /// A column's type, from its name: counts and numbers of storeys and floors are integers (a
 /// row's per-building and per-level columns end as the pair's do: `b2_drift_storey`,
 /// `level_b1f3_b2f3_impacts`).
-fn kind(column: &str) -> Kind {
+pub fn kind(column: &str) -> Kind {
     match column {
         "run" | "impacts" | "substeps" | "sample" => Kind::Int,
         "law" | "formula" | "record" | "status" => Kind::Text,

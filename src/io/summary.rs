@@ -3,36 +3,62 @@
 //! a column that may be empty (a residual drift not known) adds how many runs had no value.
 
 use crate::engine::aggregate::{may_be_empty, Aggregator, QUANTILES};
+use crate::io::parquet::{kind, Kind};
+
+/// A summary in memory: its column names, their types, and a row of cells per group (an empty
+/// cell: no value).
+pub struct SummaryTable {
+    pub header: Vec<String>,
+    pub kinds: Vec<Kind>,
+    pub rows: Vec<Vec<String>>,
+}
 
 /// The summary of `agg` as CSV text.
 pub fn csv(agg: &Aggregator) -> String {
+    let t = table(agg);
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(&t.header).expect("in memory");
+    for r in &t.rows {
+        w.write_record(r).expect("in memory");
+    }
+    String::from_utf8(w.into_inner().expect("in memory")).expect("utf-8")
+}
+
+/// The summary of `agg`: a group's columns keep their types, counts are integers, statistics
+/// reals.
+pub fn table(agg: &Aggregator) -> SummaryTable {
     let mut head: Vec<String> = agg.by().map(str::to_string).collect();
-    head.push("runs".into());
-    head.push("failures".into());
+    let mut kinds: Vec<Kind> = agg.by().map(kind).collect();
+    let count = |head: &mut Vec<String>, kinds: &mut Vec<Kind>, name: String| {
+        head.push(name);
+        kinds.push(Kind::Int);
+    };
+    count(&mut head, &mut kinds, "runs".into());
+    count(&mut head, &mut kinds, "failures".into());
     if agg.collapses() {
-        head.push("collapsed".into());
+        count(&mut head, &mut kinds, "collapsed".into());
     }
     // Columns that may be empty (a residual drift not known) say how many runs had no value.
     let exceed_open: Vec<bool> = agg.exceed().map(|(c, _)| may_be_empty(c)).collect();
     let output_open: Vec<bool> = agg.outputs().map(may_be_empty).collect();
     for (c, t) in agg.exceed() {
-        head.push(format!("exceed_{c}>{t}"));
+        count(&mut head, &mut kinds, format!("exceed_{c}>{t}"));
         if may_be_empty(c) {
-            head.push(format!("undecided_{c}>{t}"));
+            count(&mut head, &mut kinds, format!("undecided_{c}>{t}"));
         }
     }
     for o in agg.outputs() {
         if may_be_empty(o) {
-            head.push(format!("{o}_no_value"));
+            count(&mut head, &mut kinds, format!("{o}_no_value"));
         }
         head.push(format!("{o}_max"));
         head.push(format!("{o}_mean"));
         for q in QUANTILES {
             head.push(format!("{o}_p{}", (q * 100.0).round()));
         }
+        kinds.resize(head.len(), Kind::Real);
     }
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(&head).expect("in memory");
+    let mut rows = Vec::new();
     for (label, g) in agg.labelled() {
         let mut r = label.to_vec();
         r.push(g.runs.to_string());
@@ -61,9 +87,13 @@ pub fn csv(agg: &Aggregator) -> String {
                 r.push(format!("{}", s.quantile(q)));
             }
         }
-        w.write_record(&r).expect("in memory");
+        rows.push(r);
     }
-    String::from_utf8(w.into_inner().expect("in memory")).expect("utf-8")
+    SummaryTable {
+        header: head,
+        kinds,
+        rows,
+    }
 }
 
 #[cfg(test)]

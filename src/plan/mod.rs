@@ -8,6 +8,7 @@
 //! - [`sample`]: Latin hypercube and Monte Carlo samples of uncertain parameters;
 //! - [`columns`]: the schema, every run's parameters and outputs as named columns;
 //! - [`meaning`]: what each column holds, and its unit;
+//! - [`settings`]: the scheme as run and the columns written (a sweep's settings stage);
 //! - [`shard`]: cost-balanced run ranges for job arrays;
 //! - [`limits`]: the bound on every size a user types, with its reason.
 //!
@@ -31,6 +32,7 @@ pub mod limits;
 pub mod meaning;
 pub mod row;
 pub mod sample;
+pub mod settings;
 pub mod shard;
 
 use crate::physics::contact::{Contact, LawKind};

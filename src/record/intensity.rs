@@ -348,3 +348,31 @@ mod tests {
         assert!(rel(a2, 4.0 * a1) < 1e-13 && rel(c2, 2.0 * c1) < 1e-13);
     }
 }
+
+/// One period of a response spectrum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpectralOrdinate {
+    pub period_s: f64,
+    /// Pseudo-acceleration, m/s^2 (omega^2 Sd).
+    pub sa_m_s2: f64,
+    /// Peak relative displacement, m.
+    pub sd_m: f64,
+}
+
+/// The `damping`-damped pseudo-acceleration response spectrum of `rec` at `periods` (each an
+/// exact response over the whole record), computed in parallel.
+pub fn spectrum(rec: &Record, periods: &[f64], damping: f64) -> Vec<SpectralOrdinate> {
+    use rayon::prelude::*;
+    periods
+        .par_iter()
+        .map(|&t| {
+            let sd = peak_displacement(rec, t, damping);
+            let w = 2.0 * std::f64::consts::PI / t;
+            SpectralOrdinate {
+                period_s: t,
+                sa_m_s2: w * w * sd,
+                sd_m: sd,
+            }
+        })
+        .collect()
+}

@@ -263,6 +263,23 @@ pub struct GapStudy<'a> {
 }
 
 impl<'a> GapStudy<'a> {
+    /// Why `plan` has no separation gap to give, if it has none: one building alone, or a pair
+    /// of neighbours whose floors never meet.
+    pub fn refusal(plan: &Plan) -> Option<String> {
+        if let Plan::Row(r) = plan {
+            if r.buildings.len() == 1 {
+                return Some("one building stands alone: a separation gap is between neighbours; give a row of two or more [[building]] entries".into());
+            }
+        }
+        let apart = plan.pairs_without_levels();
+        (!apart.is_empty()).then(|| {
+            format!(
+                "{}: no required gap can be computed for such a pair",
+                apart.join("; ")
+            )
+        })
+    }
+
     /// Compute every response (in parallel on the current rayon pool). Err: the first run
     /// whose response could not be computed, and why (only where storeys yield).
     pub fn run(plan: &'a Plan) -> Result<GapStudy<'a>, String> {

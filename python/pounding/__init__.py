@@ -1,0 +1,458 @@
+"""pounding: earthquake-induced pounding between adjacent buildings, in-process.
+
+The engine of the ``pound`` command line, called from Python: every function mirrors a command
+and returns its results as a :class:`Table` (typed columns, read without copying by pyarrow,
+polars and pandas through the Arrow PyCapsule stream interface).
+
+    >>> import pounding
+    >>> runs = pounding.sweep("configs/quickstart.toml")          # pound sweep
+    >>> df = runs.to_pandas()
+
+Functions: :func:`sweep`, :func:`gap`, :func:`trace`, :func:`fragility`, :func:`ida`,
+:func:`record`, :func:`spectrum`, :func:`columns`. A config is a path, a TOML string or a dict
+with the config's structure (the keys of README.md, "A config"). Errors are
+:class:`PoundingError` subclasses carrying the command line's messages; the engine runs with
+the GIL released, and Ctrl-C stops it and raises ``KeyboardInterrupt``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import warnings
+from typing import Any, Iterable, NamedTuple, Optional, Sequence, Union
+
+from . import _pounding as _engine
+from ._pounding import (
+    ConfigError,
+    GpuError,
+    PoundingError,
+    RecordError,
+    SettingsError,
+    TableError,
+)
+
+__version__ = _engine.__version__
+
+__all__ = [
+    "sweep",
+    "gap",
+    "trace",
+    "fragility",
+    "ida",
+    "record",
+    "spectrum",
+    "columns",
+    "Table",
+    "Trace",
+    "Record",
+    "PoundingError",
+    "ConfigError",
+    "RecordError",
+    "SettingsError",
+    "TableError",
+    "GpuError",
+    "PoundingWarning",
+]
+
+Config = Union[str, "os.PathLike[str]", dict]
+
+
+class PoundingWarning(UserWarning):
+    """What the command line prints as a warning (a config's questionable input, runs whose
+    buildings move past their height)."""
+
+
+class Table:
+    """A table of results: typed columns (int64, float64, string; an empty cell is a null).
+
+    It is an Arrow stream (``__arrow_c_stream__``): ``pyarrow.table(t)``, ``polars.DataFrame(t)``
+    and ``t.to_pandas()`` read its numbers without copying them into Python objects.
+    ``info`` holds what the command line says of the work (runs, seconds, engine, report).
+    """
+
+    def __init__(self, inner: Any, info: Optional[dict] = None):
+        self._inner = inner
+        self.info = dict(info or {})
+
+    @property
+    def num_rows(self) -> int:
+        return self._inner.num_rows
+
+    @property
+    def column_names(self) -> list:
+        return self._inner.column_names
+
+    @property
+    def metadata(self) -> dict:
+        """The schema's key-value metadata (a sweep's plan fingerprint, backend, kernel)."""
+        return self._inner.metadata
+
+    def __len__(self) -> int:
+        return len(self._inner)
+
+    def __arrow_c_stream__(self, requested_schema: Any = None) -> Any:
+        return self._inner.__arrow_c_stream__(requested_schema)
+
+    def to_arrow(self) -> Any:
+        """A ``pyarrow.Table`` (needs pyarrow)."""
+        import pyarrow as pa
+
+        return pa.table(self)
+
+    def to_pandas(self) -> Any:
+        """A ``pandas.DataFrame`` (needs pandas and pyarrow)."""
+        return self.to_arrow().to_pandas()
+
+    def to_polars(self) -> Any:
+        """A ``polars.DataFrame`` (needs polars)."""
+        import polars as pl
+
+        return pl.DataFrame(self)
+
+    def column(self, name: str) -> Any:
+        """One column as a numpy array (needs pyarrow); nulls become NaN in a real column."""
+        if name not in self.column_names:
+            raise TableError(
+                f"no column `{name}`; the columns are: {', '.join(self.column_names)}"
+            )
+        return self.to_arrow().column(name).to_numpy()
+
+    def __repr__(self) -> str:
+        names = self.column_names
+        shown = ", ".join(names[:8]) + (", ..." if len(names) > 8 else "")
+        return f"<pounding.Table: {self.num_rows} rows x {len(names)} columns ({shown})>"
+
+
+class Trace(NamedTuple):
+    """One run whole: its time history (every record step and located event) and its row as
+    the sweep writes it."""
+
+    history: Table
+    row: Table
+
+
+class Record:
+    """A ground-motion record file as read: name, npts, dt (s), t0 (s), duration (s), pga_g,
+    pga_m_s2, pga_time (s), pgv_m_s, pgd_m (from rest, no baseline correction), and the samples
+    (``accel_m_s2``, ``accel_g``, ``time``: numpy arrays)."""
+
+    def __init__(self, path: str, options: dict, info: dict, samples: bytes):
+        self.path = path
+        self._options = options
+        self._samples = samples
+        for k, v in info.items():
+            setattr(self, k, v)
+
+    @property
+    def accel_m_s2(self) -> Any:
+        import numpy as np
+
+        return np.frombuffer(self._samples, dtype="<f8")
+
+    @property
+    def accel_g(self) -> Any:
+        return self.accel_m_s2 / 9.80665
+
+    @property
+    def time(self) -> Any:
+        import numpy as np
+
+        return self.t0 + self.dt * np.arange(self.npts)
+
+    def __repr__(self) -> str:
+        return (
+            f"<pounding.Record {self.name}: {self.npts} samples at dt {self.dt} s, "
+            f"PGA {self.pga_g:.4f} g, PGV {self.pgv_m_s:.4f} m/s>"
+        )
+
+
+def _config(config: Config) -> tuple:
+    """A config as the engine takes it: (value, kind)."""
+    if isinstance(config, dict):
+        return config, "dict"
+    if isinstance(config, os.PathLike):
+        return os.fspath(config), "path"
+    if isinstance(config, str):
+        # A TOML text has a key (=) or a table ([...]); a path has neither on one line.
+        if "\n" in config or "=" in config or config.lstrip().startswith("["):
+            return config, "text"
+        return config, "path"
+    raise TypeError(
+        f"config: a {type(config).__name__} is not a config: expected a path, a TOML string or a dict"
+    )
+
+
+def _names(value: Union[None, str, Iterable[str]], what: str) -> Optional[list]:
+    if value is None:
+        return None
+    if isinstance(value, str):
+        return [v.strip() for v in value.split(",") if v.strip()]
+    names = list(value)
+    if not all(isinstance(v, str) for v in names):
+        raise TypeError(f"{what}: expected column names (strings)")
+    return names
+
+
+def _exceed(exceed: Union[None, str, dict, Iterable[str]]) -> list:
+    if exceed is None:
+        return []
+    if isinstance(exceed, dict):
+        return [f"{k}={v!r}" if isinstance(v, float) else f"{k}={v}" for k, v in exceed.items()]
+    if isinstance(exceed, str):
+        return [exceed]
+    return list(exceed)
+
+
+def _say(lines: Sequence[str]) -> None:
+    for line in lines:
+        print(line, file=sys.stderr)
+
+
+def _warn(lines: Sequence[str]) -> None:
+    for line in lines:
+        warnings.warn(line, PoundingWarning, stacklevel=3)
+
+
+class _Progress:
+    """Runs done: a tqdm bar where tqdm is installed (a notebook's widget or a terminal's bar),
+    else a line on standard error rewritten in place. Called as (done, total)."""
+
+    def __init__(self, label: str, enabled: bool):
+        self.label, self.enabled, self.bar, self.shown = label, enabled, None, False
+
+    def __call__(self, done: int, total: int) -> None:
+        if not self.enabled or total <= 0:
+            return
+        if self.bar is None and not self.shown:
+            try:
+                from tqdm.auto import tqdm
+
+                self.bar = tqdm(total=total, desc=self.label, unit="runs", leave=False)
+            except ImportError:
+                self.bar = None
+        if self.bar is not None:
+            self.bar.update(done - self.bar.n)
+        else:
+            sys.stderr.write(f"\r{self.label}: {done}/{total} runs ({100.0 * done / total:.0f} %)")
+            sys.stderr.flush()
+            self.shown = True
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+        elif self.shown:
+            sys.stderr.write("\r" + " " * (len(self.label) + 40) + "\r")
+            sys.stderr.flush()
+
+
+def sweep(
+    config: Config,
+    *,
+    backend: str = "auto",
+    precision: Optional[str] = None,
+    threads: Optional[int] = None,
+    target_error: Optional[float] = None,
+    columns: Union[None, str, Iterable[str]] = None,
+    aggregate: Union[None, str, Iterable[str]] = None,
+    exceed: Union[None, str, dict, Iterable[str]] = None,
+    scheme: Optional[str] = None,
+    energy: bool = False,
+    chunk: Optional[int] = None,
+    progress: bool = True,
+) -> Table:
+    """Every run of a sweep config, as ``pound sweep`` runs it: a row per run (the CSV's
+    columns, typed), or with ``aggregate`` (columns to group by, e.g. ``["record", "pga_g"]``)
+    the summary per group, with ``exceed`` counts (``{"peak_force_n": 1e6}`` or
+    ``["peak_force_n=1e6"]``).
+
+    backend: "auto" (a hardware GPU if one is found, else the CPU), "gpu" or "cpu";
+    precision: "f32" (default) or "f64" on the GPU; threads: CPU worker threads (default all);
+    target_error: the relative error accepted (the fast scheme's cheapest calibrated setting);
+    columns: only these columns (``run`` is kept, first); scheme: "fast" or "reference" over
+    the config's; energy: each run's energy balance; progress: a progress bar.
+
+    The table's ``info`` holds the sweep's totals (runs, seconds, runs_per_second, impacts,
+    runs_with_impacts, failures, collapsed, engine, kernel, scene).
+    """
+    value, kind = _config(config)
+    bar = _Progress("sweep", bool(progress))
+    try:
+        inner, totals, notices, warned = _engine.sweep(
+            value,
+            kind,
+            backend,
+            precision,
+            threads,
+            target_error,
+            _names(columns, "columns"),
+            _names(aggregate, "aggregate"),
+            _exceed(exceed),
+            scheme,
+            bool(energy),
+            chunk,
+            bar if progress else None,
+        )
+    finally:
+        bar.close()
+    _say(notices)
+    _warn(warned)
+    totals["notices"] = notices
+    return Table(inner, totals)
+
+
+def columns(config: Optional[Config] = None) -> Table:
+    """A sweep's columns (of ``config``, or of a pair's sweep without one): column, unit,
+    meaning, label (as plots name it) and type (int64, float64 or string), as
+    ``pound columns`` lists them."""
+    if config is None:
+        return Table(_engine.columns(None))
+    value, kind = _config(config)
+    return Table(_engine.columns(value, kind))
+
+
+def trace(config: Config, run: int) -> Trace:
+    """One run of a sweep whole, as ``pound trace --run RUN``: its time history (every record
+    step and located event: displacements, velocities, accelerations, each level's
+    penetration, force and mode, yielding storeys' drifts) and its row as the sweep writes it."""
+    value, kind = _config(config)
+    history, row = _engine.trace(value, kind, int(run))
+    return Trace(Table(history), Table(row))
+
+
+def gap(config: Config, *, threads: Optional[int] = None) -> Table:
+    """The separation each adjacent pair of a sweep's buildings needs, run by run, as
+    ``pound gap`` writes it: exactly from the time histories, and by the ABS, SRSS and DDC
+    rules, with their ratios to the exact gap."""
+    value, kind = _config(config)
+    inner, warned = _engine.gap(value, kind, threads)
+    _warn(warned)
+    return Table(inner)
+
+
+def _study_input(table: Any) -> Any:
+    if isinstance(table, (str, os.PathLike)):
+        return os.fspath(table), "path"
+    if isinstance(table, Table):
+        return table._inner, "arrow"
+    if hasattr(table, "__arrow_c_stream__"):
+        return table, "arrow"
+    # A pandas DataFrame without the stream interface (pandas < 2.2): through pyarrow.
+    try:
+        import pyarrow as pa
+
+        return pa.table(table), "arrow"
+    except Exception:
+        raise TableError(
+            f"a {type(table).__name__} is not a table: expected a table from pounding.sweep, "
+            "a pyarrow or polars table, a pandas DataFrame, or the path of a results CSV"
+        ) from None
+
+
+def _list(value: Union[None, float, str, Iterable[Any]]) -> list:
+    if value is None:
+        return []
+    if isinstance(value, (int, float)):
+        return [float(value)]
+    if isinstance(value, str):
+        return [float(v) for v in value.split(",") if v.strip()]
+    return [float(v) for v in value]
+
+
+def fragility(
+    table: Any,
+    *,
+    im: Optional[str] = None,
+    edp: str = "peak_force_n",
+    thresholds: Union[None, float, str, Iterable[float]] = None,
+    damage_states: Optional[str] = None,
+    bootstrap: int = 0,
+    seed: Optional[int] = None,
+    by: Optional[str] = None,
+    where: Union[None, str, Iterable[str]] = None,
+) -> Table:
+    """Fragility curves from a sweep's results, as ``pound fragility``: per threshold (or named
+    damage state: ``"hazus-c1l-high"``, ``"fema-p58-residual"``, a TOML file) and intensity
+    level, the runs that exceed it, with the lognormal fitted by maximum likelihood (median,
+    beta) and, with ``bootstrap`` replicates over ``by`` (records), 90 % bands.
+
+    ``table``: a table from :func:`sweep` (or any Arrow table or DataFrame) or a results CSV's
+    path. ``info["report"]`` holds the command's report (the fits as a Markdown table).
+    """
+    source, kind = _study_input(table)
+    inner, report, notices = _engine.fragility(
+        source,
+        kind,
+        im,
+        edp,
+        _list(thresholds),
+        damage_states,
+        int(bootstrap),
+        seed,
+        by,
+        _names(where, "where") or [],
+    )
+    _say(notices)
+    return Table(inner, {"report": report, "notices": notices})
+
+
+def ida(
+    table: Any,
+    *,
+    im: Optional[str] = None,
+    edp: Optional[str] = None,
+    by: Optional[str] = None,
+    where: Union[None, str, Iterable[str]] = None,
+) -> Table:
+    """Incremental dynamic analysis from a sweep's results, as ``pound ida``: per record the
+    demand against the intensity, and the 16, 50 and 84 % fractiles across records at each
+    intensity level. ``info["report"]`` holds the command's report."""
+    source, kind = _study_input(table)
+    inner, report, notices = _engine.ida(
+        source, kind, im, edp, by, _names(where, "where") or []
+    )
+    _say(notices)
+    return Table(inner, {"report": report, "notices": notices})
+
+
+def record(
+    path: Union[str, "os.PathLike[str]"],
+    *,
+    format: str = "auto",
+    dt: Optional[float] = None,
+    units: Optional[str] = None,
+    skip_lines: int = 0,
+    window: Optional[tuple] = None,
+) -> Record:
+    """A ground-motion record file, read as ``pound record info`` reads it (format: auto, at2,
+    values or two_column; units: g, m/s2 or cm/s2; window: (start, end) s on the record's
+    clock, as a config's ``window_s``)."""
+    path = os.fspath(path)
+    options = {
+        "format": format,
+        "dt": dt,
+        "units": units,
+        "skip_lines": int(skip_lines),
+        "window": tuple(window) if window is not None else None,
+    }
+    info, samples = _engine.record(path, **options)
+    return Record(path, options, info, samples)
+
+
+def spectrum(
+    record: Union[Record, str, "os.PathLike[str]"],
+    periods: Union[float, Iterable[float]],
+    damping: float = 0.05,
+) -> Table:
+    """The damped pseudo-acceleration response spectrum of a record at ``periods`` (s), as
+    ``pound record spectrum``: period_s, sa_g, sa_m_s2, sd_m (each an exact response over the
+    whole record)."""
+    if isinstance(record, Record):
+        path, options = record.path, record._options
+    else:
+        path, options = os.fspath(record), {}
+    if isinstance(periods, (int, float)):
+        periods = [periods]
+    return Table(
+        _engine.spectrum(path, [float(t) for t in periods], float(damping), **options)
+    )

@@ -1,0 +1,693 @@
+//! `pounding._pounding`: the library's commands for Python. Glue only: a config (path, TOML text
+//! or dict) in, the library's settings stage, engine and studies run (the GIL released, Ctrl-C
+//! watched), tables out as Arrow streams (the PyCapsule interface). The package's Python layer
+//! (`pounding/__init__.py`) gives these their keyword arguments, progress and conversions.
+
+mod arrow;
+
+use arrow::{study_table, Columns, Table};
+use pounding::engine::aggregate::Aggregator;
+use pounding::engine::{Backend, Chunk, Engine, Kernel};
+use pounding::io::parquet::{kind, Kind};
+use pounding::plan::settings::{picked_columns, sweep_warnings, SchemeKind, SchemeSettings};
+use pounding::plan::{config, Plan};
+use pyo3::create_exception;
+use pyo3::exceptions::PyException;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+create_exception!(
+    pounding,
+    PoundingError,
+    PyException,
+    "An error of the pounding engine."
+);
+create_exception!(
+    pounding,
+    ConfigError,
+    PoundingError,
+    "A config that cannot be read or planned: the message names the file (or the string or dict given), the key and what was expected."
+);
+create_exception!(
+    pounding,
+    RecordError,
+    PoundingError,
+    "A ground-motion record that cannot be read: the message names the file and the line."
+);
+create_exception!(
+    pounding,
+    SettingsError,
+    PoundingError,
+    "An option refused (a column that is not there, a target error out of range, a backend that cannot run the sweep)."
+);
+create_exception!(
+    pounding,
+    TableError,
+    PoundingError,
+    "A results table a study cannot read: the message names the column and what was expected."
+);
+create_exception!(
+    pounding,
+    GpuError,
+    PoundingError,
+    "The GPU could not run the sweep."
+);
+
+/// A library error as the Python exception of its kind, with the command line's message.
+fn config_err(e: config::ConfigError) -> PyErr {
+    match e {
+        config::ConfigError::Record { .. } => RecordError::new_err(e.to_string()),
+        e => ConfigError::new_err(e.to_string()),
+    }
+}
+
+fn settings_err(e: impl std::fmt::Display) -> PyErr {
+    SettingsError::new_err(e.to_string())
+}
+
+/// The config given: its text, and the path records are found from and messages name (a
+/// string's or dict's records are found from the working folder).
+fn config_text(config: &Bound<'_, PyAny>, kind: &str) -> PyResult<(String, PathBuf)> {
+    match kind {
+        "path" => {
+            let path = PathBuf::from(config.extract::<String>()?);
+            let text = config::read_text(&path).map_err(config_err)?;
+            Ok((text, path))
+        }
+        "text" => Ok((config.extract()?, PathBuf::from("<config string>"))),
+        "dict" => {
+            let table = toml_table(config.cast::<PyDict>()?, "")?;
+            let text = toml::to_string(&table)
+                .map_err(|e| ConfigError::new_err(format!("<config dict>: {e}")))?;
+            Ok((text, PathBuf::from("<config dict>")))
+        }
+        other => Err(settings_err(format!(
+            "config kind `{other}`: expected path, text or dict"
+        ))),
+    }
+}
+
+/// A dict with a config's structure as a TOML table (keys as written; values: str, bool, int,
+/// float, lists and dicts of them).
+fn toml_table(d: &Bound<'_, PyDict>, at: &str) -> PyResult<toml::Table> {
+    let mut t = toml::Table::new();
+    for (k, v) in d.iter() {
+        let key: String = k.extract().map_err(|_| {
+            ConfigError::new_err(format!(
+                "<config dict>: {at}a key is not a string ({k:?}): keys are the config's names"
+            ))
+        })?;
+        let here = format!("{at}{key}");
+        t.insert(key, toml_value(&v, &here)?);
+    }
+    Ok(t)
+}
+
+fn toml_value(v: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
+    use pyo3::types::{PyBool, PyFloat, PyInt, PyString, PyTuple};
+    Ok(if v.is_instance_of::<PyBool>() {
+        toml::Value::Boolean(v.extract()?)
+    } else if v.is_instance_of::<PyInt>() {
+        toml::Value::Integer(v.extract()?)
+    } else if v.is_instance_of::<PyFloat>() {
+        toml::Value::Float(v.extract()?)
+    } else if v.is_instance_of::<PyString>() {
+        toml::Value::String(v.extract()?)
+    } else if let Ok(d) = v.cast::<PyDict>() {
+        toml::Value::Table(toml_table(d, &format!("{at}."))?)
+    } else if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let items: Vec<Bound<'_, PyAny>> = v.try_iter()?.collect::<PyResult<_>>()?;
+        toml::Value::Array(
+            items
+                .iter()
+                .enumerate()
+                .map(|(i, x)| toml_value(x, &format!("{at}[{i}]")))
+                .collect::<PyResult<_>>()?,
+        )
+    } else {
+        // numpy scalars and the like: as the float or int they hold.
+        match v.extract::<i64>() {
+            Ok(i) if !v.hasattr("is_integer")? => toml::Value::Integer(i),
+            _ => toml::Value::Float(v.extract().map_err(|_| {
+                ConfigError::new_err(format!(
+                    "<config dict>: {at}: a {} is not a config value (expected a string, number, bool, list or dict)",
+                    v.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+                ))
+            })?),
+        }
+    })
+}
+
+fn backend_of(b: &str) -> PyResult<Backend> {
+    match b {
+        "auto" => Ok(Backend::Auto),
+        "gpu" => Ok(Backend::Gpu),
+        "cpu" => Ok(Backend::Cpu),
+        _ => Err(settings_err(format!(
+            "backend `{b}`: expected auto, gpu or cpu"
+        ))),
+    }
+}
+
+fn precision_of(p: Option<&str>) -> PyResult<pounding::engine::gpu::Precision> {
+    use pounding::engine::gpu::Precision;
+    match p {
+        None | Some("f32") => Ok(Precision::F32),
+        Some("f64") => Ok(Precision::F64),
+        Some(p) => Err(settings_err(format!(
+            "precision `{p}`: expected f32 or f64"
+        ))),
+    }
+}
+
+fn scheme_of(s: Option<&str>) -> PyResult<Option<SchemeKind>> {
+    match s {
+        None => Ok(None),
+        Some("fast") => Ok(Some(SchemeKind::Fast)),
+        Some("reference") => Ok(Some(SchemeKind::Reference)),
+        Some(s) => Err(settings_err(format!(
+            "scheme `{s}`: expected fast or reference"
+        ))),
+    }
+}
+
+/// The worker threads (`threads`, default all cores), checked as `--threads` is.
+fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
+    use pounding::plan::limits::{MAX_THREADS, WHY_THREADS};
+    let mut b = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = threads {
+        if t == 0 || t > MAX_THREADS {
+            return Err(settings_err(format!(
+                "threads={t}: expected 1 to {MAX_THREADS} ({WHY_THREADS})"
+            )));
+        }
+        b = b.num_threads(t);
+    }
+    b.build()
+        .map_err(|e| PoundingError::new_err(format!("starting worker threads: {e}")))
+}
+
+/// What the engine's thread tells the waiting Python thread.
+enum Said {
+    Progress(u64),
+}
+
+/// Run `work` on `pool` in another thread while this (the Python) thread waits with the GIL
+/// released, calls `progress` with the runs done, and watches for Ctrl-C: an interrupt sets
+/// `stop` (the work ends after its current batch) and is raised once the work has stopped.
+fn run_watched<T: Send>(
+    py: Python<'_>,
+    pool: &rayon::ThreadPool,
+    progress: Option<(&Bound<'_, PyAny>, u64)>,
+    work: impl FnOnce(&AtomicBool, &dyn Fn(u64)) -> T + Send,
+) -> PyResult<T> {
+    let stop = AtomicBool::new(false);
+    let (tx, rx) = std::sync::mpsc::channel::<Said>();
+    // Received with the GIL released, which wants a receiver it may share.
+    let rx = std::sync::Mutex::new(rx);
+    let mut interrupted: Option<PyErr> = None;
+    if let Some((cb, total)) = progress {
+        cb.call1((0u64, total))?;
+    }
+    let out = std::thread::scope(|s| {
+        let stop = &stop;
+        let worker = s.spawn(move || {
+            let tell = move |n: u64| {
+                let _ = tx.send(Said::Progress(n));
+            };
+            pool.install(|| work(stop, &tell))
+        });
+        loop {
+            let got = py.detach(|| {
+                rx.lock()
+                    .expect("one receiver")
+                    .recv_timeout(Duration::from_millis(50))
+            });
+            match got {
+                Ok(Said::Progress(n)) => {
+                    if let (Some((cb, total)), None) = (progress, &interrupted) {
+                        if let Err(e) = cb.call1((n, total)) {
+                            stop.store(true, Ordering::Relaxed);
+                            interrupted = Some(e);
+                        }
+                    }
+                }
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+            if interrupted.is_none() {
+                if let Err(e) = py.check_signals() {
+                    stop.store(true, Ordering::Relaxed);
+                    interrupted = Some(e);
+                }
+            }
+        }
+        py.detach(|| worker.join())
+    });
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    out.map_err(|_| PoundingError::new_err("the engine's thread panicked"))
+}
+
+/// Why a sweep stopped early.
+enum Stopped {
+    Gpu(pounding::engine::gpu::GpuError),
+    Interrupted,
+    Table(String),
+}
+
+impl From<pounding::engine::gpu::GpuError> for Stopped {
+    fn from(e: pounding::engine::gpu::GpuError) -> Self {
+        Stopped::Gpu(e)
+    }
+}
+
+/// A sweep's table, its totals, and the notices and warnings said.
+type Swept<'py> = (Table, Bound<'py, PyDict>, Vec<String>, Vec<String>);
+
+/// `pounding.sweep`: every run of a config, as `pound sweep` runs it; the rows (or with
+/// `aggregate`, the summary) as a table, the sweep's totals, and the lines the command line
+/// says (notices, then warnings).
+#[pyfunction]
+#[pyo3(signature = (config, config_kind, backend, precision, threads, target_error, columns, aggregate, exceed, scheme, energy, chunk, progress))]
+#[allow(clippy::too_many_arguments)]
+fn sweep<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    config_kind: &str,
+    backend: &str,
+    precision: Option<&str>,
+    threads: Option<usize>,
+    target_error: Option<f64>,
+    columns: Option<Vec<String>>,
+    aggregate: Option<Vec<String>>,
+    exceed: Vec<String>,
+    scheme: Option<&str>,
+    energy: bool,
+    chunk: Option<usize>,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Swept<'py>> {
+    let (text, path) = config_text(config, config_kind)?;
+    let (backend, precision) = (backend_of(backend)?, precision_of(precision)?);
+    if aggregate.is_some() && columns.is_some() {
+        return Err(settings_err(
+            "aggregate writes its own summary columns: columns does not apply",
+        ));
+    }
+    if aggregate.is_none() && !exceed.is_empty() {
+        return Err(settings_err(
+            "exceed counts runs per group: it needs aggregate",
+        ));
+    }
+    let pool = pool(threads)?;
+    let mut plan = config::load_text(&text, &path).map_err(config_err)?;
+    let settled = SchemeSettings {
+        scheme: scheme_of(scheme)?,
+        energy,
+        target_error,
+    }
+    .settle(&mut plan, &text)
+    .map_err(settings_err)?;
+    let mut notices = settled.notices;
+    let mut warnings: Vec<String> = settled
+        .warnings
+        .iter()
+        .map(|w| format!("{}: {w}", path.display()))
+        .collect();
+    plan.ask_storey_columns(columns.as_deref().unwrap_or_default());
+    let gpu = pounding::engine::gpu_for(
+        &plan,
+        backend,
+        precision,
+        settled.chosen.is_some(),
+        &mut |l| notices.push(l),
+    )
+    .map_err(settings_err)?;
+    let engine =
+        Engine::new(plan.scheme(), gpu.as_ref(), precision, chunk).map_err(settings_err)?;
+    let picked = picked_columns(&plan, columns.as_deref()).map_err(settings_err)?;
+    let mut summary = aggregate
+        .as_ref()
+        .map(|by| Aggregator::for_plan(&plan, by, &exceed))
+        .transpose()
+        .map_err(settings_err)?;
+    engine
+        .check(&plan)
+        .map_err(|e| GpuError::new_err(e.to_string()))?;
+    let header = plan.header();
+    let names: Vec<String> = match &picked {
+        Some(ix) => ix.iter().map(|&i| header[i].clone()).collect(),
+        None => header,
+    };
+    let fingerprint = pounding::io::provenance::Fingerprint::of_plan(&plan);
+    let mut meta = vec![
+        ("pound.fingerprint.plan".to_string(), fingerprint.plan),
+        ("pound.fingerprint.records".into(), fingerprint.records),
+        ("pound.fingerprint.engine".into(), fingerprint.engine),
+        ("pound.backend".into(), engine.key()),
+        ("pound.kernel".into(), Kernel::of(&plan).key().into()),
+    ];
+    let runs = plan.len();
+    let (plan, engine, picked) = (&plan, &engine, picked.as_deref());
+    let agg = summary.as_mut();
+    let (outcome, describe) = run_watched(
+        py,
+        &pool,
+        progress.as_ref().map(|p| (p, runs)),
+        move |stop, tell| {
+            let describe = engine.describe();
+            let mut cols = Columns::new(&names, names.iter().map(|n| kind(n)).collect());
+            let (mut above, mut past) = (0u64, 0u64);
+            let mut agg = agg;
+            let on_device = matches!(engine, Engine::Gpu { .. }) && matches!(plan, Plan::Pair(_));
+            let report = match agg.as_deref_mut() {
+                // A pair's runs fold on the device: only the groups' partials come back.
+                Some(agg) if on_device => engine
+                    .summarise(plan, 0..runs, agg, tell)
+                    .map_err(Stopped::Gpu),
+                _ => engine.sweep(
+                    plan,
+                    0..runs,
+                    |c: Chunk<'_>| -> Result<(), Stopped> {
+                        if stop.load(Ordering::Relaxed) {
+                            return Err(Stopped::Interrupted);
+                        }
+                        above += c.above_height();
+                        past += c.past_collapse_drift();
+                        match (agg.as_deref_mut(), c) {
+                            (Some(agg), Chunk::Pairs(p, rows)) => agg.add_rows(p, rows),
+                            (Some(agg), Chunk::Rows(r, rows)) => agg.add_row_runs(r, rows),
+                            (None, c) => {
+                                let cells = match c {
+                                    Chunk::Pairs(p, rows) => {
+                                        pounding::io::csv::cells(p, rows, picked)
+                                    }
+                                    Chunk::Rows(r, rows) => {
+                                        pounding::io::csv::cells(r, rows, picked)
+                                    }
+                                };
+                                cols.append(&cells).map_err(Stopped::Table)?;
+                            }
+                        }
+                        Ok(())
+                    },
+                    tell,
+                ),
+            };
+            ((report, cols, above, past), describe)
+        },
+    )?;
+    let (report, cols, above, past) = outcome;
+    let report = match report {
+        Ok(r) => r,
+        Err(Stopped::Gpu(e)) => return Err(GpuError::new_err(e.to_string())),
+        Err(Stopped::Interrupted) => {
+            return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
+                "the sweep was stopped",
+            ))
+        }
+        Err(Stopped::Table(m)) => return Err(PoundingError::new_err(m)),
+    };
+    warnings.extend(sweep_warnings(plan, above, past));
+    let s = report.summary;
+    let totals = PyDict::new(py);
+    totals.set_item("runs", s.runs)?;
+    totals.set_item("seconds", s.seconds)?;
+    totals.set_item("runs_per_second", s.runs_per_second())?;
+    totals.set_item("runs_with_impacts", s.runs_with_impacts)?;
+    totals.set_item("impacts", s.impacts)?;
+    totals.set_item("failures", s.failures)?;
+    totals.set_item("collapsed", s.collapsed)?;
+    totals.set_item("engine", describe)?;
+    totals.set_item("kernel", Kernel::of(plan).key())?;
+    totals.set_item("scene", plan.scene())?;
+    let table = match summary {
+        Some(agg) => {
+            if agg.runs() != runs {
+                return Err(PoundingError::new_err(format!(
+                    "the summary folded {} runs where the sweep has {runs}",
+                    agg.runs()
+                )));
+            }
+            let t = pounding::io::summary::table(&agg);
+            let mut cols = Columns::new(&t.header, t.kinds);
+            cols.append(&t.rows).map_err(PoundingError::new_err)?;
+            cols.finish(&meta)
+        }
+        None => {
+            if cols.rows() as u64 != runs {
+                return Err(PoundingError::new_err(format!(
+                    "{} rows where the sweep has {runs}: the table is incomplete",
+                    cols.rows()
+                )));
+            }
+            meta.push(("pound.runs".into(), format!("0..{runs} of {runs}")));
+            cols.finish(&meta)
+        }
+    }
+    .map_err(PoundingError::new_err)?;
+    Ok((table, totals, notices, warnings))
+}
+
+/// `pounding.columns`: a sweep's columns (of `config`, or of a pair without one) with units,
+/// meanings and the type each has in a table.
+#[pyfunction]
+#[pyo3(signature = (config=None, config_kind="path"))]
+fn columns(config: Option<&Bound<'_, PyAny>>, config_kind: &str) -> PyResult<Table> {
+    let names: Vec<String> = match config {
+        Some(c) => {
+            let (text, path) = config_text(c, config_kind)?;
+            config::load_text(&text, &path)
+                .map_err(config_err)?
+                .header()
+        }
+        None => pounding::plan::columns::header()
+            .into_iter()
+            .map(String::from)
+            .collect(),
+    };
+    let rows: Vec<Vec<String>> = names
+        .iter()
+        .map(|c| {
+            let m =
+                pounding::plan::meaning::meaning(c).expect("every written column has a meaning");
+            let ty = match kind(c) {
+                Kind::Int => "int64",
+                Kind::Real => "float64",
+                Kind::Text => "string",
+            };
+            vec![
+                c.clone(),
+                m.unit.to_string(),
+                m.text.to_string(),
+                m.label.to_string(),
+                ty.to_string(),
+            ]
+        })
+        .collect();
+    let head: Vec<String> = ["column", "unit", "meaning", "label", "type"]
+        .map(String::from)
+        .to_vec();
+    let mut cols = Columns::new(&head, vec![Kind::Text; 5]);
+    cols.append(&rows).map_err(PoundingError::new_err)?;
+    cols.finish(&[]).map_err(PoundingError::new_err)
+}
+
+/// `pounding.trace`: one run whole: its time history (as `pound trace` writes it) and its row as
+/// the sweep writes it.
+#[pyfunction]
+fn trace(
+    py: Python<'_>,
+    config: &Bound<'_, PyAny>,
+    config_kind: &str,
+    run: u64,
+) -> PyResult<(Table, Table)> {
+    let (text, path) = config_text(config, config_kind)?;
+    let plan = config::load_text(&text, &path).map_err(config_err)?;
+    let t = py
+        .detach(|| pounding::studies::trace::trace(&plan, run))
+        .map_err(|e| SettingsError::new_err(format!("{}: {e}", path.display())))?;
+    let history = study_table(&t.csv(), &[]).map_err(PoundingError::new_err)?;
+    let kinds = t.header.iter().map(|n| kind(n)).collect();
+    let mut row = Columns::new(&t.header, kinds);
+    row.append(std::slice::from_ref(&t.row))
+        .map_err(PoundingError::new_err)?;
+    Ok((history, row.finish(&[]).map_err(PoundingError::new_err)?))
+}
+
+/// `pounding.gap`: the separation each adjacent pair needs, run by run, exactly and by the code
+/// rules (the table `pound gap` writes).
+#[pyfunction]
+#[pyo3(signature = (config, config_kind, threads=None))]
+fn gap(
+    py: Python<'_>,
+    config: &Bound<'_, PyAny>,
+    config_kind: &str,
+    threads: Option<usize>,
+) -> PyResult<(Table, Vec<String>)> {
+    use pounding::studies::gap::GapStudy;
+    let (text, path) = config_text(config, config_kind)?;
+    let pool = pool(threads)?;
+    let plan = config::load_text(&text, &path).map_err(config_err)?;
+    if let Some(why) = GapStudy::refusal(&plan) {
+        return Err(settings_err(format!("{}: {why}", path.display())));
+    }
+    let warnings: Vec<String> = plan
+        .input_warnings()
+        .into_iter()
+        .map(|w| format!("{}: {w}", path.display()))
+        .collect();
+    let plan = &plan;
+    let csv = run_watched(py, &pool, None, move |_, _| {
+        GapStudy::run(plan).map(|s| s.csv())
+    })?
+    .map_err(|e| PoundingError::new_err(format!("{}: {e}", path.display())))?;
+    let text = String::from_utf8(csv).map_err(|e| PoundingError::new_err(e.to_string()))?;
+    Ok((
+        study_table(&text, &[]).map_err(PoundingError::new_err)?,
+        warnings,
+    ))
+}
+
+/// A record file read as `pound record info` reads it.
+fn read_record(
+    path: &str,
+    format: &str,
+    dt: Option<f64>,
+    units: Option<&str>,
+    skip_lines: usize,
+    window: Option<(f64, f64)>,
+) -> PyResult<pounding::record::Record> {
+    use pounding::record::{Format, ReadOptions, Units};
+    let format = Format::parse(format)
+        .ok_or_else(|| settings_err(format!("format `{format}`: expected {}", Format::KEYS)))?;
+    let units = units
+        .map(|u| {
+            Units::parse(u)
+                .ok_or_else(|| settings_err(format!("units `{u}`: expected {}", Units::KEYS)))
+        })
+        .transpose()?;
+    let rec = pounding::record::read_record(
+        Path::new(path),
+        &ReadOptions {
+            format,
+            units,
+            dt,
+            skip_lines,
+        },
+    )
+    .map_err(|e| RecordError::new_err(e.to_string()))?;
+    match window {
+        Some((a, b)) => rec
+            .windowed([a, b])
+            .map_err(|m| settings_err(format!("window ({a}, {b}): {m}"))),
+        None => Ok(rec),
+    }
+}
+
+/// `pounding.record`: what a record file holds (the numbers `pound record info` gives) and its
+/// samples (m/s^2, little-endian f64 bytes for numpy).
+#[pyfunction]
+#[pyo3(signature = (path, format="auto", dt=None, units=None, skip_lines=0, window=None))]
+fn record<'py>(
+    py: Python<'py>,
+    path: &str,
+    format: &str,
+    dt: Option<f64>,
+    units: Option<&str>,
+    skip_lines: usize,
+    window: Option<(f64, f64)>,
+) -> PyResult<(Bound<'py, PyDict>, Bound<'py, pyo3::types::PyBytes>)> {
+    use pounding::record::{intensity, G};
+    let rec = read_record(path, format, dt, units, skip_lines, window)?;
+    let pga = rec.pga();
+    let (pgv, pgd) = intensity::pgv_pgd(&rec);
+    let d = PyDict::new(py);
+    d.set_item("name", &rec.name)?;
+    d.set_item("npts", rec.npts())?;
+    d.set_item("dt", rec.dt)?;
+    d.set_item("t0", rec.t0)?;
+    d.set_item("duration", rec.duration())?;
+    d.set_item("pga_g", pga.value / G)?;
+    d.set_item("pga_m_s2", pga.value)?;
+    d.set_item("pga_time", pga.time)?;
+    d.set_item("pgv_m_s", pgv)?;
+    d.set_item("pgd_m", pgd)?;
+    let bytes: Vec<u8> = rec.accel.iter().flat_map(|a| a.to_le_bytes()).collect();
+    Ok((d, pyo3::types::PyBytes::new(py, &bytes)))
+}
+
+/// `pounding.spectrum`: the damped pseudo-acceleration response spectrum of a record file at
+/// `periods` (the table `pound record spectrum` writes).
+#[pyfunction]
+#[pyo3(signature = (path, periods, damping, format="auto", dt=None, units=None, skip_lines=0, window=None))]
+#[allow(clippy::too_many_arguments)]
+fn spectrum(
+    py: Python<'_>,
+    path: &str,
+    periods: Vec<f64>,
+    damping: f64,
+    format: &str,
+    dt: Option<f64>,
+    units: Option<&str>,
+    skip_lines: usize,
+    window: Option<(f64, f64)>,
+) -> PyResult<Table> {
+    use pounding::record::G;
+    if let Some(bad) = periods.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+        return Err(settings_err(format!(
+            "periods: {bad} is out of range: expected periods above 0 s"
+        )));
+    }
+    if periods.is_empty() {
+        return Err(settings_err("periods: none given"));
+    }
+    if !(damping.is_finite() && (0.0..1.0).contains(&damping)) {
+        return Err(settings_err(format!(
+            "damping {damping}: expected a ratio from 0 to below 1 (0.05 for 5 %)"
+        )));
+    }
+    let rec = read_record(path, format, dt, units, skip_lines, window)?;
+    let rows: Vec<Vec<String>> = py
+        .detach(|| pounding::record::intensity::spectrum(&rec, &periods, damping))
+        .iter()
+        .map(|o| {
+            vec![
+                format!("{}", o.period_s),
+                format!("{}", o.sa_m_s2 / G),
+                format!("{}", o.sa_m_s2),
+                format!("{}", o.sd_m),
+            ]
+        })
+        .collect();
+    let head: Vec<String> = ["period_s", "sa_g", "sa_m_s2", "sd_m"]
+        .map(String::from)
+        .to_vec();
+    let mut cols = Columns::new(&head, vec![Kind::Real; 4]);
+    cols.append(&rows).map_err(PoundingError::new_err)?;
+    cols.finish(&[]).map_err(PoundingError::new_err)
+}
+
+#[pymodule]
+fn _pounding(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("PoundingError", py.get_type::<PoundingError>())?;
+    m.add("ConfigError", py.get_type::<ConfigError>())?;
+    m.add("RecordError", py.get_type::<RecordError>())?;
+    m.add("SettingsError", py.get_type::<SettingsError>())?;
+    m.add("TableError", py.get_type::<TableError>())?;
+    m.add("GpuError", py.get_type::<GpuError>())?;
+    m.add_class::<Table>()?;
+    m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(columns, m)?)?;
+    m.add_function(wrap_pyfunction!(trace, m)?)?;
+    m.add_function(wrap_pyfunction!(gap, m)?)?;
+    m.add_function(wrap_pyfunction!(record, m)?)?;
+    m.add_function(wrap_pyfunction!(spectrum, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

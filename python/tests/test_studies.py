@@ -1,0 +1,66 @@
+"""The studies and the records from Python against their commands: `trace`, `gap`, `record`,
+`spectrum`, `columns`, `fragility` and `ida` give the cells the command line writes."""
+
+import pyarrow as pa
+import pytest
+
+import pounding
+from conftest import CONFIGS, REPO, assert_same_cells, read_csv
+
+RECORDS = REPO.parent / "shared" / "records"
+RECORD = RECORDS / "kobe1995_jma_ns_RSN1106_KJM000.AT2"
+
+
+def test_trace_is_the_command_lines_history_and_the_sweeps_row(pound, tmp_path):
+    out = tmp_path / "trace.csv"
+    shown = pound("trace", CONFIGS / "inelastic-row.toml", "--run", 5, "-o", out)
+    history, row = pounding.trace(CONFIGS / "inelastic-row.toml", 5)
+    header, rows = read_csv(out)
+    at = pa.table(history)
+    assert at.column_names == header and at.num_rows == len(rows) > 100
+    assert_same_cells(history, out)
+    # The row is the sweep's run 5, as the command prints it.
+    lines = shown.stdout.strip().splitlines()
+    assert pa.table(row).column_names == lines[0].split(",")
+    sweep = pa.table(pounding.sweep(CONFIGS / "inelastic-row.toml", backend="cpu", progress=False))
+    assert pa.table(row).to_pylist()[0] == sweep.slice(5, 1).to_pylist()[0]
+    with pytest.raises(pounding.PoundingError, match="run 99"):
+        pounding.trace(CONFIGS / "inelastic-row.toml", 99)
+
+
+def test_gap_is_the_command_lines_table(pound, tmp_path):
+    out = tmp_path / "gaps.csv"
+    pound("gap", CONFIGS / "gap-example.toml", "-o", out)
+    assert_same_cells(pounding.gap(CONFIGS / "gap-example.toml"), out)
+
+
+def test_record_and_spectrum_are_the_command_lines(pound, tmp_path):
+    assert RECORD.exists(), f"{RECORD}: the shared records sit beside the clone"
+    rec = pounding.record(RECORD)
+    info = pound("record", "info", RECORD).stdout
+    assert f"npts      {rec.npts}" in info
+    assert f"pga       {rec.pga_g:.4f} g" in info
+    assert f"pgv       {rec.pgv_m_s:.4f} m/s" in info
+    assert len(rec.accel_m_s2) == rec.npts and abs(abs(rec.accel_g).max() - rec.pga_g) < 1e-12
+    out = tmp_path / "spectrum.csv"
+    pound("record", "spectrum", RECORD, "--periods", "0.1,0.2,0.5,1,2,4", "-o", out)
+    table = pounding.spectrum(rec, [0.1, 0.2, 0.5, 1, 2, 4])
+    assert_same_cells(table, out)
+    with pytest.raises(pounding.RecordError, match="garbled"):
+        bad = tmp_path / "garbled.AT2"
+        bad.write_text("not\na\nrecord\n")
+        pounding.record(bad)
+    with pytest.raises(pounding.SettingsError, match="periods"):
+        pounding.spectrum(rec, [0.0])
+
+
+def test_columns_are_the_command_lines_list(pound):
+    listed = pound("columns", CONFIGS / "row-3-6.toml").stdout
+    table = pa.table(pounding.columns(CONFIGS / "row-3-6.toml"))
+    names = table.column("column").to_pylist()
+    assert names == pounding.sweep(CONFIGS / "row-3-6.toml", backend="cpu", progress=False).column_names
+    for name, unit in zip(names, table.column("unit").to_pylist()):
+        assert f"| `{name}` | {unit} |" in listed
+    types = dict(zip(names, table.column("type").to_pylist()))
+    assert types["run"] == "int64" and types["record"] == "string" and types["gap_1_2_m"] == "float64"
+    assert pounding.columns().num_rows > 10
