@@ -204,6 +204,28 @@ def _exceed(exceed: Union[None, str, dict, Iterable[str]]) -> list:
     return list(exceed)
 
 
+class _QuietVulkanProbe:
+    """Mesa's software Vulkan driver probes for a Wayland display and prints
+    "XDG_RUNTIME_DIR is invalid" twice when there is none (as `pound` avoids in its main): while
+    a GPU may be opened, an absolute WAYLAND_DISPLAY that does not exist makes the probe fail
+    quietly. The environment is restored after."""
+
+    def __init__(self, backend: str):
+        self.active = (
+            backend != "cpu"
+            and "XDG_RUNTIME_DIR" not in os.environ
+            and "WAYLAND_DISPLAY" not in os.environ
+        )
+
+    def __enter__(self) -> None:
+        if self.active:
+            os.environ["WAYLAND_DISPLAY"] = "/nonexistent/pound-compute-only"
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.active:
+            os.environ.pop("WAYLAND_DISPLAY", None)
+
+
 def _say(lines: Sequence[str]) -> None:
     for line in lines:
         print(line, file=sys.stderr)
@@ -278,21 +300,22 @@ def sweep(
     value, kind = _config(config)
     bar = _Progress("sweep", bool(progress))
     try:
-        inner, totals, notices, warned = _engine.sweep(
-            value,
-            kind,
-            backend,
-            precision,
-            threads,
-            target_error,
-            _names(columns, "columns"),
-            _names(aggregate, "aggregate"),
-            _exceed(exceed),
-            scheme,
-            bool(energy),
-            chunk,
-            bar if progress else None,
-        )
+        with _QuietVulkanProbe(backend):
+            inner, totals, notices, warned = _engine.sweep(
+                value,
+                kind,
+                backend,
+                precision,
+                threads,
+                target_error,
+                _names(columns, "columns"),
+                _names(aggregate, "aggregate"),
+                _exceed(exceed),
+                scheme,
+                bool(energy),
+                chunk,
+                bar if progress else None,
+            )
     finally:
         bar.close()
     _say(notices)

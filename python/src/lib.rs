@@ -64,6 +64,15 @@ fn config_err(e: config::ConfigError) -> PyErr {
     }
 }
 
+/// The engine's refusal: of the device (none found, a scene it does not take) or of a setting.
+fn engine_err(e: pounding::engine::EngineError) -> PyErr {
+    use pounding::engine::EngineError as E;
+    match e {
+        E::Chunk { .. } => SettingsError::new_err(e.to_string()),
+        E::GpuNeedsFast | E::GpuUnfit(_) | E::Gpu(_) => GpuError::new_err(e.to_string()),
+    }
+}
+
 fn settings_err(e: impl std::fmt::Display) -> PyErr {
     SettingsError::new_err(e.to_string())
 }
@@ -326,9 +335,9 @@ fn sweep<'py>(
         settled.chosen.is_some(),
         &mut |l| notices.push(l),
     )
-    .map_err(settings_err)?;
+    .map_err(engine_err)?;
     let engine =
-        Engine::new(plan.scheme(), gpu.as_ref(), precision, chunk).map_err(settings_err)?;
+        Engine::new(plan.scheme(), gpu.as_ref(), precision, chunk).map_err(engine_err)?;
     let picked = picked_columns(&plan, columns.as_deref()).map_err(settings_err)?;
     let mut summary = aggregate
         .as_ref()

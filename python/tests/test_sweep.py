@@ -181,3 +181,13 @@ def test_ctrl_c_stops_a_long_sweep_and_raises_keyboard_interrupt(tmp_path):
     assert proc.returncode == 3, (out, err)
     assert "interrupted" in out
     assert stopped < 2.0, f"took {stopped:.2f} s to stop"
+
+
+@pytest.mark.parametrize("config", ["quickstart.toml", "inelastic-row.toml"])
+def test_the_gpu_gives_the_command_lines_cells(config, pound, tmp_path):
+    # CI has Mesa's software adapter (lavapipe); POUND_REQUIRE_GPU there makes its absence fail.
+    out = tmp_path / "runs.csv"
+    pound("sweep", CONFIGS / config, "-o", out, "--backend", "gpu")
+    table = pounding.sweep(CONFIGS / config, backend="gpu", progress=False)
+    assert table.metadata["pound.backend"] == "gpu-f32"
+    assert_same_cells(table, out)
