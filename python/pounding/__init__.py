@@ -242,6 +242,8 @@ class _Progress:
 
     def __init__(self, label: str, enabled: bool):
         self.label, self.enabled, self.bar, self.shown = label, enabled, None, False
+        # The line rewritten in place reads on a terminal or in a notebook, not in a log.
+        self.line = sys.stderr.isatty() or "ipykernel" in sys.modules
 
     def __call__(self, done: int, total: int) -> None:
         if not self.enabled or total <= 0:
@@ -255,7 +257,7 @@ class _Progress:
                 self.bar = None
         if self.bar is not None:
             self.bar.update(done - self.bar.n)
-        else:
+        elif self.line:
             sys.stderr.write(f"\r{self.label}: {done}/{total} runs ({100.0 * done / total:.0f} %)")
             sys.stderr.flush()
             self.shown = True
@@ -372,6 +374,16 @@ def _study_input(table: Any) -> Any:
         ) from None
 
 
+def _where(where: Union[None, str, Iterable[str]]) -> list:
+    """Row filters (COLUMN=VALUE, also !=, <, <=, >, >=), each whole: a filter's value may
+    hold a comma."""
+    if where is None:
+        return []
+    if isinstance(where, str):
+        return [where]
+    return list(where)
+
+
 def _list(value: Union[None, float, str, Iterable[Any]]) -> list:
     if value is None:
         return []
@@ -413,7 +425,7 @@ def fragility(
         int(bootstrap),
         seed,
         by,
-        _names(where, "where") or [],
+        _where(where),
     )
     _say(notices)
     return Table(inner, {"report": report, "notices": notices})
@@ -422,17 +434,18 @@ def fragility(
 def ida(
     table: Any,
     *,
+    edp: str,
     im: Optional[str] = None,
-    edp: Optional[str] = None,
-    by: Optional[str] = None,
+    by: Union[None, str, Iterable[str]] = None,
     where: Union[None, str, Iterable[str]] = None,
 ) -> Table:
-    """Incremental dynamic analysis from a sweep's results, as ``pound ida``: per record the
-    demand against the intensity, and the 16, 50 and 84 % fractiles across records at each
-    intensity level. ``info["report"]`` holds the command's report."""
+    """Incremental dynamic analysis from a sweep's results, as ``pound ida``: per record (or
+    the columns ``by`` names) the demand ``edp`` against the intensity ``im``, and the 16, 50
+    and 84 % fractiles across the curves at each intensity level (a collapse is an infinite
+    demand). ``info["report"]`` holds the command's report."""
     source, kind = _study_input(table)
     inner, report, notices = _engine.ida(
-        source, kind, im, edp, by, _names(where, "where") or []
+        source, kind, im, edp, _names(by, "by") or [], _where(where)
     )
     _say(notices)
     return Table(inner, {"report": report, "notices": notices})

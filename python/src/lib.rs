@@ -5,7 +5,7 @@
 
 mod arrow;
 
-use arrow::{study_table, Columns, Table};
+use arrow::{study_table, table_cells, Columns, Table};
 use pounding::engine::aggregate::Aggregator;
 use pounding::engine::{Backend, Chunk, Engine, Kernel};
 use pounding::io::parquet::{kind, Kind};
@@ -336,8 +336,7 @@ fn sweep<'py>(
         &mut |l| notices.push(l),
     )
     .map_err(engine_err)?;
-    let engine =
-        Engine::new(plan.scheme(), gpu.as_ref(), precision, chunk).map_err(engine_err)?;
+    let engine = Engine::new(plan.scheme(), gpu.as_ref(), precision, chunk).map_err(engine_err)?;
     let picked = picked_columns(&plan, columns.as_deref()).map_err(settings_err)?;
     let mut summary = aggregate
         .as_ref()
@@ -681,6 +680,90 @@ fn spectrum(
     cols.finish(&[]).map_err(PoundingError::new_err)
 }
 
+/// A study's input: a results CSV's path (read as the command reads it) or an Arrow table.
+fn study_input(table: &Bound<'_, PyAny>, kind: &str) -> PyResult<pounding::io::table::Table> {
+    match kind {
+        "path" => {
+            let path = PathBuf::from(table.extract::<String>()?);
+            pounding::io::table::Table::read(&path).map_err(|e| TableError::new_err(e.to_string()))
+        }
+        _ => table_cells(table),
+    }
+}
+
+/// A study's report: its table, what the command prints on standard output, and its notices.
+type Studied = (Table, String, Vec<String>);
+
+/// `pounding.fragility`: `pound fragility` on a table of results.
+#[pyfunction]
+#[pyo3(signature = (table, table_kind, im, edp, thresholds, damage_states, bootstrap, seed, by, filters))]
+#[allow(clippy::too_many_arguments)]
+fn fragility(
+    py: Python<'_>,
+    table: &Bound<'_, PyAny>,
+    table_kind: &str,
+    im: Option<String>,
+    edp: String,
+    thresholds: Vec<f64>,
+    damage_states: Option<String>,
+    bootstrap: usize,
+    seed: Option<u64>,
+    by: Option<String>,
+    filters: Vec<String>,
+) -> PyResult<Studied> {
+    use pounding::studies::fragility::{study, FragilityError, FragilityOptions};
+    let options = FragilityOptions {
+        im,
+        edp,
+        thresholds,
+        damage_states,
+        bootstrap,
+        seed,
+        by,
+        filters,
+    };
+    // Settings are refused before the table is read, as the command refuses them.
+    let refused = |e: FragilityError| match e {
+        FragilityError::Table(e) => TableError::new_err(e.to_string()),
+        e => SettingsError::new_err(e.to_string()),
+    };
+    options.check().map_err(refused)?;
+    let rows = study_input(table, table_kind)?;
+    let r = py.detach(|| study(&rows, &options)).map_err(refused)?;
+    let t = study_table(&r.csv, &[]).map_err(PoundingError::new_err)?;
+    Ok((t, r.said, r.notices))
+}
+
+/// `pounding.ida`: `pound ida` on a table of results.
+#[pyfunction]
+#[pyo3(signature = (table, table_kind, im, edp, by, filters))]
+fn ida(
+    py: Python<'_>,
+    table: &Bound<'_, PyAny>,
+    table_kind: &str,
+    im: Option<String>,
+    edp: String,
+    by: Vec<String>,
+    filters: Vec<String>,
+) -> PyResult<Studied> {
+    use pounding::studies::ida::{study, IdaError, IdaOptions};
+    let options = IdaOptions {
+        im,
+        edp,
+        by,
+        filters,
+    };
+    let refused = |e: IdaError| match e {
+        IdaError::Refused(m) => SettingsError::new_err(m),
+        e => TableError::new_err(e.to_string()),
+    };
+    options.check().map_err(refused)?;
+    let rows = study_input(table, table_kind)?;
+    let r = py.detach(|| study(&rows, &options)).map_err(refused)?;
+    let t = study_table(&r.csv, &[]).map_err(PoundingError::new_err)?;
+    Ok((t, r.said, r.notices))
+}
+
 #[pymodule]
 fn _pounding(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -697,6 +780,8 @@ fn _pounding(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gap, m)?)?;
     m.add_function(wrap_pyfunction!(record, m)?)?;
     m.add_function(wrap_pyfunction!(spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(fragility, m)?)?;
+    m.add_function(wrap_pyfunction!(ida, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

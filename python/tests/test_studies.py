@@ -64,3 +64,55 @@ def test_columns_are_the_command_lines_list(pound):
     types = dict(zip(names, table.column("type").to_pylist()))
     assert types["run"] == "int64" and types["record"] == "string" and types["gap_1_2_m"] == "float64"
     assert pounding.columns().num_rows > 10
+
+
+@pytest.mark.parametrize(
+    "flags, kwargs",
+    [
+        (["--edp", "b1_peak_ductility", "--threshold", "1,2,4"], {"edp": "b1_peak_ductility", "thresholds": [1, 2, 4]}),
+        (
+            ["--edp", "b1_peak_drift_ratio", "--damage-states", "hazus-c1l-high", "--bootstrap", "200", "--seed", "3"],
+            {"edp": "b1_peak_drift_ratio", "damage_states": "hazus-c1l-high", "bootstrap": 200, "seed": 3},
+        ),
+        (
+            ["--edp", "b1_residual_drift_ratio", "--damage-states", "fema-p58-residual", "--where", "gap_1_2_m<=0.01"],
+            {"edp": "b1_residual_drift_ratio", "damage_states": "fema-p58-residual", "where": "gap_1_2_m<=0.01"},
+        ),
+    ],
+)
+def test_fragility_is_the_command_lines_on_the_sweeps_table(flags, kwargs, pound, tmp_path):
+    runs_csv, out = tmp_path / "runs.csv", tmp_path / "fragility.csv"
+    pound("sweep", CONFIGS / "inelastic-fragility.toml", "-o", runs_csv, "--backend", "cpu")
+    shown = pound("fragility", runs_csv, *flags, "-o", out)
+    runs = pounding.sweep(CONFIGS / "inelastic-fragility.toml", backend="cpu", progress=False)
+    # From the sweep's table, from a pandas DataFrame, and from the CSV's path: the same study.
+    for given in (runs, runs.to_pandas(), runs.to_polars(), runs_csv):
+        curves = pounding.fragility(given, **kwargs)
+        assert_same_cells(curves, out)
+        assert curves.info["report"] == shown.stdout
+
+
+def test_ida_is_the_command_lines(pound, tmp_path):
+    runs_csv, out = tmp_path / "runs.csv", tmp_path / "ida.csv"
+    pound("sweep", CONFIGS / "collapse-ida.toml", "-o", runs_csv, "--backend", "cpu")
+    shown = pound("ida", runs_csv, "--edp", "b1_peak_drift_ratio", "-o", out)
+    runs = pounding.sweep(CONFIGS / "collapse-ida.toml", backend="cpu", progress=False)
+    curves = pounding.ida(runs, edp="b1_peak_drift_ratio")
+    assert_same_cells(curves, out)
+    assert curves.info["report"] == shown.stdout
+    # A collapsed curve's demand is infinite: a real column holding inf, as the CSV's `inf`.
+    demands = pa.table(curves).select(curves.column_names[7:]).to_pylist()
+    assert pa.table(curves).schema.field("kobe_1995_jma").type == pa.float64()
+    assert any(v == float("inf") for row in demands for v in row.values())
+
+
+def test_studies_refuse_bad_input_with_the_command_lines_messages(tmp_path):
+    runs = pounding.sweep(CONFIGS / "inelastic-fragility.toml", backend="cpu", progress=False)
+    with pytest.raises(pounding.TableError, match="no column `nope`"):
+        pounding.fragility(runs, edp="nope", thresholds=[1])
+    with pytest.raises(pounding.SettingsError, match="bootstrap"):
+        pounding.fragility(runs, edp="b1_peak_ductility", thresholds=[1], bootstrap=5)
+    with pytest.raises(pounding.TableError, match="not a table"):
+        pounding.fragility(42, edp="b1_peak_ductility", thresholds=[1])
+    with pytest.raises(pounding.TableError, match="missing.csv"):
+        pounding.ida(tmp_path / "missing.csv", edp="b1_peak_drift_ratio")

@@ -1,10 +1,9 @@
 //! `pound ida`: IDA curves and their fractiles from a results CSV.
 
 use super::{check_study_outputs, Holds};
-use anyhow::{bail, Result};
-use pounding::io::table::{Filter, Table};
-use pounding::studies::fragility::default_im;
-use pounding::studies::ida::{read, IdaSpec, FRACTILES};
+use anyhow::Result;
+use pounding::io::table::Table;
+use pounding::studies::ida::{study, IdaOptions};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -51,179 +50,20 @@ pub fn run(a: Args) -> Result<()> {
             ("--plot", a.plot.as_deref(), Holds::Plot),
         ],
     )?;
-    if let Some(twice) = pounding::plan::config::name_given_twice(&a.by) {
-        bail!("--by: `{twice}` is given twice: give each column once");
-    }
-    let table = Table::read(&a.results)?;
-    let by = if a.by.is_empty() {
-        let sampled = table
-            .col("sample")
-            .is_ok_and(|c| table.rows.iter().any(|r| !r[c].is_empty()));
-        let mut by = vec!["record".to_string()];
-        if sampled {
-            by.push("sample".into());
-        }
-        by
-    } else {
-        a.by
-    };
-    let spec = IdaSpec {
-        im: a.im.unwrap_or_else(|| default_im(&table)),
+    let options = IdaOptions {
+        im: a.im,
         edp: a.edp,
-        by,
-        filters: Filter::parse_all(&a.filters)?,
+        by: a.by,
+        filters: a.filters,
     };
-    if spec.edp == pounding::studies::fragility::COLLAPSED && table.col(&spec.edp).is_err() {
-        bail!("--edp {}: an IDA reads a demand column (e.g. b1_peak_drift_ratio), where a collapsed run is an infinite demand; the collapse fragility P(collapse | IM) is `pound fragility --edp collapsed`", spec.edp);
-    }
-    let (ida, skipped) = read(&table, &spec)?;
-    let collapsed_runs = skipped.collapsed;
-    say!(
-        "{} curves (by {}) at {} levels of {}{}{}",
-        ida.curves.len(),
-        spec.by.join(", "),
-        ida.ims.len(),
-        spec.im,
-        if collapsed_runs > 0 {
-            format!(", {collapsed_runs} runs collapsed (an infinite demand)")
-        } else {
-            String::new()
-        },
-        if skipped.total() > 0 {
-            format!(" ({} rows left out: {skipped})", skipped.total())
-        } else {
-            String::new()
-        }
-    );
-    // Failed runs are left out of the fractiles. Where the table has no collapse criterion a
-    // failed run may be a collapse, so the fractiles over the others are collapse-free; where it
-    // has one, they are over the runs that did not fail.
-    let failed: usize = ida.failed.iter().sum();
-    let can_collapse = table.col("collapse_time_s").is_ok();
-    let over = match (failed > 0, can_collapse) {
-        (false, _) => "",
-        (true, false) => " (collapse-free)",
-        (true, true) => " (failed runs left out)",
-    };
-    let head: Vec<String> = FRACTILES
-        .iter()
-        .map(|f| format!("{} {f} %{over}", spec.edp))
-        .collect();
-    say!(
-        "\n| {} | curves | collapsed | {} |\n|---:|---:|---:|---:|---:|---:|",
-        spec.im,
-        head.join(" | ")
-    );
-    let show = |x: f64| {
-        if x.is_infinite() {
-            "inf (collapse)".to_string()
-        } else {
-            format!("{x:.4e}")
-        }
-    };
-    for (l, im) in ida.ims.iter().enumerate() {
-        let f = ida.fractiles[l];
-        if ida.counts[l] == 0 {
-            say!("| {im} | 0 | | no run with a value | | |");
-            continue;
-        }
-        say!(
-            "| {im} | {} | {} ({:.0} %) | {} | {} | {} |",
-            ida.counts[l],
-            ida.collapsed[l],
-            100.0 * ida.collapsed_fraction(l).unwrap_or(0.0),
-            show(f[0]),
-            show(f[1]),
-            show(f[2])
-        );
-    }
-    // Where curves are missing at a level, say why: no run there, or a run left out.
-    let short: Vec<String> = ida
-        .ims
-        .iter()
-        .enumerate()
-        .filter(|(l, _)| ida.counts[*l] < ida.curves.len())
-        .map(|(l, im)| {
-            let (n, f, e) = (ida.counts[l], ida.failed[l], ida.no_value[l]);
-            let mut why = Vec::new();
-            if f > 0 {
-                why.push(format!("{f} failed (status neither ok nor collapsed)"));
-            }
-            if e > 0 {
-                why.push(format!(
-                    "{e} with no value of {} (a run that did not settle)",
-                    spec.edp
-                ));
-            }
-            let absent = ida.curves.len().saturating_sub(n + f + e);
-            if absent > 0 {
-                why.push(format!("{absent} with no run"));
-            }
-            format!(
-                "{im}: {n} of {} curves ({})",
-                ida.curves.len(),
-                why.join(", ")
-            )
-        })
-        .collect();
-    if !short.is_empty() {
-        note!(
-            "notice: not every curve has a value at each level of {}: {}; the fractiles there are over the runs with a value",
-            spec.im,
-            short.join("; ")
-        );
-    }
-    if failed > 0 {
-        if can_collapse {
-            note!(
-                "notice: {failed} failed runs (status neither ok nor collapsed: a numerical failure) are left out of the fractiles, which are over the runs that did not fail (the collapsed ones among them, as infinite demands)"
-            );
-        } else {
-            note!(
-                "notice: {failed} failed runs (status not ok: a collapse or a numerical failure, this table having no collapse criterion) are left out of the fractiles, which are therefore collapse-free: below the fractiles of every run where the failed runs are the most severe"
-            );
-        }
-    }
-    if ida.any_collapsed() {
-        let flat: Vec<String> = FRACTILES
-            .iter()
-            .enumerate()
-            .filter_map(|(k, f)| {
-                let l = (0..ida.ims.len())
-                    .find(|&l| ida.counts[l] > 0 && ida.fractiles[l][k].is_infinite())?;
-                Some(format!("the {f} % from {}", ida.ims[l]))
-            })
-            .collect();
-        note!(
-            "notice: collapsed runs are infinite demands (Vamvatsikos & Cornell 2002): a curve flatlines at its first collapse and is collapsed at every level above it; a fractile is infinite (`inf`) where the collapses reach it{}",
-            if flat.is_empty() {
-                ": none does here".to_string()
-            } else {
-                format!(": {}", flat.join(", "))
-            }
-        );
-    }
-    if ida.resurrected + ida.filled > 0 {
-        let mut what = Vec::new();
-        if ida.resurrected > 0 {
-            what.push(format!(
-                "{} runs that did not collapse (structural resurrection)",
-                ida.resurrected
-            ));
-        }
-        if ida.filled > 0 {
-            what.push(format!("{} levels with no run", ida.filled));
-        }
-        note!(
-            "notice: above their curve's first collapse, {} are counted as collapsed: the first collapse is the curve's capacity",
-            what.join(" and ")
-        );
-    }
+    // The settings are checked before the results are read.
+    options.check()?;
+    let table = Table::read(&a.results)?;
+    let report = study(&table, &options)?;
+    report.tell(super::say_text, |n| note!("{n}"))?;
     let plot = a.plot.as_deref().map(|p| {
-        let mut panels = vec![ida.panel(&spec)];
-        panels.extend(ida.collapse_panel(&spec));
-        let cols = panels.len();
-        (p, panels, cols)
+        let cols = report.panels.len();
+        (p, report.panels, cols)
     });
-    super::write_and_plot(&output, ida.csv(&spec).as_bytes(), plot, &a.figure)
+    super::write_and_plot(&output, report.csv.as_bytes(), plot, &a.figure)
 }

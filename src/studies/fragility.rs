@@ -12,7 +12,9 @@
 
 use crate::io::table::{caption, label, order_key, Filter, Table, TableError};
 use crate::plan::sample::phi;
+use crate::studies::damage_states::DamageStates;
 use crate::studies::plot::{Panel, Series};
+use crate::studies::report::{tell, StudyReport, Telling};
 use std::collections::BTreeMap;
 
 /// Runs at one intensity level.
@@ -960,6 +962,534 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
     }
 }
 
+// The command's study: `pound fragility` from a table already read to the text it tells and the
+// CSV it writes, so that the command line and the Python package hold none of it.
+
+/// Bootstrap replicates at most (each refits every threshold).
+pub const MAX_BOOTSTRAP: usize = 100_000;
+
+/// Bootstrap replicates at least: a 5 % and a 95 % percentile need some replicates beyond each
+/// (5 at 100), or the "90 %" band is the smallest and largest of a few draws.
+pub const MIN_BOOTSTRAP: usize = 100;
+
+/// What a fragility study counts and fits: every setting of `pound fragility` but where it
+/// writes and how it draws. [`Default`] holds the command's defaults (`--edp peak_force_n`, no
+/// threshold, no bootstrap).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FragilityOptions {
+    /// Intensity measure column; None: the table's [`default_im`].
+    pub im: Option<String>,
+    /// Demand column, or [`COLLAPSED`] for the collapse fragility.
+    pub edp: String,
+    /// Exceedance thresholds (EDP > threshold), as given (one of these and `damage_states`,
+    /// except with [`COLLAPSED`], which takes neither).
+    pub thresholds: Vec<f64>,
+    /// A built-in set's name or the path of a TOML file of states ([`DamageStates::get`]).
+    pub damage_states: Option<String>,
+    /// Bootstrap replicates (0: no bands; else [`MIN_BOOTSTRAP`] to [`MAX_BOOTSTRAP`]).
+    pub bootstrap: usize,
+    /// Seed of the bootstrap draws (None: 1); only with a bootstrap.
+    pub seed: Option<u64>,
+    /// The column whose groups the bootstrap draws (None: `record`); only with a bootstrap.
+    pub by: Option<String>,
+    /// `--where` filters as typed (`COLUMN=VALUE`, `!=`, `<`, `<=`, `>`, `>=`), all kept.
+    pub filters: Vec<String>,
+}
+
+impl Default for FragilityOptions {
+    fn default() -> FragilityOptions {
+        FragilityOptions {
+            im: None,
+            edp: "peak_force_n".into(),
+            thresholds: Vec::new(),
+            damage_states: None,
+            bootstrap: 0,
+            seed: None,
+            by: None,
+            filters: Vec::new(),
+        }
+    }
+}
+
+/// Why a fragility study gives no result; its text is the message `pound fragility` prints.
+#[derive(Debug, thiserror::Error)]
+pub enum FragilityError {
+    #[error(transparent)]
+    Table(#[from] TableError),
+    /// A setting, or a table, that gives no result.
+    #[error("{0}")]
+    Refused(String),
+    /// Refused after the study had told what it read (a bootstrap over fewer than two groups):
+    /// `said` and `notices`, told first ([`FragilityError::tell`]), then the message.
+    #[error("{message}")]
+    RefusedAfter {
+        message: String,
+        said: String,
+        notices: Vec<String>,
+        notices_at: Vec<usize>,
+    },
+}
+
+impl FragilityError {
+    /// Tell what the study had told before it refused ([`tell`]; nothing for a refusal before).
+    pub fn tell<E>(
+        &self,
+        say: impl FnMut(&str) -> Result<(), E>,
+        note: impl FnMut(&str),
+    ) -> Result<(), E> {
+        match self {
+            FragilityError::RefusedAfter {
+                said,
+                notices,
+                notices_at,
+                ..
+            } => tell(said, notices, notices_at, say, note),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The settings resolved before any table is read.
+struct Settled {
+    collapse: bool,
+    states: Option<DamageStates>,
+    thresholds: Vec<f64>,
+    names: Vec<String>,
+    by: String,
+    seed: u64,
+}
+
+impl FragilityOptions {
+    /// The checks of the settings alone, in `pound fragility`'s order, before any table is read
+    /// (a damage-state file is read here): [`study`] makes them again first.
+    pub fn check(&self) -> Result<(), FragilityError> {
+        self.settle().map(|_| ())
+    }
+
+    fn settle(&self) -> Result<Settled, FragilityError> {
+        let refuse = |m: String| Err(FragilityError::Refused(m));
+        if self.bootstrap > MAX_BOOTSTRAP {
+            return refuse(format!(
+                "--bootstrap {}: expected at most {MAX_BOOTSTRAP} replicates",
+                self.bootstrap
+            ));
+        }
+        if self.bootstrap > 0 && self.bootstrap < MIN_BOOTSTRAP {
+            return refuse(format!(
+                "--bootstrap {}: expected 0 (no bands) or at least {MIN_BOOTSTRAP} replicates: the 90 % band is the 5 and 95 % percentiles of the replicates, which fewer cannot place",
+                self.bootstrap
+            ));
+        }
+        // Flags of the bootstrap mean nothing without it.
+        for (flag, given) in [("--by", self.by.is_some()), ("--seed", self.seed.is_some())] {
+            if given && self.bootstrap == 0 {
+                return refuse(format!("{flag} applies to the bootstrap bands: give --bootstrap N (N >= {MIN_BOOTSTRAP}) with it, or leave {flag} out"));
+            }
+        }
+        let collapse = self.edp == COLLAPSED;
+        if collapse {
+            for (flag, given) in [
+                ("--threshold", !self.thresholds.is_empty()),
+                ("--damage-states", self.damage_states.is_some()),
+            ] {
+                if given {
+                    return refuse(format!("{flag} makes no sense with --edp {COLLAPSED}: a run collapsed (status `collapsed`) or it did not, and P(collapse | IM) is fitted to that; leave {flag} out, or give a demand column to --edp"));
+                }
+            }
+        } else if self.thresholds.is_empty() && self.damage_states.is_none() {
+            return refuse(format!("give --threshold T1,T2 (EDP > threshold) or --damage-states SET, or --edp {COLLAPSED} for the collapse fragility (which takes neither)"));
+        }
+        let states = self
+            .damage_states
+            .as_deref()
+            .map(DamageStates::get)
+            .transpose()
+            .map_err(FragilityError::Refused)?;
+        // Limits in another unit, or of another demand (a built-in set names its own).
+        if let Some(why) = states.as_ref().and_then(|d| {
+            let unit = crate::plan::meaning::meaning(&self.edp).map(|m| m.unit);
+            d.unit_mismatch(&self.edp, unit)
+                .or_else(|| d.demand_mismatch(&self.edp))
+        }) {
+            return refuse(why);
+        }
+        if let Some(t) = crate::plan::config::number_given_twice(&self.thresholds) {
+            return refuse(format!(
+                "--threshold: {} is given twice: give each threshold once",
+                number(t)
+            ));
+        }
+        let (thresholds, names): (Vec<f64>, Vec<String>) = match &states {
+            Some(d) => (d.limits(), d.states.iter().map(|s| s.0.clone()).collect()),
+            None if collapse => (vec![0.0], vec!["collapse".into()]),
+            None => (
+                self.thresholds.clone(),
+                self.thresholds.iter().map(|&t| number(t)).collect(),
+            ),
+        };
+        Ok(Settled {
+            collapse,
+            states,
+            thresholds,
+            names,
+            by: self.by.clone().unwrap_or_else(|| "record".into()),
+            seed: self.seed.unwrap_or(1),
+        })
+    }
+}
+
+/// `pound fragility` of `table`: the counts per threshold (or damage state) and level, the
+/// lognormal fits with their goodness of fit, the bootstrap bands over the groups of `by`, the
+/// bounds of the runs with no value of the demand, and the notices (a poor fit, fitted curves
+/// out of order, replicates with no fit, no run collapsed).
+pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, FragilityError> {
+    let Settled {
+        collapse,
+        states,
+        thresholds,
+        names,
+        by,
+        seed,
+    } = o.settle()?;
+    let spec = FragilitySpec {
+        im: o.im.clone().unwrap_or_else(|| default_im(table)),
+        edp: o.edp.clone(),
+        thresholds,
+        filters: Filter::parse_all(&o.filters)?,
+    };
+    if collapse {
+        check_collapse_table(table)?;
+    }
+    let group = (o.bootstrap > 0).then_some(by.as_str());
+    let (grouped, skipped) = Grouped::read(table, &spec, group)?;
+    let lv = grouped.pooled(&[1]);
+    let runs = grouped.runs;
+    if runs == 0 {
+        return Err(FragilityError::Refused(format!(
+            "{}: no run left to count: {}",
+            table.path.display(),
+            why_none(table, &spec, &o.filters, &skipped)?
+        )));
+    }
+    let fits: Vec<_> = lv.iter().map(|l| fit(l)).collect();
+    let collapsed = skipped.collapsed;
+    let mut t = Telling::default();
+    t.say(format_args!(
+        "{runs} runs at {} levels of {}{}{}",
+        grouped.ims.len(),
+        spec.im,
+        match (collapse, collapsed) {
+            (true, _) => format!(", {collapsed} collapsed"),
+            (false, 0) => String::new(),
+            (false, _) => format!(
+                ", {collapsed} collapsed (counted as exceeding every {}: an infinite demand)",
+                if states.is_some() {
+                    "state"
+                } else {
+                    "threshold"
+                }
+            ),
+        },
+        if skipped.total() > 0 {
+            format!(" ({} rows left out: {skipped})", skipped.total())
+        } else {
+            String::new()
+        }
+    ));
+    if grouped.ims.len() * 2 > runs && runs >= 10 {
+        t.note(format_args!(
+            "notice: {} takes {} values over {runs} runs: an intensity measure that differs from run to run (levels of one or two runs each) gives shares of little meaning; the level a sweep scales to is a target column (target_pga_g, target_sa_g, target_sa_avg_g)",
+            spec.im,
+            grouped.ims.len()
+        ));
+    }
+    if let Some(d) = &states {
+        t.say(format_args!(
+            "damage states {} ({}) on {}",
+            d.name, d.source, spec.edp
+        ));
+    }
+    let (lo, hi) = (grouped.ims[0], grouped.ims[grouped.ims.len() - 1]);
+    let plot_ims: Vec<f64> = (0..=100)
+        .map(|i| lo + (hi - lo) * i as f64 / 100.0)
+        .collect();
+    let bands = if o.bootstrap > 0 {
+        if grouped.groups.len() < 2 {
+            return Err(FragilityError::RefusedAfter {
+                message: format!(
+                    "--bootstrap: the runs fall in {} group of {}: resampling needs at least two",
+                    grouped.groups.len(),
+                    by
+                ),
+                said: t.said,
+                notices: t.notices,
+                notices_at: t.notices_at,
+            });
+        }
+        t.say(format_args!(
+            "bootstrap: {} replicates over {} groups of {} (seed {}), 90 % bands{}",
+            o.bootstrap,
+            grouped.groups.len(),
+            by,
+            seed,
+            if grouped.unknown > 0 {
+                " (of the fits to the runs decided)"
+            } else {
+                ""
+            }
+        ));
+        bootstrap(&grouped, o.bootstrap, seed, &plot_ims)
+    } else {
+        vec![None; spec.thresholds.len()]
+    };
+    let first = if collapse {
+        "P(collapse)".to_string()
+    } else if states.is_some() {
+        format!("state ({} >)", spec.edp)
+    } else {
+        format!("{} >", spec.edp)
+    };
+    let band_head = if o.bootstrap > 0 {
+        " median 90 % | beta 90 % |"
+    } else {
+        ""
+    };
+    let band_rule = if o.bootstrap > 0 { "---:|---:|" } else { "" };
+    t.say(format_args!("\n| {first} | median {} | beta | se(ln median) | se(beta) | log-likelihood | deviance (dof) | p (fit) |{band_head}\n|---:|---:|---:|---:|---:|---:|---:|---:|{band_rule}", spec.im));
+    let mut poor = Vec::new();
+    let mut unfitted = Vec::new();
+    for (i, f) in fits.iter().enumerate() {
+        let label = match &states {
+            Some(_) => format!("{} ({})", names[i], number(spec.thresholds[i])),
+            None => names[i].clone(),
+        };
+        let band = match (&bands[i], o.bootstrap > 0) {
+            (Some(b), _) => {
+                if b.unfitted > 0 {
+                    unfitted.push(format!(
+                        "{label}: {} of {}",
+                        b.unfitted,
+                        b.unfitted + b.fitted
+                    ));
+                }
+                format!(
+                    " {:.4}-{:.4} | {:.4}-{:.4} |",
+                    b.median[0], b.median[1], b.beta[0], b.beta[1],
+                )
+            }
+            (None, true) => " no replicate fitted | |".into(),
+            (None, false) => String::new(),
+        };
+        match f {
+            Ok(f) => {
+                t.say(format_args!(
+                    "| {label} | {:.4} | {:.4} | {:.4} | {:.4} | {:.2} | {:.2} ({}) | {} |{band}",
+                    f.median,
+                    f.beta,
+                    f.se_ln_median,
+                    f.se_beta,
+                    f.log_likelihood,
+                    f.deviance,
+                    f.dof,
+                    f.p_fit.map_or("-".into(), |p| format!("{p:.3}"))
+                ));
+                if f.p_fit.is_some_and(|p| p < 0.05) {
+                    poor.push(label);
+                }
+            }
+            Err(e) if collapse => t.say(format_args!(
+                "| {label} | no fit: {} | | | | | | |{band}",
+                e.collapse()
+            )),
+            Err(e) => t.say(format_args!("| {label} | no fit: {e} | | | | | | |{band}")),
+        }
+    }
+    if collapse && collapsed == 0 {
+        t.note(format_args!(
+            "notice: no run collapsed (of {runs}, at {} levels of {} up to {}): P(collapse | IM) has no fit; a collapse fragility needs runs that collapse, at intensities higher than these or with a lower [run] collapse_drift_ratio",
+            grouped.ims.len(),
+            spec.im,
+            hi
+        ));
+    }
+    if !unfitted.is_empty() {
+        t.note(format_args!(
+            "notice: bootstrap replicates with no fit (left out of the bands): {}",
+            unfitted.join("; ")
+        ));
+    }
+    if !poor.is_empty() {
+        t.note(format_args!(
+            "notice: the shares above {} do not follow a lognormal curve (goodness of fit p < 0.05): the deviance against each level's own share is larger than chance allows; read the fitted median and beta with care",
+            poor.join(", ")
+        ));
+    }
+    // The severer of two thresholds is the larger, in whatever order --threshold gave them.
+    let mut order: Vec<usize> = (0..fits.len()).collect();
+    order.sort_by(|&x, &y| spec.thresholds[x].total_cmp(&spec.thresholds[y]));
+    let ascending: Vec<_> = order.iter().map(|&k| fits[k].clone()).collect();
+    for (i, j, from, to) in crossings(&ascending, lo, hi) {
+        let (i, j) = (order[i], order[j]);
+        // The wrong order is one interval of the levels' range (two lognormal curves meet once
+        // at most): name it, and where the curves are in order.
+        let outside = match (from > lo, to < hi) {
+            (false, false) => "no level run is free of it: read them with care".to_string(),
+            (false, true) => format!("read them only above {to:.4}"),
+            (true, false) => format!("read them only below {from:.4}"),
+            (true, true) => "read them only outside it".to_string(),
+        };
+        t.note(format_args!(
+            "notice: the fitted curves of {} and {} are out of order from {} = {from:.4} to {to:.4}: there the more severe ({}) is the more probable, which no run can be (every run above {} is above {}); the curves are kept as fitted: {outside}, or fit with more runs",
+            names[i], names[j], spec.im, names[j], number(spec.thresholds[j]), number(spec.thresholds[i])
+        ));
+    }
+    if grouped.unknown > 0 {
+        undecided_table(&mut t, &grouped, &spec, states.as_ref().map(|_| &names[..]));
+    }
+    let state_names = states.as_ref().map(|_| names.as_slice());
+    let mut pl = panel(&spec, &lv, &fits);
+    if states.is_some() {
+        for s in &mut pl.series {
+            for (n, limit) in names.iter().zip(&spec.thresholds) {
+                let threshold = threshold_name(&spec.edp, *limit);
+                if let Some(rest) = s.name.strip_prefix(&format!("{threshold}:")) {
+                    s.name = format!("{n} ({threshold}):{rest}");
+                }
+            }
+        }
+    }
+    for b in bands.iter().flatten() {
+        pl.series.extend(band_series(b));
+    }
+    if bands.iter().any(|b| b.is_some()) {
+        pl.title.push_str(" (grey: 90 % bands)");
+    }
+    Ok(StudyReport {
+        csv: csv(&spec, state_names, &grouped),
+        said: t.said,
+        notices: t.notices,
+        notices_at: t.notices_at,
+        panels: vec![pl],
+    })
+}
+
+/// A bootstrap band as two grey lines (unnamed: no legend entry).
+fn band_series(b: &Band) -> [Series; 2] {
+    [0, 1].map(|k| Series {
+        name: String::new(),
+        points: b
+            .ims
+            .iter()
+            .zip(&b.curve)
+            .map(|(&im, c)| (im, c[k]))
+            .collect(),
+        scatter: false,
+        style: None,
+    })
+}
+
+/// Why no run was left to count, naming the cause: `--where` keeping no row, every run failed,
+/// the intensity or the demand column empty in every row (an intensity the sweep was not scaled
+/// to), values not finite.
+fn why_none(
+    table: &Table,
+    spec: &FragilitySpec,
+    filters: &[String],
+    skipped: &LeftOut,
+) -> Result<String, TableError> {
+    let rows = table.rows.len();
+    let kept = table.select(&spec.filters)?.len();
+    if rows == 0 {
+        return Ok("the file has no rows".into());
+    }
+    if kept == 0 {
+        return Ok(format!(
+            "--where {} keeps none of its {rows} rows",
+            filters.join(" --where ")
+        ));
+    }
+    let mut why = Vec::new();
+    if kept < rows {
+        why.push(format!("--where keeps {kept} of {rows} rows"));
+    }
+    if skipped.failed > 0 {
+        why.push(format!(
+            "{} failed (status neither ok nor collapsed)",
+            skipped.failed
+        ));
+    }
+    let empty_everywhere = |c: &str| {
+        table
+            .col(c)
+            .is_ok_and(|i| table.rows.iter().all(|r| r[i].trim().is_empty()))
+    };
+    if skipped.empty_im > 0 {
+        let mut w = format!("{} have no value of --im {}", skipped.empty_im, spec.im);
+        if empty_everywhere(&spec.im) {
+            w.push_str(&format!(
+                " (empty in every row: not an intensity this sweep was scaled to; it has {})",
+                default_im(table)
+            ));
+        }
+        why.push(w);
+    }
+    if skipped.empty_edp > 0 {
+        let mut w = format!("{} have no value of --edp {}", skipped.empty_edp, spec.edp);
+        if empty_everywhere(&spec.edp) {
+            w.push_str(" (empty in every row)");
+        }
+        why.push(w);
+    }
+    if skipped.non_finite > 0 {
+        why.push(format!(
+            "{} have a value not finite (NaN or infinite)",
+            skipped.non_finite
+        ));
+    }
+    Ok(format!("of {kept} rows, {}", why.join(", ")))
+}
+
+/// The runs with no value of the demand (a residual drift where the run did not settle): how
+/// many each threshold decides by the bounding column, how many stay undecided, and the fit
+/// with those counted as none exceeding and as all exceeding, which bound the fit to the runs
+/// decided.
+fn undecided_table(
+    t: &mut Telling,
+    grouped: &Grouped,
+    spec: &FragilitySpec,
+    states: Option<&[String]>,
+) {
+    let decided = match &grouped.bound {
+        Some(b) => format!("; {b} decides those at or below a threshold as not exceeding it (a residual drift never exceeds the peak drift)"),
+        None => ", and no column of this file bounds it: each is undecided".into(),
+    };
+    t.say(format_args!(
+        "\n{} runs have no value of {} (the run did not settle){decided}. The fits above are to the runs decided; the undecided, counted as none exceeding and as all exceeding, bound them:",
+        grouped.unknown,
+        spec.edp
+    ));
+    t.say(format_args!("\n| {} > | decided by the bound | undecided | median if none exceed | beta | median if all exceed | beta |\n|---:|---:|---:|---:|---:|---:|---:|", spec.edp));
+    let none = grouped.pooled_counting(&[1], Undecided::NotExceeding);
+    let all = grouped.pooled_counting(&[1], Undecided::Exceeding);
+    let show = |lv: &[Level]| match fit(lv) {
+        Ok(f) => format!("{:.4} | {:.4}", f.median, f.beta),
+        Err(e) => format!("no fit: {e} |"),
+    };
+    for (k, &limit) in spec.thresholds.iter().enumerate() {
+        let label = match states {
+            Some(n) => format!("{} ({})", n[k], number(limit)),
+            None => number(limit),
+        };
+        let undecided: u64 = grouped.undecided_at(k).iter().sum();
+        t.say(format_args!(
+            "| {label} | {} | {undecided} | {} | {} |",
+            grouped.bounded[k],
+            show(&none[k]),
+            show(&all[k])
+        ));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1288,5 +1818,161 @@ mod tests {
             .collect();
         let f = fit(&plateau).unwrap();
         assert!(f.p_fit.unwrap() < 1e-6, "{f:?}");
+    }
+
+    /// A table in memory: `rows` of `record, target_sa_g, status, drift`.
+    fn study_table(rows: &[(&str, f64, &str, f64)]) -> Table {
+        Table {
+            path: "r.csv".into(),
+            header: ["record", "target_sa_g", "status", "drift"]
+                .map(String::from)
+                .to_vec(),
+            rows: rows
+                .iter()
+                .map(|(r, im, st, d)| {
+                    vec![r.to_string(), im.to_string(), st.to_string(), d.to_string()]
+                })
+                .collect(),
+        }
+    }
+
+    /// Ten runs at each of four levels, two per record r0..r4, the first 1, 3, 6, 9 above 1.
+    fn ladder() -> Vec<(&'static str, f64, &'static str, f64)> {
+        let records = ["r0", "r1", "r2", "r3", "r4"];
+        [(0.1, 1), (0.2, 3), (0.4, 6), (0.8, 9)]
+            .into_iter()
+            .flat_map(|(im, k)| {
+                (0..10).map(move |j| (records[j / 2], im, "ok", if j < k { 2.0 } else { 0.5 }))
+            })
+            .collect()
+    }
+
+    /// The study of a table read gives the counts' CSV, the summary and the fits' table, a
+    /// notice placed after the line it follows, and refuses a bootstrap of one group after
+    /// telling what it read; its settings are refused before any table.
+    #[test]
+    fn the_study_counts_fits_and_tells_in_order() {
+        let o = FragilityOptions {
+            edp: "drift".into(),
+            thresholds: vec![1.0, 5.0],
+            ..FragilityOptions::default()
+        };
+        let r = study(&study_table(&ladder()), &o).unwrap();
+        assert_eq!(
+            r.csv,
+            "threshold,target_sa_g,runs,exceed,collapsed,fraction,undecided,fraction_if_none_exceed,fraction_if_all_exceed\n\
+             1,0.1,10,1,0,0.1,0,0.1,0.1\n1,0.2,10,3,0,0.3,0,0.3,0.3\n1,0.4,10,6,0,0.6,0,0.6,0.6\n1,0.8,10,9,0,0.9,0,0.9,0.9\n\
+             5,0.1,10,0,0,0,0,0,0\n5,0.2,10,0,0,0,0,0,0\n5,0.4,10,0,0,0,0,0,0\n5,0.8,10,0,0,0,0,0,0\n"
+        );
+        let lines: Vec<&str> = r.said.lines().collect();
+        assert_eq!(lines[0], "40 runs at 4 levels of target_sa_g");
+        assert!(lines[1].is_empty() && lines[2].starts_with("| drift > | median target_sa_g |"));
+        let fitted = fit(&Grouped::read(
+            &study_table(&ladder()),
+            &FragilitySpec {
+                im: "target_sa_g".into(),
+                edp: "drift".into(),
+                thresholds: vec![1.0],
+                filters: Vec::new(),
+            },
+            None,
+        )
+        .unwrap()
+        .0
+        .pooled(&[1])[0])
+        .unwrap();
+        assert!(
+            lines[4].starts_with(&format!(
+                "| 1 | {:.4} | {:.4} |",
+                fitted.median, fitted.beta
+            )),
+            "{}",
+            lines[4]
+        );
+        assert!(lines[5].starts_with("| 5 | no fit: "), "{}", lines[5]);
+        assert_eq!(r.panels.len(), 1);
+
+        // An intensity that differs from run to run: the notice comes after the first line.
+        let spread: Vec<_> = (0..12)
+            .map(|i| ("r0", 0.1 + i as f64 / 100.0, "ok", i as f64))
+            .collect();
+        let o = FragilityOptions {
+            edp: "drift".into(),
+            thresholds: vec![5.0],
+            ..FragilityOptions::default()
+        };
+        let r = study(&study_table(&spread), &o).unwrap();
+        assert!(r.notices[0].starts_with("notice: target_sa_g takes 12 values over 12 runs"));
+        assert_eq!(r.notices_at[0], r.said.find('\n').unwrap() + 1);
+        let told = std::cell::RefCell::new(Vec::new());
+        r.tell(
+            |s| -> Result<(), ()> {
+                told.borrow_mut().push(format!("say {s}"));
+                Ok(())
+            },
+            |n| told.borrow_mut().push(format!("note {n}")),
+        )
+        .unwrap();
+        let told = told.into_inner();
+        assert_eq!(told[0], "say 12 runs at 12 levels of target_sa_g\n");
+        assert!(told[1].starts_with("note notice: target_sa_g takes"));
+        assert_eq!(
+            told.iter()
+                .filter(|t| t.starts_with("say "))
+                .map(|t| &t[4..])
+                .collect::<String>(),
+            r.said
+        );
+
+        // A bootstrap over one record: refused after the summary, which it carries.
+        let o = FragilityOptions {
+            edp: "drift".into(),
+            thresholds: vec![1.0],
+            bootstrap: 100,
+            filters: vec!["record=r0".into()],
+            ..FragilityOptions::default()
+        };
+        match study(&study_table(&ladder()), &o) {
+            Err(e @ FragilityError::RefusedAfter { .. }) => {
+                assert_eq!(e.to_string(), "--bootstrap: the runs fall in 1 group of record: resampling needs at least two");
+                let mut said = String::new();
+                e.tell(
+                    |s| -> Result<(), ()> {
+                        said.push_str(s);
+                        Ok(())
+                    },
+                    |_| (),
+                )
+                .unwrap();
+                assert_eq!(said, "8 runs at 4 levels of target_sa_g\n");
+            }
+            other => panic!("{other:?}"),
+        }
+        // Settings refused with no table; a filter keeping nothing named with the file.
+        let o = FragilityOptions {
+            bootstrap: 50,
+            thresholds: vec![1.0],
+            ..FragilityOptions::default()
+        };
+        assert!(o
+            .check()
+            .unwrap_err()
+            .to_string()
+            .starts_with("--bootstrap 50: expected 0 (no bands) or at least 100"));
+        assert!(FragilityOptions::default()
+            .check()
+            .unwrap_err()
+            .to_string()
+            .starts_with("give --threshold T1,T2"));
+        let o = FragilityOptions {
+            edp: "drift".into(),
+            thresholds: vec![1.0],
+            filters: vec!["record=none".into()],
+            ..FragilityOptions::default()
+        };
+        assert_eq!(
+            study(&study_table(&ladder()), &o).unwrap_err().to_string(),
+            "r.csv: no run left to count: --where record=none keeps none of its 40 rows"
+        );
     }
 }

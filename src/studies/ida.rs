@@ -18,6 +18,7 @@
 use crate::io::table::{caption, label, name, order_key, Filter, Table, TableError};
 use crate::studies::fragility::{demand_rows, Demand, LeftOut};
 use crate::studies::plot::{Panel, Series, SMOOTH};
+use crate::studies::report::{StudyReport, Telling};
 use std::collections::{BTreeMap, HashMap};
 
 /// Curves named in a plot's legend at most.
@@ -82,6 +83,10 @@ pub enum IdaError {
         rows: usize,
         why: String,
     },
+    /// A setting that gives no result (`--by` naming a column twice, `--edp collapsed`): the
+    /// message as `pound ida` prints it.
+    #[error("{0}")]
+    Refused(String),
 }
 
 /// Quantile `q` of sorted values that may end in infinities (collapses), interpolated linearly
@@ -467,6 +472,229 @@ impl Ida {
     }
 }
 
+// The command's study: `pound ida` from a table already read to the text it tells and the CSV
+// it writes, so that the command line and the Python package hold none of it.
+
+/// What an IDA reads: every setting of `pound ida` but where it writes and how it draws.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IdaOptions {
+    /// Intensity measure column; None: the table's [`crate::studies::fragility::default_im`].
+    pub im: Option<String>,
+    /// Demand column (a collapsed run is an infinite demand).
+    pub edp: String,
+    /// The columns that name a curve; empty: `record`, and `sample` where the table has samples.
+    pub by: Vec<String>,
+    /// `--where` filters as typed (`COLUMN=VALUE`, `!=`, `<`, `<=`, `>`, `>=`), all kept.
+    pub filters: Vec<String>,
+}
+
+impl IdaOptions {
+    /// The demand `edp` with the command's defaults for the rest.
+    pub fn new(edp: impl Into<String>) -> IdaOptions {
+        IdaOptions {
+            im: None,
+            edp: edp.into(),
+            by: Vec::new(),
+            filters: Vec::new(),
+        }
+    }
+
+    /// The checks of the settings alone, made before any table is read (as `pound ida` makes
+    /// them): [`study`] makes them again first.
+    pub fn check(&self) -> Result<(), IdaError> {
+        if let Some(twice) = crate::plan::config::name_given_twice(&self.by) {
+            return Err(IdaError::Refused(format!(
+                "--by: `{twice}` is given twice: give each column once"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// `pound ida` of `table`: the curves, their fractiles per level, and the notices (curves
+/// missing at a level and why, failed runs left out, collapses and where the fractiles
+/// flatline, runs counted as collapsed above a curve's first collapse).
+pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
+    o.check()?;
+    let by = if o.by.is_empty() {
+        let sampled = table
+            .col("sample")
+            .is_ok_and(|c| table.rows.iter().any(|r| !r[c].is_empty()));
+        let mut by = vec!["record".to_string()];
+        if sampled {
+            by.push("sample".into());
+        }
+        by
+    } else {
+        o.by.clone()
+    };
+    let spec = IdaSpec {
+        im: o
+            .im
+            .clone()
+            .unwrap_or_else(|| crate::studies::fragility::default_im(table)),
+        edp: o.edp.clone(),
+        by,
+        filters: Filter::parse_all(&o.filters)?,
+    };
+    if spec.edp == crate::studies::fragility::COLLAPSED && table.col(&spec.edp).is_err() {
+        return Err(IdaError::Refused(format!("--edp {}: an IDA reads a demand column (e.g. b1_peak_drift_ratio), where a collapsed run is an infinite demand; the collapse fragility P(collapse | IM) is `pound fragility --edp collapsed`", spec.edp)));
+    }
+    let (ida, skipped) = read(table, &spec)?;
+    let mut t = Telling::default();
+    let collapsed_runs = skipped.collapsed;
+    t.say(format_args!(
+        "{} curves (by {}) at {} levels of {}{}{}",
+        ida.curves.len(),
+        spec.by.join(", "),
+        ida.ims.len(),
+        spec.im,
+        if collapsed_runs > 0 {
+            format!(", {collapsed_runs} runs collapsed (an infinite demand)")
+        } else {
+            String::new()
+        },
+        if skipped.total() > 0 {
+            format!(" ({} rows left out: {skipped})", skipped.total())
+        } else {
+            String::new()
+        }
+    ));
+    // Failed runs are left out of the fractiles. Where the table has no collapse criterion a
+    // failed run may be a collapse, so the fractiles over the others are collapse-free; where it
+    // has one, they are over the runs that did not fail.
+    let failed: usize = ida.failed.iter().sum();
+    let can_collapse = table.col("collapse_time_s").is_ok();
+    let over = match (failed > 0, can_collapse) {
+        (false, _) => "",
+        (true, false) => " (collapse-free)",
+        (true, true) => " (failed runs left out)",
+    };
+    let head: Vec<String> = FRACTILES
+        .iter()
+        .map(|f| format!("{} {f} %{over}", spec.edp))
+        .collect();
+    t.say(format_args!(
+        "\n| {} | curves | collapsed | {} |\n|---:|---:|---:|---:|---:|---:|",
+        spec.im,
+        head.join(" | ")
+    ));
+    let show = |x: f64| {
+        if x.is_infinite() {
+            "inf (collapse)".to_string()
+        } else {
+            format!("{x:.4e}")
+        }
+    };
+    for (l, im) in ida.ims.iter().enumerate() {
+        let f = ida.fractiles[l];
+        if ida.counts[l] == 0 {
+            t.say(format_args!("| {im} | 0 | | no run with a value | | |"));
+            continue;
+        }
+        t.say(format_args!(
+            "| {im} | {} | {} ({:.0} %) | {} | {} | {} |",
+            ida.counts[l],
+            ida.collapsed[l],
+            100.0 * ida.collapsed_fraction(l).unwrap_or(0.0),
+            show(f[0]),
+            show(f[1]),
+            show(f[2])
+        ));
+    }
+    // Where curves are missing at a level, say why: no run there, or a run left out.
+    let short: Vec<String> = ida
+        .ims
+        .iter()
+        .enumerate()
+        .filter(|(l, _)| ida.counts[*l] < ida.curves.len())
+        .map(|(l, im)| {
+            let (n, f, e) = (ida.counts[l], ida.failed[l], ida.no_value[l]);
+            let mut why = Vec::new();
+            if f > 0 {
+                why.push(format!("{f} failed (status neither ok nor collapsed)"));
+            }
+            if e > 0 {
+                why.push(format!(
+                    "{e} with no value of {} (a run that did not settle)",
+                    spec.edp
+                ));
+            }
+            let absent = ida.curves.len().saturating_sub(n + f + e);
+            if absent > 0 {
+                why.push(format!("{absent} with no run"));
+            }
+            format!(
+                "{im}: {n} of {} curves ({})",
+                ida.curves.len(),
+                why.join(", ")
+            )
+        })
+        .collect();
+    if !short.is_empty() {
+        t.note(format_args!(
+            "notice: not every curve has a value at each level of {}: {}; the fractiles there are over the runs with a value",
+            spec.im,
+            short.join("; ")
+        ));
+    }
+    if failed > 0 {
+        if can_collapse {
+            t.note(format_args!(
+                "notice: {failed} failed runs (status neither ok nor collapsed: a numerical failure) are left out of the fractiles, which are over the runs that did not fail (the collapsed ones among them, as infinite demands)"
+            ));
+        } else {
+            t.note(format_args!(
+                "notice: {failed} failed runs (status not ok: a collapse or a numerical failure, this table having no collapse criterion) are left out of the fractiles, which are therefore collapse-free: below the fractiles of every run where the failed runs are the most severe"
+            ));
+        }
+    }
+    if ida.any_collapsed() {
+        let flat: Vec<String> = FRACTILES
+            .iter()
+            .enumerate()
+            .filter_map(|(k, f)| {
+                let l = (0..ida.ims.len())
+                    .find(|&l| ida.counts[l] > 0 && ida.fractiles[l][k].is_infinite())?;
+                Some(format!("the {f} % from {}", ida.ims[l]))
+            })
+            .collect();
+        t.note(format_args!(
+            "notice: collapsed runs are infinite demands (Vamvatsikos & Cornell 2002): a curve flatlines at its first collapse and is collapsed at every level above it; a fractile is infinite (`inf`) where the collapses reach it{}",
+            if flat.is_empty() {
+                ": none does here".to_string()
+            } else {
+                format!(": {}", flat.join(", "))
+            }
+        ));
+    }
+    if ida.resurrected + ida.filled > 0 {
+        let mut what = Vec::new();
+        if ida.resurrected > 0 {
+            what.push(format!(
+                "{} runs that did not collapse (structural resurrection)",
+                ida.resurrected
+            ));
+        }
+        if ida.filled > 0 {
+            what.push(format!("{} levels with no run", ida.filled));
+        }
+        t.note(format_args!(
+            "notice: above their curve's first collapse, {} are counted as collapsed: the first collapse is the curve's capacity",
+            what.join(" and ")
+        ));
+    }
+    let mut panels = vec![ida.panel(&spec)];
+    panels.extend(ida.collapse_panel(&spec));
+    Ok(StudyReport {
+        csv: ida.csv(&spec),
+        said: t.said,
+        notices: t.notices,
+        notices_at: t.notices_at,
+        panels,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -611,5 +839,65 @@ mod tests {
         let (ida, _) = read(&table(text), &spec(&["record", "sample"])).unwrap();
         assert_eq!(ida.curves.len(), 2);
         assert_eq!(ida.curves[1].0, "a/1");
+    }
+
+    /// The study of a table read: the curves by record (the default, with no samples), the CSV
+    /// of [`read`], the summary, and the notices of a level short of a curve and of a failed run
+    /// in a table with no collapse criterion, in that order; `--by` twice refused first.
+    #[test]
+    fn the_study_reads_by_record_and_tells_why_curves_are_short() {
+        let mut rows = Vec::new();
+        for (r, k) in [("a", 1.0), ("b", 2.0), ("c", 3.0)] {
+            for im in [0.1, 0.2, 0.4] {
+                let status = if r == "c" && im == 0.4 {
+                    "failed"
+                } else {
+                    "ok"
+                };
+                rows.push(vec![
+                    r.to_string(),
+                    String::new(),
+                    im.to_string(),
+                    status.to_string(),
+                    (k * im).to_string(),
+                ]);
+            }
+        }
+        let table = Table {
+            path: "r.csv".into(),
+            header: ["record", "sample", "target_sa_g", "status", "drift"]
+                .map(String::from)
+                .to_vec(),
+            rows,
+        };
+        let r = study(&table, &IdaOptions::new("drift")).unwrap();
+        let (ida, _) = read(&table, &spec(&["record"])).unwrap();
+        assert_eq!(r.csv, ida.csv(&spec(&["record"])));
+        assert!(
+            r.said.starts_with(
+                "3 curves (by record) at 3 levels of target_sa_g (1 rows left out: 1 failed"
+            ),
+            "{}",
+            r.said
+        );
+        assert!(r.said.contains("| 0.4 | 2 | 0 (0 %) |"), "{}", r.said);
+        assert_eq!(r.notices.len(), 2);
+        assert!(r.notices[0].starts_with("notice: not every curve has a value at each level of target_sa_g: 0.4: 2 of 3 curves (1 failed"), "{}", r.notices[0]);
+        assert!(
+            r.notices[1].starts_with("notice: 1 failed runs (status not ok: a collapse"),
+            "{}",
+            r.notices[1]
+        );
+        assert_eq!(r.notices_at, vec![r.said.len(); 2]);
+        assert_eq!(r.panels.len(), 1);
+        let twice = IdaOptions {
+            by: vec!["record".into(), "record".into()],
+            ..IdaOptions::new("drift")
+        };
+        assert_eq!(
+            twice.check().unwrap_err().to_string(),
+            "--by: `record` is given twice: give each column once"
+        );
+        assert!(matches!(study(&table, &twice), Err(IdaError::Refused(_))));
     }
 }

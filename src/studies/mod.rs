@@ -1,7 +1,7 @@
 //! What users do with sweeps and single collisions: speed against error ([`accuracy`]),
 //! throughput ([`bench`](mod@bench)), restitution fidelity and hysteresis loops ([`fidelity`]), the
 //! formulas' zeta(e) ([`formulas`]), fragility curves ([`fragility`]) with
-//! named damage states ([`damage_states`]), incremental dynamic analysis summaries ([`ida`]), sensitivity plots
+//! named damage states ([`damage_states`]), incremental dynamic analysis summaries ([`ida`]), what a study of a table gives ([`report`]), sensitivity plots
 //! ([`sensitivity`]), one run's time history ([`trace`]), the seed paper's checks ([`paper`]), and drawing
 //! them ([`plot`]).
 //!
@@ -17,5 +17,6 @@ pub mod gap;
 pub mod ida;
 pub mod paper;
 pub mod plot;
+pub mod report;
 pub mod sensitivity;
 pub mod trace;
