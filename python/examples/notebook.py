@@ -10,11 +10,12 @@
 
 # %%
 import os
+import sys
 from pathlib import Path
 
 import matplotlib
 
-if "ipykernel" not in os.environ.get("JPY_PARENT_PID", "") and not os.environ.get("DISPLAY"):
+if "ipykernel" not in sys.modules and not os.environ.get("DISPLAY"):
     matplotlib.use("Agg")  # a script without a display writes files only
 import matplotlib.pyplot as plt
 

@@ -17,6 +17,7 @@ the GIL released, and Ctrl-C stops it and raises ``KeyboardInterrupt``.
 
 from __future__ import annotations
 
+import numbers
 import os
 import sys
 import warnings
@@ -174,7 +175,10 @@ def _config(config: Config) -> tuple:
     if isinstance(config, os.PathLike):
         return os.fspath(config), "path"
     if isinstance(config, str):
-        # A TOML text has a key (=) or a table ([...]); a path has neither on one line.
+        # A file that exists is a path (a folder may be named pga=0.3); else a TOML text has a
+        # line break, a key (=) or a table ([...]), and a path has none of them.
+        if os.path.isfile(config):
+            return config, "path"
         if "\n" in config or "=" in config or config.lstrip().startswith("["):
             return config, "text"
         return config, "path"
@@ -198,7 +202,11 @@ def _exceed(exceed: Union[None, str, dict, Iterable[str]]) -> list:
     if exceed is None:
         return []
     if isinstance(exceed, dict):
-        return [f"{k}={v!r}" if isinstance(v, float) else f"{k}={v}" for k, v in exceed.items()]
+        # numpy's numbers too: as the int or float they hold, in Python's own spelling.
+        return [
+            f"{k}={int(v)}" if isinstance(v, numbers.Integral) else f"{k}={float(v)!r}"
+            for k, v in exceed.items()
+        ]
     if isinstance(exceed, str):
         return [exceed]
     return list(exceed)
@@ -224,6 +232,17 @@ class _QuietVulkanProbe:
     def __exit__(self, *exc: Any) -> None:
         if self.active:
             os.environ.pop("WAYLAND_DISPLAY", None)
+
+
+def _count(name: str, value: Any, least: int = 0) -> Optional[int]:
+    """A whole number keyword (None stays None), at least `least`."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise SettingsError(f"{name}={value!r}: expected a whole number")
+    if value < least:
+        raise SettingsError(f"{name}={value}: expected a whole number from {least}")
+    return int(value)
 
 
 def _say(lines: Sequence[str]) -> None:
@@ -308,14 +327,14 @@ def sweep(
                 kind,
                 backend,
                 precision,
-                threads,
+                _count("threads", threads, 1),
                 target_error,
                 _names(columns, "columns"),
                 _names(aggregate, "aggregate"),
                 _exceed(exceed),
                 scheme,
                 bool(energy),
-                chunk,
+                _count("chunk", chunk, 1),
                 bar if progress else None,
             )
     finally:
@@ -341,7 +360,7 @@ def trace(config: Config, run: int) -> Trace:
     step and located event: displacements, velocities, accelerations, each level's
     penetration, force and mode, yielding storeys' drifts) and its row as the sweep writes it."""
     value, kind = _config(config)
-    history, row = _engine.trace(value, kind, int(run))
+    history, row = _engine.trace(value, kind, _count("run", run))
     return Trace(Table(history), Table(row))
 
 
@@ -350,7 +369,7 @@ def gap(config: Config, *, threads: Optional[int] = None) -> Table:
     ``pound gap`` writes it: exactly from the time histories, and by the ABS, SRSS and DDC
     rules, with their ratios to the exact gap."""
     value, kind = _config(config)
-    inner, warned = _engine.gap(value, kind, threads)
+    inner, warned = _engine.gap(value, kind, _count("threads", threads, 1))
     _warn(warned)
     return Table(inner)
 
@@ -387,11 +406,14 @@ def _where(where: Union[None, str, Iterable[str]]) -> list:
 def _list(value: Union[None, float, str, Iterable[Any]]) -> list:
     if value is None:
         return []
-    if isinstance(value, (int, float)):
-        return [float(value)]
-    if isinstance(value, str):
-        return [float(v) for v in value.split(",") if v.strip()]
-    return [float(v) for v in value]
+    try:
+        if isinstance(value, numbers.Real):
+            return [float(value)]
+        if isinstance(value, str):
+            return [float(v) for v in value.split(",") if v.strip()]
+        return [float(v) for v in value]
+    except (TypeError, ValueError):
+        raise SettingsError(f"{value!r}: expected numbers (a number, a list, or a,b,c)") from None
 
 
 def fragility(
@@ -422,8 +444,8 @@ def fragility(
         edp,
         _list(thresholds),
         damage_states,
-        int(bootstrap),
-        seed,
+        _count("bootstrap", bootstrap),
+        _count("seed", seed),
         by,
         _where(where),
     )
@@ -463,12 +485,13 @@ def record(
     """A ground-motion record file, read as ``pound record info`` reads it (format: auto, at2,
     values or two_column; units: g, m/s2 or cm/s2; window: (start, end) s on the record's
     clock, as a config's ``window_s``)."""
-    path = os.fspath(path)
+    # Absolute: spectrum() reads the file again, perhaps from another working folder.
+    path = os.path.abspath(os.fspath(path))
     options = {
         "format": format,
         "dt": dt,
         "units": units,
-        "skip_lines": int(skip_lines),
+        "skip_lines": _count("skip_lines", skip_lines),
         "window": tuple(window) if window is not None else None,
     }
     info, samples = _engine.record(path, **options)
@@ -487,8 +510,4 @@ def spectrum(
         path, options = record.path, record._options
     else:
         path, options = os.fspath(record), {}
-    if isinstance(periods, (int, float)):
-        periods = [periods]
-    return Table(
-        _engine.spectrum(path, [float(t) for t in periods], float(damping), **options)
-    )
+    return Table(_engine.spectrum(path, _list(periods), float(damping), **options))

@@ -97,8 +97,9 @@ impl Columns {
 }
 
 /// A study's CSV (a trace, a gap study, a fragility table) as a typed table: a column is text
-/// where any cell is not a number, else integers where every cell is written as one, else
-/// reals (the types `pandas.read_csv` gives the same file). An empty cell is a null.
+/// where any cell is not a number, else of its name's kind (counts are integers, measures
+/// reals: [`pounding::io::parquet::kind`]), so a column has one type whatever the run's values.
+/// An empty cell is a null.
 pub fn study_table(csv_text: &str, meta: &[(String, String)]) -> Result<Table, String> {
     let mut r = csv::ReaderBuilder::new().from_reader(csv_text.as_bytes());
     let header: Vec<String> = r
@@ -114,13 +115,18 @@ pub fn study_table(csv_text: &str, meta: &[(String, String)]) -> Result<Table, S
         .map_err(|e| e.to_string())?;
     let kinds = (0..header.len())
         .map(|c| {
-            let cells = || rows.iter().map(|r| r[c].as_str()).filter(|v| !v.is_empty());
-            if cells().all(|v| v.parse::<i64>().is_ok()) && cells().next().is_some() {
-                Kind::Int
-            } else if cells().all(|v| v.parse::<f64>().is_ok()) {
-                Kind::Real
-            } else {
-                Kind::Text
+            let mut cells = rows.iter().map(|r| r[c].as_str()).filter(|v| !v.is_empty());
+            match pounding::io::parquet::kind(&header[c]) {
+                Kind::Int if cells.all(|v| v.parse::<i64>().is_ok()) => Kind::Int,
+                _ if rows
+                    .iter()
+                    .map(|r| r[c].as_str())
+                    .filter(|v| !v.is_empty())
+                    .all(|v| v.parse::<f64>().is_ok()) =>
+                {
+                    Kind::Real
+                }
+                _ => Kind::Text,
             }
         })
         .collect();
@@ -205,25 +211,51 @@ pub fn table_cells(obj: &Bound<'_, PyAny>) -> PyResult<pounding::io::table::Tabl
         .iter()
         .map(|f| f.name().clone())
         .collect();
+    // A column of neither numbers nor text (a timestamp, say) is left out, and named in the
+    // table's label that a study's messages show.
+    let mut left_out: Vec<String> = Vec::new();
+    let mut keep: Vec<bool> = vec![true; header.len()];
     let mut rows: Vec<Vec<String>> = Vec::new();
     for batch in reader {
         let batch = batch.map_err(|e| bad(format!("reading the table: {e}")))?;
         let first = rows.len();
         rows.extend((0..batch.num_rows()).map(|_| Vec::with_capacity(header.len())));
         for (c, col) in batch.columns().iter().enumerate() {
-            let cells = cells_of(col.as_ref()).map_err(|ty| {
-                bad(format!(
-                    "column `{}` is of type {ty}: expected numbers or text",
-                    header[c]
-                ))
-            })?;
-            for (i, v) in cells.into_iter().enumerate() {
-                rows[first + i].push(v);
+            if !keep[c] {
+                continue;
+            }
+            match cells_of(col.as_ref()) {
+                Ok(cells) => {
+                    for (i, v) in cells.into_iter().enumerate() {
+                        rows[first + i].push(v);
+                    }
+                }
+                Err(ty) => {
+                    keep[c] = false;
+                    left_out.push(format!("{} ({ty})", header[c]));
+                    for r in &mut rows[..first] {
+                        r.remove(keep[..c].iter().filter(|k| **k).count());
+                    }
+                }
             }
         }
     }
+    let header: Vec<String> = header
+        .into_iter()
+        .zip(&keep)
+        .filter(|(_, k)| **k)
+        .map(|(h, _)| h)
+        .collect();
+    let path = if left_out.is_empty() {
+        "<table>".to_string()
+    } else {
+        format!(
+            "<table, without {}: neither numbers nor text>",
+            left_out.join(", ")
+        )
+    };
     Ok(pounding::io::table::Table {
-        path: "<table>".into(),
+        path: path.into(),
         header,
         rows,
     })
@@ -307,6 +339,21 @@ fn cells_of(a: &dyn Array) -> Result<Vec<String>, String> {
                 .collect()
         }
         DataType::Null => vec![String::new(); a.len()],
+        DataType::Dictionary(_, _) => {
+            // Categories (pandas' category, polars' Categorical): each key's value.
+            let d = a.as_any_dictionary();
+            let values = cells_of(d.values().as_ref())?;
+            let keys = d.normalized_keys();
+            (0..a.len())
+                .map(|i| {
+                    if a.is_null(i) {
+                        String::new()
+                    } else {
+                        values[keys[i]].clone()
+                    }
+                })
+                .collect()
+        }
         other => return Err(other.to_string()),
     })
 }

@@ -120,7 +120,11 @@ fn toml_value(v: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
     Ok(if v.is_instance_of::<PyBool>() {
         toml::Value::Boolean(v.extract()?)
     } else if v.is_instance_of::<PyInt>() {
-        toml::Value::Integer(v.extract()?)
+        toml::Value::Integer(v.extract().map_err(|_| {
+            ConfigError::new_err(format!(
+                "<config dict>: {at}: {v} is beyond a 64-bit integer"
+            ))
+        })?)
     } else if v.is_instance_of::<PyFloat>() {
         toml::Value::Float(v.extract()?)
     } else if v.is_instance_of::<PyString>() {
@@ -136,17 +140,25 @@ fn toml_value(v: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
                 .map(|(i, x)| toml_value(x, &format!("{at}[{i}]")))
                 .collect::<PyResult<_>>()?,
         )
+    } else if matches!(v.get_type().name()?.to_string().as_str(), "bool_" | "bool") {
+        // numpy's bool: as the bool it holds (before __index__, which numpy refuses on it).
+        toml::Value::Boolean(v.is_truthy()?)
+    } else if v.hasattr("__index__")? {
+        // numpy's integers and the like: whole numbers stay whole.
+        toml::Value::Integer(v.call_method0("__index__")?.extract().map_err(|_| {
+            ConfigError::new_err(format!(
+                "<config dict>: {at}: {v} is beyond a 64-bit integer"
+            ))
+        })?)
     } else {
-        // numpy scalars and the like: as the float or int they hold.
-        match v.extract::<i64>() {
-            Ok(i) if !v.hasattr("is_integer")? => toml::Value::Integer(i),
-            _ => toml::Value::Float(v.extract().map_err(|_| {
-                ConfigError::new_err(format!(
-                    "<config dict>: {at}: a {} is not a config value (expected a string, number, bool, list or dict)",
-                    v.get_type().name().map(|n| n.to_string()).unwrap_or_default()
-                ))
-            })?),
-        }
+        // numpy's floats and the like: as the float they hold.
+        toml::Value::Float(v.extract().map_err(|_| {
+            ConfigError::new_err(format!(
+                "<config dict>: {at}: a {} is not a config value (expected a string, number, bool, list or dict{})",
+                v.get_type().name().map(|n| n.to_string()).unwrap_or_default(),
+                if v.hasattr("tolist").unwrap_or(false) { "; an array's .tolist() is a list" } else { "" }
+            ))
+        })?)
     })
 }
 
@@ -519,7 +531,9 @@ fn trace(
     let t = py
         .detach(|| pounding::studies::trace::trace(&plan, run))
         .map_err(|e| SettingsError::new_err(format!("{}: {e}", path.display())))?;
-    let history = study_table(&t.csv(), &[]).map_err(PoundingError::new_err)?;
+    let history = py
+        .detach(|| study_table(&t.csv(), &[]))
+        .map_err(PoundingError::new_err)?;
     let kinds = t.header.iter().map(|n| kind(n)).collect();
     let mut row = Columns::new(&t.header, kinds);
     row.append(std::slice::from_ref(&t.row))
@@ -555,10 +569,10 @@ fn gap(
     })?
     .map_err(|e| PoundingError::new_err(format!("{}: {e}", path.display())))?;
     let text = String::from_utf8(csv).map_err(|e| PoundingError::new_err(e.to_string()))?;
-    Ok((
-        study_table(&text, &[]).map_err(PoundingError::new_err)?,
-        warnings,
-    ))
+    let table = py
+        .detach(|| study_table(&text, &[]))
+        .map_err(PoundingError::new_err)?;
+    Ok((table, warnings))
 }
 
 /// A record file read as `pound record info` reads it.
@@ -646,14 +660,8 @@ fn spectrum(
     window: Option<(f64, f64)>,
 ) -> PyResult<Table> {
     use pounding::record::G;
-    if let Some(bad) = periods.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
-        return Err(settings_err(format!(
-            "periods: {bad} is out of range: expected periods above 0 s"
-        )));
-    }
-    if periods.is_empty() {
-        return Err(settings_err("periods: none given"));
-    }
+    pounding::plan::limits::check_periods(&periods)
+        .map_err(|m| settings_err(format!("periods: {m}")))?;
     if !(damping.is_finite() && (0.0..1.0).contains(&damping)) {
         return Err(settings_err(format!(
             "damping {damping}: expected a ratio from 0 to below 1 (0.05 for 5 %)"
@@ -730,7 +738,9 @@ fn fragility(
     options.check().map_err(refused)?;
     let rows = study_input(table, table_kind)?;
     let r = py.detach(|| study(&rows, &options)).map_err(refused)?;
-    let t = study_table(&r.csv, &[]).map_err(PoundingError::new_err)?;
+    let t = py
+        .detach(|| study_table(&r.csv, &[]))
+        .map_err(PoundingError::new_err)?;
     Ok((t, r.said, r.notices))
 }
 
@@ -760,7 +770,9 @@ fn ida(
     options.check().map_err(refused)?;
     let rows = study_input(table, table_kind)?;
     let r = py.detach(|| study(&rows, &options)).map_err(refused)?;
-    let t = study_table(&r.csv, &[]).map_err(PoundingError::new_err)?;
+    let t = py
+        .detach(|| study_table(&r.csv, &[]))
+        .map_err(PoundingError::new_err)?;
     Ok((t, r.said, r.notices))
 }
 

@@ -116,3 +116,26 @@ def test_studies_refuse_bad_input_with_the_command_lines_messages(tmp_path):
         pounding.fragility(42, edp="b1_peak_ductility", thresholds=[1])
     with pytest.raises(pounding.TableError, match="missing.csv"):
         pounding.ida(tmp_path / "missing.csv", edp="b1_peak_drift_ratio")
+
+
+def test_a_studys_columns_keep_their_types_whatever_the_values():
+    import polars as pl
+
+    pounded = pounding.trace(CONFIGS / "quickstart.toml", 0).history
+    untouched = pounding.trace(CONFIGS / "quickstart.toml", 4).history
+    assert pa.table(pounded).schema == pa.table(untouched).schema
+    assert pl.concat([pounded.to_polars(), untouched.to_polars()]).height == pounded.num_rows + untouched.num_rows
+    with pytest.raises(pounding.SettingsError, match="run=-1"):
+        pounding.trace(CONFIGS / "quickstart.toml", -1)
+
+
+def test_categories_are_read_and_other_columns_left_out(pound, tmp_path):
+    runs = pounding.sweep(CONFIGS / "inelastic-fragility.toml", backend="cpu", progress=False)
+    df = runs.to_pandas()
+    df["record"] = df["record"].astype("category")
+    df["when"] = __import__("pandas").Timestamp("2020-01-01")
+    expected = pa.table(pounding.fragility(runs, edp="b1_peak_ductility", thresholds=[1, 2], bootstrap=100))
+    got = pa.table(pounding.fragility(df, edp="b1_peak_ductility", thresholds=[1, 2], bootstrap=100))
+    assert got.equals(expected)
+    with pytest.raises(pounding.TableError, match="without when"):
+        pounding.fragility(df, edp="when", thresholds=[1])

@@ -191,3 +191,32 @@ def test_the_gpu_gives_the_command_lines_cells(config, pound, tmp_path):
     table = pounding.sweep(CONFIGS / config, backend="gpu", progress=False)
     assert table.metadata["pound.backend"] == "gpu-f32"
     assert_same_cells(table, out)
+
+
+def test_numpy_values_and_awkward_paths_are_taken_as_meant(tmp_path):
+    import numpy as np
+
+    assert tomllib is not None
+    with open(CONFIGS / "fragility-example.toml", "rb") as f:
+        plain = tomllib.load(f)
+    # The same config with numpy's numbers where a notebook would put them.
+    numpyish = tomllib.loads((CONFIGS / "fragility-example.toml").read_text())
+    numpyish["record"] = [
+        {"synthetic": {k: (np.int64(v) if isinstance(v, int) else np.float64(v)) for k, v in r["synthetic"].items()}}
+        for r in numpyish["record"]
+    ]
+    numpyish.setdefault("run", {})["energy"] = np.bool_(False)
+    expected = pa.table(pounding.sweep(plain, backend="cpu", progress=False))
+    assert pa.table(pounding.sweep(numpyish, backend="cpu", progress=False)).equals(expected)
+    # A folder named like a key is still a path.
+    folder = tmp_path / "pga=0.3"
+    folder.mkdir()
+    (folder / "c.toml").write_text((CONFIGS / "fragility-example.toml").read_text())
+    assert pa.table(pounding.sweep(str(folder / "c.toml"), backend="cpu", progress=False)).equals(expected)
+    summary = pounding.sweep(
+        CONFIGS / "quickstart.toml", backend="cpu", aggregate="formula", exceed={"peak_force_n": np.float64(1e6)}, progress=False
+    )
+    assert "exceed_peak_force_n>1000000" in summary.column_names
+    for bad in ({"threads": -1}, {"threads": 1.5}, {"chunk": 0}):
+        with pytest.raises(pounding.SettingsError):
+            pounding.sweep(CONFIGS / "quickstart.toml", progress=False, **bad)

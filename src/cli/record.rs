@@ -99,9 +99,6 @@ pub enum Cmd {
     },
 }
 
-/// Periods of a spectrum at most (each is an exact response over the whole record).
-const MAX_PERIODS: usize = 10_000;
-
 /// `--periods`: FROM:TO:N, log-spaced, or a list; each from the shortest building period
 /// ([`pounding::plan::limits::MIN_PERIOD_S`]) to 100 s.
 fn parse_periods(text: &str) -> Result<Vec<f64>> {
@@ -117,8 +114,11 @@ fn parse_periods(text: &str) -> Result<Vec<f64>> {
                 b.trim().parse::<f64>().map_err(|_| bad())?,
             );
             let n: usize = n.trim().parse().map_err(|_| bad())?;
-            if n == 0 || n > MAX_PERIODS {
-                bail!("--periods `{text}`: {n} periods: expected 1 to {MAX_PERIODS}");
+            if n == 0 || n > pounding::plan::limits::MAX_PERIODS {
+                bail!(
+                    "--periods `{text}`: {n} periods: expected 1 to {}",
+                    pounding::plan::limits::MAX_PERIODS
+                );
             }
             if !(a > 0.0 && b > a) {
                 bail!("--periods `{text}`: expected 0 < FROM < TO");
@@ -135,25 +135,8 @@ fn parse_periods(text: &str) -> Result<Vec<f64>> {
             .collect::<Result<Vec<_>>>()?,
         _ => return Err(bad()),
     };
-    if periods.len() > MAX_PERIODS {
-        bail!(
-            "--periods: {} periods: expected at most {MAX_PERIODS}",
-            periods.len()
-        );
-    }
-    if let Some(t) = pounding::plan::config::number_given_twice(&periods) {
-        bail!(
-            "--periods: {} s is given twice: give each period once",
-            pounding::plan::limits::show(t)
-        );
-    }
-    let lo = pounding::plan::limits::MIN_PERIOD_S;
-    if let Some(t) = periods.iter().find(|t| !(**t >= lo && **t <= 100.0)) {
-        bail!(
-            "--periods: {} s is out of range: expected {lo} to 100 s",
-            pounding::plan::limits::show(*t)
-        );
-    }
+    pounding::plan::limits::check_periods(&periods)
+        .map_err(|m| anyhow::anyhow!("--periods: {m}"))?;
     Ok(periods)
 }
 

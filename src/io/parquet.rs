@@ -32,6 +32,8 @@ pub enum Kind {
 pub fn kind(column: &str) -> Kind {
     match column {
         "run" | "impacts" | "substeps" | "sample" => Kind::Int,
+        // The counts of a study's table (fragility, IDA): no sweep column has these names.
+        "runs" | "exceed" | "collapsed" | "undecided" | "curves" | "pounding" => Kind::Int,
         "law" | "formula" | "record" | "status" => Kind::Text,
         c if [
             "_impacts",

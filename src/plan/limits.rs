@@ -119,3 +119,36 @@ pub const COLLAPSE_DRIFT_RATIO: f64 = 0.10;
 /// The largest gravity mass ratio a P-Delta building takes: the gravity its leaning column
 /// carries over its frame's own floors' (2 or 3 in the archetypes of FEMA P-695).
 pub const MAX_GRAVITY_MASS_RATIO: f64 = 10.0;
+
+/// Periods of a response spectrum at most (each is an exact response over the whole record).
+pub const MAX_PERIODS: usize = 10_000;
+
+/// A spectrum's periods: at most [`MAX_PERIODS`], each once, each from [`MIN_PERIOD_S`] to
+/// 100 s (a shorter period would take the exact response millions of steps per sample).
+pub fn check_periods(periods: &[f64]) -> Result<(), String> {
+    if periods.is_empty() {
+        return Err("no period given".into());
+    }
+    if periods.len() > MAX_PERIODS {
+        return Err(format!(
+            "{} periods: expected at most {MAX_PERIODS}",
+            periods.len()
+        ));
+    }
+    if let Some(t) = crate::plan::config::number_given_twice(periods) {
+        return Err(format!(
+            "{} s is given twice: give each period once",
+            show(t)
+        ));
+    }
+    if let Some(t) = periods
+        .iter()
+        .find(|t| !(**t >= MIN_PERIOD_S && **t <= 100.0))
+    {
+        return Err(format!(
+            "{} s is out of range: expected {MIN_PERIOD_S} to 100 s",
+            show(*t)
+        ));
+    }
+    Ok(())
+}
