@@ -265,18 +265,22 @@ pub fn table_cells(obj: &Bound<'_, PyAny>) -> PyResult<pounding::io::table::Tabl
 fn cells_of(a: &dyn Array) -> Result<Vec<String>, String> {
     use arrow_array::cast::AsArray;
     use arrow_array::types::*;
+    // Each value as `value` writes it, a null as an empty cell.
+    let each = |value: &dyn Fn(usize) -> String| -> Vec<String> {
+        (0..a.len())
+            .map(|i| {
+                if a.is_null(i) {
+                    String::new()
+                } else {
+                    value(i)
+                }
+            })
+            .collect()
+    };
     macro_rules! prim {
         ($t:ty) => {{
             let p = a.as_primitive::<$t>();
-            (0..p.len())
-                .map(|i| {
-                    if p.is_null(i) {
-                        String::new()
-                    } else {
-                        format!("{}", p.value(i))
-                    }
-                })
-                .collect()
+            each(&|i| format!("{}", p.value(i)))
         }};
     }
     Ok(match a.data_type() {
@@ -292,51 +296,19 @@ fn cells_of(a: &dyn Array) -> Result<Vec<String>, String> {
         DataType::Float64 => prim!(Float64Type),
         DataType::Boolean => {
             let b = a.as_boolean();
-            (0..b.len())
-                .map(|i| {
-                    if b.is_null(i) {
-                        String::new()
-                    } else {
-                        b.value(i).to_string()
-                    }
-                })
-                .collect()
+            each(&|i| b.value(i).to_string())
         }
         DataType::Utf8 => {
             let s = a.as_string::<i32>();
-            (0..s.len())
-                .map(|i| {
-                    if s.is_null(i) {
-                        String::new()
-                    } else {
-                        s.value(i).to_string()
-                    }
-                })
-                .collect()
+            each(&|i| s.value(i).to_string())
         }
         DataType::LargeUtf8 => {
             let s = a.as_string::<i64>();
-            (0..s.len())
-                .map(|i| {
-                    if s.is_null(i) {
-                        String::new()
-                    } else {
-                        s.value(i).to_string()
-                    }
-                })
-                .collect()
+            each(&|i| s.value(i).to_string())
         }
         DataType::Utf8View => {
             let s = a.as_string_view();
-            (0..s.len())
-                .map(|i| {
-                    if s.is_null(i) {
-                        String::new()
-                    } else {
-                        s.value(i).to_string()
-                    }
-                })
-                .collect()
+            each(&|i| s.value(i).to_string())
         }
         DataType::Null => vec![String::new(); a.len()],
         DataType::Dictionary(_, _) => {
@@ -344,15 +316,7 @@ fn cells_of(a: &dyn Array) -> Result<Vec<String>, String> {
             let d = a.as_any_dictionary();
             let values = cells_of(d.values().as_ref())?;
             let keys = d.normalized_keys();
-            (0..a.len())
-                .map(|i| {
-                    if a.is_null(i) {
-                        String::new()
-                    } else {
-                        values[keys[i]].clone()
-                    }
-                })
-                .collect()
+            each(&|i| values[keys[i]].clone())
         }
         other => return Err(other.to_string()),
     })

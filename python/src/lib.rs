@@ -9,8 +9,11 @@ use arrow::{study_table, table_cells, Columns, Table};
 use pounding::engine::aggregate::Aggregator;
 use pounding::engine::{Backend, Chunk, Engine, Kernel};
 use pounding::io::parquet::{kind, Kind};
-use pounding::plan::settings::{picked_columns, sweep_warnings, SchemeKind, SchemeSettings};
+use pounding::plan::settings::{
+    check_threads, picked_columns, sweep_warnings, SchemeKind, SchemeSettings,
+};
 use pounding::plan::{config, Plan};
+use pounding::studies::report::StudyReport;
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
@@ -197,15 +200,9 @@ fn scheme_of(s: Option<&str>) -> PyResult<Option<SchemeKind>> {
 
 /// The worker threads (`threads`, default all cores), checked as `--threads` is.
 fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
-    use pounding::plan::limits::{MAX_THREADS, WHY_THREADS};
     let mut b = rayon::ThreadPoolBuilder::new();
     if let Some(t) = threads {
-        if t == 0 || t > MAX_THREADS {
-            return Err(settings_err(format!(
-                "threads={t}: expected 1 to {MAX_THREADS} ({WHY_THREADS})"
-            )));
-        }
-        b = b.num_threads(t);
+        b = b.num_threads(check_threads(t).map_err(settings_err)?);
     }
     b.build()
         .map_err(|e| PoundingError::new_err(format!("starting worker threads: {e}")))
@@ -358,11 +355,7 @@ fn sweep<'py>(
     engine
         .check(&plan)
         .map_err(|e| GpuError::new_err(e.to_string()))?;
-    let header = plan.header();
-    let names: Vec<String> = match &picked {
-        Some(ix) => ix.iter().map(|&i| header[i].clone()).collect(),
-        None => header,
-    };
+    let names = picked.names;
     let fingerprint = pounding::io::provenance::Fingerprint::of_plan(&plan);
     let mut meta = vec![
         ("pound.fingerprint.plan".to_string(), fingerprint.plan),
@@ -372,7 +365,7 @@ fn sweep<'py>(
         ("pound.kernel".into(), Kernel::of(&plan).key().into()),
     ];
     let runs = plan.len();
-    let (plan, engine, picked) = (&plan, &engine, picked.as_deref());
+    let (plan, engine, picked) = (&plan, &engine, picked.indices.as_deref());
     let agg = summary.as_mut();
     let (outcome, describe) = run_watched(
         py,
@@ -398,22 +391,15 @@ fn sweep<'py>(
                         }
                         above += c.above_height();
                         past += c.past_collapse_drift();
-                        match (agg.as_deref_mut(), c) {
-                            (Some(agg), Chunk::Pairs(p, rows)) => agg.add_rows(p, rows),
-                            (Some(agg), Chunk::Rows(r, rows)) => agg.add_row_runs(r, rows),
-                            (None, c) => {
-                                let cells = match c {
-                                    Chunk::Pairs(p, rows) => {
-                                        pounding::io::csv::cells(p, rows, picked)
-                                    }
-                                    Chunk::Rows(r, rows) => {
-                                        pounding::io::csv::cells(r, rows, picked)
-                                    }
-                                };
-                                cols.append(&cells).map_err(Stopped::Table)?;
-                            }
+                        if let Some(agg) = agg.as_deref_mut() {
+                            c.fold_into(agg);
+                            return Ok(());
                         }
-                        Ok(())
+                        let cells = match c {
+                            Chunk::Pairs(p, rows) => pounding::io::csv::cells(p, rows, picked),
+                            Chunk::Rows(r, rows) => pounding::io::csv::cells(r, rows, picked),
+                        };
+                        cols.append(&cells).map_err(Stopped::Table)
                     },
                     tell,
                 ),
@@ -702,6 +688,25 @@ fn study_input(table: &Bound<'_, PyAny>, kind: &str) -> PyResult<pounding::io::t
 /// A study's report: its table, what the command prints on standard output, and its notices.
 type Studied = (Table, String, Vec<String>);
 
+/// A study of a table of results, as its command runs it: its settings `check`ed before the
+/// table is read, then the `study` (the GIL released), its refusals `refused` as exceptions.
+fn run_study<E: Send>(
+    py: Python<'_>,
+    table: &Bound<'_, PyAny>,
+    table_kind: &str,
+    check: impl FnOnce() -> Result<(), E>,
+    study: impl FnOnce(&pounding::io::table::Table) -> Result<StudyReport, E> + Send,
+    refused: impl Fn(E) -> PyErr,
+) -> PyResult<Studied> {
+    check().map_err(&refused)?;
+    let rows = study_input(table, table_kind)?;
+    let r = py.detach(|| study(&rows)).map_err(&refused)?;
+    let t = py
+        .detach(|| study_table(&r.csv, &[]))
+        .map_err(PoundingError::new_err)?;
+    Ok((t, r.said, r.notices))
+}
+
 /// `pounding.fragility`: `pound fragility` on a table of results.
 #[pyfunction]
 #[pyo3(signature = (table, table_kind, im, edp, thresholds, damage_states, bootstrap, seed, by, filters))]
@@ -730,18 +735,18 @@ fn fragility(
         by,
         filters,
     };
-    // Settings are refused before the table is read, as the command refuses them.
     let refused = |e: FragilityError| match e {
         FragilityError::Table(e) => TableError::new_err(e.to_string()),
         e => SettingsError::new_err(e.to_string()),
     };
-    options.check().map_err(refused)?;
-    let rows = study_input(table, table_kind)?;
-    let r = py.detach(|| study(&rows, &options)).map_err(refused)?;
-    let t = py
-        .detach(|| study_table(&r.csv, &[]))
-        .map_err(PoundingError::new_err)?;
-    Ok((t, r.said, r.notices))
+    run_study(
+        py,
+        table,
+        table_kind,
+        || options.check(),
+        |rows| study(rows, &options),
+        refused,
+    )
 }
 
 /// `pounding.ida`: `pound ida` on a table of results.
@@ -767,13 +772,14 @@ fn ida(
         IdaError::Refused(m) => SettingsError::new_err(m),
         e => TableError::new_err(e.to_string()),
     };
-    options.check().map_err(refused)?;
-    let rows = study_input(table, table_kind)?;
-    let r = py.detach(|| study(&rows, &options)).map_err(refused)?;
-    let t = py
-        .detach(|| study_table(&r.csv, &[]))
-        .map_err(PoundingError::new_err)?;
-    Ok((t, r.said, r.notices))
+    run_study(
+        py,
+        table,
+        table_kind,
+        || options.check(),
+        |rows| study(rows, &options),
+        refused,
+    )
 }
 
 #[pymodule]

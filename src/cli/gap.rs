@@ -50,7 +50,10 @@ pub fn run(a: Args) -> Result<()> {
         ],
     )?;
     let gaps = a.gaps.as_deref().map(parse_gaps).transpose()?;
-    let threads = a.threads.map(super::sweep::check_threads).transpose()?;
+    let threads = a
+        .threads
+        .map(pounding::plan::settings::check_threads)
+        .transpose()?;
     let plan = config::load_text(&text, &a.config)?;
     if let Some(why) = GapStudy::refusal(&plan) {
         bail!("{}: {why}", a.config.display());

@@ -8,7 +8,9 @@ use pounding::engine::aggregate::Aggregator;
 use pounding::engine::{Backend, Chunk, Engine, Kernel};
 use pounding::io::provenance::{Fingerprint, Meta};
 use pounding::io::sweep_output::{Format, Opened, SweepOutput};
-use pounding::plan::settings::{picked_columns, sweep_warnings, SchemeKind, SchemeSettings};
+use pounding::plan::settings::{
+    check_threads, picked_columns, sweep_warnings, SchemeKind, SchemeSettings,
+};
 use pounding::plan::shard::Shard;
 use pounding::plan::{config, Plan};
 use std::io::IsTerminal;
@@ -87,18 +89,6 @@ enum FormatArg {
 
 fn parse_shard(s: &str) -> std::result::Result<Shard, String> {
     Shard::parse(s).ok_or_else(|| format!("`{s}`: expected I/N with 0 <= I < N, e.g. 3/16"))
-}
-
-/// `--threads`, checked.
-pub fn check_threads(t: usize) -> Result<usize> {
-    use pounding::plan::limits::{MAX_THREADS, WHY_THREADS};
-    if t == 0 || t > MAX_THREADS {
-        bail!(
-            "--threads {t}: expected 1 to {MAX_THREADS} ({WHY_THREADS}; this machine has {})",
-            std::thread::available_parallelism().map_or(1, |n| n.get())
-        );
-    }
-    Ok(t)
 }
 
 pub fn run(a: Args) -> Result<()> {
@@ -286,7 +276,6 @@ impl Flags {
 
     /// How runs are written ([`Columns`]).
     fn output_columns(&self, plan: &Plan) -> Result<Columns> {
-        let header = plan.header();
         let picked = picked_columns(plan, self.columns.as_deref())?;
         let summary = self
             .aggregate
@@ -294,10 +283,7 @@ impl Flags {
             .map(|by| Aggregator::for_plan(plan, by, &self.exceed))
             .transpose()?;
         let format = output_format(summary, self.format);
-        let names: Vec<String> = match &picked {
-            Some(ix) => ix.iter().map(|&i| header[i].clone()).collect(),
-            None => header,
-        };
+        let names = picked.names;
         let fixed = names
             .iter()
             .map(String::as_str)
@@ -305,7 +291,7 @@ impl Flags {
         let named = !matches!(format, Format::Summary(_)) && !fixed;
         Ok(Columns {
             format,
-            picked,
+            picked: picked.indices,
             names: named.then_some(names),
         })
     }

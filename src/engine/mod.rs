@@ -270,6 +270,14 @@ pub enum Chunk<'a> {
 }
 
 impl Chunk<'_> {
+    /// Fold these runs into their groups of `agg` (built for this chunk's plan) on the host.
+    pub fn fold_into(&self, agg: &mut Aggregator) {
+        match self {
+            Chunk::Pairs(p, rows) => agg.add_rows(p, rows),
+            Chunk::Rows(r, rows) => agg.add_row_runs(r, rows),
+        }
+    }
+
     /// Runs in which a building's peak displacement exceeds its height: physically absurd (a
     /// units mix-up?). A pair's height is estimated from its period, a row's is the sum of its
     /// storey heights.
@@ -472,9 +480,7 @@ impl<'c> Engine<'c> {
                 plan,
                 runs,
                 |c: Chunk<'_>| -> Result<(), GpuError> {
-                    if let Chunk::Rows(r, rows) = c {
-                        agg.add_row_runs(r, rows);
-                    }
+                    c.fold_into(agg);
                     Ok(())
                 },
                 progress,

@@ -127,30 +127,53 @@ impl SchemeSettings {
     }
 }
 
-/// The columns `asked` (`--columns`) as indices into `plan`'s header, `run` first; None for
-/// every column.
-pub fn picked_columns(
-    plan: &Plan,
-    asked: Option<&[String]>,
-) -> Result<Option<Vec<usize>>, SettingsError> {
+/// The columns a sweep writes: `indices` into its plan's header (None: every column, in
+/// order) and their `names`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Picked {
+    pub indices: Option<Vec<usize>>,
+    pub names: Vec<String>,
+}
+
+/// The columns `asked` (`--columns`) of `plan`, `run` first; every column without.
+pub fn picked_columns(plan: &Plan, asked: Option<&[String]>) -> Result<Picked, SettingsError> {
+    let header = plan.header();
     let Some(asked) = asked else {
-        return Ok(None);
+        return Ok(Picked {
+            indices: None,
+            names: header,
+        });
     };
     if let Some(twice) = crate::plan::config::name_given_twice(asked) {
         return Err(SettingsError(format!(
             "--columns: `{twice}` is given twice: give each column once"
         )));
     }
-    let header = plan.header();
-    crate::plan::columns::select_in(&header, asked)
-        .map(Some)
-        .map_err(|bad| {
-            SettingsError(format!(
-                "--columns: `{bad}` is not a column of this sweep ({}); its columns are: {}",
-                plan.scene(),
-                header.join(", ")
-            ))
-        })
+    let indices = crate::plan::columns::select_in(&header, asked).map_err(|bad| {
+        SettingsError(format!(
+            "--columns: `{bad}` is not a column of this sweep ({}); its columns are: {}",
+            plan.scene(),
+            header.join(", ")
+        ))
+    })?;
+    Ok(Picked {
+        names: indices.iter().map(|&i| header[i].clone()).collect(),
+        indices: Some(indices),
+    })
+}
+
+/// Worker threads asked for (`--threads`), checked: 1 to [`MAX_THREADS`].
+///
+/// [`MAX_THREADS`]: crate::plan::limits::MAX_THREADS
+pub fn check_threads(t: usize) -> Result<usize, SettingsError> {
+    use crate::plan::limits::{MAX_THREADS, WHY_THREADS};
+    if t == 0 || t > MAX_THREADS {
+        return Err(SettingsError(format!(
+            "--threads {t}: expected 1 to {MAX_THREADS} ({WHY_THREADS}; this machine has {})",
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        )));
+    }
+    Ok(t)
 }
 
 /// The warnings a finished sweep ends with: `above_height` runs had a building whose peak
