@@ -91,6 +91,8 @@ const END_NONE: u32 = 0u;
 const END_FREE: u32 = 1u;
 const END_STEP: u32 = 2u;
 const END_EVENT: u32 = 3u;
+// An event fires at the step's end: substep_unit starts the search over it.
+const END_SEARCH: u32 = 4u;
 
 var<private> LOC: Locator;
 var<private> LAW: u32;
@@ -178,19 +180,52 @@ fn fli(e: u32, q: u32, k: u32) -> u32 {
 // structural_rel_accel(l, z), the structural relative acceleration of level l's floors (no
 // ground, no contact), is written out per shape by the host (RowShape::wgsl_unrolled).
 
-fn force(l: u32, mode: u32, v0: real, z: ptr<function, ZA>) -> real {
+// Each level's gap and rate at the start (D0, R0) and the end (D1, R1) of a substep unit's RK4
+// step, computed once (`level_ends`) and read by its event values, the probe of a hidden touch,
+// the transitions and the tracking: a dozen places, and a lavapipe group runs every one any of
+// its lanes reaches. The same values, so the same bits. A record interval's start sets them
+// for its exact free step (D0 and R0 alone where a level is in contact).
+var<private> D0: array<real, NLA>;
+var<private> R0: array<real, NLA>;
+var<private> D1: array<real, NLA>;
+var<private> R1: array<real, NLA>;
+
+fn level_ends(z0: ptr<function, ZA>, z1: ptr<function, ZA>) {
+    level_starts(z0);
+    for (var l = 0u; l < NL; l++) {
+        D1[l] = delta(l, z1);
+        R1[l] = ddelta(l, z1);
+    }
+    if (NS > 0u) {
+        storey_ends(z0, z1);
+    }
+}
+
+fn level_starts(z0: ptr<function, ZA>) {
+    for (var l = 0u; l < NL; l++) {
+        D0[l] = delta(l, z0);
+        R0[l] = ddelta(l, z0);
+    }
+}
+
+// Level l's contact force in `mode` at gap d and rate r.
+fn force_of(l: u32, mode: u32, v0: real, d: real, r: real) -> real {
     if (mode == MODE_FREE) {
         return 0.0;
     }
-    let d = delta(l, z);
-    let r = ddelta(l, z);
     use_level(l);
     return contact_force(d, r, v0, mode == MODE_APPROACH);
 }
 
-fn event_value(l: u32, mode: u32, v0: real, z: ptr<function, ZA>) -> real {
-    let d = delta(l, z);
-    let r = ddelta(l, z);
+fn force(l: u32, mode: u32, v0: real, z: ptr<function, ZA>) -> real {
+    if (mode == MODE_FREE) {
+        return 0.0;
+    }
+    return force_of(l, mode, v0, delta(l, z), ddelta(l, z));
+}
+
+// Level l's event value in `mode` at gap d and rate r.
+fn event_value(l: u32, mode: u32, v0: real, d: real, r: real) -> real {
     use_level(l);
     let g = gauge(d, r, v0);
     switch mode {
@@ -205,9 +240,9 @@ fn event_value(l: u32, mode: u32, v0: real, z: ptr<function, ZA>) -> real {
     }
 }
 
-// LevelModel::reapproaches: a restitution that closes again.
-fn reapproaches(l: u32, mode: u32, z: ptr<function, ZA>) -> bool {
-    return mode == MODE_RESTITUTION && ddelta(l, z) > 0.0;
+// LevelModel::reapproaches: a restitution that closes again (r: the gap's rate).
+fn reapproaches(mode: u32, r: real) -> bool {
+    return mode == MODE_RESTITUTION && r > 0.0;
 }
 
 // Each mode's fourth-derivative bound over the free step being tried (QB), which every
@@ -229,11 +264,12 @@ fn fill_mode_bounds(seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>) {
     }
 }
 
-fn may_touch(l: u32, seg: Seg, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real, v0: real) -> bool {
-    let d0 = delta(l, z0);
-    let d1 = delta(l, z1);
-    let r0 = ddelta(l, z0);
-    let r1 = ddelta(l, z1);
+// Level l over the exact free step of length h whose ends' gaps and rates are in D0, R0, D1, R1.
+fn may_touch(l: u32, h: real, v0: real) -> bool {
+    let d0 = D0[l];
+    let d1 = D1[l];
+    let r0 = R0[l];
+    let r1 = R1[l];
     let bound = level_bound(l);
     let margin = -error_margin(bound, h);
     if (cubic_max_bound(d0, r0, d1, r1, h) <= margin) {
@@ -271,40 +307,62 @@ fn rk4(seg: Seg, tau: real, z: ptr<function, ZA>, h: real, out: ptr<function, ZA
     }
 }
 
-// RowRun::event_max: the largest of the levels' and storeys' event values.
-fn event_max(z: ptr<function, ZA>) -> real {
-    var m = -BIG;
-    for (var l = 0u; l < NL; l++) {
-        m = max(m, event_value(l, LMODE[l], LV0[l], z));
-    }
-    if (NS > 0u) {
-        m = storey_event_max(z, m);
-    }
-    return m;
-}
+// Each level's event value at the end of the unit's RK4 step (EV) and at its start (EV0), as
+// each yielding storey's (SEV, SEV0): computed once per unit and read by event_max,
+// firing_max, mark_firing and transitions, eight places a lavapipe group would otherwise
+// evaluate them at. The same values, so the same bits.
+var<private> EV: array<real, NLA>;
+var<private> EV0: array<real, NLA>;
 
-// RowRun::firing_max: the largest event value of the events that fire in the step's trial
-// (LFIRE, SFIRE), the function an event is located on.
-fn firing_max(z: ptr<function, ZA>) -> real {
-    var m = -BIG;
+// The events' values in z: the step's start (EV0, from D0 and R0) where `start`, else its end
+// (EV, from D1 and R1).
+fn event_values(z: ptr<function, ZA>, start: bool) {
     for (var l = 0u; l < NL; l++) {
-        if (LFIRE[l]) {
-            m = max(m, event_value(l, LMODE[l], LV0[l], z));
+        if (start) {
+            EV0[l] = event_value(l, LMODE[l], LV0[l], D0[l], R0[l]);
+        } else {
+            EV[l] = event_value(l, LMODE[l], LV0[l], D1[l], R1[l]);
         }
     }
     if (NS > 0u) {
-        m = storey_firing_max(z, m);
+        storey_event_values(z, start);
+    }
+}
+
+// RowRun::event_max at the step's end: the largest of the levels' and storeys' event values.
+fn event_max() -> real {
+    var m = -BIG;
+    for (var l = 0u; l < NL; l++) {
+        m = max(m, EV[l]);
+    }
+    if (NS > 0u) {
+        m = storey_event_max(m);
     }
     return m;
 }
 
-// RowRun::mark_firing: the events whose value is positive in z.
-fn mark_firing(z: ptr<function, ZA>) {
+// RowRun::firing_max at the step's start (`start`) or end: the largest event value of the
+// events that fire in the step's trial (LFIRE, SFIRE), the function an event is located on.
+fn firing_max(start: bool) -> real {
+    var m = -BIG;
     for (var l = 0u; l < NL; l++) {
-        LFIRE[l] = event_value(l, LMODE[l], LV0[l], z) > 0.0;
+        if (LFIRE[l]) {
+            m = max(m, select(EV[l], EV0[l], start));
+        }
     }
     if (NS > 0u) {
-        storey_mark_firing(z);
+        m = storey_firing_max(m, start);
+    }
+    return m;
+}
+
+// RowRun::mark_firing: the events whose value is positive at the step's end.
+fn mark_firing() {
+    for (var l = 0u; l < NL; l++) {
+        LFIRE[l] = EV[l] > 0.0;
+    }
+    if (NS > 0u) {
+        storey_mark_firing();
     }
 }
 
@@ -441,13 +499,15 @@ fn spread_on_column(b: u32, f: u32, w: real, force: real) {
     FF[B_OFF[b] + f] += w * force;
 }
 
-fn set_floor_forces(z: ptr<function, ZA>) {
+// The contact forces on the floors (FF) at the start (`start`) or end of the unit's step, from
+// its levels' gaps and rates (D0, R0, D1, R1).
+fn set_floor_forces(start: bool) {
     for (var k = 0u; k < NM; k++) { FF[k] = 0.0; }
     for (var l = 0u; l < NL; l++) {
         if (LMODE[l] == MODE_FREE) {
             continue;
         }
-        let f = force(l, LMODE[l], LV0[l], z);
+        let f = force_of(l, LMODE[l], LV0[l], select(D1[l], D0[l], start), select(R1[l], R0[l], start));
         let a = L_A[l];
         if (HAS_COLUMNS && L_CS[l] < 2u) {
             spread_on_column(a, L_FA[l], L_WA[l], -f);
@@ -483,7 +543,8 @@ fn since_onset(l: u32, tau: real) -> real {
     return real(CI - rcount[lci(l, LC_I_ONSET)]) * DT + (tau - rstate[lsi(l, LS_TAU_ONSET)]);
 }
 
-// RowRun::track: a piece tau0 -> tau0 + h from z0 to z1 in the current modes.
+// RowRun::track: a piece tau0 -> tau0 + h from z0 to z1 in the current modes (a contact
+// level's gaps and rates at its ends in D0, R0, D1, R1).
 fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1: real) {
     track_buildings(z0, z1, ag0, ag1, h);
     ENDS_VALID = true;
@@ -493,10 +554,10 @@ fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0:
             continue;
         }
         rstate[lsi(l, LS_CONTACT_TIME)] += h;
-        let y0 = delta(l, z0);
-        let d0 = ddelta(l, z0);
-        let y1 = delta(l, z1);
-        let d1 = ddelta(l, z1);
+        let y0 = D0[l];
+        let d0 = R0[l];
+        let y1 = D1[l];
+        let d1 = R1[l];
         let pen = rstate[lsi(l, LS_PENETRATION)];
         if (cubic_max_bound(y0, d0, y1, d1, h) > pen) {
             rstate[lsi(l, LS_PENETRATION)] = max(pen, hermite_range(y0, d0, y1, d1, h).hi);
@@ -509,14 +570,14 @@ fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0:
         let accel1 = side_fl(1u, 2u, a, L_FA[l], L_WA[l]) - side_fl(1u, 2u, a + 1u, L_FB[l], L_WB[l]);
         let approaching = mode == MODE_APPROACH;
         let v0 = LV0[l];
-        let f = force(l, mode, v0, z1);
+        let f = force_of(l, mode, v0, y1, d1);
         let r1 = contact_force_rate(y1, d1, accel1, v0, approaching);
         // The start's force and rate where the force's peak or a struck column needs them.
         let column = HAS_COLUMNS && L_CS[l] < 2u;
         var f0: real = 0.0;
         var r0: real = 0.0;
         if (r1 < 0.0 || column) {
-            f0 = force(l, mode, v0, z0);
+            f0 = force_of(l, mode, v0, y0, d0);
             r0 = contact_force_rate(y0, d0, accel0, v0, approaching);
         }
         rstate[lsi(l, LS_IMP_PEAK)] = raise_force_peak(rstate[lsi(l, LS_IMP_PEAK)], f0, r0, f, r1, h);
@@ -621,13 +682,14 @@ fn end_impact(l: u32) {
     }
 }
 
-// RowRun::transitions at state z (local time tau); `before`: the state at the step's start.
-fn transitions(tau: real, z: ptr<function, ZA>, before: ptr<function, ZA>) {
+// RowRun::transitions at state z, the end of the unit's step (local time tau; its event values
+// in EV, the levels' gaps and rates at both ends in D0, R0, D1, R1).
+fn transitions(tau: real) {
     for (var l = 0u; l < NL; l++) {
         let mode = LMODE[l];
         let v0 = LV0[l];
-        if (event_value(l, mode, v0, z) <= 0.0) {
-            if (reapproaches(l, mode, z)) {
+        if (EV[l] <= 0.0) {
+            if (reapproaches(mode, R1[l])) {
                 LMODE[l] = MODE_APPROACH;
                 ENDS_VALID = false;
             }
@@ -636,20 +698,20 @@ fn transitions(tau: real, z: ptr<function, ZA>, before: ptr<function, ZA>) {
         ENDS_VALID = false;
         if (mode == MODE_FREE) {
             // events::touch
-            let r = ddelta(l, z);
+            let r = R1[l];
             var nv0 = v0;
-            if (delta(l, before) <= 0.0 || v0 <= 0.0) {
+            if (D0[l] <= 0.0 || v0 <= 0.0) {
                 nv0 = abs(r);
             }
             nv0 = max(nv0, 1e-12);
             var next = MODE_RESTITUTION;
             if (r > 0.0) { next = MODE_APPROACH; }
-            let f = force(l, next, nv0, z);
+            let f = force_of(l, next, nv0, D1[l], r);
             onset(l, tau, nv0, f);
             LMODE[l] = next;
         } else if (mode == MODE_APPROACH) {
             LMODE[l] = MODE_RESTITUTION;
-        } else if (reapproaches(l, mode, z)) {
+        } else if (reapproaches(mode, R1[l])) {
             // Closing again: the same impact goes on.
             LMODE[l] = MODE_APPROACH;
         } else {
@@ -718,22 +780,23 @@ fn locator_take(x: real, fx: real) {
 // step to its far end); substep_unit takes the step `step_length` gives and `step_taken` says
 // what it means.
 
-// The event search over the step of length h whose end `trial` (event value f1 > 0) has
-// events firing, from z0 (RowRun::accept's `locate`).
-fn start_search(h: real, f1: real, trial: ptr<function, ZA>, z0: ptr<function, ZA>) {
-    mark_firing(trial);
-    let f0 = firing_max(z0);
+// The event search over the step of length h from z0 whose end has events firing (event value
+// f1 > 0; RowRun::accept's `locate`). substep_unit calls it at one place for the trial and the
+// probe of a hidden touch, so that lavapipe evaluates the events at z0 once.
+fn start_search(h: real, f1: real, z0: ptr<function, ZA>) {
+    mark_firing();
+    event_values(z0, true);
+    let f0 = firing_max(true);
     let tol = max(LOCATE_TOL * h, 4.0 * EPS * DT);
     LOC = Locator(0.0, min(f0, 0.0), h, f1, tol, 0.0, LOC_ESTIMATE, 0u, 0);
 }
 
-// The trial of length h from z0 ended at `trial`: an event inside starts the search; a touch
-// hidden inside a free level (or a storey's yield) is probed next; else the step is accepted.
+// The trial of length h from z0 ended at `trial` (its event values in EV): an event inside
+// starts the search; a touch hidden inside a free level (or a storey's yield) is probed next;
+// else the step is accepted.
 fn trial_taken(h: real, trial: ptr<function, ZA>, z0: ptr<function, ZA>) -> u32 {
-    let f1 = event_max(trial);
-    if (f1 > 0.0) {
-        start_search(h, f1, trial, z0);
-        return END_NONE;
+    if (event_max() > 0.0) {
+        return END_SEARCH;
     }
     // The earliest touch hidden inside the step at a free level.
     var best: real = -1.0;
@@ -741,7 +804,7 @@ fn trial_taken(h: real, trial: ptr<function, ZA>, z0: ptr<function, ZA>) -> u32 
         if (LMODE[l] != MODE_FREE) {
             continue;
         }
-        let s = hidden_rise(delta(l, z0), ddelta(l, z0), delta(l, trial), ddelta(l, trial), h);
+        let s = hidden_rise(D0[l], R0[l], D1[l], R1[l], h);
         if (s >= 0.0 && (best < 0.0 || s < best)) {
             best = s;
         }
@@ -776,16 +839,15 @@ fn step_length(last: ptr<function, bool>) -> real {
     }
 }
 
-// What the step of length x from z0 to zx (not the trial) means for the piece's phase.
+// What the step of length x from z0 to zx (not the trial; its event values in EV) means for
+// the piece's phase.
 fn step_taken(x: real, last: bool, zx: ptr<function, ZA>, z0: ptr<function, ZA>) -> u32 {
     switch LOC.phase {
         case LOC_HIDDEN: {
-            let fs = event_max(zx);
-            if (fs > 0.0) {
-                start_search(x, fs, zx, z0);
-            } else {
-                LOC.phase = LOC_RETAKE;
+            if (event_max() > 0.0) {
+                return END_SEARCH;
             }
+            LOC.phase = LOC_RETAKE;
             return END_NONE;
         }
         case LOC_RETAKE: { return END_STEP; }
@@ -793,7 +855,7 @@ fn step_taken(x: real, last: bool, zx: ptr<function, ZA>, z0: ptr<function, ZA>)
             if (last) {
                 return END_EVENT;
             }
-            locator_take(x, firing_max(zx));
+            locator_take(x, firing_max(false));
             return END_NONE;
         }
     }
@@ -855,6 +917,7 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>, z1: ptr<function, ZA>) -> bool
                     + models[c + 7u] * a1;
             }
         }
+        level_ends(z, z1);
         // A storey that yields, or may in the free step, takes the step in substeps.
         if (NS > 0u || COUPLED) {
             mode_bounds(seg, z, z1);
@@ -866,12 +929,12 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>, z1: ptr<function, ZA>) -> bool
         fill_mode_bounds(seg, z, z1);
         var touching = false;
         for (var l = 0u; l < NL; l++) {
-            if (!may_touch(l, seg, z, z1, dt, LV0[l])) {
+            if (!may_touch(l, dt, LV0[l])) {
                 continue;
             }
             touching = true;
-            let v_est = 1.5 * max(abs(ddelta(l, z)), abs(ddelta(l, z1)));
-            let d_est = max(delta(l, z), delta(l, z1));
+            let v_est = 1.5 * max(abs(R0[l]), abs(R1[l]));
+            let d_est = max(D0[l], D1[l]);
             let a_est = max(abs(structural_rel_accel(l, z)), abs(structural_rel_accel(l, z1)));
             use_level(l);
             h = min(h, min(impact_step(v_est, a_est, PER_CONTACT), h_rate_of(d_est, LV0[l])));
@@ -881,9 +944,10 @@ fn begin_interval(seg: Seg, z: ptr<function, ZA>, z1: ptr<function, ZA>) -> bool
             return true;
         }
     } else {
+        level_starts(z);
         for (var l = 0u; l < NL; l++) {
-            let d = delta(l, z);
-            let r = ddelta(l, z);
+            let d = D0[l];
+            let r = R0[l];
             let a = abs(structural_rel_accel(l, z));
             use_level(l);
             if (LMODE[l] == MODE_FREE) {
@@ -965,10 +1029,19 @@ fn substep_unit(seg: Seg, z: ptr<function, ZA>, zx: ptr<function, ZA>, x: ptr<fu
     }
     *x = h;
     rk4(seg, TAU, z, h, zx);
+    level_ends(z, zx);
+    event_values(zx, false);
+    var end: u32;
     if (searching) {
-        return step_taken(h, last, zx, z);
+        end = step_taken(h, last, zx, z);
+    } else {
+        end = trial_taken(h, zx, z);
     }
-    return trial_taken(h, zx, z);
+    if (end == END_SEARCH) {
+        start_search(h, event_max(), z);
+        return END_NONE;
+    }
+    return end;
 }
 
 // The local time substep j of M ends at (the record step's end for the last).
@@ -1028,14 +1101,14 @@ fn run_unit(seg: Seg, z: ptr<function, ZA>) {
         return;
     }
     if (end == END_EVENT) {
-        transitions(TAU + x, &zx, z);
+        transitions(TAU + x);
         if (NS > 0u) {
             storey_transitions(&zx);
         }
     } else {
         // A level whose phase is not an event (the law's force does not depend on it).
         for (var l = 0u; l < NL; l++) {
-            if (reapproaches(l, LMODE[l], &zx)) {
+            if (reapproaches(LMODE[l], R1[l])) {
                 LMODE[l] = MODE_APPROACH;
                 ENDS_VALID = false;
             }

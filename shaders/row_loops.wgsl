@@ -216,10 +216,10 @@ fn track_buildings(z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1:
     if (ENDS_VALID) {
         copy_floor_ends();
     } else {
-        set_floor_forces(z0);
+        set_floor_forces(true);
         for (var b = 0u; b < NB; b++) { fill(b, 0u, z0, ag0); }
     }
-    set_floor_forces(z1);
+    set_floor_forces(false);
     var touched: array<bool, NB>;
     for (var l = 0u; l < NL; l++) {
         if (LMODE[l] != MODE_FREE) {

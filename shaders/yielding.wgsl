@@ -64,32 +64,62 @@ fn storey_event(s: u32, mode: u32, d: real, r: real, p: real) -> real {
     return -mode_sign(mode) * r;
 }
 
+// Each storey's event value at the unit's step end (SEV) and start (SEV0), beside the levels'
+// (row.wgsl's EV, EV0); its drift and drift rate at the step's start (SD0, SR0) and end (SD1,
+// SR1), beside the levels' gaps and rates (`level_ends`, which calls storey_ends).
+var<private> SEV: array<real, NSA>;
+var<private> SEV0: array<real, NSA>;
+var<private> SD0: array<real, NSA>;
+var<private> SR0: array<real, NSA>;
+var<private> SD1: array<real, NSA>;
+var<private> SR1: array<real, NSA>;
+
+fn storey_ends(z0: ptr<function, ZA>, z1: ptr<function, ZA>) {
+    for (var s = 0u; s < NS; s++) {
+        SD0[s] = storey_drift(s, z0, 0u);
+        SR0[s] = storey_drift(s, z0, NM);
+        SD1[s] = storey_drift(s, z1, 0u);
+        SR1[s] = storey_drift(s, z1, NM);
+    }
+}
+
+// The storeys' part of event_values: in z, the step's start where `start`, else its end.
+fn storey_event_values(z: ptr<function, ZA>, start: bool) {
+    for (var s = 0u; s < NS; s++) {
+        let e = storey_event(s, SM[s], select(SD1[s], SD0[s], start), select(SR1[s], SR0[s], start),
+            (*z)[PS0 + s]);
+        if (start) {
+            SEV0[s] = e;
+        } else {
+            SEV[s] = e;
+        }
+    }
+}
+
 // The storeys' part of RowRun::event_max, from `m` (the levels').
-fn storey_event_max(z: ptr<function, ZA>, m_in: real) -> real {
+fn storey_event_max(m_in: real) -> real {
     var m = m_in;
     for (var s = 0u; s < NS; s++) {
-        let e = storey_event(s, SM[s], storey_drift(s, z, 0u), storey_drift(s, z, NM), (*z)[PS0 + s]);
-        m = max(m, e);
+        m = max(m, SEV[s]);
     }
     return m;
 }
 
 // The storeys' part of RowRun::firing_max, from `m` (the levels').
-fn storey_firing_max(z: ptr<function, ZA>, m_in: real) -> real {
+fn storey_firing_max(m_in: real, start: bool) -> real {
     var m = m_in;
     for (var s = 0u; s < NS; s++) {
         if (SFIRE[s]) {
-            let e = storey_event(s, SM[s], storey_drift(s, z, 0u), storey_drift(s, z, NM), (*z)[PS0 + s]);
-            m = max(m, e);
+            m = max(m, select(SEV[s], SEV0[s], start));
         }
     }
     return m;
 }
 
 // The storeys' part of RowRun::mark_firing.
-fn storey_mark_firing(z: ptr<function, ZA>) {
+fn storey_mark_firing() {
     for (var s = 0u; s < NS; s++) {
-        SFIRE[s] = storey_event(s, SM[s], storey_drift(s, z, 0u), storey_drift(s, z, NM), (*z)[PS0 + s]) > 0.0;
+        SFIRE[s] = SEV[s] > 0.0;
     }
 }
 
@@ -163,7 +193,8 @@ fn may_yield(s: u32, d0: real, r0: real, d1: real, r1: real, p: real, bound: rea
 }
 
 // RowModel::yield_watch over the exact free step z0 -> z1 of length h (QS and, by
-// mode_bounds, MBND set): does a storey yield now, or may it reach a bounding line?
+// mode_bounds, MBND set; the storeys' drifts at its ends in SD0, SR0, SD1, SR1): does a storey
+// yield now, or may it reach a bounding line?
 fn yield_watch(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) -> bool {
     var watch = false;
     for (var s = 0u; s < NS; s++) {
@@ -176,8 +207,7 @@ fn yield_watch(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) -> bool {
         for (var i = 0u; i < B_N[S_B[s]]; i++) {
             bound += abs(st_row(s, i)) * MBND[o + i];
         }
-        if (may_yield(s, storey_drift(s, z0, 0u), storey_drift(s, z0, NM), storey_drift(s, z1, 0u),
-                      storey_drift(s, z1, NM), (*z0)[PS0 + s], bound, h)) {
+        if (may_yield(s, SD0[s], SR0[s], SD1[s], SR1[s], (*z0)[PS0 + s], bound, h)) {
             watch = true;
             break;
         }
@@ -185,9 +215,9 @@ fn yield_watch(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) -> bool {
     return watch;
 }
 
-// RowRun::hidden_yield: the earliest fraction of the step z0 -> z1 (length h) at which an
-// elastic storey's back drift could rise past its band between the ends, from `best` (-1:
-// none yet).
+// RowRun::hidden_yield: the earliest fraction of the step z0 -> z1 (length h; the storeys'
+// drifts at its ends in SD0, SR0, SD1, SR1) at which an elastic storey's back drift could rise
+// past its band between the ends, from `best` (-1: none yet).
 fn hidden_yield(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real, best_in: real) -> real {
     var best = best_in;
     for (var s = 0u; s < NS; s++) {
@@ -195,10 +225,10 @@ fn hidden_yield(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real, best_in: 
             continue;
         }
         let dy = st_dy(s) * (1.0 + YIELD_SLACK);
-        let s0 = back_drift(s, storey_drift(s, z0, 0u), (*z0)[PS0 + s]);
-        let s1 = back_drift(s, storey_drift(s, z1, 0u), (*z1)[PS0 + s]);
-        let r0 = storey_drift(s, z0, NM);
-        let r1 = storey_drift(s, z1, NM);
+        let s0 = back_drift(s, SD0[s], (*z0)[PS0 + s]);
+        let s1 = back_drift(s, SD1[s], (*z1)[PS0 + s]);
+        let r0 = SR0[s];
+        let r1 = SR1[s];
         for (var e = 0u; e < 2u; e++) {
             let sg = select(real(-1.0), real(1.0), e == 0u);
             let x = hidden_rise(sg * s0 - dy, sg * r0, sg * s1 - dy, sg * r1, h);
@@ -210,15 +240,16 @@ fn hidden_yield(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real, best_in: 
     return best;
 }
 
-// RowRun::storey_transitions at state z: yield onset on a bounding line when moving outwards,
+// RowRun::storey_transitions at state z, the end of the unit's step (the storeys' drifts there
+// in SD1, SR1): yield onset on a bounding line when moving outwards,
 // unloading when the drift rate reverses; a storey that reached its line already turning back
 // takes the return map (its plastic drift moves by (1 - b) times the overshoot, with the work
 // of that flow) and stays elastic.
 fn storey_transitions(z: ptr<function, ZA>) {
     for (var s = 0u; s < NS; s++) {
         let slot = PS0 + s;
-        let d = storey_drift(s, z, 0u);
-        let r = storey_drift(s, z, NM);
+        let d = SD1[s];
+        let r = SR1[s];
         let p = (*z)[slot];
         let mode = SM[s];
         if (storey_event(s, mode, d, r, p) <= 0.0) {

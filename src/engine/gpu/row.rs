@@ -753,11 +753,11 @@ impl RowShape {
         }
         s.push_str("        default: {}\n    }\n}\n");
         // RowRun::track_buildings (row_loops.wgsl's), each building and storey written out.
-        s.push_str("fn track_buildings(z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1: real, h: real) {\n    if (ENDS_VALID) {\n        copy_floor_ends();\n    } else {\n        set_floor_forces(z0);\n");
+        s.push_str("fn track_buildings(z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0: real, ag1: real, h: real) {\n    if (ENDS_VALID) {\n        copy_floor_ends();\n    } else {\n        set_floor_forces(true);\n");
         for b in 0..self.storeys.len() {
             s.push_str(&format!("        fill({b}u, 0u, z0, ag0);\n"));
         }
-        s.push_str("    }\n    set_floor_forces(z1);\n");
+        s.push_str("    }\n    set_floor_forces(false);\n");
         for b in 0..self.storeys.len() {
             s.push_str(&format!("    var touched{b} = false;\n"));
         }
@@ -914,13 +914,15 @@ impl RowShape {
         // rhs: per level the force (gap and rate), its rate again, the force onto both sides.
         let rhs = nm + 4 * d + nl + 1 + storeys + ns * nmax + sqc + nb_all * coupled;
         let rk4 = 4 * rhs + 4 * zlen;
-        let event_max = 2 * d + nl + storeys;
-        let forces = nm + 2 * d + nl;
-        // track: the floors at both ends (fill), each building's storeys, and per level its
-        // gap and rate at both ends and the force at both ends.
-        let track = 5 * nm + 2 * forces + 2 * sq + nl + nm + 8 * d + 2 * nl;
+        // The levels' gaps and rates at a substep's two ends, once (`level_ends`); the event
+        // values, the forces, the tracking and the transitions read them.
+        let ends = 4 * d + nl + ns * (4 * nmax + 1);
+        let event_values = nl + storeys;
+        let forces = nm + nl;
+        // track: the floors at both ends (fill), each building's storeys, and per level.
+        let track = 5 * nm + 2 * forces + 2 * sq + nl + nm + 2 * nl;
         let track = track + 2 * (storeys + ns * nmax) + ns + 4 * sqc + 2 * nb_all * coupled;
-        let transitions = 8 * d + 2 * nl + storeys;
+        let transitions = 2 * nl + storeys;
         // A unit is one RK4 step of a piece (its trial, a probe of a hidden touch or of the
         // event search, the step to its far end) or a record interval's start, then the
         // tracking and transitions of the units that end a piece or a free step. A software
@@ -929,12 +931,17 @@ impl RowShape {
         // one RK4 call). In a small row the right-hand side, the gaps and the floors are
         // written out (`wgsl_unrolled`), loop-free; they are still counted as loops here,
         // which only over-counts.
-        let substep = nl + rk4 + 7 * event_max + 4 * d + nl + storeys + 2;
+        // The events' values at the step's end and (starting a search) its start, each once,
+        // then read from their arrays: the largest three times, the firing ones marked once
+        // and their largest twice; the probe of a hidden touch per level.
+        let substep = nl + rk4 + ends + 2 * event_values + 6 * (nl + ns) + nl + storeys + 2;
         let tail = track + transitions + storeys + d + nl + 3 * zlen;
         // begin: the modes' bounds (`fill_mode_bounds`), per level may_touch (gaps, rates,
         // both sides' bounds), the touching level's estimates (gaps, rates, structural
         // accelerations), a contact level's.
-        let begin = nl + 2 * nm + 11 * d + 3 * d * (1 + coupled) + 6 * nl + zlen;
+        // The gaps and rates at both ends are taken once (`level_ends`; at the start alone in
+        // contact).
+        let begin = nl + 2 * nm + 7 * d + 3 * d * (1 + coupled) + 6 * nl + zlen;
         let begin = begin + 3 * nm * yields + 2 * storeys + ns * nmax;
         // mode_bounds (with yielding storeys or coupled modes) and the coupled parts.
         let begin = begin + 3 * nm * yields.max(coupled);
