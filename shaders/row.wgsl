@@ -839,9 +839,9 @@ fn step_length(last: ptr<function, bool>) -> real {
     }
 }
 
-// What the step of length x from z0 to zx (not the trial; its event values in EV) means for
-// the piece's phase.
-fn step_taken(x: real, last: bool, zx: ptr<function, ZA>, z0: ptr<function, ZA>) -> u32 {
+// What the step of length x (not the trial; its end's event values in EV) means for the
+// piece's phase.
+fn step_taken(x: real, last: bool) -> u32 {
     switch LOC.phase {
         case LOC_HIDDEN: {
             if (event_max() > 0.0) {
@@ -1033,7 +1033,7 @@ fn substep_unit(seg: Seg, z: ptr<function, ZA>, zx: ptr<function, ZA>, x: ptr<fu
     event_values(zx, false);
     var end: u32;
     if (searching) {
-        end = step_taken(h, last, zx, z);
+        end = step_taken(h, last);
     } else {
         end = trial_taken(h, zx, z);
     }

@@ -241,10 +241,10 @@ fn hidden_yield(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real, best_in: 
 }
 
 // RowRun::storey_transitions at state z, the end of the unit's step (the storeys' drifts there
-// in SD1, SR1): yield onset on a bounding line when moving outwards,
-// unloading when the drift rate reverses; a storey that reached its line already turning back
-// takes the return map (its plastic drift moves by (1 - b) times the overshoot, with the work
-// of that flow) and stays elastic.
+// in SD1, SR1): yield onset on a bounding line when moving outwards, unloading when the drift
+// rate reverses; a storey that reached its line already turning back takes the return map (its
+// plastic drift moves by (1 - b) times the overshoot, with the work of that flow) and stays
+// elastic.
 fn storey_transitions(z: ptr<function, ZA>) {
     for (var s = 0u; s < NS; s++) {
         let slot = PS0 + s;

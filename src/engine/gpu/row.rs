@@ -931,16 +931,16 @@ impl RowShape {
         // one RK4 call). In a small row the right-hand side, the gaps and the floors are
         // written out (`wgsl_unrolled`), loop-free; they are still counted as loops here,
         // which only over-counts.
-        // The events' values at the step's end and (starting a search) its start, each once,
-        // then read from their arrays: the largest three times, the firing ones marked once
-        // and their largest twice; the probe of a hidden touch per level.
+        // Past RK4: the gaps and rates at the step's ends and the events' values at its end
+        // and (starting a search) its start, each once, then read from their arrays: the
+        // largest three times, the firing ones marked once and their largest twice; the probe
+        // of a hidden touch per level.
         let substep = nl + rk4 + ends + 2 * event_values + 6 * (nl + ns) + nl + storeys + 2;
         let tail = track + transitions + storeys + d + nl + 3 * zlen;
-        // begin: the modes' bounds (`fill_mode_bounds`), per level may_touch (gaps, rates,
-        // both sides' bounds), the touching level's estimates (gaps, rates, structural
-        // accelerations), a contact level's.
-        // The gaps and rates at both ends are taken once (`level_ends`; at the start alone in
-        // contact).
+        // begin: the modes' bounds (`fill_mode_bounds`), the gaps and rates at the free step's
+        // ends once (`level_ends`; the start's alone in contact), per level may_touch (both
+        // sides' bounds), the touching level's estimates (structural accelerations), a contact
+        // level's.
         let begin = nl + 2 * nm + 7 * d + 3 * d * (1 + coupled) + 6 * nl + zlen;
         let begin = begin + 3 * nm * yields + 2 * storeys + ns * nmax;
         // mode_bounds (with yielding storeys or coupled modes) and the coupled parts.
