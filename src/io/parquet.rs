@@ -42,6 +42,8 @@ pub fn kind(column: &str) -> Kind {
             "_accel_floor",
             "_residual_storey",
             "_ductility_storey",
+            "_collapsed",
+            "_collapse_storey",
         ]
         .iter()
         .any(|end| c.ends_with(end)) =>

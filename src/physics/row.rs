@@ -369,6 +369,9 @@ pub struct BuildingOutput {
     pub accel_floor: u32,
     /// Residual drift, ductility and hysteretic energy, where its storeys yield.
     pub inelastic: Option<InelasticOutput>,
+    /// Where and when this building collapsed (physics.md section 12): it left the scene
+    /// there, its peaks are over `[0, t_c]`; None where it stood to the end.
+    pub collapse: Option<Collapse>,
 }
 
 /// What a yielding building reports besides the elastic peaks.
@@ -453,7 +456,8 @@ pub struct RowOutput {
     /// Per contact level, its floors' closing and peaks, where the run was asked to track them
     /// (the separation of uncoupled buildings); empty otherwise.
     pub closings: Vec<LevelClosing>,
-    /// Where the run collapsed (status `collapsed`).
+    /// The run's first collapse (status `collapsed`): the earliest of the buildings'
+    /// ([`BuildingOutput::collapse`]).
     pub collapse: Option<Collapse>,
 }
 
@@ -501,6 +505,7 @@ impl RowOutput {
             peak_accel: a,
             accel_floor: (a > 0.0) as u32,
             inelastic: None,
+            collapse: None,
         };
         let mut row = RowOutput {
             status: out.status,

@@ -204,19 +204,19 @@ const FIXED: [(&str, &str, &str, &str); 44] = [
         "collapse_time_s",
         "s",
         "collapse time",
-        "when a storey's drift ratio reached the collapse limit ([run] collapse_drift_ratio; the run ends there; empty where the run did not collapse)",
+        "when a storey's drift ratio first reached the collapse limit in any building ([run] collapse_drift_ratio; the run's first collapse: that building left the scene, the others went on, each has its own bK_collapse_time_s; empty where no building collapsed)",
     ),
     (
         "collapse_building",
         "-",
         "collapsed building",
-        "the building of that storey (from 1; empty where the run did not collapse)",
+        "the building of that first collapse (from 1; empty where no building collapsed)",
     ),
     (
         "collapse_storey",
         "-",
         "collapsed storey",
-        "the storey that reached the collapse limit (from 1; empty where the run did not collapse)",
+        "the storey of that first collapse (from 1; empty where no building collapsed)",
     ),
     (
         "input_energy_j",
@@ -243,7 +243,7 @@ const ENERGY: [(&str, &str, &str, &str); 2] = [
 ];
 
 /// Per building `k`: suffix, unit, short name, meaning.
-const PER_BUILDING: [(&str, &str, &str, &str); 19] = [
+const PER_BUILDING: [(&str, &str, &str, &str); 22] = [
     ("sa_t1_g", "g", "Sa(T1), building {k}", "Sa(T1, 5 %) of the scaled record at building {k}'s fundamental period b{k}_t1_s, whatever it was scaled to: pseudo-spectral acceleration (w^2 times the peak displacement) of a linear oscillator from rest, exact for the acceleration linear between samples, over the record as simulated (its window if any, not the free tail)"),
     ("storeys", "-", "storeys, building {k}", "storeys of building {k}"),
     ("mass_kg", "kg", "floor mass, building {k}", "floor mass of building {k} (empty where floor masses are given)"),
@@ -263,6 +263,9 @@ const PER_BUILDING: [(&str, &str, &str, &str); 19] = [
     ("hysteretic_energy_j", "J", "hysteretic energy, building {k}", "hysteretic energy of building {k}'s storeys: their work less the elastic energy they hold at the end"),
     ("yielded_storeys", "-", "yielded storeys, building {k}", "storeys of building {k} that yielded"),
     ("stability_coefficient", "-", "stability coefficient, building {k}", "largest storey stability coefficient P/(k h) of building {k} (P-Delta): gravity load over storey stiffness times height"),
+    ("collapsed", "-", "collapsed, building {k}", "1 where a storey of building {k} reached the collapse limit ([run] collapse_drift_ratio), else 0; the building left the scene there and the others went on"),
+    ("collapse_time_s", "s", "collapse time, building {k}", "when building {k} collapsed (empty where it did not); its peaks are over the time before it"),
+    ("collapse_storey", "-", "collapsed storey, building {k}", "the storey of building {k} that reached the collapse limit (from 1; empty where it did not collapse)"),
 ];
 
 /// Per contact level: suffix, unit, short name, meaning.

@@ -786,6 +786,11 @@ impl RowPlan {
             if self.buildings[b].p_delta.is_some() {
                 h.push(format!("b{}_stability_coefficient", b + 1));
             }
+            if self.collapse_drift_ratio.is_finite() {
+                for c in BUILDING_COLLAPSE_OUTPUTS {
+                    h.push(format!("b{}_{c}", b + 1));
+                }
+            }
             if y.is_some() {
                 for c in INELASTIC_OUTPUTS {
                     h.push(format!("b{}_{c}", b + 1));
@@ -847,6 +852,9 @@ impl RowPlan {
             .filter(|c| {
                 !skip.contains(&c.as_str())
                     && !COLLAPSE_OUTPUTS.contains(&c.as_str())
+                    && !c.ends_with("_collapsed")
+                    && !c.ends_with("_collapse_time_s")
+                    && !c.ends_with("_collapse_storey")
                     && !c.ends_with("_stability_coefficient")
                     && !c.ends_with("_drift_storey")
                     && !c.ends_with("_accel_floor")
@@ -913,6 +921,14 @@ impl RowPlan {
             let a = &self.buildings[k];
             if a.p_delta.is_some() {
                 c.push(num(a.stability_at_1s * run.period[k] * run.period[k]));
+            }
+            if self.collapse_drift_ratio.is_finite() {
+                let cl = b.collapse;
+                c.extend([
+                    (cl.is_some() as u8).to_string(),
+                    opt(cl.map(|x| x.time)),
+                    cl.map(|x| x.storey.to_string()).unwrap_or_default(),
+                ]);
             }
             if y.is_some() {
                 // A run that failed, or did not settle, has no residual drift: empty.
@@ -1029,6 +1045,11 @@ pub const BUILDING_OUTPUTS: [&str; 5] = [
 /// Where a run collapsed (empty where it did not): the time, the building and its storey (from
 /// 1). Rows with a collapse limit have them.
 pub const COLLAPSE_OUTPUTS: [&str; 3] = ["collapse_time_s", "collapse_building", "collapse_storey"];
+
+/// Each building's collapse columns (after its `b1_` prefix), in rows with a collapse limit:
+/// whether it collapsed (0 or 1), when and in which storey (empty where it did not).
+pub const BUILDING_COLLAPSE_OUTPUTS: [&str; 3] =
+    ["collapsed", "collapse_time_s", "collapse_storey"];
 
 /// A yielding building's further output columns (after its `b1_` prefix).
 pub const INELASTIC_OUTPUTS: [&str; 6] = [

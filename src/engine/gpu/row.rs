@@ -1375,6 +1375,7 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> 
                 peak_accel: bs[BS_ACCEL],
                 accel_floor: bc[BC_ACCEL_FLOOR],
                 inelastic: None,
+                collapse: None,
             }
         })
         .collect();
