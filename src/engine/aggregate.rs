@@ -141,8 +141,10 @@ impl Sketch {
 pub struct Group {
     pub runs: u64,
     pub failures: u64,
-    /// Runs that collapsed: counted apart, as exceeding every `--exceed` threshold (an
-    /// infinite demand), not in the statistics (their peaks end at the collapse).
+    /// Runs in which a building collapsed: counted apart; a collapsed building's outputs and
+    /// the run's own count as exceeding every `--exceed` threshold (an infinite demand) and
+    /// stay out of the statistics (their peaks end at the collapse), a building left standing
+    /// is summarised as in any run (physics.md section 12).
     pub collapsed: u64,
     pub exceed: Vec<u64>,
     pub stats: Vec<Sketch>,
@@ -174,33 +176,42 @@ impl Group {
     /// Fold in one run: `exceed` holds (output index, threshold) pairs. Failed runs are
     /// counted, not summarised. The per-run body of `shaders/aggregate.wgsl`, line for line.
     pub fn add(&mut self, o: &RunOutput, exceed: &[(usize, f64)]) {
-        // A pair's outputs are never empty.
-        self.add_values(o.status, &outputs(o).map(Some), exceed);
+        // A pair's outputs are never empty, and a pair never collapses.
+        self.add_values(o.status, &outputs(o).map(Some), exceed, &[]);
     }
 
     /// Fold in one run's summarised outputs `x` (magnitudes, in the aggregator's output order),
     /// None where its cell was empty: such a run is counted apart (`undecided`, `no_value`),
-    /// neither exceeding nor in the statistics.
-    fn add_values(&mut self, status: Status, x: &[Option<f64>], exceed: &[(usize, f64)]) {
+    /// neither exceeding nor in the statistics. In a collapsed run, the outputs marked in
+    /// `standing` (a building that did not collapse) are taken as in any run; the others
+    /// exceed every threshold and stay out of the statistics.
+    fn add_values(
+        &mut self,
+        status: Status,
+        x: &[Option<f64>],
+        exceed: &[(usize, f64)],
+        standing: &[bool],
+    ) {
         self.runs += 1;
-        if status == Status::Collapsed {
+        let collapsed = status == Status::Collapsed;
+        if collapsed {
             self.collapsed += 1;
-            for e in self.exceed.iter_mut() {
-                *e += 1;
-            }
-            return;
-        }
-        if status != Status::Ok {
+        } else if status != Status::Ok {
             self.failures += 1;
             return;
         }
+        let stands = |i: usize| !collapsed || standing.get(i).copied().unwrap_or(false);
         for (k, &(i, t)) in exceed.iter().enumerate() {
             match x[i] {
+                _ if !stands(i) => self.exceed[k] += 1,
                 Some(v) => self.exceed[k] += (v > t) as u64,
                 None => self.undecided[k] += 1,
             }
         }
-        for ((s, n), v) in self.stats.iter_mut().zip(self.no_value.iter_mut()).zip(x) {
+        for (_, ((s, n), v)) in (self.stats.iter_mut().zip(self.no_value.iter_mut()).zip(x))
+            .enumerate()
+            .filter(|(i, _)| stands(*i))
+        {
             match v {
                 Some(v) => s.add(*v),
                 None => *n += 1,
@@ -382,6 +393,10 @@ pub struct Aggregator {
     groups: Vec<(Vec<String>, Group)>,
     /// Its runs may collapse (rows of buildings with storey heights): the summary counts them.
     collapses: bool,
+    /// Per output, the header index of its building's `bK_collapsed` column (a row's
+    /// per-building outputs): in a collapsed run, an output of a building left standing is
+    /// summarised as in any run.
+    building_collapsed: Vec<Option<usize>>,
 }
 
 impl Aggregator {
@@ -401,9 +416,21 @@ impl Aggregator {
                 by,
                 exceed,
             )
-            .map(|a| Aggregator {
-                collapses: true,
-                ..a
+            .map(|a| {
+                let h = r.header();
+                let building_collapsed = (a.outputs.iter())
+                    .map(|(o, _)| {
+                        let (k, _) = o.strip_prefix('b')?.split_once('_')?;
+                        k.bytes().all(|c| c.is_ascii_digit()).then_some(())?;
+                        let c = format!("b{k}_collapsed");
+                        h.iter().position(|x| *x == c)
+                    })
+                    .collect();
+                Aggregator {
+                    collapses: true,
+                    building_collapsed,
+                    ..a
+                }
             }),
         }
     }
@@ -547,6 +574,7 @@ impl Aggregator {
             label_ids: HashMap::new(),
             groups: Vec::new(),
             collapses: false,
+            building_collapsed: Vec::new(),
         })
     }
 
@@ -588,8 +616,13 @@ impl Aggregator {
                 (!c.is_empty()).then(|| c.parse::<f64>().map_or(f64::NAN, f64::abs))
             })
             .collect();
+        let standing: Vec<bool> = (self.building_collapsed.iter())
+            .map(|c| c.is_some_and(|i| cells[i] == "0"))
+            .collect();
         let exceed = &self.exceed;
-        self.groups[id as usize].1.add_values(status, &x, exceed);
+        self.groups[id as usize]
+            .1
+            .add_values(status, &x, exceed, &standing);
     }
 
     /// The (output index, threshold) pairs of `--exceed`.

@@ -531,21 +531,19 @@ impl RowOutput {
     pub(crate) fn gather_storeys(
         &mut self,
         spans: &[Option<std::ops::Range<usize>>],
-        settled: bool,
+        settled: &[bool],
     ) {
-        for (b, span) in self.buildings.iter_mut().zip(spans) {
+        for ((b, span), &settled) in self.buildings.iter_mut().zip(spans).zip(settled) {
             b.inelastic = span.clone().map(|r| {
-                let mut ie = InelasticOutput::gather(&self.storeys[r]);
+                let mut ie = InelasticOutput::gather(&self.storeys[r.clone()]);
                 if !settled {
                     ie.residual_drift_ratio = f64::NAN;
+                    for st in self.storeys[r].iter_mut() {
+                        st.residual_drift_ratio = f64::NAN;
+                    }
                 }
                 ie
             });
-        }
-        if !settled {
-            for st in self.storeys.iter_mut() {
-                st.residual_drift_ratio = f64::NAN;
-            }
         }
     }
 

@@ -1405,7 +1405,7 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> 
             .map(|(f, &n)| f.map(|f| f..f + n))
             .collect();
         let settled = c[shape.c_settled()] != 0 && status == Status::Ok;
-        out.gather_storeys(&spans, settled);
+        out.gather_storeys(&spans, &vec![settled; spans.len()]);
     }
     out.gather();
     Some(out)

@@ -79,29 +79,37 @@ impl<'m> RowRun<'m> {
         any
     }
 
-    /// The collapse the located events at `zb` (time `t`) mark, if one of them is a storey's
-    /// drift reaching the limit: the storey furthest past it.
-    fn collapse_transition(&mut self, t: f64, zb: &[f64]) {
-        let first = self.m.levels.len() + self.m.storeys.len();
+    /// The largest collapse event value in `z` of the watched moving buildings' storeys
+    /// (positive once a drift is past the limit; `-inf` where none is watched).
+    fn collapse_max(&self, z: &[f64]) -> f64 {
         let limit = self.m.collapse_limit;
-        let mut best: Option<(f64, usize)> = None;
-        for (i, d) in self.m.drifts.iter().enumerate() {
-            if !self.firing.get(first + i).copied().unwrap_or(false) {
+        (self.m.drifts.iter())
+            .filter(|d| self.watch[d.building] && self.active[d.building])
+            .map(|d| d.drift(z, 0).abs() - limit * d.height)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// The collapses at a located event's state `zb`: each watched moving building with a
+    /// storey past the limit there (to leave the scene), with its storey furthest past it.
+    fn collapses_at(&self, zb: &[f64]) -> Vec<(usize, usize)> {
+        let limit = self.m.collapse_limit;
+        let mut best: Vec<Option<(f64, usize)>> = vec![None; self.m.buildings.len()];
+        for d in &self.m.drifts {
+            if !self.watch[d.building] || !self.active[d.building] {
                 continue;
             }
             let v = d.drift(zb, 0).abs() - limit * d.height;
-            if best.is_none_or(|(b, _)| v > b) {
-                best = Some((v, i));
+            if v <= 0.0 {
+                continue;
+            }
+            let b = &mut best[d.building];
+            if b.is_none_or(|(x, _)| v > x) {
+                *b = Some((v, d.storey));
             }
         }
-        if let Some((_, i)) = best {
-            let d = &self.m.drifts[i];
-            self.collapse = Some(crate::physics::row::Collapse {
-                time: t,
-                building: d.building as u32 + 1,
-                storey: d.storey as u32 + 1,
-            });
-        }
+        (best.into_iter().enumerate())
+            .filter_map(|(k, b)| b.map(|(_, storey)| (k, storey)))
+            .collect()
     }
 
     /// The largest event value of the checked levels and storeys (positive once any level's
@@ -143,6 +151,30 @@ impl<'m> RowRun<'m> {
             let e0 = sm.edges(sm.drift(z0, 0), sm.drift(z0, n), z0[p]);
             let e1 = sm.edges(sm.drift(z1, 0), sm.drift(z1, n), z1[p]);
             for (a, b) in e0.iter().zip(&e1) {
+                if let Some(x) = hidden_rise(a.0, a.1, b.0, b.1, h) {
+                    first = Some(first.map_or(x, |f| f.min(x)));
+                }
+            }
+        }
+        first
+    }
+
+    /// The earliest fraction of a step `z0 -> z1` (length `h`) at which a watched storey's
+    /// drift could pass the collapse limit between the ends (both below it): a storey that
+    /// turns back just past the limit inside a step (the Hermite peaks see it) collapses there.
+    pub(super) fn hidden_collapse(&self, z0: &[f64], z1: &[f64], h: f64) -> Option<f64> {
+        let (n, limit) = (self.m.n, self.m.collapse_limit);
+        let mut first: Option<f64> = None;
+        for d in &self.m.drifts {
+            if !self.watch[d.building] || !self.active[d.building] {
+                continue;
+            }
+            let top = limit * d.height;
+            let edges = |z: &[f64]| {
+                let (x, r) = (d.drift(z, 0), d.drift(z, n));
+                [(x - top, r), (-x - top, -r)]
+            };
+            for (a, b) in edges(z0).iter().zip(&edges(z1)) {
                 if let Some(x) = hidden_rise(a.0, a.1, b.0, b.1, h) {
                     first = Some(first.map_or(x, |f| f.min(x)));
                 }
@@ -252,6 +284,9 @@ impl<'m> RowRun<'m> {
         let n = self.m.n;
         let z0 = std::mem::take(&mut self.z);
         let (mut trial, mut h) = (trial, h);
+        if !self.m.drifts.is_empty() {
+            self.watch_reached(&trial);
+        }
         let mut f1 = self.event_max(&trial);
         if f1 <= 0.0 {
             let hidden = self
@@ -268,10 +303,12 @@ impl<'m> RowRun<'m> {
                 .fold(None, |acc: Option<f64>, s| {
                     Some(acc.map_or(s, |a| a.min(s)))
                 });
-            let hidden = match (hidden, self.hidden_yield(&z0, &trial, h)) {
+            let earliest = |a: Option<f64>, b: Option<f64>| match (a, b) {
                 (Some(a), Some(b)) => Some(a.min(b)),
                 (a, b) => a.or(b),
             };
+            let hidden = earliest(hidden, self.hidden_yield(&z0, &trial, h));
+            let hidden = earliest(hidden, self.hidden_collapse(&z0, &trial, h));
             if let Some(s) = hidden {
                 let zs = step(s * h);
                 let fs = self.event_max(&zs);
@@ -285,7 +322,7 @@ impl<'m> RowRun<'m> {
             self.mark_firing(&trial);
             let f0 = self.firing_max(&z0);
             let tol = (tol_rel * h).max(4.0 * f64::EPSILON * t.abs());
-            let (x, zb) = locate(
+            let (mut x, mut zb) = locate(
                 h,
                 f0,
                 trial,
@@ -295,12 +332,36 @@ impl<'m> RowRun<'m> {
                 &mut step,
                 |s: &Vec<f64>| self.firing_max(s),
             );
-            self.track(t, x, &z0, &zb, (ag(t), ag(t + x)));
+            // A drift that passed the collapse limit before the event located (and turned back
+            // inside the step, so that its event did not fire at the trial's end): the
+            // collapse is where it crossed, located on its own.
             if !self.m.drifts.is_empty() {
-                self.collapse_transition(t + x, &zb);
+                let c = self.collapse_max(&zb);
+                let c0 = self.collapse_max(&z0);
+                if c > 0.0 && c0 <= 0.0 {
+                    (x, zb) = locate(
+                        x,
+                        c0,
+                        zb,
+                        c,
+                        tol,
+                        max_iter,
+                        &mut step,
+                        |s: &Vec<f64>| self.collapse_max(s),
+                    );
+                }
             }
+            self.track(t, x, &z0, &zb, (ag(t), ag(t + x)));
+            let collapsing = if self.m.drifts.is_empty() {
+                Vec::new()
+            } else {
+                self.collapses_at(&zb)
+            };
             self.transitions(t + x, &zb, &z0);
             self.z = zb;
+            for (k, storey) in collapsing {
+                self.leave_scene(k, t + x, storey);
+            }
             if !self.m.storeys.is_empty() {
                 self.storey_transitions();
             }

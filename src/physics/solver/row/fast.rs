@@ -314,10 +314,15 @@ fn run_with<'a>(
     let mut i = 0;
     // The step's start, in a buffer kept from step to step (as `z1`, its end).
     let mut z_start = Vec::with_capacity(len);
+    // Each mode's building: a building that collapsed stands frozen, out of the free steps.
+    let mode_building: Vec<usize> = (m.buildings.iter().enumerate())
+        .flat_map(|(k, b)| std::iter::repeat_n(k, b.n()))
+        .collect();
     while let Some(seg) = super::yielding::next_segment(m, forcing, i, &mut run) {
         i += 1;
         // A building near collapse moves in substeps, where its storeys' collapse is an event.
-        let watched = !m.drifts.is_empty() && run.refresh_watch();
+        let mut watched = !m.drifts.is_empty() && run.refresh_watch();
+        let any_gone = run.gone.iter().any(|&g| g);
         z_start.clone_from(&run.z);
         let z = &z_start;
         // The exact free step of every mode: the step itself when no level may touch, and the
@@ -330,7 +335,7 @@ fn run_with<'a>(
                 m.static_offsets(z, &mut q_static);
             }
             for k in 0..n {
-                if in_coupled[k] {
+                if in_coupled[k] || (any_gone && run.gone[mode_building[k]]) {
                     if forms.is_some() {
                         work.push((0.0, 0.0));
                     }
@@ -349,6 +354,9 @@ fn run_with<'a>(
                 }
             }
             for c in coupled.iter_mut() {
+                if run.gone[c.building()] {
+                    continue;
+                }
                 let qs = yields.then_some(&q_static[..]);
                 let w = forms.is_some().then_some(&mut work[..]);
                 c.step(m, z, qs, (seg.a0, seg.a1), &mut z1, w);
@@ -359,6 +367,14 @@ fn run_with<'a>(
                     }
                 }
             }
+        }
+        if prepare_ends && !any_contact {
+            run.prepare_free_ends(z, &z1, (seg.a0, seg.a1));
+        }
+        // A building whose drift runs past half the limit within the step is watched from its
+        // start, so that a crossing inside it is located.
+        if !m.drifts.is_empty() && (can_stand || !any_contact) && run.watch_reached(&z1) {
+            watched = true;
         }
         may_touch.fill(None);
         let mut bounded = false;
@@ -387,6 +403,13 @@ fn run_with<'a>(
                 yielding = true;
             }
         }
+        // A building that left the scene neither yields nor collapses again.
+        if any_gone && (yields || watched) {
+            for (y, &g) in yield_watch.iter_mut().zip(&run.gone) {
+                *y &= !g;
+            }
+            yielding = yield_watch.iter().any(|&y| y) || (yielding && any_contact && !can_stand);
+        }
         if !any_contact {
             if !bounded {
                 m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
@@ -398,7 +421,6 @@ fn run_with<'a>(
             let mut touching = false;
             if prepare_ends {
                 m.coarse_floor_bounds(&bounds, &mut coarse);
-                run.prepare_free_ends(z, &z1, (seg.a0, seg.a1));
                 for (l, ((lm, ls), may)) in m
                     .levels
                     .iter()
@@ -406,6 +428,10 @@ fn run_with<'a>(
                     .zip(may_touch.iter_mut())
                     .enumerate()
                 {
+                    if any_gone && run.level_dead(l) {
+                        *may = Some(false);
+                        continue;
+                    }
                     let ends = run.level_ends(l);
                     let open = coarse[lm.buildings.0] + coarse[lm.buildings.1];
                     let t = lm.may_touch_within(ends, open, dt, ls.v0)
@@ -419,7 +445,14 @@ fn run_with<'a>(
                     touching |= t;
                 }
             } else {
-                for ((lm, ls), may) in m.levels.iter().zip(&run.levels).zip(may_touch.iter_mut()) {
+                for (l, ((lm, ls), may)) in (m.levels.iter().zip(&run.levels))
+                    .zip(may_touch.iter_mut())
+                    .enumerate()
+                {
+                    if any_gone && run.level_dead(l) {
+                        *may = Some(false);
+                        continue;
+                    }
                     let t = lm.may_touch_bounded(n, &bounds, z, &z1, dt, ls.v0);
                     *may = Some(t);
                     touching |= t;
@@ -432,7 +465,7 @@ fn run_with<'a>(
                 if !run.z.iter().all(|x| x.is_finite()) {
                     return finish(run, Status::NonFinite, substeps, tally);
                 }
-                if run.collapse.is_some() {
+                if run.all_gone() {
                     return finish(run, Status::Collapsed, substeps, tally);
                 }
                 continue;
@@ -460,7 +493,7 @@ fn run_with<'a>(
             grew = false;
             for (l, (lm, ls)) in m.levels.iter().zip(&run.levels).enumerate() {
                 let (a, b) = lm.buildings;
-                if active[a] && active[b] {
+                if (active[a] && active[b]) || (any_gone && run.level_dead(l)) {
                     continue;
                 }
                 let (d, r) = (lm.delta(z), lm.ddelta(n, z));
@@ -479,6 +512,11 @@ fn run_with<'a>(
                     (active[a], active[b]) = (true, true);
                     grew = true;
                 }
+            }
+        }
+        if any_gone {
+            for (a, &g) in active.iter_mut().zip(&run.gone) {
+                *a &= !g;
             }
         }
         // The substep: the shortest any level asks for, and the moving structures' own rate.
@@ -545,7 +583,9 @@ fn run_with<'a>(
         run.set_active(&active);
         moving.clone_from(&active);
         let any_still = active.iter().any(|a| !a);
-        tally.still += active.iter().filter(|a| !**a).count() as u64;
+        tally.still += (active.iter().zip(&run.gone))
+            .filter(|(a, g)| !**a && !**g)
+            .count() as u64;
         lookouts.clear();
         if any_still {
             if !bounded {
@@ -553,7 +593,7 @@ fn run_with<'a>(
             }
             for (l, lm) in m.levels.iter().enumerate() {
                 let (a, b) = lm.buildings;
-                if active[a] != active[b] {
+                if active[a] != active[b] && !(any_gone && run.level_dead(l)) {
                     lookouts.push(Lookout::new(m, l, active[a], &bounds, z, &z1, dt));
                 }
             }
@@ -612,7 +652,10 @@ fn run_with<'a>(
                     lookouts.retain(|w| !run.level_on(w.level));
                     for (l, lm) in m.levels.iter().enumerate() {
                         let (a, b) = lm.buildings;
-                        if (a == k || b == k) && run.active[a] != run.active[b] {
+                        if (a == k || b == k)
+                            && run.active[a] != run.active[b]
+                            && !run.level_dead(l)
+                        {
                             lookouts.push(Lookout::new(m, l, a == k, &bounds, z, &z1, dt));
                         }
                     }
@@ -636,8 +679,13 @@ fn run_with<'a>(
                 if !run.z.iter().all(|x| x.is_finite()) {
                     return finish(run, Status::NonFinite, substeps, tally);
                 }
-                if run.collapse.is_some() {
-                    return finish(run, Status::Collapsed, substeps, tally);
+                if run.active != moving {
+                    // A building left the scene: it stands frozen from here on.
+                    if run.all_gone() {
+                        return finish(run, Status::Collapsed, substeps, tally);
+                    }
+                    moving.clone_from(&run.active);
+                    lookouts.retain(|w| !run.level_dead(w.level));
                 }
             }
             t = t_target;

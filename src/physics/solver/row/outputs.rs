@@ -320,6 +320,9 @@ impl<'m> RowRun<'m> {
             .map(|k| {
                 if self.active[k] {
                     m.floors(k, &self.z)
+                } else if self.gone[k] {
+                    // Frozen where it collapsed, in its modes.
+                    modal.floors(k, &self.z)
                 } else {
                     let mut z = self.z.clone();
                     if t > seg.t0 {
@@ -331,12 +334,15 @@ impl<'m> RowRun<'m> {
             .collect();
         let sample = RowSample {
             t,
-            penetrations: m
-                .levels
-                .iter()
-                .map(|lm| {
+            // A level beside a building that left the scene is gone with it.
+            penetrations: (m.levels.iter().enumerate())
+                .map(|(l, lm)| {
                     let ((a, b), [sa, sb]) = (lm.buildings, &lm.sides);
-                    (sa.at(&floors[a]) - sb.at(&floors[b]) - lm.gap).max(0.0)
+                    if self.level_dead(l) {
+                        0.0
+                    } else {
+                        (sa.at(&floors[a]) - sb.at(&floors[b]) - lm.gap).max(0.0)
+                    }
                 })
                 .collect(),
             forces: (m.levels.iter().zip(&self.levels).zip(&self.level_on))
@@ -383,6 +389,11 @@ impl<'m> RowRun<'m> {
     /// End the run with `status`, after `substeps` steps of integration work.
     pub fn finish(mut self, status: Status, substeps: u64) -> RowOutput {
         self.leave_substeps();
+        // A run in which a building collapsed and the rest went on to the end has collapsed.
+        let status = match status {
+            Status::Ok if self.collapse.is_some() => Status::Collapsed,
+            s => s,
+        };
         let m = self.m;
         let n = m.n;
         let nl = m.levels.len();
@@ -448,7 +459,11 @@ impl<'m> RowRun<'m> {
             ..RowOutput::default()
         };
         if ns > 0 {
-            out.gather_storeys(&m.storey_spans(), self.settled && status == Status::Ok);
+            // The buildings still standing have residual drifts where the run went on to the
+            // end and settled; those that collapsed have none.
+            let ended = matches!(status, Status::Ok | Status::Collapsed) && self.settled;
+            let settled: Vec<bool> = self.gone.iter().map(|&g| ended && !g).collect();
+            out.gather_storeys(&m.storey_spans(), &settled);
         }
         out.gather();
         out

@@ -19,20 +19,19 @@ use crate::physics::solver::{impact_step, Mode, Segment};
 #[allow(clippy::too_many_arguments)]
 fn dopri(
     m: &RowModel,
-    (lv, storeys): (&LevelModes, &[StoreyMode]),
+    (lv, storeys, active): (&LevelModes, &[StoreyMode], &[bool]),
     seg: &Segment,
     t: f64,
     z: &[f64],
     h: f64,
     rtol: f64,
 ) -> (Vec<f64>, f64) {
-    // Every building moves in every step of the reference.
-    let active = vec![true; m.buildings.len()];
+    // Every building still standing moves in every step of the reference.
     let (y, ev) = dopri_stages(&z.to_vec(), t, h, |tt, y: &Vec<f64>| {
         let mut out = vec![0.0; y.len()];
         let motion = Motion {
             levels: lv,
-            active: &active,
+            active,
             energy: true,
             storeys,
         };
@@ -104,6 +103,7 @@ pub(crate) fn run_tracked<'a>(
     let mut h = forcing.dt / 8.0;
     let mut modes = Vec::with_capacity(m.levels.len());
     let mut storeys = Vec::with_capacity(m.storeys.len());
+    let mut active = run.active.clone();
     let mut i = 0;
     while let Some(seg) = super::yielding::next_segment(m, forcing, i, &mut run) {
         i += 1;
@@ -128,7 +128,7 @@ pub(crate) fn run_tracked<'a>(
             }
             run.level_modes(&mut modes);
             storeys.clone_from(&run.storey_modes);
-            let (trial, err) = dopri(m, (&modes, &storeys), &seg, t, &z0, hs, o.rtol);
+            let (trial, err) = dopri(m, (&modes, &storeys, &active), &seg, t, &z0, hs, o.rtol);
             if err.is_nan() || err > 1.0 {
                 let finite = trial.iter().all(|x| x.is_finite());
                 match retry(&seg, t, hs, err, finite) {
@@ -140,8 +140,8 @@ pub(crate) fn run_tracked<'a>(
             // A free level that could touch inside a step longer than its contact time scale
             // shortens the step to that scale.
             let mut h_touch = f64::INFINITY;
-            for (lm, ls) in m.levels.iter().zip(&run.levels) {
-                if ls.mode != Mode::Free {
+            for (l, (lm, ls)) in m.levels.iter().zip(&run.levels).enumerate() {
+                if ls.mode != Mode::Free || run.level_dead(l) {
                     continue;
                 }
                 let v_est = 1.5 * lm.ddelta(n, &z0).abs().max(lm.ddelta(n, &trial).abs());
@@ -158,10 +158,15 @@ pub(crate) fn run_tracked<'a>(
                 h = h_touch;
                 continue;
             }
-            let step = |x: f64| dopri(m, (&modes, &storeys), &seg, t, &z0, x, o.rtol).0;
+            let step =
+                |x: f64| dopri(m, (&modes, &storeys, &active), &seg, t, &z0, x, o.rtol).0;
             t += run.accept(&seg, t, hs, trial, 1e-13, 100, step);
-            if run.collapse.is_some() {
-                return run.finish(Status::Collapsed, steps);
+            if run.active != active {
+                // A building left the scene: it stands frozen from here on.
+                if run.all_gone() {
+                    return run.finish(Status::Collapsed, steps);
+                }
+                active.clone_from(&run.active);
             }
             h = hs * (0.9 * err.max(1e-12).powf(-0.2)).min(5.0);
         }

@@ -216,8 +216,12 @@ pub(crate) struct RowRun<'m> {
     /// drift ratio reaches [`COLLAPSE_WATCH`] of the limit (every building in the reference
     /// scheme, [`RowRun::watch_all`]).
     pub(super) watch: Vec<bool>,
-    /// Where the run collapsed; it ends there.
+    /// The run's first collapse ([`RowOutput::collapse`]); each building's is in its output.
     pub collapse: Option<Collapse>,
+    /// Per building, whether it has collapsed and left the scene (physics.md section 12): it
+    /// stands frozen as it was at its collapse (no further work, its peaks kept), never moves
+    /// again in substeps or free steps, and its levels are dead (no contact, no check).
+    pub(super) gone: Vec<bool>,
 }
 
 /// A building's storeys are watched for collapse once its peak drift ratio reaches this share
@@ -256,6 +260,7 @@ impl<'m> RowRun<'m> {
             observer: None,
             watch: vec![false; m.buildings.len()],
             collapse: None,
+            gone: vec![false; m.buildings.len()],
             z,
         };
         let z = run.z.clone();
@@ -273,31 +278,110 @@ impl<'m> RowRun<'m> {
         }
     }
 
-    /// Watch the buildings whose peak drift ratio has reached [`COLLAPSE_WATCH`] of the limit;
-    /// whether any is watched.
+    /// Watch the buildings still standing whose peak drift ratio has reached
+    /// [`COLLAPSE_WATCH`] of the limit; whether any is watched.
     pub fn refresh_watch(&mut self) -> bool {
         let limit = COLLAPSE_WATCH * self.m.collapse_limit;
-        for (w, b) in self.watch.iter_mut().zip(&self.buildings) {
-            *w |= b.peak_drift_ratio >= limit;
+        for ((w, b), &gone) in self.watch.iter_mut().zip(&self.buildings).zip(&self.gone) {
+            *w = !gone && (*w || b.peak_drift_ratio >= limit);
         }
         self.watch.iter().any(|&w| w)
     }
 
-    /// A run that has not collapsed by an event but whose tracked peaks reached the limit
-    /// inside a step (a crossing between its ends) collapses at the step's end `t`.
-    pub(super) fn collapse_by_peaks(&mut self, t: f64) {
-        if self.collapse.is_some() {
+    /// Watch each moving building not yet watched one of whose storeys' drift in `z` (the
+    /// end of a step about to be taken, whose floors [`RowRun::prepare_free_ends`] may hold)
+    /// reaches [`COLLAPSE_WATCH`] of the limit; whether any
+    /// was added. The peaks only say where a building has been: one whose drift runs from
+    /// below half the limit past it within a step (a P-Delta storey running away) would
+    /// otherwise cross unwatched, its collapse not located.
+    pub(super) fn watch_reached(&mut self, z: &[f64]) -> bool {
+        let limit = COLLAPSE_WATCH * self.m.collapse_limit;
+        let mut added = false;
+        for d in &self.m.drifts {
+            let k = d.building;
+            if self.watch[k] || !self.active[k] {
+                continue;
+            }
+            // From the floors where a prepared free step holds them (O(1), not O(N)).
+            let drift = if self.ends_ready {
+                let u = &self.floors[k][1].u;
+                u[d.storey] - if d.storey > 0 { u[d.storey - 1] } else { 0.0 }
+            } else {
+                d.drift(z, 0)
+            };
+            if drift.abs() >= limit * d.height {
+                self.watch[k] = true;
+                added = true;
+            }
+        }
+        added
+    }
+
+    /// Has every building left the scene? Nothing moves any more: the run can end.
+    pub fn all_gone(&self) -> bool {
+        self.gone.iter().all(|&g| g)
+    }
+
+    /// Whether level `l` joins a building that has left the scene (no contact, no check).
+    pub fn level_dead(&self, l: usize) -> bool {
+        let (a, b) = self.m.levels[l].buildings;
+        self.gone[a] || self.gone[b]
+    }
+
+    /// Building `k` collapses at `t` in storey `storey` (from 0) and leaves the scene: its
+    /// peaks are those over `[0, t]`, the collapsing storey's drift ratio the limit (the
+    /// crossing is located to the event tolerance; the limit is where it is), its contacts end
+    /// there, and it moves no more. The run's first collapse is the earliest building's.
+    pub(super) fn leave_scene(&mut self, k: usize, t: f64, storey: usize) {
+        if self.gone[k] {
             return;
         }
+        let cl = Collapse {
+            time: t,
+            building: k as u32 + 1,
+            storey: storey as u32 + 1,
+        };
         let limit = self.m.collapse_limit;
-        if let Some((k, b)) =
-            (self.buildings.iter().enumerate()).find(|(_, b)| b.peak_drift_ratio >= limit)
-        {
-            self.collapse = Some(Collapse {
-                time: t,
-                building: k as u32 + 1,
-                storey: b.drift_storey,
-            });
+        let b = &mut self.buildings[k];
+        b.collapse = Some(cl);
+        (b.peak_drift_ratio, b.drift_storey) = (limit, cl.storey);
+        if let Some(first) = self.m.buildings[k].first_storey {
+            self.storeys[first + storey].peak_drift_ratio = limit;
+        }
+        if self.collapse.is_none_or(|c| t < c.time) {
+            self.collapse = Some(cl);
+        }
+        // Back to its modes (the coordinates it stands in from here on) if it was in the
+        // substeps' floor coordinates.
+        if !std::ptr::eq(self.m, self.modal) && self.active[k] {
+            self.m.building_to_modes(k, &mut self.z);
+        }
+        self.gone[k] = true;
+        self.watch[k] = false;
+        for (ls, lm) in self.levels.iter_mut().zip(&self.m.levels) {
+            let (a, b) = lm.buildings;
+            if (a == k || b == k) && ls.mode != Mode::Free {
+                ls.end_impact();
+                ls.mode = Mode::Free;
+            }
+        }
+        // The contact forces and storey states at the last piece's end change.
+        self.ends_valid = false;
+        self.active[k] = false;
+        self.refresh_levels_on();
+    }
+
+    /// A building whose tracked peaks reached the limit inside a step without a located event
+    /// (a crossing between the step's ends that no watch saw) collapses at the step's end
+    /// `t`: a last guard, which [`RowRun::watch_reached`] keeps from firing.
+    pub(super) fn collapse_by_peaks(&mut self, t: f64) {
+        let limit = self.m.collapse_limit;
+        for k in 0..self.buildings.len() {
+            let b = &self.buildings[k];
+            if !self.gone[k] && b.peak_drift_ratio >= limit {
+                let storey = b.drift_storey.max(1) as usize - 1;
+                self.leave_scene(k, t, storey);
+            }
         }
     }
 
@@ -317,6 +401,10 @@ impl<'m> RowRun<'m> {
         };
         for (c, lm) in closings.iter_mut().zip(&self.m.levels) {
             let ((a, b), [sa, sb]) = (lm.buildings, &lm.sides);
+            // A level's closing is known up to the first collapse of its two buildings.
+            if self.gone[a] || self.gone[b] {
+                continue;
+            }
             let ([a0, a1], [b0, b1]) = (&self.floors[a], &self.floors[b]);
             let (ua, va, aa) = (
                 [sa.at(&a0.u), sa.at(&a1.u)],
@@ -372,7 +460,9 @@ impl<'m> RowRun<'m> {
     /// Let only the `active` buildings move in the substeps to come (and the levels between
     /// two of them be checked).
     pub fn set_active(&mut self, active: &[bool]) {
-        self.active.copy_from_slice(active);
+        for ((a, &b), &gone) in self.active.iter_mut().zip(active).zip(&self.gone) {
+            *a = b && !gone;
+        }
         self.refresh_levels_on();
     }
 
@@ -388,10 +478,13 @@ impl<'m> RowRun<'m> {
         self.level_on[l]
     }
 
-    /// Every building moves again (after a record step with some standing still).
+    /// Every building still standing moves again (after a record step with some standing
+    /// still).
     pub fn all_active(&mut self) {
-        self.active.fill(true);
-        self.level_on.fill(true);
+        for (a, &gone) in self.active.iter_mut().zip(&self.gone) {
+            *a = !gone;
+        }
+        self.refresh_levels_on();
     }
 
     /// A building that stood still since `seg.t0` joins the substeps at `t`: its modes are
@@ -422,7 +515,7 @@ impl<'m> RowRun<'m> {
         let modal = self.modal;
         let (n, nl) = (modal.n, modal.levels.len());
         for k in 0..modal.buildings.len() {
-            if self.active[k] {
+            if self.active[k] || self.gone[k] {
                 continue;
             }
             let b = &modal.buildings[k];
@@ -483,11 +576,31 @@ impl<'m> RowRun<'m> {
         self.levels.iter().any(|l| l.mode != Mode::Free)
     }
 
-    /// Is some storey on a bounding line?
+    /// Is some storey of a building still standing on a bounding line?
     pub fn any_yielding(&self) -> bool {
-        self.storey_modes
-            .iter()
-            .any(|m| matches!(m, StoreyMode::Yielding(_)))
+        (self.storey_modes.iter().zip(&self.m.storeys))
+            .any(|(m, sm)| matches!(m, StoreyMode::Yielding(_)) && !self.gone[sm.building])
+    }
+
+    /// `z` with the buildings that left the scene at rest: what the settling check reads (a
+    /// frozen building's motion is not the row's any more).
+    pub(super) fn standing_state(&self, z: &[f64]) -> Option<Vec<f64>> {
+        if !self.gone.iter().any(|&g| g) {
+            return None;
+        }
+        let m = self.modal;
+        let mut live = z.to_vec();
+        for (k, b) in m.buildings.iter().enumerate().filter(|(k, _)| self.gone[*k]) {
+            for i in b.off..b.off + b.n() {
+                (live[i], live[m.n + i]) = (0.0, 0.0);
+            }
+            for (s, sm) in m.storeys.iter().enumerate() {
+                if sm.building == k {
+                    live[m.plastic_slot(s)] = 0.0;
+                }
+            }
+        }
+        Some(live)
     }
 
     /// A free record step over `seg` to `z1`, with no possible contact (checked by the caller);

@@ -337,7 +337,11 @@ pub(crate) fn next_segment(
     if m.storeys.is_empty() {
         return None;
     }
-    if !run.any_contact() && !run.any_yielding() && m.settled(&run.z) {
+    let settled = || match run.standing_state(&run.z) {
+        Some(standing) => m.settled(&standing),
+        None => m.settled(&run.z),
+    };
+    if !run.any_contact() && !run.any_yielding() && settled() {
         run.settled = true;
         return None;
     }
