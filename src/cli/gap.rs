@@ -3,6 +3,7 @@
 
 use super::{write_file, Holds};
 use anyhow::{bail, Context, Result};
+use pounding::physics::separation::Rule;
 use pounding::plan::config;
 use pounding::studies::gap::{GapStudy, PoundingCurve};
 use std::path::PathBuf;
@@ -84,9 +85,48 @@ pub fn run(a: Args) -> Result<()> {
             study.refined_steps()
         );
     }
+    // Collapses and failures, each run with its record and intensity (the first few).
+    const LISTED: usize = 8;
+    let collapsed = study.collapsed();
+    if !collapsed.is_empty() {
+        let list = study.run_list(&collapsed, LISTED, |o| {
+            let each: Vec<String> = o
+                .collapses
+                .iter()
+                .map(|c| format!("building {} at {:.2} s", c.building, c.time))
+                .collect();
+            each.join(", ")
+        });
+        say!(
+            "{} of {runs} runs collapsed (a building's storey reached [run] collapse_drift_ratio): each pair's gaps are up to the earlier collapse of its two buildings, the required gap a lower bound (columns censored_by, censored_at_s): {list}",
+            collapsed.len()
+        );
+    }
+    let failed = study.failed();
+    if !failed.is_empty() {
+        let list = study.run_list(&failed, LISTED, |o| o.end.key().to_string());
+        say!(
+            "{} of {runs} runs ended early and are left out of every statistic (status in the CSV): {list}",
+            failed.len()
+        );
+    }
     let summary = study.summary();
     say!("\n| pair | rule | runs | floors close | median rule / exact | p10 | p90 | unconservative |\n|---|---|---:|---:|---:|---:|---:|---:|");
     for s in &summary {
+        if s.runs == 0 {
+            // No statistic over zero runs.
+            say!(
+                "| {} | {} | 0 | 0 | no run: {} | | | |",
+                study.pair_name(s.pair),
+                s.rule.key().to_uppercase(),
+                if s.censored > 0 {
+                    "a collapse censored every run of this pair"
+                } else {
+                    "every run of this pair ended early"
+                }
+            );
+            continue;
+        }
         say!(
             "| {} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {} ({:.1} %) |",
             study.pair_name(s.pair),
@@ -97,7 +137,17 @@ pub fn run(a: Args) -> Result<()> {
             s.p10,
             s.p90,
             s.unconservative,
-            100.0 * s.unconservative as f64 / s.runs.max(1) as f64
+            100.0 * s.unconservative as f64 / s.runs as f64
+        );
+    }
+    for s in summary
+        .iter()
+        .filter(|s| s.rule == Rule::ALL[0] && s.censored > 0)
+    {
+        say!(
+            "Pair {}: {} runs censored by a collapse are left out of this table (a rule's gap against a lower bound of the exact one is no record of the rule).",
+            study.pair_name(s.pair),
+            s.censored
         );
     }
     let curves: Vec<Vec<PoundingCurve>> = (0..study.pairs())
@@ -143,6 +193,25 @@ pub fn run(a: Args) -> Result<()> {
             ),
         }
     }
+    let censored: Vec<String> = curves
+        .iter()
+        .flatten()
+        .filter(|c| c.censored > 0)
+        .map(|c| {
+            format!(
+                "pair {}, {}: {}",
+                study.pair_name(c.pair),
+                study.intensity_label(c.intensity),
+                c.censored
+            )
+        })
+        .collect();
+    if !censored.is_empty() {
+        say!(
+            "Runs censored by a collapse count as pounding at every gap below their lower bound and enter each fit as that bound (right-censored maximum likelihood; docs/gap-study.md): {}.",
+            censored.join("; ")
+        );
+    }
     // The figure is checked before any output is written: one refused leaves none behind.
     let panels = a.plot.as_deref().map(|p| (p, study.panels(&curves)));
     if let Some((p, panels)) = &panels {
@@ -180,11 +249,16 @@ fn curve_csv(study: &GapStudy, curves: &[Vec<PoundingCurve>]) -> String {
                 Ok(f) => format!("{}", f.pounding(g)),
                 _ => String::new(),
             };
+            // No share over zero runs (at a gap above every run's bound, all censored).
+            let share = if n > 0 {
+                format!("{}", k as f64 / n as f64)
+            } else {
+                String::new()
+            };
             s.push_str(&format!(
-                "{},{},{g},{n},{k},{},{fitted}\n",
+                "{},{},{g},{n},{k},{share},{fitted}\n",
                 study.pair_name(c.pair),
                 study.intensity_label(c.intensity),
-                k as f64 / n.max(1) as f64
             ));
         }
     }

@@ -8,15 +8,19 @@
 //!
 //! Elastic responses are linear in the record's scale, so one response per record and building
 //! values serves every intensity. Where storeys yield they are not: every run is its own
-//! response ([`yielding_separation`]).
+//! response, the row scheme's run of the uncoupled buildings under the config's collapse limit
+//! ([`uncoupled`]). There a building may collapse: each pair's gaps are then taken up to the
+//! earlier collapse of its two buildings, a lower bound on what the pair needs (censored,
+//! [`PairGap::censored`]); a run that ends early for another reason has no gaps and is left
+//! out of every statistic ([`RunEnd::Failed`]).
 
-use crate::physics::model::Oscillator;
-use crate::physics::row::LevelRule;
+use crate::physics::contact::LawKind;
+use crate::physics::model::{Oscillator, Status};
+use crate::physics::row::{Collapse, LevelRule, Row};
 use crate::physics::separation::{cqc_rho, Rule};
 use crate::physics::shear::ShearBuilding;
-use crate::physics::solver::separation::{
-    separation_with, yielding_separation, LevelSeparation, Separation,
-};
+use crate::physics::solver::row::{simulate_uncoupled, RowModel, UNCOUPLED_GAP_M};
+use crate::physics::solver::separation::{separation_with, LevelSeparation, Separation};
 use crate::plan::columns::{at, contact_and_motion, num, RECORD_IMS};
 use crate::plan::intensity::TARGET_COLUMNS;
 use crate::plan::row::level_name;
@@ -151,27 +155,37 @@ impl Scenes<'_> {
     }
 
     /// Motion `m`'s response: its separation at unit scale where the buildings are elastic,
-    /// else at its own scale.
-    fn response(&self, m: u64, record: usize) -> Result<Separation, String> {
+    /// else at its own scale, with how that run ended ([`uncoupled`]).
+    fn response(&self, m: u64, record: usize) -> (Separation, Option<Outcome>) {
         match self.0 {
             Plan::Row(plan) if self.0.yields() => {
                 let run = plan.motion_run(m);
-                let buildings = plan.row(&run).buildings;
-                yielding_separation(
-                    &buildings,
+                let (sep, outcome) = uncoupled(
+                    plan.row(&run).buildings,
+                    plan.level_rule,
+                    plan.collapse_drift_ratio,
                     &plan.forcing(&run),
                     &plan.scheme(),
-                    plan.level_rule,
-                )
+                );
+                (sep, Some(outcome))
             }
             _ => {
                 let spec = &self.base().spec;
-                Ok(separation_with(
+                let sep = separation_with(
                     &self.buildings(m),
                     &spec.records[record].forcing(1.0, spec.tail),
                     self.level_rule(),
-                ))
+                );
+                (sep, None)
             }
+        }
+    }
+
+    /// The drift ratio at which a building collapses (infinite: never, and for a pair).
+    fn collapse_limit(&self) -> f64 {
+        match self.0 {
+            Plan::Row(r) => r.collapse_drift_ratio,
+            Plan::Pair(_) => f64::INFINITY,
         }
     }
 
@@ -198,6 +212,153 @@ impl Scenes<'_> {
     }
 }
 
+/// How a run of the study ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunEnd {
+    /// Every building stood to the end of the record and its tail.
+    Whole,
+    /// Some building collapsed (status `collapsed`): each pair's gaps are up to the earlier
+    /// collapse of its two buildings ([`PairGap::censored`]).
+    Collapsed,
+    /// The run ended early for another reason (`non_finite`, `step_limit`), or a floor ran
+    /// away to the levels' gap of 1e6 m with no collapse limit to stop it (`runaway`): it has
+    /// no gaps and is left out of every statistic.
+    Failed(&'static str),
+}
+
+impl RunEnd {
+    /// The `status` cell: `ok`, `collapsed`, or why the run failed.
+    pub fn key(self) -> &'static str {
+        match self {
+            RunEnd::Whole => "ok",
+            RunEnd::Collapsed => "collapsed",
+            RunEnd::Failed(why) => why,
+        }
+    }
+}
+
+/// How one run that the study steps on its own (storeys yield) ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    pub end: RunEnd,
+    /// The buildings that collapsed, left to right.
+    pub collapses: Vec<Collapse>,
+    /// Per adjacent pair, the collapse its gaps stop at (None: they are over the whole run).
+    pub censors: Vec<Option<Collapse>>,
+}
+
+/// The separation `buildings` (left to right; storeys may yield) need under `forcing`, from
+/// their run by the row `scheme` with every level out of reach ([`simulate_uncoupled`]) under
+/// the collapse limit `collapse_drift_ratio` (infinite: none), and how that run ended.
+///
+/// [`crate::physics::solver::separation::yielding_separation`] runs them with no collapse
+/// limit: a P-Delta storey past its collapse drift has a negative stiffness, and its frame runs
+/// away until a floor travels the levels' gap of [`UNCOUPLED_GAP_M`] (an impact, which it
+/// refuses: "a floor moved 1000000 m") or overflows (`non_finite`). Here the run stops at the
+/// collapse, and each level's closing and peaks are over the time before it. Where the solver
+/// ends the whole run at the first collapse (it names it only in [`RowOutput::collapse`]),
+/// every pair's gaps stop there; where each building collapses on its own
+/// ([`crate::physics::row::BuildingOutput::collapse`]) the others going on, a pair's gaps
+/// stop at the earlier collapse of its two buildings.
+///
+/// [`RowOutput::collapse`]: crate::physics::row::RowOutput::collapse
+pub fn uncoupled(
+    buildings: Vec<ShearBuilding>,
+    rule: LevelRule,
+    collapse_drift_ratio: f64,
+    forcing: &crate::physics::model::Forcing,
+    scheme: &crate::physics::solver::row::RowScheme,
+) -> (Separation, Outcome) {
+    let pairs = buildings.len() - 1;
+    // The contact law is never reached; it only has to be valid.
+    let row = Row::with_levels(
+        buildings,
+        vec![UNCOUPLED_GAP_M; pairs],
+        LawKind::Linear,
+        1.0,
+        0.0,
+        rule,
+    )
+    .with_collapse(collapse_drift_ratio);
+    let model = RowModel::new(&row);
+    let out = simulate_uncoupled(&model, forcing, scheme);
+    let fundamental = model
+        .buildings
+        .iter()
+        .map(|b| (b.modes.omega[0], b.modes.xi[0]))
+        .collect();
+    let failed = match out.status {
+        Status::Ok | Status::Collapsed if out.impacts > 0 => Some("runaway"),
+        Status::Ok | Status::Collapsed => None,
+        other => Some(other.key()),
+    };
+    if let Some(why) = failed {
+        let sep = Separation {
+            substeps: out.substeps,
+            fundamental,
+            ..Separation::default()
+        };
+        let outcome = Outcome {
+            end: RunEnd::Failed(why),
+            collapses: Vec::new(),
+            censors: vec![None; pairs],
+        };
+        return (sep, outcome);
+    }
+    let own: Vec<Option<Collapse>> = out.buildings.iter().map(|b| b.collapse).collect();
+    let (collapses, censors): (Vec<Collapse>, _) = if own.iter().all(Option::is_none) {
+        // No building collapsed, or the run ended at its first collapse: every level's
+        // closing stops there.
+        (
+            out.collapse.into_iter().collect(),
+            vec![out.collapse; pairs],
+        )
+    } else {
+        let earlier = |a: Option<Collapse>, b: Option<Collapse>| match (a, b) {
+            (Some(x), Some(y)) => Some(if y.time < x.time { y } else { x }),
+            (x, y) => x.or(y),
+        };
+        (
+            own.iter().flatten().copied().collect(),
+            (0..pairs).map(|a| earlier(own[a], own[a + 1])).collect(),
+        )
+    };
+    let levels = row
+        .levels
+        .iter()
+        .zip(&out.closings)
+        .map(|(l, c)| LevelSeparation {
+            pair: l.left,
+            sides: l.sides,
+            elevation: l.elevation,
+            required: c.closing.max(0.0),
+            time: c.time,
+            peak_left: c.peak_left,
+            peak_right: c.peak_right,
+        })
+        .collect();
+    let sep = Separation {
+        levels,
+        refined_steps: 0,
+        substeps: out.substeps,
+        fundamental,
+        error_bound: None,
+    };
+    let end = if collapses.is_empty() {
+        RunEnd::Whole
+    } else {
+        RunEnd::Collapsed
+    };
+    (
+        sep,
+        Outcome {
+            end,
+            collapses,
+            censors,
+        },
+    )
+}
+
 /// What one adjacent pair needs in one run: the exact gap at its governing level (the level
 /// that needs the most) and, per rule, the largest over its levels of the rule's gap.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -217,6 +378,11 @@ pub struct PairGap {
     pub period_ratio: f64,
     /// CQC correlation of the two fundamental modes.
     pub rho: f64,
+    /// The collapse of one of the two buildings that ended the time the gaps are taken over
+    /// (the earlier one; where the solver ends the whole run at its first collapse, that
+    /// one): `required` is then a lower bound on what the pair needs, and the rules' gaps are
+    /// from the peaks before it. None: over the whole run.
+    pub censored: Option<Collapse>,
 }
 
 impl PairGap {
@@ -244,8 +410,9 @@ pub fn covering_rule(required: f64, peak_left: f64, peak_right: f64, rho: f64) -
 pub struct GapRun {
     pub motion: u64,
     pub separation: Separation,
-    /// Per adjacent pair (None where the two share no floor level).
+    /// Per adjacent pair (None where the two share no floor level, or the run failed).
     pub pairs: Vec<Option<PairGap>>,
+    pub end: RunEnd,
 }
 
 /// A study, run.
@@ -254,6 +421,8 @@ pub struct GapStudy<'a> {
     motions: Motions,
     /// One per record and inner motion, at unit scale; or, where storeys yield, one per run.
     responses: Vec<Separation>,
+    /// Where storeys yield, how each run ended (empty otherwise: every run is whole).
+    outcomes: Vec<Outcome>,
     /// Per run, what each adjacent pair needs.
     pair_gaps: Vec<Vec<Option<PairGap>>>,
     /// The contact levels' column prefixes (the same in every run).
@@ -293,7 +462,7 @@ impl<'a> GapStudy<'a> {
         } else {
             motions.records as u64 * inner
         };
-        let responses: Vec<Separation> = (0..count)
+        let (responses, outcomes): (Vec<Separation>, Vec<Option<Outcome>>) = (0..count)
             .into_par_iter()
             .map(|u| {
                 // Elastic: the response's first intensity, at unit scale.
@@ -302,12 +471,12 @@ impl<'a> GapStudy<'a> {
                 } else {
                     ((u / inner) * per_record + u % inner, (u / inner) as usize)
                 };
-                scenes
-                    .response(m, record)
-                    .map_err(|e| format!("run {m}: {e}"))
+                scenes.response(m, record)
             })
-            .collect::<Result<_, _>>()?;
-        let first = responses.first();
+            .unzip();
+        let outcomes: Vec<Outcome> = outcomes.into_iter().flatten().collect();
+        // A failed run has no levels: the names are any other's (every run has the same).
+        let first = responses.iter().find(|s| !s.levels.is_empty());
         let level_names = first.map_or(Vec::new(), |s| {
             s.levels
                 .iter()
@@ -319,19 +488,91 @@ impl<'a> GapStudy<'a> {
             scenes,
             motions,
             responses,
+            outcomes,
             level_names,
             level_pairs,
             pair_gaps: Vec::new(),
         };
+        let failed = study.failed();
+        if !study.is_empty() && failed.len() as u64 == study.len() {
+            // Statistics over zero runs are not zeros.
+            return Err(format!(
+                "every run ended early, so there is no gap to give: {}",
+                study.run_list(&failed, 5, |o| o.end.key().to_string())
+            ));
+        }
         study.pair_gaps = (0..study.len())
             .into_par_iter()
             .map(|m| {
+                let outcome = study.outcome(m);
+                if outcome.is_some_and(|o| matches!(o.end, RunEnd::Failed(_))) {
+                    return vec![None; study.pairs()];
+                }
                 // One decode of the motion serves its scale and its periods.
                 let (periods, scale) = study.scenes.periods(m);
-                study.pairs_of(&study.scaled(m, scale), &periods)
+                let censors = outcome.map(|o| &o.censors[..]);
+                study.pairs_of(&study.scaled(m, scale), &periods, censors)
             })
             .collect();
         Ok(study)
+    }
+
+    /// How run `m` ended, where runs are stepped one by one (storeys yield).
+    pub fn outcome(&self, m: u64) -> Option<&Outcome> {
+        self.outcomes.get(m as usize)
+    }
+
+    /// The runs where some building collapsed, in run order.
+    pub fn collapsed(&self) -> Vec<u64> {
+        self.runs_where(|o| o.end == RunEnd::Collapsed)
+    }
+
+    /// The runs that ended early for another reason (left out of every statistic).
+    pub fn failed(&self) -> Vec<u64> {
+        self.runs_where(|o| matches!(o.end, RunEnd::Failed(_)))
+    }
+
+    fn runs_where(&self, f: impl Fn(&Outcome) -> bool) -> Vec<u64> {
+        (0..self.outcomes.len() as u64)
+            .filter(|&m| f(&self.outcomes[m as usize]))
+            .collect()
+    }
+
+    /// Run `m` for a message: `run 43 (kobe_1995_jma, Sa 1.25 g)`.
+    pub fn run_label(&self, m: u64) -> String {
+        let (record, intensity) = self.motions.record_and_intensity(m);
+        let name = &self.scenes.base().spec.records[record].name;
+        let sample = match self.scenes.0 {
+            Plan::Pair(p) => p.motion_run(m).sample,
+            Plan::Row(r) => r.motion_run(m).sample,
+        };
+        let sample = sample.map(|s| format!(", sample {s}")).unwrap_or_default();
+        format!(
+            "run {m} ({name}, {}{sample})",
+            self.intensity_label(intensity)
+        )
+    }
+
+    /// The first `most` of `runs` labelled, each with `what` of its outcome, and how many more.
+    pub fn run_list(&self, runs: &[u64], most: usize, what: impl Fn(&Outcome) -> String) -> String {
+        let mut parts: Vec<String> = runs
+            .iter()
+            .take(most)
+            .map(|&m| {
+                let o = &self.outcomes[m as usize];
+                format!("{}: {}", self.run_label(m), what(o))
+            })
+            .collect();
+        if runs.len() > most {
+            parts.push(format!("and {} more", runs.len() - most));
+        }
+        parts.join("; ")
+    }
+
+    /// Does the CSV say per pair which collapse its gaps stop at (storeys yield, with a
+    /// collapse limit)?
+    fn censoring(&self) -> bool {
+        self.per_run() && self.scenes.collapse_limit().is_finite()
     }
 
     /// Run `m`'s separation: its response, scaled to its intensity (per run: a spectral target
@@ -409,12 +650,18 @@ impl<'a> GapStudy<'a> {
             motion: m,
             separation: self.separation(m),
             pairs: self.pair_gaps[m as usize].clone(),
+            end: self.outcome(m).map_or(RunEnd::Whole, |o| o.end),
         }
     }
 
     /// What each adjacent pair needs in a run of separation `sep` whose buildings have these
-    /// fundamental periods.
-    fn pairs_of(&self, sep: &Separation, periods: &[f64]) -> Vec<Option<PairGap>> {
+    /// fundamental periods, each pair's gaps stopping at `censors`' collapse where given.
+    fn pairs_of(
+        &self,
+        sep: &Separation,
+        periods: &[f64],
+        censors: Option<&[Option<Collapse>]>,
+    ) -> Vec<Option<PairGap>> {
         (0..self.pairs())
             .map(|a| {
                 let (wa, xa) = sep.fundamental[a];
@@ -436,6 +683,7 @@ impl<'a> GapStudy<'a> {
                                 rules,
                                 period_ratio: periods[a + 1] / periods[a],
                                 rho,
+                                censored: censors.and_then(|c| c[a]),
                             })
                         }
                         Some(b) => {
@@ -457,12 +705,19 @@ impl<'a> GapStudy<'a> {
     /// Every column, in file order.
     pub fn header(&self) -> Vec<String> {
         let mut h = self.scenes.parameter_header();
+        if self.per_run() {
+            h.push("status".into());
+        }
         for a in 0..self.pairs() {
             let s = self.suffix(a);
             h.push(format!("period_ratio{s}"));
             h.push(format!("rho{s}"));
             h.push(format!("required_gap{s}_m"));
             h.push(format!("required_at{s}_s"));
+            if self.censoring() {
+                h.push(format!("censored_by{s}"));
+                h.push(format!("censored_at{s}_s"));
+            }
             h.push(format!("peak_left{s}_m"));
             h.push(format!("peak_right{s}_m"));
             for r in Rule::ALL {
@@ -494,11 +749,20 @@ impl<'a> GapStudy<'a> {
     pub fn cells(&self, run: &GapRun) -> Vec<String> {
         let mut c = self.scenes.cells(run.motion);
         let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+        if self.per_run() {
+            c.push(run.end.key().into());
+        }
+        let censoring = self.censoring();
         for p in &run.pairs {
             match p {
                 Some(p) => {
                     c.extend([p.period_ratio, p.rho, p.required].map(num));
                     c.push(opt(p.time));
+                    if censoring {
+                        let by = p.censored.map(|x| x.building.to_string());
+                        c.push(by.unwrap_or_default());
+                        c.push(opt(p.censored.map(|x| x.time)));
+                    }
                     c.extend([p.peak_left, p.peak_right].map(num));
                     c.extend(p.rules.map(num));
                     c.extend((0..3).map(|r| opt(p.ratio(r))));
@@ -507,12 +771,17 @@ impl<'a> GapStudy<'a> {
                     }
                 }
                 None => {
-                    let n = 12 + usize::from(self.per_level());
+                    let n = 12 + usize::from(self.per_level()) + 2 * usize::from(censoring);
                     c.extend(std::iter::repeat_n(String::new(), n));
                 }
             }
         }
         if self.per_level() {
+            if run.separation.levels.is_empty() {
+                // A failed run: no level has a value.
+                let n = self.level_names.len() * (4 + Rule::ALL.len());
+                c.extend(std::iter::repeat_n(String::new(), n));
+            }
             for l in &run.separation.levels {
                 let rho = run.pairs[l.pair].expect("a level's pair shares it").rho;
                 c.extend([l.required, l.peak_left, l.peak_right].map(num));
@@ -547,15 +816,15 @@ impl<'a> GapStudy<'a> {
 
     /// Per pair and rule: the ratio of the rule's gap to the exact one over the runs whose
     /// floors close, and how often the rule is unconservative (asks for less than the exact
-    /// gap), over all runs.
+    /// gap), over all runs whose gaps are over the whole run: a run censored by a collapse
+    /// (its exact gap a lower bound, its rules' from the peaks before the collapse) is
+    /// counted apart, and a failed one left out.
     pub fn summary(&self) -> Vec<RuleSummary> {
         let mut out = Vec::new();
         for a in 0..self.pairs() {
-            let pairs: Vec<&PairGap> = self
-                .pair_gaps
-                .iter()
-                .filter_map(|r| r[a].as_ref())
-                .collect();
+            let all = self.pair_gaps.iter().filter_map(|r| r[a].as_ref());
+            let censored = all.clone().filter(|p| p.censored.is_some()).count();
+            let pairs: Vec<&PairGap> = all.filter(|p| p.censored.is_none()).collect();
             for (k, rule) in Rule::ALL.into_iter().enumerate() {
                 let mut ratios: Vec<f64> = pairs.iter().filter_map(|p| p.ratio(k)).collect();
                 ratios.sort_by(f64::total_cmp);
@@ -564,6 +833,7 @@ impl<'a> GapStudy<'a> {
                     pair: a,
                     rule,
                     runs: pairs.len(),
+                    censored,
                     closing: ratios.len(),
                     median: quantile(&ratios, 0.5),
                     p10: quantile(&ratios, 0.1),
@@ -575,7 +845,8 @@ impl<'a> GapStudy<'a> {
         out
     }
 
-    /// The largest required gap of pair `a` over the study's runs, m.
+    /// The largest required gap of pair `a` over the study's runs (or lower bound, where a
+    /// collapse censored it), m.
     pub fn largest_required(&self, a: usize) -> f64 {
         self.pair_gaps
             .iter()
@@ -602,35 +873,49 @@ impl<'a> GapStudy<'a> {
     }
 
     /// Per intensity, the share of runs of pair `a` that pound at each of `gaps` (their
-    /// required gap exceeds it), and the lognormal fitted to the runs' required gaps.
+    /// required gap exceeds it), and the lognormal fitted to the runs' required gaps. A run
+    /// censored by a collapse pounds at the gaps below its lower bound; above it, whether it
+    /// would is unknown, so it is counted there in neither the runs nor those that pound, and
+    /// it enters the fit as a lower bound ([`GapFit::censored`]).
     pub fn pounding(&self, a: usize, gaps: &[f64]) -> Vec<PoundingCurve> {
-        let required: Vec<(usize, f64)> = (0..self.len())
+        // (intensity, required gap or its lower bound, censored)
+        let required: Vec<(usize, f64, bool)> = (0..self.len())
             .filter_map(|m| {
                 let (_, intensity) = self.motions.record_and_intensity(m);
-                self.pair_gaps[m as usize][a].map(|p| (intensity, p.required))
+                self.pair_gaps[m as usize][a].map(|p| (intensity, p.required, p.censored.is_some()))
             })
             .collect();
         (0..self.motions.intensities)
             .map(|i| {
-                let mine: Vec<f64> = required
-                    .iter()
-                    .filter(|(k, _)| *k == i)
-                    .map(|(_, g)| *g)
-                    .collect();
+                let of = |censored: bool| -> Vec<f64> {
+                    required
+                        .iter()
+                        .filter(|(k, _, c)| *k == i && *c == censored)
+                        .map(|(_, g, _)| *g)
+                        .collect()
+                };
+                let (mine, bounds) = (of(false), of(true));
                 let points: Vec<(f64, u64, u64)> = gaps
                     .iter()
                     .map(|&g| {
-                        let pound = mine.iter().filter(|&&r| r > g).count() as u64;
-                        (g, mine.len() as u64, pound)
+                        let known = bounds.iter().filter(|&&b| b > g).count() as u64;
+                        let pound = mine.iter().filter(|&&r| r > g).count() as u64 + known;
+                        (g, mine.len() as u64 + known, pound)
                     })
                     .collect();
+                let closing = |v: &[f64]| v.iter().filter(|&&r| r > 0.0).count() as u64;
                 PoundingCurve {
                     pair: a,
                     intensity: i,
                     points,
-                    runs: mine.len() as u64,
-                    closing: mine.iter().filter(|&&r| r > 0.0).count() as u64,
-                    fit: GapFit::of(&mine),
+                    runs: mine.len() as u64 + closing(&bounds),
+                    closing: closing(&mine) + closing(&bounds),
+                    censored: bounds.len() as u64,
+                    fit: if bounds.is_empty() {
+                        GapFit::of(&mine)
+                    } else {
+                        GapFit::censored(&mine, &bounds)
+                    },
                 }
             })
             .collect()
@@ -695,7 +980,8 @@ impl<'a> GapStudy<'a> {
                 let points: Vec<(f64, f64)> = runs
                     .iter()
                     .filter(|x| x.0 == r)
-                    .filter_map(|x| x.1[a].map(|p| (x_of(r, &p), p.required * 1e3)))
+                    .filter_map(|x| x.1[a].filter(|p| p.censored.is_none()))
+                    .map(|p| (x_of(r, &p), p.required * 1e3))
                     .collect();
                 if !points.is_empty() {
                     by_record.push(Series {
@@ -705,6 +991,19 @@ impl<'a> GapStudy<'a> {
                         style: None,
                     });
                 }
+            }
+            let bounds: Vec<(f64, f64)> = runs
+                .iter()
+                .filter_map(|x| x.1[a].filter(|p| p.censored.is_some()).map(|p| (x.0, p)))
+                .map(|(r, p)| (x_of(r, &p), p.required * 1e3))
+                .collect();
+            if !bounds.is_empty() {
+                by_record.push(Series {
+                    name: "a building collapsed: lower bound (any record)".into(),
+                    points: bounds,
+                    scatter: true,
+                    style: None,
+                });
             }
             panels.push(Panel {
                 title: format!("Required gap (time history){name}"),
@@ -729,7 +1028,9 @@ impl<'a> GapStudy<'a> {
                             } else {
                                 0.0
                             };
-                            x.1[a].and_then(|p| p.ratio(k).map(|q| (x_of(x.0, &p) + dodge, q)))
+                            // A censored run's ratio is to a lower bound: not a rule's record.
+                            let p = x.1[a].filter(|p| p.censored.is_none());
+                            p.and_then(|p| p.ratio(k).map(|q| (x_of(x.0, &p) + dodge, q)))
                         })
                         .collect(),
                     scatter: true,
@@ -771,7 +1072,8 @@ impl<'a> GapStudy<'a> {
                     points: c
                         .points
                         .iter()
-                        .map(|&(g, n, k)| (g * 1e3, k as f64 / n.max(1) as f64))
+                        .filter(|p| p.1 > 0)
+                        .map(|&(g, n, k)| (g * 1e3, k as f64 / n as f64))
                         .collect(),
                     scatter: true,
                     style: Some(k),
@@ -813,8 +1115,10 @@ impl<'a> GapStudy<'a> {
 pub struct RuleSummary {
     pub pair: usize,
     pub rule: Rule,
-    /// Runs where the pair shares a level.
+    /// Runs where the pair shares a level, whose gaps are over the whole run.
     pub runs: usize,
+    /// Runs censored by a collapse (left out of the statistics here).
+    pub censored: usize,
     /// Of those, runs whose floors close at all (the ratio is defined).
     pub closing: usize,
     /// Quantiles of rule / exact over the closing runs (NaN where there are none).
@@ -832,9 +1136,13 @@ pub struct PoundingCurve {
     pub intensity: usize,
     /// `(gap, runs, runs that pound)`, at the gaps counted (for display).
     pub points: Vec<(f64, u64, u64)>,
-    /// Runs of the pair at this intensity, and of those, runs whose floors close.
+    /// Runs of the pair at this intensity, and of those, runs whose floors close (a run
+    /// censored by a collapse counts in both where its lower bound is above 0; at 0 it says
+    /// nothing and counts in neither).
     pub runs: u64,
     pub closing: u64,
+    /// Runs censored by a collapse at this intensity (their required gaps lower bounds).
+    pub censored: u64,
     /// The lognormal fitted to the runs' required gaps.
     pub fit: Result<GapFit, NoGapFit>,
 }
@@ -865,6 +1173,8 @@ pub struct GapFit {
     /// Runs counted, and of those, runs whose floors close (required gap > 0).
     pub runs: u64,
     pub closing: u64,
+    /// Of the closing runs, those whose required gap is a lower bound ([`GapFit::censored`]).
+    pub censored: u64,
 }
 
 /// Why no lognormal could be fitted to the required gaps.
@@ -878,6 +1188,8 @@ pub enum NoGapFit {
     OneCloses,
     #[error("every run whose floors close needs the same gap: the dispersion is 0")]
     AllEqual,
+    #[error("fewer than two exact gaps (the other runs collapsed): their lower bounds alone fix no lognormal")]
+    TooFewExact,
 }
 
 impl GapFit {
@@ -909,6 +1221,120 @@ impl GapFit {
             se_beta: beta / (2.0 * n as f64).sqrt(),
             runs: required.len() as u64,
             closing: n as u64,
+            censored: 0,
+        })
+    }
+
+    /// As [`GapFit::of`], with `bounds` the required gaps of runs a collapse censored: each is
+    /// a lower bound (the floors had closed that far when a building collapsed; how far they
+    /// would have closed had it stood is unknown). A bound above 0 is a run whose floors close
+    /// and enters the likelihood with the probability of exceeding it,
+    /// `1 - Phi((ln b - ln median) / beta)` (right-censored maximum likelihood, as survival
+    /// analysis fits lifetimes still running); a bound of 0 says nothing and is left out.
+    /// At least two exact required gaps above 0, not all equal, are needed: the bounds alone
+    /// fix no lognormal (its likelihood grows without limit as the median does).
+    ///
+    /// The maximum is found by Newton's method in `(ln median / beta, 1 / beta)`, where the
+    /// log-likelihood is concave (Olsen 1978, for the Tobit model), so it is the only one;
+    /// the standard errors are from the observed information there.
+    pub fn censored(required: &[f64], bounds: &[f64]) -> Result<GapFit, NoGapFit> {
+        let c: Vec<f64> = bounds
+            .iter()
+            .filter(|&&b| b > 0.0)
+            .map(|b| b.ln())
+            .collect();
+        if c.is_empty() {
+            return GapFit::of(required);
+        }
+        let x: Vec<f64> = required
+            .iter()
+            .filter(|&&r| r > 0.0)
+            .map(|r| r.ln())
+            .collect();
+        if x.len() < 2 {
+            return Err(NoGapFit::TooFewExact);
+        }
+        let n = x.len() as f64;
+        let mean = x.iter().sum::<f64>() / n;
+        let spread = (x.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n).sqrt();
+        if spread.is_nan() || spread <= 1e-12 {
+            return Err(NoGapFit::AllEqual);
+        }
+        // (g, h) = (mu / sigma, 1 / sigma): an exact value's log-density is
+        // ln h - (h x - g)^2 / 2, a bound's ln(1 - Phi(h c - g)).
+        let loglik = |g: f64, h: f64| -> f64 {
+            let exact: f64 = x.iter().map(|&v| h.ln() - 0.5 * (h * v - g).powi(2)).sum();
+            exact + c.iter().map(|&v| ln_upper_tail(h * v - g)).sum::<f64>()
+        };
+        // The gradient and the Hessian (negative definite everywhere).
+        let derivatives = |g: f64, h: f64| -> ([f64; 2], [f64; 3]) {
+            let (mut dg, mut dh) = (0.0, 0.0);
+            let (mut hgg, mut hgh, mut hhh) = (0.0, 0.0, 0.0);
+            for &v in &x {
+                let r = h * v - g;
+                dg += r;
+                dh += 1.0 / h - r * v;
+                hgg -= 1.0;
+                hgh += v;
+                hhh -= 1.0 / (h * h) + v * v;
+            }
+            for &v in &c {
+                let z = h * v - g;
+                let l = mills(z);
+                let d = l * (l - z);
+                dg += l;
+                dh -= l * v;
+                hgg -= d;
+                hgh += d * v;
+                hhh -= d * v * v;
+            }
+            ([dg, dh], [hgg, hgh, hhh])
+        };
+        let (mut g, mut h) = (mean / spread, 1.0 / spread);
+        for _ in 0..200 {
+            let ([dg, dh], [a, b, d]) = derivatives(g, h);
+            let det = a * d - b * b;
+            // Newton's step -H^-1 grad.
+            let (mut sg, mut sh) = (-(d * dg - b * dh) / det, -(a * dh - b * dg) / det);
+            let l0 = loglik(g, h);
+            let mut halvings = 0;
+            while !(h + sh > 0.0 && loglik(g + sg, h + sh) >= l0 - 1e-12 * l0.abs())
+                && halvings < 60
+            {
+                sg *= 0.5;
+                sh *= 0.5;
+                halvings += 1;
+            }
+            if halvings == 60 {
+                break;
+            }
+            g += sg;
+            h += sh;
+            if sg.abs() <= 1e-12 * (1.0 + g.abs()) && sh.abs() <= 1e-12 * h {
+                break;
+            }
+        }
+        let (_, [a, b, d]) = derivatives(g, h);
+        // Covariance of (g, h): the inverse of the observed information -H; then the delta
+        // method for ln median = g / h and beta = 1 / h.
+        let det = a * d - b * b;
+        let (vgg, vgh, vhh) = (-d / det, b / det, -a / det);
+        let (ug, uh) = (1.0 / h, -g / (h * h));
+        let var_ln_median = ug * ug * vgg + 2.0 * ug * uh * vgh + uh * uh * vhh;
+        let beta = 1.0 / h;
+        if !(beta.is_finite() && beta > 1e-12 && g.is_finite()) {
+            return Err(NoGapFit::AllEqual);
+        }
+        let positive = |v: &[f64]| v.iter().filter(|&&r| r > 0.0).count() as u64;
+        let known = required.len() as u64 + c.len() as u64;
+        Ok(GapFit {
+            median: (g / h).exp(),
+            beta,
+            se_ln_median: var_ln_median.max(0.0).sqrt(),
+            se_beta: vhh.max(0.0).sqrt() / (h * h),
+            runs: known,
+            closing: positive(required) + c.len() as u64,
+            censored: c.len() as u64,
         })
     }
 
@@ -936,6 +1362,26 @@ impl GapFit {
             return Some(0.0);
         }
         Some(self.median * (self.beta * crate::plan::sample::phi_inv(1.0 - q)).exp())
+    }
+}
+
+/// `ln(1 - Phi(z))`, also where `1 - Phi(z)` underflows (its asymptotic series there).
+fn ln_upper_tail(z: f64) -> f64 {
+    if z < 30.0 {
+        phi(-z).ln()
+    } else {
+        -0.5 * z * z - (z * (2.0 * std::f64::consts::PI).sqrt()).ln() + (-1.0 / (z * z)).ln_1p()
+    }
+}
+
+/// The inverse Mills ratio `phi(z) / (1 - Phi(z))`: the mean of a standard normal above `z`.
+fn mills(z: f64) -> f64 {
+    if z < 30.0 {
+        let density = (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
+        density / phi(-z)
+    } else {
+        // z + 1/z - 2/z^3 + ...: within 1e-7 of it from z = 30.
+        z + 1.0 / z - 2.0 / (z * z * z)
     }
 }
 
@@ -1034,6 +1480,80 @@ mod tests {
         assert_eq!(GapFit::of(&[0.0, 0.0]), Err(NoGapFit::NoneClose));
         assert_eq!(GapFit::of(&[0.0, 0.03]), Err(NoGapFit::OneCloses));
         assert_eq!(GapFit::of(&[0.03, 0.03]), Err(NoGapFit::AllEqual));
+    }
+
+    /// The right-censored fit: with no bound above 0 it is the exact fit; bounds far below
+    /// every exact gap carry no information (the same median, beta and standard errors, from
+    /// the observed information); bounds above them raise the median.
+    #[test]
+    fn a_censored_fit_without_information_is_the_exact_one() {
+        let exact = [0.0, 0.011, 0.023, 0.017, 0.031, 0.014];
+        assert_eq!(GapFit::censored(&exact, &[]), GapFit::of(&exact));
+        assert_eq!(GapFit::censored(&exact, &[0.0, 0.0]), GapFit::of(&exact));
+        let of = GapFit::of(&exact).unwrap();
+        let far = GapFit::censored(&exact, &[1e-9, 2e-9]).unwrap();
+        assert_eq!((far.runs, far.closing, far.censored), (8, 7, 2));
+        for (a, b) in [
+            (far.median, of.median),
+            (far.beta, of.beta),
+            (far.se_ln_median, of.se_ln_median),
+            (far.se_beta, of.se_beta),
+        ] {
+            assert!((a - b).abs() < 1e-9 * b, "{a} against {b}");
+        }
+        let high = GapFit::censored(&exact, &[0.03, 0.04]).unwrap();
+        assert!(high.median > of.median * 1.2, "{high:?}");
+        assert_eq!(
+            GapFit::censored(&[0.0, 0.02], &[0.03]),
+            Err(NoGapFit::TooFewExact)
+        );
+        assert_eq!(
+            GapFit::censored(&[0.02, 0.02], &[0.03]),
+            Err(NoGapFit::AllEqual)
+        );
+    }
+
+    /// The right-censored fit is the maximum of its likelihood, written here in `(ln median,
+    /// beta)` and searched on a grid: no grid point beats it, and the best is within a grid
+    /// step of it.
+    #[test]
+    fn the_censored_fit_maximises_its_likelihood() {
+        let exact = [0.012, 0.02, 0.027, 0.035, 0.016, 0.05, 0.022];
+        let bounds = [0.03, 0.045, 0.06, 0.018];
+        let f = GapFit::censored(&exact, &bounds).unwrap();
+        assert_eq!((f.runs, f.closing, f.censored), (11, 11, 4));
+        let loglik = |mu: f64, beta: f64| -> f64 {
+            let density: f64 = exact
+                .iter()
+                .map(|g| {
+                    let z = (g.ln() - mu) / beta;
+                    -beta.ln() - 0.5 * z * z
+                })
+                .sum();
+            let tails: f64 = bounds
+                .iter()
+                .map(|b| (1.0 - phi((b.ln() - mu) / beta)).ln())
+                .sum();
+            density + tails
+        };
+        let (mu, beta) = (f.median.ln(), f.beta);
+        let top = loglik(mu, beta);
+        let (step_mu, step_beta) = (0.002, 0.001);
+        let mut best = (f64::NEG_INFINITY, 0.0, 0.0);
+        for i in -200..=200 {
+            for j in -200..=200 {
+                let (m, b) = (mu + i as f64 * step_mu, beta + j as f64 * step_beta);
+                let l = loglik(m, b);
+                assert!(l <= top + 1e-6, "({m}, {b}): {l} above {top}");
+                if l > best.0 {
+                    best = (l, m, b);
+                }
+            }
+        }
+        assert!((best.1 - mu).abs() <= step_mu && (best.2 - beta).abs() <= step_beta);
+        // The censored runs needed more than their bounds: the median is above the exact
+        // gaps' alone.
+        assert!(f.median > GapFit::of(&exact).unwrap().median);
     }
 
     #[test]

@@ -16,6 +16,7 @@ mod fidelity;
 mod figures;
 mod floor_column;
 mod gap;
+mod gap_collapse;
 mod gpu;
 mod gpu_rows;
 mod hard;
