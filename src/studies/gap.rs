@@ -14,12 +14,10 @@
 //! [`PairGap::censored`]); a run that ends early for another reason has no gaps and is left
 //! out of every statistic ([`RunEnd::Failed`]).
 
-use crate::physics::contact::LawKind;
 use crate::physics::model::{Oscillator, Status};
-use crate::physics::row::{Collapse, LevelRule, Row};
+use crate::physics::row::{Collapse, LevelRule};
 use crate::physics::separation::{cqc_rho, Rule};
 use crate::physics::shear::ShearBuilding;
-use crate::physics::solver::row::{simulate_uncoupled, RowModel, UNCOUPLED_GAP_M};
 use crate::physics::solver::separation::{separation_with, LevelSeparation, Separation};
 use crate::plan::columns::{at, contact_and_motion, num, RECORD_IMS};
 use crate::plan::intensity::TARGET_COLUMNS;
@@ -248,20 +246,13 @@ pub struct Outcome {
 }
 
 /// The separation `buildings` (left to right; storeys may yield) need under `forcing`, from
-/// their run by the row `scheme` with every level out of reach ([`simulate_uncoupled`]) under
-/// the collapse limit `collapse_drift_ratio` (infinite: none), and how that run ended.
-///
-/// [`crate::physics::solver::separation::yielding_separation`] runs them with no collapse
-/// limit: a P-Delta storey past its collapse drift has a negative stiffness, and its frame runs
-/// away until a floor travels the levels' gap of [`UNCOUPLED_GAP_M`] (an impact, which it
-/// refuses: "a floor moved 1000000 m") or overflows (`non_finite`). Here the run stops at the
-/// collapse, and each level's closing and peaks are over the time before it. Where the solver
-/// ends the whole run at the first collapse (it names it only in [`RowOutput::collapse`]),
-/// every pair's gaps stop there; where each building collapses on its own
-/// ([`crate::physics::row::BuildingOutput::collapse`]) the others going on, a pair's gaps
-/// stop at the earlier collapse of its two buildings.
-///
-/// [`RowOutput::collapse`]: crate::physics::row::RowOutput::collapse
+/// their uncoupled run ([`crate::physics::solver::separation::uncoupled_separation`]) under
+/// the collapse limit `collapse_drift_ratio` (infinite: none), and how that run ended. Without
+/// the limit a P-Delta storey past its collapse drift has a negative stiffness and its frame
+/// runs away until a floor travels the levels' far gap (an impact: "runaway") or overflows
+/// (`non_finite`). With it, each building that collapses leaves the scene and the others go on
+/// (physics.md section 12): a pair's closing and peaks stop at the earlier collapse of its two
+/// buildings.
 pub fn uncoupled(
     buildings: Vec<ShearBuilding>,
     rule: LevelRule,
@@ -270,23 +261,13 @@ pub fn uncoupled(
     scheme: &crate::physics::solver::row::RowScheme,
 ) -> (Separation, Outcome) {
     let pairs = buildings.len() - 1;
-    // The contact law is never reached; it only has to be valid.
-    let row = Row::with_levels(
+    let (sep, out) = crate::physics::solver::separation::uncoupled_separation(
         buildings,
-        vec![UNCOUPLED_GAP_M; pairs],
-        LawKind::Linear,
-        1.0,
-        0.0,
         rule,
-    )
-    .with_collapse(collapse_drift_ratio);
-    let model = RowModel::new(&row);
-    let out = simulate_uncoupled(&model, forcing, scheme);
-    let fundamental = model
-        .buildings
-        .iter()
-        .map(|b| (b.modes.omega[0], b.modes.xi[0]))
-        .collect();
+        collapse_drift_ratio,
+        forcing,
+        scheme,
+    );
     let failed = match out.status {
         Status::Ok | Status::Collapsed if out.impacts > 0 => Some("runaway"),
         Status::Ok | Status::Collapsed => None,
@@ -294,9 +275,8 @@ pub fn uncoupled(
     };
     if let Some(why) = failed {
         let sep = Separation {
-            substeps: out.substeps,
-            fundamental,
-            ..Separation::default()
+            levels: Vec::new(),
+            ..sep
         };
         let outcome = Outcome {
             end: RunEnd::Failed(why),
@@ -306,44 +286,12 @@ pub fn uncoupled(
         return (sep, outcome);
     }
     let own: Vec<Option<Collapse>> = out.buildings.iter().map(|b| b.collapse).collect();
-    let (collapses, censors): (Vec<Collapse>, _) = if own.iter().all(Option::is_none) {
-        // No building collapsed, or the run ended at its first collapse: every level's
-        // closing stops there.
-        (
-            out.collapse.into_iter().collect(),
-            vec![out.collapse; pairs],
-        )
-    } else {
-        let earlier = |a: Option<Collapse>, b: Option<Collapse>| match (a, b) {
-            (Some(x), Some(y)) => Some(if y.time < x.time { y } else { x }),
-            (x, y) => x.or(y),
-        };
-        (
-            own.iter().flatten().copied().collect(),
-            (0..pairs).map(|a| earlier(own[a], own[a + 1])).collect(),
-        )
+    let earlier = |a: Option<Collapse>, b: Option<Collapse>| match (a, b) {
+        (Some(x), Some(y)) => Some(if y.time < x.time { y } else { x }),
+        (x, y) => x.or(y),
     };
-    let levels = row
-        .levels
-        .iter()
-        .zip(&out.closings)
-        .map(|(l, c)| LevelSeparation {
-            pair: l.left,
-            sides: l.sides,
-            elevation: l.elevation,
-            required: c.closing.max(0.0),
-            time: c.time,
-            peak_left: c.peak_left,
-            peak_right: c.peak_right,
-        })
-        .collect();
-    let sep = Separation {
-        levels,
-        refined_steps: 0,
-        substeps: out.substeps,
-        fundamental,
-        error_bound: None,
-    };
+    let collapses: Vec<Collapse> = own.iter().flatten().copied().collect();
+    let censors = (0..pairs).map(|a| earlier(own[a], own[a + 1])).collect();
     let end = if collapses.is_empty() {
         RunEnd::Whole
     } else {

@@ -159,7 +159,11 @@ fn at_a_gap_no_motion_closes_each_building_collapses_as_it_would_alone() {
             // The run's first collapse is the earlier of the two.
             if any {
                 let first = (0..2)
-                    .filter_map(|k| r[&format!("b{}_collapse_time_s", k + 1)].parse::<f64>().ok())
+                    .filter_map(|k| {
+                        r[&format!("b{}_collapse_time_s", k + 1)]
+                            .parse::<f64>()
+                            .ok()
+                    })
                     .fold(f64::INFINITY, f64::min);
                 assert_eq!(num(r, "collapse_time_s"), first, "{scheme} run {i}");
             }
@@ -198,8 +202,7 @@ fn a_crossing_is_located_however_the_drift_moves_in_the_step() {
                 let what = format!("limit {limit}, {substeps} substeps, run {i}");
                 assert_eq!(f["b1_collapsed"], "1", "{what}");
                 assert_eq!(f["b1_collapse_storey"], r["b1_collapse_storey"], "{what}");
-                let err =
-                    (num(f, "b1_collapse_time_s") - num(r, "b1_collapse_time_s")).abs();
+                let err = (num(f, "b1_collapse_time_s") - num(r, "b1_collapse_time_s")).abs();
                 // At the default (16) and finer within 1e-4 s; at 8 a grazing crossing (the
                 // drift turning back at the limit) moves by 2.9e-4 s.
                 let bound = if substeps < 16 { 1e-3 } else { 1e-4 };
@@ -253,7 +256,10 @@ fn a_collapsed_buildings_contacts_end_and_its_neighbour_goes_on() {
         .collect();
     assert!(after.len() > 100, "the trace goes on after the collapse");
     let end = num(after.last().unwrap(), "t_s");
-    assert!(end > t_c + 2.0, "to the record's and tail's end: {end} after {t_c}");
+    assert!(
+        end > t_c + 2.0,
+        "to the record's and tail's end: {end} after {t_c}"
+    );
     let first = after[0];
     let mut neighbour_moved = false;
     for s in &after {

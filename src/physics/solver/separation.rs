@@ -558,17 +558,33 @@ pub fn yielding_separation(
     scheme: &RowScheme,
     rule: LevelRule,
 ) -> Result<Separation, String> {
-    let gaps = vec![UNCOUPLED_GAP_M; buildings.len() - 1];
-    // The contact law is never reached; it only has to be valid.
-    let row = Row::with_levels(buildings.to_vec(), gaps, LawKind::Linear, 1.0, 0.0, rule);
-    let model = RowModel::new(&row);
-    let out = simulate_uncoupled(&model, forcing, scheme);
+    let (sep, out) = uncoupled_separation(buildings.to_vec(), rule, f64::INFINITY, forcing, scheme);
     if out.status != Status::Ok {
         return Err(format!("the run ended early ({})", out.status.key()));
     }
     if out.impacts > 0 {
         return Err(format!("a floor moved {UNCOUPLED_GAP_M} m"));
     }
+    Ok(sep)
+}
+
+/// [`yielding_separation`] under a collapse drift ratio (infinite: none), with the run's output
+/// for the caller to judge: its status, each building's collapse (a level's closing and peaks
+/// are over the time before the earlier collapse of its two buildings), and impacts where a
+/// floor travelled the levels' gap of [`UNCOUPLED_GAP_M`] (a runaway).
+pub fn uncoupled_separation(
+    buildings: Vec<ShearBuilding>,
+    rule: LevelRule,
+    collapse_drift_ratio: f64,
+    forcing: &Forcing,
+    scheme: &RowScheme,
+) -> (Separation, crate::physics::row::RowOutput) {
+    let gaps = vec![UNCOUPLED_GAP_M; buildings.len() - 1];
+    // The contact law is never reached; it only has to be valid.
+    let row = Row::with_levels(buildings, gaps, LawKind::Linear, 1.0, 0.0, rule)
+        .with_collapse(collapse_drift_ratio);
+    let model = RowModel::new(&row);
+    let out = simulate_uncoupled(&model, forcing, scheme);
     let levels = row
         .levels
         .iter()
@@ -583,7 +599,7 @@ pub fn yielding_separation(
             peak_right: c.peak_right,
         })
         .collect();
-    Ok(Separation {
+    let sep = Separation {
         levels,
         refined_steps: 0,
         substeps: out.substeps,
@@ -594,7 +610,8 @@ pub fn yielding_separation(
             .map(|b| (b.modes.omega[0], b.modes.xi[0]))
             .collect(),
         error_bound: None,
-    })
+    };
+    (sep, out)
 }
 
 #[cfg(test)]

@@ -170,7 +170,10 @@ fn no_silent_physics() {
             &STOREYS3.replace("storey_height_m = 3.0", "storey_height_m = 1e-9"),
             "",
         )
-        .replace("tail_s = 0.5", "tail_s = 0.5\ncollapse_drift_ratio = \"none\""),
+        .replace(
+            "tail_s = 0.5",
+            "tail_s = 0.5\ncollapse_drift_ratio = \"none\"",
+        ),
     );
     warns(
         &super::sweep(&flat, &d.path().join("flat.csv"), &[]),

@@ -339,16 +339,9 @@ impl<'m> RowRun<'m> {
                 let c = self.collapse_max(&zb);
                 let c0 = self.collapse_max(&z0);
                 if c > 0.0 && c0 <= 0.0 {
-                    (x, zb) = locate(
-                        x,
-                        c0,
-                        zb,
-                        c,
-                        tol,
-                        max_iter,
-                        &mut step,
-                        |s: &Vec<f64>| self.collapse_max(s),
-                    );
+                    (x, zb) = locate(x, c0, zb, c, tol, max_iter, &mut step, |s: &Vec<f64>| {
+                        self.collapse_max(s)
+                    });
                 }
             }
             self.track(t, x, &z0, &zb, (ag(t), ag(t + x)));

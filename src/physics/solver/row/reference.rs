@@ -158,8 +158,7 @@ pub(crate) fn run_tracked<'a>(
                 h = h_touch;
                 continue;
             }
-            let step =
-                |x: f64| dopri(m, (&modes, &storeys, &active), &seg, t, &z0, x, o.rtol).0;
+            let step = |x: f64| dopri(m, (&modes, &storeys, &active), &seg, t, &z0, x, o.rtol).0;
             t += run.accept(&seg, t, hs, trial, 1e-13, 100, step);
             if run.active != active {
                 // A building left the scene: it stands frozen from here on.

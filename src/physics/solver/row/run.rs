@@ -590,7 +590,12 @@ impl<'m> RowRun<'m> {
         }
         let m = self.modal;
         let mut live = z.to_vec();
-        for (k, b) in m.buildings.iter().enumerate().filter(|(k, _)| self.gone[*k]) {
+        for (k, b) in m
+            .buildings
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| self.gone[*k])
+        {
             for i in b.off..b.off + b.n() {
                 (live[i], live[m.n + i]) = (0.0, 0.0);
             }
