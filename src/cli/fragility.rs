@@ -22,12 +22,14 @@ pub struct Args {
     im: Option<String>,
     /// Demand column (e.g. peak_force_n, b1_peak_drift_ratio; `impacts` with threshold 0 for
     /// "pounds at all"), or `collapsed` for the collapse fragility P(collapse | IM) (no
-    /// threshold: a run collapsed, its status `collapsed`, or it did not). A collapsed run counts
-    /// as exceeding every threshold and damage state of any column (an infinite demand).
+    /// threshold: a run collapsed, its status `collapsed`, or it did not), `bK_collapsed` for
+    /// building K's, P(building K collapses | IM). A collapse counts as exceeding every threshold
+    /// and damage state (an infinite demand): of a building's column (bK_...), building K's own
+    /// collapse (bK_collapsed); of a column of the run, any building's.
     #[arg(long, default_value = "peak_force_n")]
     edp: String,
     /// Exceedance thresholds (EDP > threshold), comma-separated (one of --threshold and
-    /// --damage-states, except with --edp collapsed, which takes neither).
+    /// --damage-states, except with --edp collapsed or bK_collapsed, which take neither).
     #[arg(long, value_delimiter = ',')]
     threshold: Vec<f64>,
     /// Named damage states instead of thresholds: a built-in set (hazus-TYPE-LEVEL, e.g.

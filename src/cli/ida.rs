@@ -16,8 +16,9 @@ pub struct Args {
     /// scaled to, else pga_g.
     #[arg(long)]
     im: Option<String>,
-    /// Demand column (e.g. b1_peak_drift_ratio, peak_force_n). A collapsed run (status
-    /// `collapsed`) is an infinite demand: its curve flatlines at its first collapse.
+    /// Demand column (e.g. b1_peak_drift_ratio, peak_force_n). A collapse is an infinite demand:
+    /// a curve flatlines at its first collapse, of a building's column (bK_...) building K's own
+    /// (bK_collapsed), of a column of the run any building's (status `collapsed`).
     #[arg(long)]
     edp: String,
     /// The columns that name a curve, comma-separated (default: record, and sample where the

@@ -4,11 +4,14 @@
 //! likelihood (binomial at each level; Baker 2015), solved as a probit regression on `ln IM` by
 //! Fisher scoring.
 //!
-//! Collapse (physics.md section 10): a run whose status is `collapsed` ended where a storey's
-//! drift ratio reached the limit; its demand is taken as infinite, so it exceeds every threshold
-//! and damage state (counted, not left out), and `--edp collapsed` ([`COLLAPSED`]) fits the
-//! collapse fragility `P(collapse | IM)` itself: each run is 1 if it collapsed, else 0 (FEMA
-//! P-695; Baker 2015). Runs of any other status but `ok` failed, and are left out.
+//! Collapse (physics.md sections 10 and 12): a collapsed demand is taken as infinite, so it
+//! exceeds every threshold and damage state (counted, not left out). Whose collapse it is follows
+//! the demand ([`CollapseOf`]): a building's column (`bK_...`) collapses with building K alone
+//! (its `bK_collapsed`), a column of the run (`peak_force_n`, a contact level's) with any building
+//! (status `collapsed`). `--edp collapsed` ([`COLLAPSED`]) fits the run's collapse fragility
+//! `P(collapse | IM)` itself, `--edp bK_collapsed` building K's: each run is 1 if it (building K)
+//! collapsed, else 0 (FEMA P-695; Baker 2015). Runs of any other status but `ok` failed, and are
+//! left out.
 
 use crate::io::table::{caption, label, order_key, Filter, Table, TableError};
 use crate::plan::sample::phi;
@@ -83,11 +86,18 @@ impl NoFit {
 
     /// The reason in full for the collapse fragility, whose "threshold" is collapse itself.
     pub fn collapse(&self) -> String {
-        match self {
-            NoFit::NoneExceed => "no run collapsed".into(),
-            NoFit::AllExceed => "every run collapsed".into(),
-            NoFit::Separated => "the counts separate perfectly (no collapse below one intensity, all collapse above): the dispersion is 0".into(),
-            e => e.to_string(),
+        self.collapse_of(None)
+    }
+
+    /// [`NoFit::collapse`] for the collapse of building `k` (None: of the run, any building).
+    pub fn collapse_of(&self, building: Option<usize>) -> String {
+        match (self, building) {
+            (NoFit::NoneExceed, None) => "no run collapsed".into(),
+            (NoFit::NoneExceed, Some(k)) => format!("building {k} collapsed in no run"),
+            (NoFit::AllExceed, None) => "every run collapsed".into(),
+            (NoFit::AllExceed, Some(k)) => format!("building {k} collapsed in every run"),
+            (NoFit::Separated, _) => "the counts separate perfectly (no collapse below one intensity, all collapse above): the dispersion is 0".into(),
+            (e, _) => e.to_string(),
         }
     }
 
@@ -294,6 +304,123 @@ pub fn chi_square_sf(x: f64, dof: f64) -> f64 {
 /// The `--edp` of the collapse fragility: not a column, the runs' status (`collapsed` or not).
 pub const COLLAPSED: &str = "collapsed";
 
+/// The building whose column `column` is (`b2_peak_drift_ratio`, `b2_s1_residual_drift_ratio`,
+/// `b2_collapsed`: 2); None for a column of the run (`peak_force_n`, a contact level's
+/// `level_b1f3_b2f3_...`).
+pub fn building_of(column: &str) -> Option<usize> {
+    let (k, _) = column.strip_prefix('b')?.split_once('_')?;
+    if k.is_empty() || !k.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    k.parse().ok().filter(|&k| k > 0)
+}
+
+/// Building K's collapse column, `bK_collapsed` (0 or 1: physics.md section 12).
+pub fn collapsed_column(k: usize) -> String {
+    format!("b{k}_{COLLAPSED}")
+}
+
+/// The building whose collapse fragility `--edp` names (`b2_collapsed`: 2); None for any other
+/// (the run's, [`COLLAPSED`], included).
+pub fn collapse_building(edp: &str) -> Option<usize> {
+    building_of(edp).filter(|&k| edp == collapsed_column(k))
+}
+
+/// Whether `edp` is a collapse fragility's: the run's ([`COLLAPSED`]) or a building's
+/// (`bK_collapsed`).
+pub fn is_collapse_edp(edp: &str) -> bool {
+    edp == COLLAPSED || collapse_building(edp).is_some()
+}
+
+/// Whose collapse makes a run's demand infinite (physics.md section 12): a building's own for a
+/// building's column, any building's for a column of the run.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum CollapseOf {
+    /// The run's: status `collapsed` (any building collapsed).
+    Run,
+    /// Building `k`'s: its `bK_collapsed` column (index `column`; None where the table has none,
+    /// an output from before the per-building columns, or of `--columns` that left it out: the
+    /// run's status then stands for it). `all`: the table's `bJ_collapsed` columns, which tell a
+    /// collapsed run that names the building that collapsed from one whose columns were written
+    /// unfilled (every one 0: the run's status then stands for them too).
+    Building {
+        k: usize,
+        column: Option<usize>,
+        all: Vec<usize>,
+    },
+}
+
+impl CollapseOf {
+    /// Whose collapse counts for demand `edp` of `table`.
+    pub fn of(table: &Table, edp: &str) -> CollapseOf {
+        match building_of(edp) {
+            None => CollapseOf::Run,
+            Some(k) => CollapseOf::Building {
+                k,
+                column: table.col(&collapsed_column(k)).ok(),
+                all: (0..table.header.len())
+                    .filter(|&c| collapse_building(&table.header[c]).is_some())
+                    .collect(),
+            },
+        }
+    }
+
+    /// "collapsed", or "where building K collapsed" where the table said so for every one of
+    /// them (`skipped.run_collapse` 0), after a count of runs.
+    pub fn runs_collapsed(&self, skipped: &LeftOut) -> String {
+        match self {
+            CollapseOf::Building {
+                k, column: Some(_), ..
+            } if skipped.run_collapse == 0 => format!("where building {k} collapsed"),
+            _ => "collapsed".into(),
+        }
+    }
+
+    /// The notice for `n` runs whose demand is building K's but that were counted as collapsed
+    /// by the run's status (the table does not say which building collapsed); None where there
+    /// are none.
+    pub fn notice(&self, n: usize, edp: &str) -> Option<String> {
+        let CollapseOf::Building { k, column, .. } = self else {
+            return None;
+        };
+        if n == 0 {
+            return None;
+        }
+        let col = collapsed_column(*k);
+        let why = match column {
+            None => format!("this table has no column {col} (an output from before each building's collapse was written, or of --columns that left it out)"),
+            Some(_) => "in them every bJ_collapsed of this table is 0 (columns written before they were filled, or --columns that left out the building that collapsed)".to_string(),
+        };
+        Some(format!(
+            "notice: {n} collapsed runs (status `collapsed`) are counted as collapsed for {edp}, as the run, not building {k} alone: {why}; where {col} says whether building {k} collapsed, a run where another building collapsed counts {edp} as measured"
+        ))
+    }
+}
+
+/// Whether a building collapsed in row `i`: its `bK_collapsed` cell (column `c`), 0 or 1
+/// (`false` or `true` from a table of booleans handed to the Python package).
+fn collapsed_flag(table: &Table, i: usize, c: usize) -> Result<bool, TableError> {
+    let text = table.rows[i][c].trim();
+    if let Some(b) = ["false", "true"]
+        .iter()
+        .position(|t| text.eq_ignore_ascii_case(t))
+    {
+        return Ok(b == 1);
+    }
+    match table.num(i, c).ok().flatten() {
+        Some(x) if x == 0.0 || x == 1.0 => Ok(x == 1.0),
+        _ => Err(TableError::Read {
+            path: table.path.clone(),
+            message: format!(
+                "line {}, column `{}`: `{}` is not 0 or 1 (whether the building collapsed)",
+                i + 2,
+                table.header[c],
+                table.rows[i][c]
+            ),
+        }),
+    }
+}
+
 /// What to count.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FragilitySpec {
@@ -316,42 +443,69 @@ impl FragilitySpec {
         }
     }
 
-    /// Whether this is the collapse fragility (`--edp collapsed`).
+    /// Whether this is a collapse fragility (`--edp collapsed`, `--edp bK_collapsed`).
     pub fn is_collapse(&self) -> bool {
-        self.edp == COLLAPSED
+        is_collapse_edp(&self.edp)
     }
 }
 
-/// Whether `table` can give a collapse fragility, or why not (named): it needs a status column
-/// (whose `collapsed` runs it counts), the collapse columns a sweep with a collapse limit writes
-/// ([`crate::plan::row::COLLAPSE_OUTPUTS`]: without them its runs could not collapse, and a
-/// curve of none would be no result) and rows.
-pub fn check_collapse_table(table: &Table) -> Result<(), TableError> {
+/// Whether `table` can give the collapse fragility of `edp` ([`is_collapse_edp`]), or why not
+/// (named). The run's (`collapsed`) needs a status column (whose `collapsed` runs it counts) and
+/// some collapse column that a sweep with a collapse limit writes
+/// ([`crate::plan::row::COLLAPSE_OUTPUTS`], or a building's `bK_collapsed`: without any its runs
+/// could not collapse, and a curve of none would be no result); building K's needs its
+/// `bK_collapsed`. Both need rows.
+pub fn check_collapse_table(table: &Table, edp: &str) -> Result<(), TableError> {
     let refuse = |message: String| {
         Err(TableError::Read {
             path: table.path.clone(),
             message,
         })
     };
-    if table.col("status").is_err() {
-        return refuse(format!(
-            "--edp {COLLAPSED} counts the runs whose status is `collapsed`, and this table has no status column (the runs of a `pound sweep` table have one; a table of --aggregate or of a study has none)"
-        ));
-    }
-    let missing: Vec<&str> = crate::plan::row::COLLAPSE_OUTPUTS
+    let run_columns = crate::plan::row::COLLAPSE_OUTPUTS;
+    let has = |c: &str| table.col(c).is_ok();
+    let buildings: Vec<&str> = table
+        .header
         .iter()
-        .copied()
-        .filter(|c| table.col(c).is_err())
+        .map(String::as_str)
+        .filter(|c| collapse_building(c).is_some())
         .collect();
-    if !missing.is_empty() {
-        return refuse(format!(
-            "--edp {COLLAPSED}: this table has no collapse columns ({} missing): its runs could not collapse (a sweep writes them where its runs can: rows of buildings with storey heights under a collapse limit, [run] collapse_drift_ratio, default 0.10; a pair, or a row with collapse_drift_ratio = \"none\", has none), so a collapse fragility of it would be no result",
-            missing.join(", ")
-        ));
+    let limit = "a sweep writes them where its runs can collapse: rows of buildings with storey heights under a collapse limit, [run] collapse_drift_ratio, default 0.10";
+    let none = |missing: &[String]| {
+        format!("this table has no collapse columns ({} missing; {limit}): either its sweep had no collapse limit (a pair, or a row with collapse_drift_ratio = \"none\"), so a collapse fragility of it would be no result, or it was written with --columns that left them out (give them to --columns)", missing.join(", "))
+    };
+    match collapse_building(edp) {
+        None => {
+            if !has("status") {
+                return refuse(format!(
+                    "--edp {COLLAPSED} counts the runs whose status is `collapsed`, and this table has no status column (the runs of a `pound sweep` table have one; a table of --aggregate or of a study has none)"
+                ));
+            }
+            // Any collapse column shows a collapse limit: the status is what is counted.
+            if buildings.is_empty() && !run_columns.iter().any(|c| has(c)) {
+                let mut missing: Vec<String> = run_columns.iter().map(|c| c.to_string()).collect();
+                missing.push("bK_collapsed".into());
+                return refuse(format!("--edp {COLLAPSED}: {}", none(&missing)));
+            }
+        }
+        Some(k) if !has(edp) => {
+            let present: Vec<&str> = run_columns.iter().copied().filter(|c| has(c)).collect();
+            let why = if !buildings.is_empty() {
+                format!("this table has no column {edp} (it has {}): no building {k} in its rows, or it was written with --columns that left {edp} out (give it to --columns)", buildings.join(", "))
+            } else if !present.is_empty() {
+                format!("this table has the run's collapse columns ({}) but no building's (bK_collapsed): an output from before each building's collapse was written, or of --columns that left them out (give {edp} to --columns); --edp {COLLAPSED} gives the run's collapse fragility (any building)", present.join(", "))
+            } else {
+                let mut missing = vec![edp.to_string()];
+                missing.extend(run_columns.iter().map(|c| c.to_string()));
+                none(&missing)
+            };
+            return refuse(format!("--edp {edp}: {why}"));
+        }
+        Some(_) => {}
     }
     if table.rows.is_empty() {
         return refuse(format!(
-            "--edp {COLLAPSED}: the table has no rows: no run to count"
+            "--edp {edp}: the table has no rows: no run to count"
         ));
     }
     Ok(())
@@ -373,6 +527,9 @@ pub struct LeftOut {
     /// `collapsed`, [`Demand::Collapsed`]), which a fragility counts as exceeding every threshold
     /// and an IDA as an infinite demand. Not in [`LeftOut::total`].
     pub collapsed: usize,
+    /// Of `collapsed`, the runs of a building's demand counted by the run's status, the table not
+    /// saying which building collapsed ([`CollapseOf::notice`]).
+    pub run_collapse: usize,
 }
 
 impl LeftOut {
@@ -445,9 +602,10 @@ pub fn bounding_column(edp: &str) -> Option<String> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Demand {
     Value(f64),
-    /// The run collapsed (status `collapsed`): an infinite demand, above every threshold
-    /// (physics.md section 10), whatever its cells hold (its peaks end at the collapse, its
-    /// residual drifts are empty).
+    /// The run collapsed (status `collapsed`), or for a building's demand the building did
+    /// ([`CollapseOf`]): an infinite demand, above every threshold (physics.md sections 10 and
+    /// 12), whatever its cells hold (its peaks end at the collapse, its residual drifts are
+    /// empty).
     Collapsed,
     /// No value in a run that did not fail, of a column that may be empty there (a residual
     /// drift where the run did not settle: [`crate::engine::aggregate::may_be_empty`]): not
@@ -459,8 +617,9 @@ pub enum Demand {
 
 /// The rows of `table` that `filters` keep, whose status is `ok` or `collapsed` (where there is a
 /// status column) and whose IM (column `ci`) and EDP (`ce`) are finite numbers: (row, intensity
-/// level, EDP). A collapsed run is [`Demand::Collapsed`] whatever its EDP cell holds (counted in
-/// `skipped.collapsed`); with `ce` None (the collapse fragility) a run that did not collapse is
+/// level, EDP). A collapsed run (`collapse` says whose collapse: the run's, or the building's
+/// whose demand it is) is [`Demand::Collapsed`] whatever its EDP cell holds (counted in
+/// `skipped.collapsed`); with `ce` None (a collapse fragility) a run that did not collapse is
 /// `Value(0)`. An empty EDP of a column that may be empty in a run that did not fail is kept as
 /// [`Demand::Unknown`] (with its bound where the table has the [`bounding_column`]); an empty one
 /// of another column is left out. The level is the IM rounded to 12 significant digits (CSV
@@ -471,6 +630,7 @@ pub fn demand_rows(
     filters: &[Filter],
     ci: usize,
     ce: Option<usize>,
+    collapse: &CollapseOf,
     skipped: &mut LeftOut,
 ) -> Result<Vec<(usize, f64, Demand)>, TableError> {
     let cs = table.col("status").ok();
@@ -482,14 +642,38 @@ pub fn demand_rows(
     let mut out = Vec::new();
     for i in table.select(filters)? {
         let status = cs.map(|c| table.rows[i][c].as_str());
-        let collapsed = status == Some("collapsed");
-        if status.is_some_and(|s| s != "ok" && !collapsed) {
+        let run_collapsed = status == Some("collapsed");
+        if status.is_some_and(|s| s != "ok" && !run_collapsed) {
             skipped.failed += 1;
             continue;
         }
         let Some(im) = table.num(i, ci)? else {
             skipped.empty_im += 1;
             continue;
+        };
+        // Whether the demand is collapsed, and whether the run's status decided it for a
+        // building's demand (the table not saying which building collapsed).
+        let (collapsed, by_status) = match collapse {
+            CollapseOf::Run => (run_collapsed, false),
+            CollapseOf::Building {
+                column: Some(c),
+                all,
+                ..
+            } => {
+                if collapsed_flag(table, i, *c)? {
+                    (true, false)
+                } else if run_collapsed {
+                    // A collapsed run where no building says it collapsed: unfilled columns.
+                    let mut named = false;
+                    for &a in all {
+                        named |= collapsed_flag(table, i, a)?;
+                    }
+                    (!named, !named)
+                } else {
+                    (false, false)
+                }
+            }
+            CollapseOf::Building { column: None, .. } => (run_collapsed, run_collapsed),
         };
         let demand = match ce {
             _ if collapsed => Demand::Collapsed,
@@ -514,6 +698,7 @@ pub fn demand_rows(
             continue;
         }
         skipped.collapsed += usize::from(collapsed);
+        skipped.run_collapse += usize::from(by_status);
         out.push((i, crate::io::table::level(im), demand));
     }
     Ok(out)
@@ -570,12 +755,13 @@ impl Grouped {
         }
         let ci = table.col(&spec.im)?;
         let ce = if spec.is_collapse() {
-            check_collapse_table(table)?;
+            check_collapse_table(table, &spec.edp)?;
             if spec.thresholds != [0.0] {
                 return Err(TableError::Read {
                     path: table.path.clone(),
                     message: format!(
-                        "--edp {COLLAPSED} takes no threshold: a run collapsed or it did not"
+                        "--edp {} takes no threshold: a run collapsed or it did not",
+                        spec.edp
                     ),
                 });
             }
@@ -589,7 +775,10 @@ impl Grouped {
         let mut groups: Vec<String> = Vec::new();
         let mut group_of: std::collections::HashMap<String, usize> = Default::default();
         let mut runs: Vec<(usize, u64, Demand)> = Vec::new();
-        for (i, level, demand) in demand_rows(table, &spec.filters, ci, ce, &mut skipped)? {
+        let collapse = CollapseOf::of(table, &spec.edp);
+        for (i, level, demand) in
+            demand_rows(table, &spec.filters, ci, ce, &collapse, &mut skipped)?
+        {
             ims.insert(order_key(level), level);
             let name = cg.map_or(String::new(), |c| table.rows[i][c].clone());
             let g = *group_of.entry(name.clone()).or_insert_with(|| {
@@ -887,6 +1076,15 @@ pub fn threshold_name(edp: &str, t: f64) -> String {
     format!("> {}", crate::io::table::quantity(edp, t))
 }
 
+/// What a collapse fragility of `edp` gives: `P(collapse)` (the run's), `P(building K
+/// collapses)`.
+pub fn collapse_probability(edp: &str) -> String {
+    match collapse_building(edp) {
+        Some(k) => format!("P(building {k} collapses)"),
+        None => "P(collapse)".into(),
+    }
+}
+
 /// One panel: the observed fractions (points) and the fitted curves (lines), per threshold (the
 /// collapse fragility's one curve is named `collapse`).
 pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, NoFit>]) -> Panel {
@@ -940,7 +1138,7 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
         crate::io::table::name(&spec.im),
     );
     let what = if spec.is_collapse() {
-        "P(collapse)".to_string()
+        collapse_probability(&spec.edp)
     } else {
         format!("P({edp} > threshold)")
     };
@@ -950,7 +1148,9 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
             c => format!("{what} against {im}; {c}"),
         },
         x_label: label(&spec.im),
-        y_label: if spec.is_collapse() {
+        y_label: if let Some(k) = collapse_building(&spec.edp) {
+            format!("probability of building {k}'s collapse")
+        } else if spec.is_collapse() {
             "probability of collapse".into()
         } else {
             "probability of exceedance".into()
@@ -1086,14 +1286,24 @@ impl FragilityOptions {
                 return refuse(format!("{flag} applies to the bootstrap bands: give --bootstrap N (N >= {MIN_BOOTSTRAP}) with it, or leave {flag} out"));
             }
         }
-        let collapse = self.edp == COLLAPSED;
+        let collapse = is_collapse_edp(&self.edp);
         if collapse {
+            let (what, which) = match collapse_building(&self.edp) {
+                None => (
+                    "a run collapsed (status `collapsed`)".to_string(),
+                    "P(collapse | IM)".to_string(),
+                ),
+                Some(k) => (
+                    format!("building {k} collapsed in a run ({})", self.edp),
+                    format!("P(building {k} collapses | IM)"),
+                ),
+            };
             for (flag, given) in [
                 ("--threshold", !self.thresholds.is_empty()),
                 ("--damage-states", self.damage_states.is_some()),
             ] {
                 if given {
-                    return refuse(format!("{flag} makes no sense with --edp {COLLAPSED}: a run collapsed (status `collapsed`) or it did not, and P(collapse | IM) is fitted to that; leave {flag} out, or give a demand column to --edp"));
+                    return refuse(format!("{flag} makes no sense with --edp {}: {what} or it did not, and {which} is fitted to that; leave {flag} out, or give a demand column to --edp", self.edp));
                 }
             }
         } else if self.thresholds.is_empty() && self.damage_states.is_none() {
@@ -1141,7 +1351,8 @@ impl FragilityOptions {
 /// `pound fragility` of `table`: the counts per threshold (or damage state) and level, the
 /// lognormal fits with their goodness of fit, the bootstrap bands over the groups of `by`, the
 /// bounds of the runs with no value of the demand, and the notices (a poor fit, fitted curves
-/// out of order, replicates with no fit, no run collapsed).
+/// out of order, replicates with no fit, no run collapsed, a median extrapolated beyond the
+/// levels run, a building's collapse read from the run's status).
 pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, FragilityError> {
     let Settled {
         collapse,
@@ -1158,7 +1369,7 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
         filters: Filter::parse_all(&o.filters)?,
     };
     if collapse {
-        check_collapse_table(table)?;
+        check_collapse_table(table, &spec.edp)?;
     }
     let group = (o.bootstrap > 0).then_some(by.as_str());
     let (grouped, skipped) = Grouped::read(table, &spec, group)?;
@@ -1173,16 +1384,18 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
     }
     let fits: Vec<_> = lv.iter().map(|l| fit(l)).collect();
     let collapsed = skipped.collapsed;
+    let whose = CollapseOf::of(table, &spec.edp);
     let mut t = Telling::default();
     t.say(format_args!(
         "{runs} runs at {} levels of {}{}{}",
         grouped.ims.len(),
         spec.im,
         match (collapse, collapsed) {
-            (true, _) => format!(", {collapsed} collapsed"),
+            (true, _) => format!(", {collapsed} {}", whose.runs_collapsed(&skipped)),
             (false, 0) => String::new(),
             (false, _) => format!(
-                ", {collapsed} collapsed (counted as exceeding every {}: an infinite demand)",
+                ", {collapsed} {} (counted as exceeding every {}: an infinite demand)",
+                whose.runs_collapsed(&skipped),
                 if states.is_some() {
                     "state"
                 } else {
@@ -1196,6 +1409,9 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
             String::new()
         }
     ));
+    if let Some(n) = whose.notice(skipped.run_collapse, &spec.edp) {
+        t.note(n);
+    }
     if grouped.ims.len() * 2 > runs && runs >= 10 {
         t.note(format_args!(
             "notice: {} takes {} values over {runs} runs: an intensity measure that differs from run to run (levels of one or two runs each) gives shares of little meaning; the level a sweep scales to is a target column (target_pga_g, target_sa_g, target_sa_avg_g)",
@@ -1243,7 +1459,7 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
         vec![None; spec.thresholds.len()]
     };
     let first = if collapse {
-        "P(collapse)".to_string()
+        collapse_probability(&spec.edp)
     } else if states.is_some() {
         format!("state ({} >)", spec.edp)
     } else {
@@ -1258,6 +1474,7 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
     t.say(format_args!("\n| {first} | median {} | beta | se(ln median) | se(beta) | log-likelihood | deviance (dof) | p (fit) |{band_head}\n|---:|---:|---:|---:|---:|---:|---:|---:|{band_rule}", spec.im));
     let mut poor = Vec::new();
     let mut unfitted = Vec::new();
+    let mut extrapolated = Vec::new();
     for (i, f) in fits.iter().enumerate() {
         let label = match &states {
             Some(_) => format!("{} ({})", names[i], number(spec.thresholds[i])),
@@ -1293,20 +1510,61 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
                     f.dof,
                     f.p_fit.map_or("-".into(), |p| format!("{p:.3}"))
                 ));
+                // A median outside the levels this fit counted is read off the curve's tail.
+                let (lowest, highest) = (lv[i][0].im, lv[i][lv[i].len() - 1].im);
+                if f.median > highest || f.median < lowest {
+                    let what = if collapse {
+                        collapse_probability(&spec.edp)
+                    } else if states.is_some() {
+                        format!(
+                            "{} ({} > {})",
+                            names[i],
+                            spec.edp,
+                            number(spec.thresholds[i])
+                        )
+                    } else {
+                        format!("{} > {}", spec.edp, names[i])
+                    };
+                    extrapolated.push((what, f.median, lowest, highest));
+                }
                 if f.p_fit.is_some_and(|p| p < 0.05) {
                     poor.push(label);
                 }
             }
             Err(e) if collapse => t.say(format_args!(
                 "| {label} | no fit: {} | | | | | | |{band}",
-                e.collapse()
+                e.collapse_of(collapse_building(&spec.edp))
             )),
             Err(e) => t.say(format_args!("| {label} | no fit: {e} | | | | | | |{band}")),
         }
     }
-    if collapse && collapsed == 0 {
+    for (what, median, lowest, highest) in extrapolated {
+        let q = |x: f64| crate::io::table::quantity(&spec.im, x);
+        let (side, end, beyond) = if median > highest {
+            ("ends", highest, "above the highest")
+        } else {
+            ("starts", lowest, "below the lowest")
+        };
         t.note(format_args!(
-            "notice: no run collapsed (of {runs}, at {} levels of {} up to {}): P(collapse | IM) has no fit; a collapse fragility needs runs that collapse, at intensities higher than these or with a lower [run] collapse_drift_ratio",
+            "notice: the fitted median of {what} is {} from a ladder of {} that {side} at {}: extrapolated, read off the fitted curve {beyond} level run, where no run bracketed it; read it with care, or run levels that reach it",
+            q(median),
+            spec.im,
+            q(end)
+        ));
+    }
+    if collapse && collapsed == 0 {
+        let (none, p) = match collapse_building(&spec.edp) {
+            Some(k) => (
+                format!("building {k} collapsed in no run"),
+                format!("P(building {k} collapses | IM)"),
+            ),
+            None => (
+                "no run collapsed".to_string(),
+                "P(collapse | IM)".to_string(),
+            ),
+        };
+        t.note(format_args!(
+            "notice: {none} (of {runs}, at {} levels of {} up to {}): {p} has no fit; a collapse fragility needs runs that collapse, at intensities higher than these or with a lower [run] collapse_drift_ratio",
             grouped.ims.len(),
             spec.im,
             hi

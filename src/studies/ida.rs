@@ -2,12 +2,17 @@
 //! record, or a record and a sample) the demand against the intensity, and across curves the
 //! 16, 50 and 84 % fractiles of the demand at each intensity level.
 //!
-//! Collapse (Vamvatsikos & Cornell 2002; physics.md section 10): a run whose status is
-//! `collapsed` is an infinite demand. A curve flatlines at its first collapse: from that level up
-//! it is infinite, at every level (a run above it that did not collapse, "structural
-//! resurrection", is counted as collapsed and reported; a level with no run there is collapsed
-//! too), and it is drawn through its points up to the last it survived, then at that demand up to
-//! the level of its first collapse and along it to the right edge of the plot. The fractiles are
+//! Collapse (Vamvatsikos & Cornell 2002; physics.md sections 10 and 12): a collapsed run is an
+//! infinite demand. Of a building's demand (`bK_...`) that is a run where building K collapsed
+//! (its `bK_collapsed`: a run where only another building collapsed is its value as measured);
+//! of the run's (`peak_force_n`, a contact level's), a run whose status is `collapsed`; where the
+//! table does not say which building collapsed (no `bK_collapsed`, or every one 0 in a collapsed
+//! run) the run's status stands for the building's, and a notice says so. A curve flatlines at
+//! its first collapse: from that level up it is infinite, at every level (a run above it that
+//! did not collapse, "structural resurrection", is counted as collapsed and reported; a level
+//! with no run there is collapsed too), and it is drawn through its points up to the last it
+//! survived, then at that demand up to the level of its first collapse and along it to the
+//! right edge of the plot. The fractiles are
 //! over every curve with a value at a level, collapsed ones included as infinite: a fractile is
 //! infinite (`inf` in the table, a flatline in the plot) where the curves collapsed there reach
 //! its position among the sorted demands, about where more than `100 - p` % of them collapsed.
@@ -16,7 +21,7 @@
 //! level, and the fractiles there are over the others, and say so.
 
 use crate::io::table::{caption, label, name, order_key, Filter, Table, TableError};
-use crate::studies::fragility::{demand_rows, Demand, LeftOut};
+use crate::studies::fragility::{demand_rows, CollapseOf, Demand, LeftOut};
 use crate::studies::plot::{Panel, Series, SMOOTH};
 use crate::studies::report::{StudyReport, Telling};
 use std::collections::{BTreeMap, HashMap};
@@ -52,6 +57,10 @@ pub struct Ida {
     pub fractiles: Vec<[f64; 3]>,
     /// Per level: the curves collapsed there (a run that collapsed there or at a lower level).
     pub collapsed: Vec<usize>,
+    /// The building whose own collapse flatlines the curves (read from its `bK_collapsed`);
+    /// None: the run's collapse (a demand of the run, or a table that does not say which
+    /// building collapsed).
+    pub building: Option<usize>,
     /// Runs that did not collapse at a level above their curve's first collapse (structural
     /// resurrection), counted as collapsed; and the levels with no run of a curve above its
     /// first collapse, filled as collapsed.
@@ -127,7 +136,10 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
     let mut points: HashMap<(usize, u64), (usize, f64)> = HashMap::new();
     // Runs kept out at a level: failed, and with no value of the demand.
     let mut missing: HashMap<u64, (usize, usize)> = HashMap::new();
-    for (i, key, demand) in demand_rows(table, &spec.filters, ci, Some(ce), &mut skipped)? {
+    let collapse = CollapseOf::of(table, &spec.edp);
+    for (i, key, demand) in
+        demand_rows(table, &spec.filters, ci, Some(ce), &collapse, &mut skipped)?
+    {
         ims.insert(order_key(key), key);
         let edp = match demand {
             Demand::Value(edp) => edp,
@@ -233,6 +245,13 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
             counts,
             fractiles,
             collapsed,
+            // Where the run's status stood for some building's collapse, the run's.
+            building: match collapse {
+                CollapseOf::Building {
+                    k, column: Some(_), ..
+                } if skipped.run_collapse == 0 => Some(k),
+                _ => None,
+            },
             resurrected,
             filled,
             failed: keys.iter().map(|k| at(k).0).collect(),
@@ -446,9 +465,13 @@ impl Ida {
         if !self.any_collapsed() {
             return None;
         }
+        let whose = match self.building {
+            Some(k) => format!("where building {k} collapsed"),
+            None => "collapsed".into(),
+        };
         Some(Panel {
             title: format!(
-                "Share of the curves collapsed against {}{}",
+                "Share of the curves {whose} against {}{}",
                 name(&spec.im),
                 match caption(&spec.filters) {
                     c if c.is_empty() => c,
@@ -456,7 +479,7 @@ impl Ida {
                 }
             ),
             x_label: label(&spec.im),
-            y_label: "share of curves collapsed".into(),
+            y_label: format!("share of curves {whose}"),
             log_x: false,
             log_y: false,
             series: vec![Series {
@@ -537,10 +560,16 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
         by,
         filters: Filter::parse_all(&o.filters)?,
     };
-    if spec.edp == crate::studies::fragility::COLLAPSED && table.col(&spec.edp).is_err() {
+    use crate::studies::fragility::{collapse_building, collapse_probability, COLLAPSED};
+    if spec.edp == COLLAPSED && table.col(&spec.edp).is_err() {
         return Err(IdaError::Refused(format!("--edp {}: an IDA reads a demand column (e.g. b1_peak_drift_ratio), where a collapsed run is an infinite demand; the collapse fragility P(collapse | IM) is `pound fragility --edp collapsed`", spec.edp)));
     }
+    // A 0/1 column would draw curves of 0 that flatline at the collapse: the fragility's.
+    if collapse_building(&spec.edp).is_some() {
+        return Err(IdaError::Refused(format!("--edp {}: an IDA reads a demand column (e.g. b1_peak_drift_ratio), where the building's collapse is an infinite demand; its collapse fragility {} is `pound fragility --edp {}`", spec.edp, collapse_probability(&spec.edp), spec.edp)));
+    }
     let (ida, skipped) = read(table, &spec)?;
+    let whose = CollapseOf::of(table, &spec.edp);
     let mut t = Telling::default();
     let collapsed_runs = skipped.collapsed;
     t.say(format_args!(
@@ -550,7 +579,10 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
         ida.ims.len(),
         spec.im,
         if collapsed_runs > 0 {
-            format!(", {collapsed_runs} runs collapsed (an infinite demand)")
+            format!(
+                ", {collapsed_runs} runs {} (an infinite demand)",
+                whose.runs_collapsed(&skipped)
+            )
         } else {
             String::new()
         },
@@ -560,6 +592,9 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
             String::new()
         }
     ));
+    if let Some(n) = whose.notice(skipped.run_collapse, &spec.edp) {
+        t.note(n);
+    }
     // Failed runs are left out of the fractiles. Where the table has no collapse criterion a
     // failed run may be a collapse, so the fractiles over the others are collapse-free; where it
     // has one, they are over the runs that did not fail.
@@ -659,8 +694,12 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
                 Some(format!("the {f} % from {}", ida.ims[l]))
             })
             .collect();
+        let what = match ida.building {
+            Some(k) => format!("runs where building {k} collapsed are infinite demands of {} (a run where only another building collapsed is its value as measured)", spec.edp),
+            None => "collapsed runs are infinite demands".to_string(),
+        };
         t.note(format_args!(
-            "notice: collapsed runs are infinite demands (Vamvatsikos & Cornell 2002): a curve flatlines at its first collapse and is collapsed at every level above it; a fractile is infinite (`inf`) where the collapses reach it{}",
+            "notice: {what} (Vamvatsikos & Cornell 2002): a curve flatlines at its first collapse and is collapsed at every level above it; a fractile is infinite (`inf`) where the collapses reach it{}",
             if flat.is_empty() {
                 ": none does here".to_string()
             } else {

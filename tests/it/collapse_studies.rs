@@ -152,8 +152,10 @@ fn collapse_fragility_is_the_mle_of_the_collapse_counts() {
         ),
         (
             "no collapse columns",
-            cut("nocollapse.csv", &|t| drop_column(t, 4)),
-            "no collapse columns (collapse_time_s missing)",
+            cut("nocollapse.csv", &|t| {
+                drop_column(&drop_column(&drop_column(t, 4), 4), 4)
+            }),
+            "no collapse columns (collapse_time_s, collapse_building, collapse_storey, bK_collapsed missing",
         ),
         (
             "no rows",

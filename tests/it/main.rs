@@ -4,6 +4,7 @@ mod accelerations;
 mod accuracy;
 mod cli;
 mod collapse;
+mod collapse_by_building;
 mod collapse_opensees;
 mod collapse_scene;
 mod collapse_studies;
