@@ -518,6 +518,12 @@ impl RowPlan {
         run
     }
 
+    /// How the gaps take their axes (the fingerprint covers it): per adjacent pair, whether
+    /// `contact.gap_m` gives its gap, and the gap axis it reads.
+    pub fn gap_layout(&self) -> (&[bool], &[usize]) {
+        (&self.shared_gap, &self.gap_axis)
+    }
+
     /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`
     /// (the contact runs', each repeated for the row's own axes).
     pub fn cost_before(&self, end: u64, record_cost: &[u64]) -> u128 {

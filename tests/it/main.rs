@@ -4,6 +4,7 @@ mod accelerations;
 mod accuracy;
 mod cli;
 mod collapse;
+mod collapse_limits;
 mod collapse_opensees;
 mod collapse_studies;
 mod config;
