@@ -289,3 +289,50 @@ fn shards_at_two_collapse_limits_do_not_merge() {
         std::fs::read(&full).unwrap()
     );
 }
+
+/// A P-Delta storey whose stability coefficient passes 0.1 is named before any run, with its
+/// building, storey and value: one storey of 3 m at T = 0.5 s carrying 9 times its floor's
+/// weight has `theta = g r T^2 / (4 pi^2 h)` = 0.186 (k = m (2 pi / T)^2). A building below
+/// 0.1 is not named.
+#[test]
+fn a_storey_past_a_stability_coefficient_of_a_tenth_is_named() {
+    let dir = tempdir();
+    let cfg = dir.path().join("leaning.toml");
+    let text = "[[building]]\nstoreys = 1\nstorey_height_m = 3.0\nmass_kg = 2e5\nperiod_s = [0.3, 0.5]\ndamping_ratio = 0.05\np_delta = true\ngravity_mass_ratio = 9.0\ngap_right_m = 0.05\n\
+        [[building]]\nstoreys = 3\nstorey_height_m = 3.0\nmass_kg = 2e5\nperiod_s = 0.4\ndamping_ratio = 0.05\np_delta = true\n\
+        [contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\n\
+        [[record]]\nsynthetic = { seed = 4, duration_s = 1.0, dt_s = 0.01, pga_g = 0.1 }\n";
+    std::fs::write(&cfg, text).unwrap();
+    let theta = pounding::record::G * 9.0 * 0.25 / (4.0 * std::f64::consts::PI.powi(2) * 3.0);
+    let plan = plan_of(text);
+    let named: Vec<String> = plan
+        .input_warnings()
+        .into_iter()
+        .filter(|w| w.contains("stability coefficient"))
+        .collect();
+    assert_eq!(named.len(), 1, "{named:?}");
+    for part in [
+        "building 1 ".to_string(),
+        "storey 1 ".into(),
+        format!("{theta:.3}"),
+        "period_s = 0.5".into(),
+    ] {
+        assert!(named[0].contains(&part), "`{part}` in {}", named[0]);
+    }
+    // The sweep says it, and its column agrees at that period.
+    let out = dir.path().join("leaning.csv");
+    let r = sweep_cpu(&cfg, &out, &[]);
+    ok(&r);
+    assert!(
+        err(&r).contains(&format!("warning: {}: {}", cfg.display(), named[0])),
+        "{}",
+        err(&r)
+    );
+    let column: f64 = crate::support::run::table(&out)
+        .iter()
+        .find(|row| row["b1_t1_s"] == "0.5")
+        .unwrap()["b1_stability_coefficient"]
+        .parse()
+        .unwrap();
+    assert!((column - theta).abs() < 1e-9 * theta, "{column} {theta}");
+}
