@@ -336,3 +336,51 @@ fn a_storey_past_a_stability_coefficient_of_a_tenth_is_named() {
         .unwrap();
     assert!((column - theta).abs() < 1e-9 * theta, "{column} {theta}");
 }
+
+/// Every status a run can end with: the match fails to compile when one is added.
+fn every_status() -> Vec<&'static str> {
+    use pounding::physics::model::Status;
+    [
+        Status::Ok,
+        Status::NonFinite,
+        Status::StepLimit,
+        Status::Collapsed,
+    ]
+    .iter()
+    .map(|s| {
+        match s {
+            Status::Ok | Status::NonFinite | Status::StepLimit | Status::Collapsed => {}
+        }
+        s.key()
+    })
+    .collect()
+}
+
+/// `pound columns` of a row with a collapse limit names every status the `status` column may
+/// hold, `collapsed` among them; so does the README's table of columns.
+#[test]
+fn every_list_of_statuses_names_collapsed() {
+    let dir = tempdir();
+    let cfg = dir.path().join("row.toml");
+    std::fs::write(&cfg, row_with("collapse_drift_ratio = 0.05")).unwrap();
+    let table = ok(&pound(&["columns", s(&cfg)]));
+    let line = table
+        .lines()
+        .find(|l| l.starts_with("| `status` |"))
+        .expect("a status row");
+    let readme = std::fs::read_to_string("README.md").unwrap();
+    let in_readme = readme
+        .lines()
+        .find(|l| l.starts_with("| `status` |"))
+        .expect("README names the status column");
+    for status in every_status() {
+        assert!(
+            line.contains(status),
+            "pound columns: {status} not in {line}"
+        );
+        assert!(
+            in_readme.contains(&format!("`{status}`")),
+            "README: {status} not in {in_readme}"
+        );
+    }
+}
