@@ -128,6 +128,7 @@ pub fn run(a: Args) -> Result<()> {
         columns: names,
         content: None,
         target_error: chosen.map(pounding::io::provenance::TargetError::of),
+        settings: Some(pounding::io::provenance::Settings::of_plan(&plan)),
     };
     // Every refusal that the plan decides comes before any file is made.
     engine.check(&plan)?;

@@ -51,12 +51,14 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, SidecarError> {
     }
     let (first_path, first) = (&parts[0].0, parts[0].1.clone());
     for (p, m) in &parts[1..] {
-        if let Some(what) = m.fingerprint.differs(&first.fingerprint) {
+        // The keys that differ are named where both sidecars record them.
+        let there = meta_path(first_path).display().to_string();
+        if let Some(d) = m.differs(&first, &there) {
             return Err(fail(
                 p,
                 format!(
-                    "{what} differs from {}'s: not shards of one sweep",
-                    first_path.display()
+                    "{}: not shards of one sweep",
+                    d.differs_from(&format!("{}'s", first_path.display()))
                 ),
             ));
         }
@@ -169,6 +171,7 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, SidecarError> {
             content: Some(content.clone()),
             // Shards share the fingerprint, so the setting; the first one's target is kept.
             target_error: first.target_error,
+            settings: first.settings.clone(),
         };
         let is_file = target.is_file();
         let (_, content) = w

@@ -6,7 +6,11 @@ use crate::plan::shard::Shard;
 use crate::plan::PairPlan;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+
+/// [`Fingerprint::differs`]' words for a plan that differs.
+const CONFIG: &str = "the config (the validated plan)";
 
 /// What an output was computed from: the validated plan (axes, scheme, settings), the records'
 /// content, and the engine version. Two outputs may be combined or continued only when all three
@@ -112,6 +116,30 @@ impl Fingerprint {
         if plan.level_rule != crate::physics::row::LevelRule::default() {
             text.push_str(&format!("|{:?}", plan.level_rule));
         }
+        // Rows at the default collapse limit hash as they did before the limit was hashed
+        // (sidecars of sweeps at it stay resumable); any other limit, `none` included, changes
+        // the runs (their status, their end, the collapse columns) and so the hash.
+        if plan.collapse_drift_ratio.to_bits()
+            != crate::plan::limits::COLLAPSE_DRIFT_RATIO.to_bits()
+        {
+            text.push_str(&format!("|collapse {:?}", plan.collapse_drift_ratio));
+        }
+        // Equal gap values taken in two layouts are two sets of runs: `contact.gap_m` one axis
+        // that its pairs share, or each pair its own. Rows whose pairs each read their own axis
+        // hash as before the shared axis (they have the runs they had then).
+        let (shared, axis) = plan.gap_layout();
+        if axis.iter().enumerate().any(|(a, &x)| x != a) {
+            text.push_str(&format!("|gap axes {axis:?}"));
+        }
+        // A sampled `contact.gap_m` sets the pairs it gives; which, where some pair has its own
+        // `gap_right_m` (the grid's placeholder gap may equal that one's value).
+        let sampled_gap = plan
+            .samples
+            .as_ref()
+            .is_some_and(|s| s.axes.contains(&crate::plan::row::RowSampled::SharedGap));
+        if sampled_gap && shared.contains(&false) {
+            text.push_str(&format!("|sampled gap on {shared:?}"));
+        }
         Fingerprint {
             plan: hex(Sha256::digest(text.as_bytes())),
             ..base
@@ -125,9 +153,152 @@ impl Fingerprint {
         } else if self.records != other.records {
             Some("the records (their content)")
         } else if self.plan != other.plan {
-            Some("the config (the validated plan)")
+            Some(CONFIG)
         } else {
             None
+        }
+    }
+}
+
+/// The plan by the config's keys, recorded in a sidecar so that a refusal to join two outputs
+/// names what differs: each `[run]` key in effect with its value, and each other part of the
+/// plan (a section, or the gaps) as a digest of its validated values. The fingerprint decides;
+/// these only name.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Settings {
+    /// `[run]` keys in effect (the scheme's own, the tail, a row's collapse limit) and their
+    /// values as a config gives them, with what flags set (`--scheme`, `--energy`, the
+    /// substeps `--target-error` chose).
+    #[serde(default)]
+    pub run: BTreeMap<String, String>,
+    /// Every other part, by its section (`[contact]`, `[levels]`, ...): a digest.
+    #[serde(default)]
+    pub parts: BTreeMap<String, String>,
+}
+
+impl Settings {
+    /// The settings of any plan, as its runs take them.
+    pub fn of_plan(plan: &crate::plan::Plan) -> Settings {
+        use crate::physics::solver::Scheme;
+        use crate::plan::Plan;
+        let spec = &plan.contact().spec;
+        let mut run = BTreeMap::new();
+        let mut put = |k: &str, v: String| run.insert(k.to_string(), v);
+        put("scheme", spec.scheme.key().into());
+        match spec.scheme {
+            Scheme::Fast(o) => {
+                put("substeps_per_contact", crate::show(o.substeps_per_contact));
+                put("energy", o.energy.to_string());
+            }
+            Scheme::Reference(o) => {
+                // The stated accuracy the options were made from (`rtol = tol / 100`), read
+                // back to 12 digits: a rounding of the product is not a setting.
+                let tol: f64 = format!("{:.11e}", o.rtol * 100.0)
+                    .parse()
+                    .unwrap_or(f64::NAN);
+                put("tol", crate::show(tol));
+            }
+        }
+        put("tail_s", crate::show(spec.tail));
+        let digest = |x: &dyn std::fmt::Debug| hex(Sha256::digest(format!("{x:?}").as_bytes()));
+        let mut parts = BTreeMap::new();
+        let mut part = |k: &str, x: &dyn std::fmt::Debug| parts.insert(k.to_string(), digest(x));
+        part(
+            "[contact]",
+            &(
+                &spec.laws,
+                &spec.formulas,
+                &spec.e,
+                &spec.k_linear,
+                &spec.beta,
+            ),
+        );
+        part("[intensity]", &spec.intensities);
+        part(
+            "[[record]] (their labels)",
+            &spec.records.iter().map(|r| &r.name).collect::<Vec<_>>(),
+        );
+        match plan {
+            Plan::Pair(p) => {
+                part("[contact] gap_m", &p.gaps);
+                part("[building1]", &p.building1);
+                part("[building2]", &p.building2);
+                part("[sample]", &p.samples);
+            }
+            Plan::Row(r) => {
+                let cdr = r.collapse_drift_ratio;
+                put(
+                    "collapse_drift_ratio",
+                    if cdr.is_finite() {
+                        crate::show(cdr)
+                    } else {
+                        "\"none\"".into()
+                    },
+                );
+                part("[[building]]", &(&r.buildings, &r.yielding));
+                part(
+                    "the gaps ([contact] gap_m, [[building]] gap_right_m)",
+                    &(&r.gaps, r.gap_layout()),
+                );
+                part("[levels]", &r.level_rule);
+                part("[sample]", &r.samples);
+            }
+        }
+        Settings { run, parts }
+    }
+
+    /// The keys whose values differ from `theirs`', in words (`there` names where theirs are
+    /// recorded): `[run] collapse_drift_ratio: 0.05 here, 0.1 in OUT.meta.toml`. Empty where
+    /// none does.
+    pub fn differing(&self, theirs: &Settings, there: &str) -> Vec<String> {
+        let mut said = Vec::new();
+        let keys = |a: &BTreeMap<String, String>, b: &BTreeMap<String, String>| {
+            let mut k: Vec<String> = a.keys().chain(b.keys()).cloned().collect();
+            k.sort();
+            k.dedup();
+            k
+        };
+        let none = "not set".to_string();
+        for k in keys(&self.run, &theirs.run) {
+            let (here, them) = (self.run.get(&k), theirs.run.get(&k));
+            if here != them {
+                said.push(format!(
+                    "[run] {k}: {} here, {} in {there}",
+                    here.unwrap_or(&none),
+                    them.unwrap_or(&none)
+                ));
+            }
+        }
+        for k in keys(&self.parts, &theirs.parts) {
+            if self.parts.get(&k) != theirs.parts.get(&k) {
+                said.push(k);
+            }
+        }
+        said
+    }
+}
+
+/// What differs between two outputs' plans: the engine, the records or the config, the config's
+/// keys named where both sidecars record them.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Difference {
+    /// The part of the fingerprint ([`Fingerprint::differs`]).
+    pub what: &'static str,
+    /// The config's keys that differ, in words (empty where not known: an older sidecar).
+    pub keys: Vec<String>,
+}
+
+impl Difference {
+    /// `{what} differs from {whose}`, with the keys that differ in parentheses.
+    pub fn differs_from(&self, whose: &str) -> String {
+        if self.keys.is_empty() {
+            format!("{} differs from {whose}", self.what)
+        } else {
+            format!(
+                "{} differs from {whose} ({})",
+                self.what,
+                self.keys.join("; ")
+            )
         }
     }
 }
@@ -158,6 +329,25 @@ pub struct Meta {
     /// `--target-error`: the error asked for and the setting it chose.
     #[serde(default)]
     pub target_error: Option<TargetError>,
+    /// The plan by the config's keys, to name what differs (absent in sidecars written before
+    /// it was recorded: their refusals name the config as a whole).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settings: Option<Settings>,
+}
+
+impl Meta {
+    /// What differs between the plan of this output and `theirs` (recorded in `there`), or
+    /// None where their fingerprints match.
+    pub fn differs(&self, theirs: &Meta, there: &str) -> Option<Difference> {
+        let what = self.fingerprint.differs(&theirs.fingerprint)?;
+        // Keys are named only where the config is what differs first (another engine may read
+        // the same config otherwise), and where both sides record them.
+        let keys = match (&self.settings, &theirs.settings) {
+            (Some(a), Some(b)) if what == CONFIG => a.differing(b, there),
+            _ => Vec::new(),
+        };
+        Some(Difference { what, keys })
+    }
 }
 
 /// The accuracy a sweep was asked for (`--target-error`) and what it chose: the fast scheme's
@@ -268,6 +458,76 @@ mod tests {
                 b.plan = "q".into();
             })),
             Some("the engine version")
+        );
+    }
+
+    /// A refusal names the `[run]` keys that differ, with both values, where both sidecars
+    /// record them (they survive TOML); against a sidecar written before they were recorded it
+    /// names the config as a whole; where the engine differs, only that.
+    #[test]
+    fn sidecars_name_the_keys_that_differ() {
+        let meta = |limit: &str| {
+            let text = format!(
+                "[[building]]\nstoreys = 2\nstorey_height_m = 3.0\nmass_kg = 2e5\nperiod_s = 0.3\ndamping_ratio = 0.05\n\
+                 [[building]]\nstoreys = 1\nstorey_height_m = 3.0\nmass_kg = 2e5\nperiod_s = 0.2\ndamping_ratio = 0.05\n\
+                 [contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = 0.01\n\
+                 [[record]]\nsynthetic = {{ seed = 1, duration_s = 1.0 }}\n[run]\ncollapse_drift_ratio = {limit}\n"
+            );
+            let plan = crate::plan::config::load_text(&text, Path::new("row.toml")).unwrap();
+            Meta {
+                fingerprint: Fingerprint::of_plan(&plan),
+                plan_runs: plan.len(),
+                first_run: 0,
+                end_run: plan.len(),
+                shard: None,
+                backend: "cpu".into(),
+                kernel: None,
+                columns: None,
+                content: None,
+                target_error: None,
+                settings: Some(Settings::of_plan(&plan)),
+            }
+        };
+        let round_trip =
+            |m: &Meta| -> Meta { toml::from_str(&toml::to_string(m).unwrap()).unwrap() };
+        let (here, there) = (meta("0.05"), round_trip(&meta("0.1")));
+        assert_eq!(there, meta("0.1"));
+        let d = here.differs(&there, "OUT.meta.toml").unwrap();
+        assert_eq!(
+            d.differs_from("the sweep that wrote it"),
+            "the config (the validated plan) differs from the sweep that wrote it ([run] collapse_drift_ratio: 0.05 here, 0.1 in OUT.meta.toml)"
+        );
+        assert_eq!(
+            meta("\"none\"").differs(&there, "X").unwrap().keys,
+            ["[run] collapse_drift_ratio: \"none\" here, 0.1 in X"]
+        );
+        assert_eq!(here.differs(&meta("0.05"), "X"), None);
+        // An older sidecar: no settings in its text.
+        let older = {
+            let text = toml::to_string(&Meta {
+                settings: None,
+                ..there.clone()
+            })
+            .unwrap();
+            assert!(!text.contains("settings"), "{text}");
+            toml::from_str::<Meta>(&text).unwrap()
+        };
+        assert_eq!(
+            here.differs(&older, "X").unwrap().differs_from("its sweep"),
+            "the config (the validated plan) differs from its sweep"
+        );
+        let other_engine = Meta {
+            fingerprint: Fingerprint {
+                engine: "0.0.0".into(),
+                ..there.fingerprint.clone()
+            },
+            ..there.clone()
+        };
+        assert_eq!(
+            here.differs(&other_engine, "X")
+                .unwrap()
+                .differs_from("its sweep"),
+            "the engine version differs from its sweep"
         );
     }
 

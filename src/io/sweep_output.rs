@@ -222,8 +222,16 @@ impl SweepOutput {
                     ),
                 )
             };
-            if let Some(what) = p.meta.fingerprint.differs(&meta.fingerprint) {
-                return Err(cannot(what));
+            // The keys that differ are named where the journal records them.
+            if let Some(d) = meta.differs(&p.meta, &progress_file.display().to_string()) {
+                return Err(at(
+                    path,
+                    format!(
+                        "cannot resume: {}; rerun without --resume after deleting {} to start over",
+                        d.differs_from("the sweep that wrote it"),
+                        progress_file.display()
+                    ),
+                ));
             }
             if (p.meta.first_run, p.meta.end_run, p.meta.shard)
                 != (meta.first_run, meta.end_run, meta.shard)
@@ -578,6 +586,7 @@ synthetic = { seed = 2, duration_s = 2.0 }
             columns: None,
             content: None,
             target_error: None,
+            settings: None,
         }
     }
 

@@ -144,7 +144,12 @@ const FIXED: [(&str, &str, &str, &str); 44] = [
         "sample",
         "the sample that set the sampled parameters (empty without [sample])",
     ),
-    ("status", "-", "status", "ok, non_finite or step_limit"),
+    (
+        "status",
+        "-",
+        "status",
+        "ok; collapsed (rows with a collapse limit: a storey reached [run] collapse_drift_ratio, a result, not a failure); or a failure: non_finite (the state became NaN or infinite) or step_limit (the step budget ran out)",
+    ),
     (
         "impacts",
         "-",

@@ -70,6 +70,10 @@ pub struct RawLevels {
     pub floor_column: Option<bool>,
 }
 
+/// A storey stability coefficient `P/(k h)` above which a sweep warns before any run: up to it
+/// design codes neglect P-Delta (ASCE 7 section 12.8.7).
+pub const WARN_STABILITY: f64 = 0.1;
+
 /// The largest `[levels] same_level_m`: the depth of a thick slab, m.
 pub const MAX_SAME_LEVEL_M: f64 = 0.5;
 /// The smallest, m: two floors just beyond it apart share the contact up to twice it
@@ -518,6 +522,12 @@ impl RowPlan {
         run
     }
 
+    /// How the gaps take their axes (the fingerprint covers it): per adjacent pair, whether
+    /// `contact.gap_m` gives its gap, and the gap axis it reads.
+    pub fn gap_layout(&self) -> (&[bool], &[usize]) {
+        (&self.shared_gap, &self.gap_axis)
+    }
+
     /// The summed cost of runs `0..end` when a run costs `record_cost[r]` for its record `r`
     /// (the contact runs', each repeated for the row's own axes).
     pub fn cost_before(&self, end: u64, record_cost: &[u64]) -> u128 {
@@ -531,7 +541,57 @@ impl RowPlan {
     pub fn warnings(&self) -> Vec<String> {
         let mut w = self.contact.pga_warnings(&self.run(0).period);
         w.extend(self.pairs_without_levels());
+        w.extend(self.leaning_storeys());
         w.extend(self.ignored.iter().cloned());
+        w
+    }
+
+    /// Each P-Delta building with a storey whose stability coefficient `P/(k h)` passes
+    /// [`WARN_STABILITY`] at the longest period it takes (where it is largest: it grows as the
+    /// period squared), naming the storey and the value. Such a building is stable (the plan
+    /// refuses `theta >= 1`) but far softer than its `period_s` says.
+    pub fn leaning_storeys(&self) -> Vec<String> {
+        let mut w = Vec::new();
+        for (b, a) in self.buildings.iter().enumerate() {
+            let Some(ratio) = a.p_delta else { continue };
+            let mut period = a.period.iter().cloned().fold(0.0, f64::max);
+            if let Some(smp) = &self.samples {
+                for (j, x) in smp.axes.iter().enumerate() {
+                    if *x == RowSampled::Period(b) {
+                        period = smp.points.iter().map(|p| p[j]).fold(0.0, f64::max);
+                    }
+                }
+            }
+            let theta: Vec<f64> = stability_at_1s(a, ratio)
+                .iter()
+                .map(|t| t * period * period)
+                .collect();
+            let above = theta.iter().filter(|t| **t > WARN_STABILITY).count();
+            let Some((j, worst)) = theta
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| **t > WARN_STABILITY)
+                .max_by(|x, y| x.1.total_cmp(y.1))
+            else {
+                continue;
+            };
+            let others = match above {
+                1 => String::new(),
+                n => format!(
+                    "; {} storeys of {} are above {WARN_STABILITY}",
+                    n,
+                    theta.len()
+                ),
+            };
+            w.push(format!(
+                "building {} (p_delta, gravity_mass_ratio {}): storey {} has a stability coefficient P/(k h) of {worst:.3} at period_s = {} (its longest{others}), above {WARN_STABILITY}: gravity takes that share of the storey's stiffness (an elastic storey's period is T0 / sqrt(1 - theta), {:.2} T0 here), past where design codes neglect P-Delta (ASCE 7 section 12.8.7); check gravity_mass_ratio and period_s",
+                b + 1,
+                crate::show(ratio),
+                j + 1,
+                crate::show(period),
+                1.0 / (1.0 - worst).sqrt(),
+            ));
+        }
         w
     }
 
@@ -1460,6 +1520,24 @@ fn level_rule(raw: &RawLevels) -> Result<LevelRule, (&'static str, String)> {
     Ok(rule)
 }
 
+/// Each storey's stability coefficient `theta_j = P_j / (k_j h_j)` of a P-Delta building (of
+/// gravity mass ratio `ratio`) at a period of 1 s: at period `T` it is this times `T^2`.
+fn stability_at_1s(a: &ShearAxes, ratio: f64) -> Vec<f64> {
+    let masses = a
+        .floor_masses
+        .clone()
+        .unwrap_or_else(|| vec![1.0; a.storeys()]);
+    ShearBuilding::from_period(
+        masses,
+        &a.profile,
+        a.heights.clone(),
+        1.0,
+        Damping::Modal(0.05),
+    )
+    .with_p_delta(ratio)
+    .stability_coefficients()
+}
+
 /// Every P-Delta building stable under gravity alone at every period it takes (`taken`): each
 /// storey's stability coefficient `theta_j = P_j / (k_j h_j)` below 1. With the floor masses
 /// fixed, or all one swept mass, `theta` grows with the period squared and does not depend on
@@ -1471,19 +1549,7 @@ fn check_stability(
     for (b, (a, periods)) in buildings.iter_mut().zip(taken).enumerate() {
         let Some(ratio) = a.p_delta else { continue };
         let period = periods.iter().cloned().fold(0.0, f64::max);
-        let masses = a
-            .floor_masses
-            .clone()
-            .unwrap_or_else(|| vec![1.0; a.storeys()]);
-        let at_1s = ShearBuilding::from_period(
-            masses,
-            &a.profile,
-            a.heights.clone(),
-            1.0,
-            Damping::Modal(0.05),
-        )
-        .with_p_delta(ratio)
-        .stability_coefficients();
+        let at_1s = stability_at_1s(a, ratio);
         a.stability_at_1s = at_1s.iter().cloned().fold(0.0, f64::max);
         // As the column reads it: theta at `period` is theta at 1 s times `period^2`.
         let theta: Vec<f64> = at_1s.iter().map(|t| t * period * period).collect();

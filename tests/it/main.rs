@@ -5,6 +5,7 @@ mod accuracy;
 mod cli;
 mod collapse;
 mod collapse_by_building;
+mod collapse_limits;
 mod collapse_opensees;
 mod collapse_scene;
 mod collapse_studies;
