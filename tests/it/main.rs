@@ -16,6 +16,7 @@ mod figures;
 mod floor_column;
 mod gap;
 mod gpu;
+mod gpu_collapse;
 mod gpu_rows;
 mod hard;
 mod hostile;
