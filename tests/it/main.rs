@@ -20,6 +20,7 @@ mod floor_column;
 mod gap;
 mod gap_collapse;
 mod gpu;
+mod gpu_collapse;
 mod gpu_rows;
 mod hard;
 mod hostile;

@@ -241,6 +241,11 @@ pub const STATUS_STEP_LIMIT: u32 = 2;
 /// The run needs more substeps per record step than the kernel's precision resolves; the host
 /// finishes it on the CPU.
 pub const STATUS_HANDOFF: u32 = 3;
+/// The row kernel: a building's peak drift ratio reached the run's collapse limit. The kernel
+/// has no collapse event; it ends the run there and the host runs it again on the CPU, which
+/// locates the collapse (past the limit a P-Delta storey runs away, and its substeps per
+/// record step grow with it).
+pub const STATUS_COLLAPSE: u32 = 4;
 
 /// Reals per run in the `forms` buffer: the exact free-step energy integrals
 /// (`propagator::EnergyForms`) of building 1 (`vv`, then `agv`), then building 2. The shader's

@@ -10,7 +10,7 @@
 //! masses, heights, propagators) are shared by the runs that use the same one.
 
 use super::context::{GpuContext, GpuError};
-use super::layout::{MODE_FREE, STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK};
+use super::layout::{MODE_FREE, STATUS_COLLAPSE, STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK};
 use super::run::{
     bind_group, read, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions, GpuRecords,
     WorkLists,
@@ -40,9 +40,12 @@ pub const P_STIFFNESS: usize = 4;
 pub const P_RATIO: usize = 5;
 /// The row's structural rate (`RowModel::structural_rate`).
 pub const P_RATE: usize = 6;
+/// The collapse limit on a storey's drift ratio (`RowModel::collapse_limit`, infinite: none;
+/// in f32 rounded up, [`collapse_param`]).
+pub const P_COLLAPSE: usize = 7;
 /// Then one gap per adjacent pair, then per level its contact (`LEVEL_PARAMS`), then each struck
 /// storey's stiffness (`RowShape::p_columns`).
-pub const P_GAPS: usize = 7;
+pub const P_GAPS: usize = 8;
 // A run's meta block (u32), then each building's model block offset.
 pub const M_LAW: usize = 0;
 pub const M_REC_OFFSET: usize = 1;
@@ -356,6 +359,7 @@ impl RowShape {
             ("P_STIFFNESS", P_STIFFNESS),
             ("P_RATIO", P_RATIO),
             ("P_RATE", P_RATE),
+            ("P_COLLAPSE", P_COLLAPSE),
             ("P_GAPS", P_GAPS),
             ("P_LEVELS", P_GAPS + nb - 1),
             ("LEVEL_PARAMS", LEVEL_PARAMS),
@@ -369,6 +373,7 @@ impl RowShape {
             ("M_SETTLE_END", M_MODELS + nb),
             ("M_STRIDE", self.m_stride()),
             ("C_STATUS", C_STATUS),
+            ("STATUS_COLLAPSE", STATUS_COLLAPSE as usize),
             ("C_SUBSTEPS", C_SUBSTEPS),
             ("C_I", C_I),
             ("C_J", C_J),
@@ -476,12 +481,27 @@ impl RowShape {
             self.coupled.iter().any(|&c| c),
             !self.columns.is_empty()
         ));
+        s.push_str(&self.wgsl_collapse_reached());
         if self.unrolled() {
             s.push_str(&self.wgsl_unrolled());
         } else {
             s.push_str(super::shader::ROW_LOOPS_WGSL);
         }
         s
+    }
+
+    /// `collapse_reached()`: has a building's peak drift ratio reached the run's collapse
+    /// limit (the host's test of a run's output, `!(peak < limit)`, so that a NaN peak ends it
+    /// too)? Written out per building: no loop, so the loop trips per unit stay as counted.
+    fn wgsl_collapse_reached(&self) -> String {
+        let mut e = String::from("false");
+        for b in 0..self.storeys.len() {
+            e.push_str(&format!(
+                " || !(rstate[RS + S_BUILDINGS + {}u] < limit)",
+                BS_STRIDE * b + BS_DRIFT
+            ));
+        }
+        format!("fn collapse_reached() -> bool {{\n    let limit = rp(P_COLLAPSE);\n    return {e};\n}}\n")
     }
 
     /// Is the row small enough to write its per-shape functions out (`wgsl_unrolled`)? The
@@ -1043,6 +1063,16 @@ impl PackedRows {
         self.runs == 0
     }
 
+    /// The runs' parameters for a kernel in `precision` (each collapse limit as
+    /// [`collapse_param`] gives it).
+    fn params_in(&self, precision: Precision) -> Vec<f64> {
+        let mut params = self.params.clone();
+        for run in params.chunks_mut(self.shape.p_stride()) {
+            run[P_COLLAPSE] = collapse_param(run[P_COLLAPSE], precision);
+        }
+        params
+    }
+
     /// Add one run of model `m` (of this chunk's shape) on `forcing`, the `record`-th of `recs`.
     pub fn push(
         &mut self,
@@ -1082,6 +1112,7 @@ impl PackedRows {
             first.map_or(0.0, |c| c.stiffness),
             first.map_or(0.0, |c| c.damping_ratio),
             m.structural_rate(),
+            m.collapse_limit,
         ]);
         let mut gaps = vec![0.0; self.shape.storeys.len() - 1];
         for l in &m.levels {
@@ -1115,6 +1146,24 @@ impl PackedRows {
                 .extend((0..m.storeys.len()).map(|s| StoreyReadout::of(m, s)));
         }
         self.runs += 1;
+    }
+}
+
+/// The collapse limit `limit` as the kernel in `precision` compares with it: in f32 the least
+/// f32 not below it, so that an f32 peak `d` is below it exactly where `d as f64 < limit` (the
+/// host's test of a run's output); round to nearest, it could fall below the limit and end a
+/// run at a peak the host keeps.
+pub fn collapse_param(limit: f64, precision: Precision) -> f64 {
+    match precision {
+        Precision::F64 => limit,
+        Precision::F32 => {
+            let x = limit as f32;
+            if (x as f64) < limit {
+                x.next_up() as f64
+            } else {
+                x as f64
+            }
+        }
     }
 }
 
@@ -1224,15 +1273,46 @@ pub fn check_fits(ctx: &GpuContext, plan: &RowPlan) -> Result<(), GpuError> {
     software_cap(ctx, &shape).map(|_| ())
 }
 
+/// How the kernel left a run. Nearly every run ends with its output, so it is not boxed.
+#[allow(clippy::large_enum_variant)]
+enum Ended {
+    Output(RowOutput),
+    /// More substeps per record step than the precision resolves (`STATUS_HANDOFF`).
+    HandedBack,
+    /// A building's peak drift ratio reached the collapse limit (`STATUS_COLLAPSE`).
+    Collapse,
+}
+
+impl Ended {
+    fn output(self) -> Option<RowOutput> {
+        match self {
+            Ended::Output(o) => Some(o),
+            Ended::HandedBack | Ended::Collapse => None,
+        }
+    }
+}
+
 /// Integrate a chunk of packed rows over their whole records; results in input order, None
 /// for runs handed back to the host (more substeps per record step than `opts` allows the
-/// precision).
+/// precision, or a building's peak drift ratio reached the collapse limit: the kernel ends
+/// such a run there).
 pub fn run_rows(
     ctx: &GpuContext,
     recs: &GpuRecords,
     chunk: &PackedRows,
     opts: &GpuOptions,
 ) -> Result<(Vec<Option<RowOutput>>, ChunkTimes), GpuError> {
+    let (ends, times) = integrate_rows(ctx, recs, chunk, opts)?;
+    Ok((ends.into_iter().map(Ended::output).collect(), times))
+}
+
+/// [`run_rows`], each run's end as the kernel left it.
+fn integrate_rows(
+    ctx: &GpuContext,
+    recs: &GpuRecords,
+    chunk: &PackedRows,
+    opts: &GpuOptions,
+) -> Result<(Vec<Ended>, ChunkTimes), GpuError> {
     let mut times = ChunkTimes::default();
     let n = chunk.runs;
     if n == 0 {
@@ -1251,7 +1331,7 @@ pub fn run_rows(
     let params = storage(
         ctx,
         "row params",
-        &p.reals(&chunk.params),
+        &p.reals(&chunk.params_in(p)),
         wgpu::BufferUsages::empty(),
     )?;
     let meta = storage(
@@ -1331,10 +1411,11 @@ pub fn run_rows(
 }
 
 /// A run's results from its final state and counters (what `RowRun::finish` does on the CPU,
-/// without the energy balance), `storeys`: its yielding storeys'; None for a run handed back.
-fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> Option<RowOutput> {
+/// without the energy balance), `storeys`: its yielding storeys'; or that it was handed back.
+fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> Ended {
     let status = match c[C_STATUS] {
-        STATUS_HANDOFF => return None,
+        STATUS_HANDOFF => return Ended::HandedBack,
+        STATUS_COLLAPSE => return Ended::Collapse,
         STATUS_OK => Status::Ok,
         STATUS_NON_FINITE => Status::NonFinite,
         _ => Status::StepLimit,
@@ -1408,7 +1489,7 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> 
         out.gather_storeys(&spans, &vec![settled; spans.len()]);
     }
     out.gather();
-    Some(out)
+    Ended::Output(out)
 }
 
 /// The runs `runs` of a row plan on the GPU in chunks of `chunk`, each chunk's runs handed back
@@ -1466,23 +1547,28 @@ pub fn sweep_rows<E: From<GpuError>>(
         let end = first + specs.len() as u64;
         times.pack += pack_s;
         let (done, upcoming) = rayon::join(
-            || run_rows(ctx, &recs, &packed, opts),
+            || integrate_rows(ctx, &recs, &packed, opts),
             || (end < runs.end).then(|| prep(end)),
         );
         next = upcoming;
         let (outs, ct) = done?;
         times.add_chunk(&ct);
         let t = Instant::now();
-        times.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
+        times.handed_off += outs
+            .iter()
+            .filter(|o| matches!(o, Ended::HandedBack))
+            .count() as u64;
         // The runs handed back, on every thread.
         let rows: Vec<(RowRunSpec, RowOutput)> = specs
             .into_par_iter()
             .zip(outs)
             .zip(&models)
             .map(|((s, o), m)| {
-                // The kernel has no collapse event: a run whose storey reached the limit is
-                // run again on the CPU, which ends it there.
-                let o = o.filter(|o| {
+                // The kernel has no collapse event: it ends a run once a building's peak drift
+                // ratio reaches the limit (`Ended::Collapse`), and the CPU runs it again and
+                // ends it at the collapse. The kernel's test is this one (the limit rounded up
+                // in f32), so this only restates it.
+                let o = o.output().filter(|o| {
                     o.buildings
                         .iter()
                         .all(|b| b.peak_drift_ratio < plan.collapse_drift_ratio)
@@ -1501,4 +1587,30 @@ pub fn sweep_rows<E: From<GpuError>>(
     }
     summary.seconds = start.elapsed().as_secs_f64();
     Ok((summary, times))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// In f32 the kernel's limit is the least f32 not below the collapse limit, so an f32
+    /// peak is below it exactly where the host finds the peak below the limit; in f64 (or
+    /// with no limit) it is the limit.
+    #[test]
+    fn an_f32_peak_is_below_the_kernels_limit_where_the_host_finds_it_below() {
+        // f32 rounds 0.12 down and 0.1 up.
+        for limit in [0.1, 0.12, 0.3, 0.04, 1.0] {
+            assert_eq!(collapse_param(limit, Precision::F64), limit);
+            let x = collapse_param(limit, Precision::F32);
+            assert_eq!(x as f32 as f64, x, "{limit}: an f32");
+            let x = x as f32;
+            let mut d = x.next_down().next_down();
+            for _ in 0..5 {
+                assert_eq!(d < x, (d as f64) < limit, "{limit}: peak {d}");
+                d = d.next_up();
+            }
+        }
+        let none = collapse_param(f64::INFINITY, Precision::F32);
+        assert_eq!(none, f64::INFINITY);
+    }
 }
