@@ -276,3 +276,43 @@ fn a_collapsed_buildings_contacts_end_and_its_neighbour_goes_on() {
     }
     assert!(neighbour_moved, "the neighbour goes on moving");
 }
+
+/// The same pair on the software adapter in f64 (and f32): each frame's collapse, its time and
+/// storey, and its peaks are the CPU's, run by run (a run that reaches the limit is ended by
+/// the row kernel and run again on the CPU, which lets each frame collapse on its own), so each
+/// frame collapses on the GPU as it would alone.
+#[test]
+fn on_the_gpu_each_building_collapses_as_on_the_cpu() {
+    if crate::support::gpu::ctx().is_none() {
+        return;
+    }
+    let dir = tempdir();
+    let motion = motion(&records_dir());
+    let pair = format!("{RUN}{FRAME_4}gap_right_m = 5.0\n{FRAME_3}{CONTACT}{motion}");
+    let cpu = rows(dir.path(), "cpu", &pair, &["--backend", "cpu"]);
+    assert!(cpu.iter().any(|r| r["b1_collapsed"] != r["b2_collapsed"]));
+    for precision in ["f64", "f32"] {
+        let flags = ["--backend", "gpu", "--precision", precision];
+        let gpu = rows(dir.path(), &format!("gpu-{precision}"), &pair, &flags);
+        for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+            let what = format!("{precision} run {i}");
+            assert_eq!(g["status"], c["status"], "{what}");
+            for k in 1..=2 {
+                for col in ["collapsed", "collapse_time_s", "collapse_storey"] {
+                    let col = format!("b{k}_{col}");
+                    assert_eq!(g[&col], c[&col], "{what}: {col}");
+                }
+                // A run that collapsed is the CPU's own; one that did not, the kernel's
+                // (within f32's error of the twin).
+                let col = format!("b{k}_peak_drift_ratio");
+                let (x, y) = (num(g, &col), num(c, &col));
+                let tol = if c["status"] == "collapsed" {
+                    0.0
+                } else {
+                    1e-3
+                };
+                assert!((x - y).abs() <= tol * y, "{what}: {col} {x} cpu {y}");
+            }
+        }
+    }
+}
