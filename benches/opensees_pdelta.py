@@ -4,7 +4,7 @@ which the test `collapse_opensees::opensees_cross_check` compares `pound sweep` 
 with.
 
 Three scenes on real records no other OpenSees cross-check uses, each scaled by a factor (from a
-PGA), each but the collapse followed by a 60 s free tail (ground at rest) for the residual drift:
+PGA), each followed by a 60 s free tail (ground at rest) for the residual drift:
   G  a yielding one-storey building with P-Delta (m 3e5 kg, T0 1.0 s, h 3.5 m: theta =
      g / (w0^2 h) = 0.071; strength 0.15 W, b = 0.02: post-yield tangent -0.051 k) beside a far
      elastic neighbour (gap 1 m, no contact), El Centro 1940 NS, Peknold version (the first
@@ -18,7 +18,9 @@ PGA), each but the collapse followed by a 60 s free tail (ground at rest) for th
      b k - P/h < 0), gap 20 mm, Tabas 1978 fault-normal (OpenSees' example record, the first
      20 s at 0.8 g): the two pound, then the frame's first storey runs away from its neighbour:
      the collapse time (the first time some |d_j| / h_j reaches 0.10, interpolated linearly
-     between OpenSees' steps), building and storey, and the peaks over [0, t_c]
+     between OpenSees' steps), building and storey, the frame's peaks over [0, t_c]; the frame
+     then leaves the scene and the neighbour goes on through the record and the tail (its peak
+     drift over the whole run)
 
 The scales are chosen where the answers are well conditioned: a change of 1e-4 in the scale
 moves G's and H's peak drifts by about 1.3e-4, their residual drifts by at most 4.4e-4 of the
@@ -43,18 +45,30 @@ Conventions (physics.md sections 6, 8 and 10; the same in `pound`):
   - contact at every floor level two neighbours share: a linear compression-only spring
     (`ElasticPPGap`, `law = "linear"` in pound), one gap per pair;
   - the ground motion: the record's samples linearly interpolated (`Path` time series), then
-    the ground at rest.
+    the ground at rest;
+  - collapse (physics.md section 12): a building leaves the scene at the end of the step in
+    which one of its storeys reaches the limit (stepping one step at a time once a standing
+    building is past half of it): its contact elements and its own elements are removed
+    (`remove element`), its leaning column's `equalDOF` ties too (`remove mp`), and every free
+    DOF of its nodes is fixed, so it stands frozen out of the equations and its runaway cannot
+    stop the analysis; the others go on to the end of the record and tail. pound takes it out at
+    t_c, inside the step: the same for its neighbours where its contacts are open through that
+    step (the script prints the largest contact force there).
 
-The model is checked against closed forms before any scene runs (printed, and written to the
-file's [checks]): (a) an eigen analysis after gravity of an elastic P-Delta SDOF gives
-T0 / sqrt(1 - theta), and of each scene's P-Delta frames the periods of (K0 - K_G, M) from
-numpy; (b) a static pushover (displacement control) of an elastic-perfectly-plastic P-Delta
-SDOF rises with slope k - P/h to F_y (1 - theta) and then falls with slope -P/h.
+The model is checked before any scene runs (printed, and written to the file's [checks]): (a)
+an eigen analysis after gravity of an elastic P-Delta SDOF gives T0 / sqrt(1 - theta), and of
+each scene's P-Delta frames the periods of (K0 - K_G, M) from numpy; (b) a static pushover
+(displacement control) of an elastic-perfectly-plastic P-Delta SDOF rises with slope k - P/h to
+F_y (1 - theta) and then falls with slope -P/h; (c) a building leaving the scene leaves its
+neighbour as it was: scene I with the two 1 m apart (never touching) at dt 1e-3, against each
+building alone, the neighbour's displacements over the whole run and the frame's up to its
+collapse are the same (to 1e-12 of their peaks; measured: to the bit).
 
 OpenSees integrates with Newmark average acceleration (Newton, NormDispIncr 1e-12) at two steps
 (dt and dt / 2) so the file states its own error. Peaks are over the recorded steps (for a
-collapse, over the steps before t_c and the values interpolated at t_c). Residual drift: each
-storey's drift at the end of the free tail (with P-Delta, at rest `k (d - p) = P d / h`, so
+collapsed building and its contacts, over the steps before t_c and the values interpolated at
+t_c; for the others, over the whole run). Residual drift (buildings that stand): each storey's
+drift at the end of the free tail (with P-Delta, at rest `k (d - p) = P d / h`, so
 `d = p / (1 - theta)`). Reported per building: peak interstorey drift ratio, residual drift
 ratio per storey (signed) and per level the peak contact force; per scene whether it collapsed
 and when, where.
@@ -63,7 +77,7 @@ Set-up (OpenSees 3.8 needs Python 3.12), from the repository root:
     PYENV_VERSION=3.12.1 python3.12 -m venv /tmp/ospy && /tmp/ospy/bin/pip install openseespy numpy
     /tmp/ospy/bin/python benches/opensees_pdelta.py [--dt 2e-4] [--check]
 
-`--check` runs only the closed-form checks. Records are read from POUND_RECORDS_DIR (default
+`--check` runs only the checks. Records are read from POUND_RECORDS_DIR (default
 ../shared/records), never copied.
 """
 
@@ -199,12 +213,14 @@ SCENES = [
 
 def build(ops, buildings, gaps=None):
     """The scene's model with gravity applied and held (LoadConst); returns the floor nodes per
-    building, the contact elements and each P-Delta building's leaning column elements."""
+    building, the contact elements with the pair each joins (its left building, from 0) and per
+    building what takes it out of the scene at its collapse: its elements and, per node, the
+    DOFs that are free (to fix) and whether an equalDOF constrains it (to remove)."""
     ops.wipe()
     ops.model("basic", "-ndm", 2, "-ndf", 3)
     ops.geomTransf("PDelta", 1)
     tags = iter(range(1, 1_000_000))
-    floor_nodes, lean_eles = [], []
+    floor_nodes, parts = [], []
     gravity = []
     for bi, b in enumerate(buildings):
         a0, a1 = rayleigh(b)
@@ -213,6 +229,7 @@ def build(ops, buildings, gaps=None):
         ops.node(ground, 0.0, 0.0)
         ops.fix(ground, 1, 1, 1)
         nodes = []
+        part = {"elements": [], "free": [], "tied": []}
         below = ground
         for j, (mj, kj) in enumerate(zip(b["masses"], b["stiffness"])):
             node = next(tags)
@@ -227,15 +244,18 @@ def build(ops, buildings, gaps=None):
                 ops.uniaxialMaterial("Steel01", spring, b["fy"][j], kj, b["b"][j])
             ops.uniaxialMaterial("Viscous", dashpot, a1 * kj, 1.0)
             ops.uniaxialMaterial("Parallel", storey, spring, dashpot)
-            ops.element("zeroLength", next(tags), below, node, "-mat", storey, "-dir", 1)
+            ele = next(tags)
+            ops.element("zeroLength", ele, below, node, "-mat", storey, "-dir", 1)
             anchor, mass_dashpot = next(tags), next(tags)
             ops.node(anchor, 0.0, 0.0)
             ops.fix(anchor, 1, 1, 1)
             ops.uniaxialMaterial("Viscous", mass_dashpot, a0 * mj, 1.0)
-            ops.element("zeroLength", next(tags), anchor, node, "-mat", mass_dashpot, "-dir", 1)
+            dashpot_ele = next(tags)
+            ops.element("zeroLength", dashpot_ele, anchor, node, "-mat", mass_dashpot, "-dir", 1)
+            part["elements"] += [ele, dashpot_ele]
+            part["free"].append((node, (1, 0, 0)))
             below = node
         floor_nodes.append(nodes)
-        eles = []
         if b["ratio"] is not None:
             # The leaning column, off to the side at x = 10 (bi + 1): massless, pinned base.
             x = 10.0 * (bi + 1)
@@ -252,16 +272,18 @@ def build(ops, buildings, gaps=None):
                 ops.element("elasticBeamColumn", ele, below, node, LEAN_A, LEAN_E, LEAN_I, 1)
                 ops.equalDOF(nodes[j], node, 1)
                 gravity.append((node, G * mj * b["ratio"]))
-                eles.append(ele)
+                part["elements"].append(ele)
+                part["free"].append((node, (1, 1, 0)))
+                part["tied"].append(node)
                 below = node
-        lean_eles.append(eles)
-    contact_eles = []
+        parts.append(part)
+    contacts = []
     if gaps is not None:
         for a, fa, fb in levels({"buildings": buildings}):
             gap_mat, ele = next(tags), next(tags)
             ops.uniaxialMaterial("ElasticPPGap", gap_mat, K_CONTACT, -1e30, -gaps[a])
             ops.element("zeroLength", ele, floor_nodes[a][fa], floor_nodes[a + 1][fb], "-mat", gap_mat, "-dir", 1)
-            contact_eles.append(ele)
+            contacts.append((ele, a))
     ops.constraints("Plain")
     ops.numberer("RCM")
     ops.system("BandGeneral")
@@ -286,7 +308,7 @@ def build(ops, buildings, gaps=None):
     for nodes in floor_nodes:
         for n in nodes:
             assert ops.nodeDisp(n, 1) == 0.0, "gravity alone moved a floor sideways"
-    return floor_nodes, contact_eles, lean_eles
+    return floor_nodes, contacts, parts
 
 
 def check_period(ops, b):
@@ -409,8 +431,31 @@ def closed_form_checks(ops):
     return out
 
 
-def run_opensees(ops, tmp, scene, ag, dt_rec, dt, duration, tail=TAIL_S):
-    floor_nodes, contact_eles, _ = build(ops, scene["buildings"], scene["gaps"])
+def leave_scene(ops, part, contacts, k):
+    """Building k leaves the scene at its collapse (physics.md section 12): its contacts end, and
+    its own elements go too (storeys, dashpots, leaning column), so its runaway cannot stop the
+    analysis; its leaning column's equalDOF ties go and every free DOF of its nodes is fixed, so
+    none of its DOFs is left in the equations (it stands frozen). The others' state carries on:
+    the analysis sets itself up again and Newmark::domainChanged reads the committed
+    displacements, velocities and accelerations back."""
+    for ele, a in contacts:
+        if k in (a, a + 1):
+            ops.remove("element", ele)
+    for ele in part["elements"]:
+        ops.remove("element", ele)
+    for node in part["tied"]:
+        ops.remove("mp", node)
+    for node, dofs in part["free"]:
+        ops.fix(node, *dofs)
+
+
+def simulate(ops, tmp, scene, ag, dt_rec, dt, duration, tail=TAIL_S):
+    """The scene through the record and the tail, each building leaving at its collapse. Returns
+    the times, the floor displacements (building by building; a collapsed building's frozen after
+    it left), |force| per contact (0 once it ended), the contacts and, per collapsed building, the
+    step at whose end it left."""
+    buildings = scene["buildings"]
+    floor_nodes, contacts, parts = build(ops, buildings, scene["gaps"])
     # The record, then the ground at rest through the tail.
     values = list(ag) + [0.0, 0.0]
     ops.timeSeries("Path", 1, "-dt", dt_rec, "-values", *values, "-factor", 1.0)
@@ -418,46 +463,84 @@ def run_opensees(ops, tmp, scene, ag, dt_rec, dt, duration, tail=TAIL_S):
     ops.integrator("Newmark", 0.5, 0.25)
     ops.analysis("Transient")
     all_nodes = [n for ns in floor_nodes for n in ns]
-    disp = os.path.join(tmp, "disp.txt")
-    force = os.path.join(tmp, "force.txt")
-    ops.recorder("Node", "-file", disp, "-precision", 14, "-time", "-node", *all_nodes, "-dof", 1, "disp")
-    if contact_eles:
-        ops.recorder("Element", "-file", force, "-precision", 14, "-ele", *contact_eles, "force")
-    steps = int(round((duration + tail) / dt))
-    # In chunks of 0.5 s, stopping once a storey is past the collapse drift (with margin).
-    chunk = int(round(0.5 / dt))
-    done = 0
-    stopped = False
+    # One recorder phase per stretch between collapses: an element recorder must not outlive the
+    # contacts it reads, so the recorders are replaced at each collapse.
+    live = list(range(len(contacts)))
+    phases = []
 
-    def largest_drift():
-        out = 0.0
-        for b, nodes in zip(scene["buildings"], floor_nodes):
-            below = 0.0
-            for n, h in zip(nodes, b["heights"]):
-                u = ops.nodeDisp(n, 1)
-                out = max(out, abs(u - below) / h)
-                below = u
+    def record():
+        disp = os.path.join(tmp, f"disp{len(phases)}.txt")
+        force = os.path.join(tmp, f"force{len(phases)}.txt")
+        ops.recorder(
+            "Node", "-file", disp, "-precision", 14, "-time", "-node", *all_nodes, "-dof", 1, "disp"
+        )
+        if live:
+            eles = [contacts[i][0] for i in live]
+            ops.recorder("Element", "-file", force, "-precision", 14, "-ele", *eles, "force")
+        phases.append((disp, force, list(live)))
+
+    def largest_drift(k):
+        out, below = 0.0, 0.0
+        for n, h in zip(floor_nodes[k], buildings[k]["heights"]):
+            u = ops.nodeDisp(n, 1)
+            out = max(out, abs(u - below) / h)
+            below = u
         return out
 
-    while done < steps:
-        n = min(chunk, steps - done)
+    record()
+    steps = int(round((duration + tail) / dt))
+    # In chunks of 0.05 s, step by step once a standing building is past half the collapse drift,
+    # so a building leaves at the end of the step in which it reaches the limit.
+    chunk = int(round(0.05 / dt))
+    standing = list(range(len(buildings)))
+    left = {}
+    done = 0
+    while done < steps and standing:
+        near = any(largest_drift(k) >= 0.5 * COLLAPSE_DRIFT_RATIO for k in standing)
+        n = 1 if near else min(chunk, steps - done)
         if ops.analyze(n, dt) != 0:
             raise RuntimeError(f"OpenSees failed on {scene['name']} near t = {done * dt:.2f} s")
         done += n
-        if largest_drift() > 1.2 * COLLAPSE_DRIFT_RATIO:
-            stopped = True
-            break
+        crossed = [k for k in standing if largest_drift(k) >= COLLAPSE_DRIFT_RATIO]
+        if crossed and n > 1:
+            raise RuntimeError(
+                f"{scene['name']}: building {crossed[0] + 1} reached the collapse drift inside a "
+                f"chunk of {n} steps (t = {done * dt:.2f} s): shorten the chunk"
+            )
+        if crossed:
+            ops.remove("recorders")
+            for k in crossed:
+                leave_scene(ops, parts[k], contacts, k)
+                live = [i for i in live if k not in (contacts[i][1], contacts[i][1] + 1)]
+                standing.remove(k)
+                left[k] = done
+            if standing:
+                record()
     ops.wipe()
-    rows = np.loadtxt(disp, ndmin=2)
-    t = np.concatenate([[0.0], rows[:, 0]])
-    u = np.vstack([np.zeros((1, rows.shape[1] - 1)), rows[:, 1:]])
-    nc = len(contact_eles)
-    if nc:
-        fr = np.loadtxt(force, ndmin=2)
-        per = fr.shape[1] // nc  # global forces at both nodes: 2 x 3 per element
-        f = np.vstack([np.zeros((1, nc)), np.abs(fr[:, [per * i for i in range(nc)]])])
-    else:
-        f = np.zeros((len(t), 0))
+    nc = len(contacts)
+    t, u, f = [np.zeros(1)], [np.zeros((1, len(all_nodes)))], [np.zeros((1, nc))]
+    for disp, force, cols in phases:
+        if os.path.getsize(disp) == 0:
+            continue
+        rows = np.loadtxt(disp, ndmin=2)
+        t.append(rows[:, 0])
+        u.append(rows[:, 1:])
+        fp = np.zeros((rows.shape[0], nc))
+        if cols:
+            fr = np.loadtxt(force, ndmin=2)
+            per = fr.shape[1] // len(cols)  # global forces at both nodes: 2 x 3 per element
+            fp[:, cols] = np.abs(fr[:, [per * i for i in range(len(cols))]])
+        f.append(fp)
+    t, u, f = np.concatenate(t), np.vstack(u), np.vstack(f)
+    if len(t) != done + 1 or np.any(np.diff(t) <= 0):
+        raise RuntimeError(f"{scene['name']}: the recorders hold {len(t) - 1} steps, not {done}")
+    return t, u, f, contacts, left
+
+
+def run_opensees(ops, tmp, scene, ag, dt_rec, dt, duration, tail=TAIL_S):
+    """Peak contact forces, peak drift ratios and residual drift ratios per building (None for
+    a collapsed one), and the collapses (time, building, storey, drift rate there), by time."""
+    t, u, f, contacts, left = simulate(ops, tmp, scene, ag, dt_rec, dt, duration, tail)
     # Drift ratios, storey by storey (building by building).
     ratios = []
     col = 0
@@ -467,40 +550,106 @@ def run_opensees(ops, tmp, scene, ag, dt_rec, dt, duration, tail=TAIL_S):
         col += n
         below = np.hstack([np.zeros((ub.shape[0], 1)), ub[:, :-1]])
         ratios.append((ub - below) / np.array(b["heights"]))
-    # Collapse: the first step at which some |d_j| / h_j reaches the limit; the time each storey
-    # crosses it inside that step, by linear interpolation, the earliest of them.
-    allr = np.abs(np.hstack(ratios))
-    over = np.nonzero(np.max(allr, axis=1) >= COLLAPSE_DRIFT_RATIO)[0]
-    collapse = None
-    if len(over):
-        i = int(over[0])
+    # Each collapse: the first step at which some |d_j| / h_j of the building reaches the limit
+    # (the step at whose end it left); the time each storey crosses it inside that step, by
+    # linear interpolation, the earliest of them. Its peaks, and those of its contacts, are over
+    # [0, t_c]: the steps before it and the values interpolated at t_c. The others' are over the
+    # whole run.
+    forces = [f[:, c] for c in range(f.shape[1])]
+    collapses = []
+    for k, step in sorted(left.items(), key=lambda x: x[1]):
+        r = np.abs(ratios[k])
+        i = int(np.nonzero(np.max(r, axis=1) >= COLLAPSE_DRIFT_RATIO)[0][0])
+        if i != step:
+            raise RuntimeError(f"{scene['name']}: building {k + 1} left at step {step}, not {i}")
         best = None
-        for c in range(allr.shape[1]):
-            a, b_ = allr[i - 1, c], allr[i, c]
+        for c in range(r.shape[1]):
+            a, b_ = r[i - 1, c], r[i, c]
             if b_ >= COLLAPSE_DRIFT_RATIO:
                 s = (COLLAPSE_DRIFT_RATIO - a) / (b_ - a)
                 if best is None or s < best[0]:
                     best = (s, c)
         s, c = best
         tc = t[i - 1] + s * (t[i] - t[i - 1])
-        # Building and storey of column c (both from 1).
-        k, j = 0, c
-        while j >= len(scene["buildings"][k]["masses"]):
-            j -= len(scene["buildings"][k]["masses"])
-            k += 1
         # The drift ratio's rate there: how a drift error maps to a time error.
-        rate = (allr[i, c] - allr[i - 1, c]) / (t[i] - t[i - 1])
-        collapse = (float(tc), k + 1, j + 1, float(rate))
-        # Peaks over [0, t_c]: the steps before it and the values interpolated at t_c.
-        cut = lambda x: np.vstack([x[:i], (1 - s) * x[i - 1] + s * x[i]])  # noqa: E731
-        ratios = [cut(r) for r in ratios]
-        f = cut(f)
-    elif stopped:
-        raise RuntimeError("stopped without a collapse")
-    forces = [float(np.max(f[:, i])) for i in range(nc)]
+        rate = (r[i, c] - r[i - 1, c]) / (t[i] - t[i - 1])
+        # It left at t_i, not t_c: the same for its neighbours where its contacts are open
+        # through that step (printed).
+        mine = [e for e, (_, a) in enumerate(contacts) if k in (a, a + 1)]
+        touching = [float(f[j, e]) for e in mine for j in (i - 1, i)]
+        collapses.append((float(tc), k + 1, c + 1, float(rate), max(touching, default=0.0)))
+        cut = lambda x: np.concatenate([x[:i], [(1 - s) * x[i - 1] + s * x[i]]])  # noqa: E731
+        ratios[k] = np.vstack([ratios[k][:i], (1 - s) * ratios[k][i - 1] + s * ratios[k][i]])
+        for e, (_, a) in enumerate(contacts):
+            # A contact ends at the earlier collapse of its two buildings.
+            if k in (a, a + 1) and len(forces[e]) == len(t):
+                forces[e] = cut(forces[e])
+    peak_forces = [float(np.max(x)) for x in forces]
     drifts = [float(np.max(np.abs(r))) for r in ratios]
-    residuals = [[float(x) for x in r[-1, :]] for r in ratios]
-    return forces, drifts, residuals, collapse
+    residuals = [None if k in left else [float(x) for x in r[-1, :]] for k, r in enumerate(ratios)]
+    return peak_forces, drifts, residuals, collapses
+
+
+def ground_motion(records, scene):
+    """The scene's record, its first `seconds` scaled to `pga_g`: (ground acceleration m/s^2,
+    its dt, npts, the scale, the duration)."""
+    path = os.path.join(records, scene["record"])
+    if path.endswith(".AT2"):
+        dt_rec, acc_g = read_at2(path)
+    elif "record_dt_s" in scene:
+        dt_rec, acc_g = read_values(path, scene["record_dt_s"])
+    else:
+        dt_rec, acc_g = read_time_acc(path)
+    npts = min(len(acc_g), int(round(scene["seconds"] / dt_rec)) + 1)
+    acc_g = acc_g[:npts]
+    ipga = max(range(npts), key=lambda i: abs(acc_g[i]))
+    scale = scene["pga_g"] / abs(acc_g[ipga])
+    return [x * scale * G for x in acc_g], dt_rec, npts, scale, (npts - 1) * dt_rec
+
+
+def leaving_check(ops, tmp, records, dt=1e-3, gap=1.0):
+    """(c) A building that leaves the scene leaves its neighbour as it was: scene I with the
+    neighbours 1 m apart (they never touch), run through the record and the tail with the
+    collapsing frame leaving at its collapse, against each building alone (the frame's run ends
+    at its collapse, nothing being left standing): the neighbour's displacements over the whole
+    run and the frame's up to its collapse. Printed, and returned as TOML."""
+    scene = next(s for s in SCENES if s["name"].startswith("I_"))
+    ag, dt_rec, _, _, duration = ground_motion(records, scene)
+    far = dict(scene, gaps=[gap])
+    t, u, f, _, left = simulate(ops, tmp, far, ag, dt_rec, dt, duration)
+    alone = [
+        simulate(ops, tmp, dict(scene, buildings=[b], gaps=[]), ag, dt_rec, dt, duration)
+        for b in scene["buildings"]
+    ]
+    if np.any(f != 0.0) or sorted(left) != [1] or sorted(alone[1][4]) != [0]:
+        raise RuntimeError("the leaving check's scene: the frame must collapse, untouched")
+    n0 = len(scene["buildings"][0]["masses"])
+    t0, u0 = alone[0][0], alone[0][1]
+    t1, u1 = alone[1][0], alone[1][1]
+    standing = float(np.max(np.abs(u[:, :n0] - u0))) if np.array_equal(t, t0) else math.inf
+    frame = math.inf
+    if np.array_equal(t[: len(t1)], t1):
+        frame = float(np.max(np.abs(u[: len(t1), n0:] - u1)))
+    peak0, peak1 = float(np.max(np.abs(u0))), float(np.max(np.abs(u1)))
+    print(
+        f"  (c) scene I, gap {gap} m, dt {dt}: the frame leaves at t = {t[left[1]]:.4f} s; the "
+        f"neighbour over {t[-1]:.1f} s against it alone: largest difference {standing:.1e} m "
+        f"(its peak {peak0:.3e} m); the frame up to its collapse against it alone {frame:.1e} m",
+        file=sys.stderr,
+    )
+    # The same equations in another order at most (the numberer runs again): rounding.
+    if standing > 1e-12 * peak0 or frame > 1e-12 * peak1:
+        raise RuntimeError("a building leaving the scene changed its neighbour's response")
+    return [
+        "[checks.leaving]",
+        f'scene = "{scene["name"]}"',
+        f"gap_m = {gap!r}",
+        f"dt_s = {dt!r}",
+        f"left_at_s = {float(t[left[1]])!r}",
+        f"run_s = {float(t[-1])!r}",
+        f"neighbour_largest_difference_m = {standing!r}",
+        f"frame_largest_difference_m = {frame!r}",
+    ]
 
 
 def main():
@@ -513,9 +662,11 @@ def main():
     import openseespy.opensees as ops
 
     checks = closed_form_checks(ops)
+    records = os.environ.get("POUND_RECORDS_DIR", "../shared/records")
+    with tempfile.TemporaryDirectory() as tmp:
+        checks += leaving_check(ops, tmp, records)
     if a.check:
         return 0
-    records = os.environ.get("POUND_RECORDS_DIR", "../shared/records")
     lines = [
         "# Written by benches/opensees_pdelta.py (see its docstring for the conventions).",
         f"# openseespy {version('openseespy')}, Newmark average acceleration at dt and dt / 2.",
@@ -532,34 +683,25 @@ def main():
         for scene in SCENES:
             if a.scenes and scene["name"][0] not in a.scenes:
                 continue
-            path = os.path.join(records, scene["record"])
-            if path.endswith(".AT2"):
-                dt_rec, acc_g = read_at2(path)
-            elif "record_dt_s" in scene:
-                dt_rec, acc_g = read_values(path, scene["record_dt_s"])
-            else:
-                dt_rec, acc_g = read_time_acc(path)
-            npts = min(len(acc_g), int(round(scene["seconds"] / dt_rec)) + 1)
-            acc_g = acc_g[:npts]
-            ipga = max(range(npts), key=lambda i: abs(acc_g[i]))
-            scale = scene["pga_g"] / abs(acc_g[ipga])
-            ag = [x * scale * G for x in acc_g]
-            duration = (npts - 1) * dt_rec
+            ag, dt_rec, npts, scale, duration = ground_motion(records, scene)
             results = {}
             for dt in (a.dt, a.dt / 2):
                 t = time.perf_counter()
                 results[dt] = run_opensees(ops, tmp, scene, ag, dt_rec, dt, duration)
-                forces, drifts, residuals, collapse = results[dt]
+                forces, drifts, residuals, collapses = results[dt]
                 print(
                     f"{scene['name']}: dt {dt:g}: {time.perf_counter() - t:.1f} s: peak drift "
-                    f"{drifts}, peak force {forces}, residual {residuals}, collapse {collapse}",
+                    f"{drifts}, peak force {forces}, residual {residuals}, collapses (t_c, "
+                    f"building, storey, drift rate, largest force of its contacts over the step "
+                    f"it left in) {collapses}",
                     file=sys.stderr,
                 )
             coarse, fine = results[a.dt], results[a.dt / 2]
-            if (coarse[3] is None) != (fine[3] is None) or (
-                fine[3] is not None and fine[3][1:3] != coarse[3][1:3]
-            ):
+            if [c[1:3] for c in coarse[3]] != [c[1:3] for c in fine[3]]:
                 raise RuntimeError(f"{scene['name']}: dt and dt / 2 disagree on the collapse")
+            if len(fine[3]) > 1:
+                raise RuntimeError(f"{scene['name']}: the file holds one collapse per scene")
+            collapse, collapse_coarse = (fine[3][0], coarse[3][0]) if fine[3] else (None, None)
             names = [f"b{a_ + 1}f{fa + 1}_b{a_ + 2}f{fb + 1}" for a_, fa, fb in levels(scene)]
             lines += [
                 "[[scene]]",
@@ -577,15 +719,15 @@ def main():
                 f"peak_force_n_coarse = {toml_list(coarse[0])}",
                 f"peak_drift_ratio = {toml_list(fine[1])}",
                 f"peak_drift_ratio_coarse = {toml_list(coarse[1])}",
-                f"collapsed = {'true' if fine[3] else 'false'}",
+                f"collapsed = {'true' if collapse else 'false'}",
             ]
-            if fine[3]:
+            if collapse:
                 lines += [
-                    f"collapse_time_s = {fine[3][0]!r}",
-                    f"collapse_time_s_coarse = {coarse[3][0]!r}",
-                    f"collapse_building = {fine[3][1]}",
-                    f"collapse_storey = {fine[3][2]}",
-                    f"collapse_drift_rate_per_s = {fine[3][3]!r}",
+                    f"collapse_time_s = {collapse[0]!r}",
+                    f"collapse_time_s_coarse = {collapse_coarse[0]!r}",
+                    f"collapse_building = {collapse[1]}",
+                    f"collapse_storey = {collapse[2]}",
+                    f"collapse_drift_rate_per_s = {collapse[3]!r}",
                 ]
             for b, r, rc in zip(scene["buildings"], fine[2], coarse[2]):
                 lines += [
@@ -606,7 +748,7 @@ def main():
                         f"yield_force_n = {toml_list(b['fy'])}",
                         f"post_yield_ratio = {toml_list(b['b'])}",
                     ]
-                    if not fine[3]:
+                    if r is not None:
                         lines += [
                             f"residual_drift_ratio = {toml_list(r)}",
                             f"residual_drift_ratio_coarse = {toml_list(rc)}",
