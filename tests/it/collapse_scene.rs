@@ -118,8 +118,8 @@ fn at_a_gap_no_motion_closes_each_building_collapses_as_it_would_alone() {
             kinds.insert(flags.clone());
             let any = flags.0 == "1" || flags.1 == "1";
             assert_eq!(r["status"] == "collapsed", any, "{scheme} run {i}");
-            for k in 0..2 {
-                let (b, q) = (format!("b{}_", k + 1), &a[k][i]);
+            for (k, alone) in a.iter().enumerate() {
+                let (b, q) = (format!("b{}_", k + 1), &alone[i]);
                 let what = format!("{scheme} run {i}, building {}", k + 1);
                 assert_eq!(r[&format!("{b}collapsed")], q["b1_collapsed"], "{what}");
                 assert_eq!(
