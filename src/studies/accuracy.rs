@@ -280,6 +280,7 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
             log_y: true,
             series: lines.chain(marks).collect(),
             y_span: None,
+            ..Default::default()
         }
     };
     vec![
@@ -696,6 +697,7 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
             log_y: true,
             series: lines.chain(marks).collect(),
             y_span: None,
+            ..Default::default()
         }
     };
     vec![panel("median error", 0), panel("99th percentile error", 1)]

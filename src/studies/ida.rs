@@ -437,6 +437,7 @@ impl Ida {
             log_y: false,
             series,
             y_span: None,
+            ..Default::default()
         }
     }
 
@@ -468,6 +469,7 @@ impl Ida {
                 style: None,
             }],
             y_span: Some((0.0, 1.0)),
+            ..Default::default()
         })
     }
 }

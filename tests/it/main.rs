@@ -5,6 +5,7 @@ mod accuracy;
 mod cli;
 mod collapse;
 mod collapse_opensees;
+mod collapse_outputs;
 mod collapse_studies;
 mod config;
 mod convergence;
