@@ -1,11 +1,15 @@
-//! What the studies of a table do with runs that collapse (issue 64).
+//! What the studies of a table and `pound accuracy` do with runs that collapse (issue 64).
 //!
 //! `pound plot`: collapsed runs are left out (or drawn apart with `--collapsed mark`), and the
 //! figure itself says how many per x value and series; an x value where every run collapsed
 //! stays on the axis, marked. A building's column reads that building's `bK_collapsed`, so a
-//! run where only its neighbour collapsed is a result for it. The sweep:
-//! `configs/accuracy-collapse.toml` (Tabas 1978 at Sa(T1) 0.6, 0.8, 1.0 and 1.25 g: the last two
-//! collapse).
+//! run where only its neighbour collapsed is a result for it.
+//!
+//! `pound accuracy`: a collapse is compared with the reference's (the same building and
+//! storey, the time's error relative to the reference's collapse time); one on one side only is
+//! named and fails `--target-error`; a point where no run could be compared is refused, with
+//! why, and writes nothing. The scene: `configs/accuracy-collapse.toml` (Tabas 1978 at Sa(T1)
+//! 0.6, 0.8, 1.0 and 1.25 g: the last two collapse).
 
 use crate::support::{ok, pound, table, tempdir};
 use std::path::{Path, PathBuf};
@@ -311,4 +315,147 @@ fn plot_of_a_sweep_keeps_the_intensities_where_it_collapsed() {
     let text = svg_text(&drawn);
     assert!(text.contains("1 g, all 1; 1.25 g, all 1."), "{text}");
     assert_eq!(text.matches("all 1 collapsed").count(), 2, "{text}");
+}
+
+/// `pound accuracy ARGS`: its output (stdout, stderr) and whether it succeeded.
+fn accuracy(args: &[&str]) -> (String, String, bool) {
+    let mut all = vec!["accuracy"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--backend", "cpu"]);
+    let o = pound(&all);
+    (
+        String::from_utf8_lossy(&o.stdout).to_string(),
+        String::from_utf8_lossy(&o.stderr).to_string(),
+        o.status.success(),
+    )
+}
+
+/// The collapse scene's collapses are compared with the reference's (both runs, the same
+/// building and storey, the time within 1e-3 of the reference's), and `--target-error 1e-2`
+/// passes: before, the collapsed runs counted as failed and no target could.
+#[test]
+fn accuracy_compares_collapses_and_a_target_can_pass() {
+    let d = tempdir();
+    let csv = d.path().join("a.csv");
+    let cfg = shipped("accuracy-collapse.toml");
+    let (out, err, passed) = accuracy(&[
+        cfg.to_str().unwrap(),
+        "--target-error",
+        "1e-2",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(passed, "{out}\n{err}");
+    assert!(
+        out.contains("collapses at 8 substeps per contact, cpu-fast-f64: 2 compared with the reference's (both sides, the same building and storey), collapse time error median")
+            && out.contains("(relative to the reference's collapse time); 0 differ"),
+        "{out}"
+    );
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("--target-error 1e-2: 8 substeps per contact, cpu-fast-f64"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        line.contains("and the collapse time")
+            && line.contains("2 collapse(s) compared")
+            && line.contains("over 4 runs compared, 0 failed (met)"),
+        "{line}"
+    );
+    assert!(!out.contains("NaN"), "{out}");
+    let rows = table(&csv);
+    let fast = rows.iter().find(|r| r["path"] == "cpu-fast-f64").unwrap();
+    assert_eq!(fast["collapses_compared"], "2");
+    assert_eq!(fast["collapses_differ"], "0");
+    let time: f64 = fast["collapse_time_p99"].parse().unwrap();
+    assert!(time > 0.0 && time < 1e-3, "{time}");
+    assert_eq!(fast["failed"], "0");
+}
+
+/// A collapse on one side only is named (run, record, intensity, building, which side) and
+/// fails the target; where no run could be compared, `pound accuracy` says why and writes
+/// nothing. The limit is put between the reference's and the fast scheme's peak drift of the
+/// 0.8 g run (they differ by about 2e-3 at 8 substeps per contact), so one side reaches it and
+/// the other does not.
+#[test]
+fn a_collapse_on_one_side_only_is_named_and_fails_the_target() {
+    let d = tempdir();
+    let base = std::fs::read_to_string(shipped("accuracy-collapse.toml")).unwrap();
+    let peak = |run: &str, name: &str| -> f64 {
+        let cfg = d.path().join(format!("{name}.toml"));
+        let text = base
+            .replace("sa_g = [0.6, 0.8, 1.0, 1.25]", "sa_g = [0.8]")
+            .replace(
+                "collapse_drift_ratio = 0.10",
+                &format!("collapse_drift_ratio = 0.10\n{run}"),
+            );
+        std::fs::write(&cfg, text).unwrap();
+        let csv = d.path().join(format!("{name}.csv"));
+        ok(&crate::support::sweep_cpu(&cfg, &csv, &[]));
+        let rows = table(&csv);
+        assert_eq!(rows[0]["status"], "ok");
+        rows[0]["b1_peak_drift_ratio"].parse().unwrap()
+    };
+    let truth = peak("scheme = \"reference\"\ntol = 1e-8", "reference");
+    let fast = peak("substeps_per_contact = 8", "fast");
+    assert!(
+        (fast - truth).abs() > 1e-3 * truth,
+        "the two peaks, {truth} and {fast}, are too close to put a limit between"
+    );
+    let limit = 0.5 * (truth + fast);
+    let side = if fast > truth {
+        "collapsed on cpu-fast-f64 only"
+    } else {
+        "collapsed in the reference only"
+    };
+    let scene = |levels: &str| {
+        let cfg = d.path().join(format!("mid-{}.toml", levels.len()));
+        let text = base
+            .replace("sa_g = [0.6, 0.8, 1.0, 1.25]", &format!("sa_g = {levels}"))
+            .replace(
+                "collapse_drift_ratio = 0.10",
+                &format!("collapse_drift_ratio = {limit:e}"),
+            );
+        std::fs::write(&cfg, text).unwrap();
+        cfg
+    };
+    let csv = d.path().join("a.csv");
+    let (out, err, passed) = accuracy(&[
+        scene("[0.6, 0.8]").to_str().unwrap(),
+        "--target-error",
+        "1e-2",
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(!passed, "{out}");
+    assert!(
+        out.contains(&format!(
+            "collapse differs at 8 substeps per contact: run 1 (record tabas_1978, Sa(T) 0.8 g), building 1: {side} (storey "
+        )),
+        "{out}"
+    );
+    assert!(
+        out.contains("NOT met: 1 of 2 runs collapsed otherwise than in the reference"),
+        "{out}"
+    );
+    assert!(err.contains("--target-error not met"), "{err}");
+    assert_eq!(table(&csv)[1]["collapses_differ"], "1");
+
+    // The 0.8 g run alone: nothing to compare, refused with why, nothing written.
+    let none = d.path().join("none.csv");
+    let (out, err, passed) = accuracy(&[
+        scene("[0.8]").to_str().unwrap(),
+        "--settings",
+        "8",
+        "-o",
+        none.to_str().unwrap(),
+    ]);
+    assert!(!passed, "{out}");
+    assert!(
+        err.contains("no run could be compared with the reference")
+            && err.contains("8 substeps per contact, cpu-fast-f64: of 1 runs, 0 failed")
+            && err.contains("1 collapsed otherwise than in the reference"),
+        "{err}"
+    );
+    assert!(!err.contains("NaN") && !out.contains("NaN"), "{out}\n{err}");
+    assert!(!none.exists());
 }
