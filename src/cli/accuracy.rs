@@ -32,7 +32,8 @@ pub struct Args {
     /// Check `--target-error` instead of trying --settings: for each error E, run the setting
     /// it chooses and fail unless every path's p99 peak-force error on CONFIG is at most E (on
     /// a row whose storeys yield, the largest p99 of peak force, drift, residual drift and
-    /// ductility).
+    /// ductility; where runs collapse, and of the collapse time, relative to the reference's).
+    /// A run that fails, or collapses on one side only or in another storey, fails the target.
     #[arg(
         long,
         value_delimiter = ',',
@@ -115,14 +116,38 @@ pub fn run(a: Args) -> Result<()> {
     for line in rising {
         say!("{line}");
     }
-    let figure_out = plot.as_deref().map(|p| (p, points.panels(), 2));
-    super::write_and_plot(&output, points.csv().as_bytes(), figure_out, &figure)?;
+    // Where runs collapse: the collapses compared, and each one the two sides disagree on.
+    for line in points.collapses() {
+        say!("{line}");
+    }
     let runs = plan.len();
     let measured: Vec<Measured> = points
         .verdicts()
         .into_iter()
         .map(|verdict| Measured { verdict, runs })
         .collect();
+    // A statistic over no run is no figure: refused, with why, before any output is written.
+    let none: Vec<String> = measured
+        .iter()
+        .filter(|m| m.verdict.path != "reference" && m.verdict.runs_compared == 0)
+        .map(|m| {
+            format!(
+                "{} substeps per contact, {}: {}",
+                m.verdict.substeps_per_contact,
+                m.verdict.path,
+                m.verdict.why_none(runs)
+            )
+        })
+        .collect();
+    if !none.is_empty() {
+        bail!(
+            "{}: no run could be compared with the reference, so its errors are statistics over zero runs; nothing written. {}",
+            config.display(),
+            none.join("; ")
+        );
+    }
+    let figure_out = plot.as_deref().map(|p| (p, points.panels(), 2));
+    super::write_and_plot(&output, points.csv().as_bytes(), figure_out, &figure)?;
     check_targets(&choices, &measured, &config, suite)
 }
 
@@ -141,10 +166,20 @@ impl Measured {
                 "{} of {} runs failed (here or in the reference; pound sweep shows their status)",
                 self.verdict.failed, self.runs
             ))
+        } else if self.verdict.collapse_differs > 0 {
+            Some(format!(
+                "{} of {} runs collapsed otherwise than in the reference (named above)",
+                self.verdict.collapse_differs, self.runs
+            ))
         } else if self.verdict.compared == 0 {
             Some(format!(
                 "no run was compared (of {}, none pounded with the reference's impact count)",
                 self.runs
+            ))
+        } else if !self.verdict.over_no_run.is_empty() {
+            Some(format!(
+                "the {} error is a statistic over zero runs (no run compared gives it), no evidence",
+                self.verdict.over_no_run.join(", ")
             ))
         } else if self.verdict.p99.is_nan() || self.verdict.p99 > target {
             Some(format!("p99 above {target:e}"))
@@ -155,8 +190,8 @@ impl Measured {
 }
 
 /// `--target-error`: each chosen setting's p99 peak-force error on every path against its
-/// target; an error naming the targets missed. Met only with every run `ok` on both sides and
-/// at least one run compared.
+/// target; an error naming the targets missed. Met only where no run failed on either side,
+/// every collapse is the reference's (building and storey), and at least one run was compared.
 fn check_targets(
     choices: &[pounding::physics::solver::calibration::Choice],
     measured: &[Measured],
@@ -170,13 +205,29 @@ fn check_targets(
                 && m.verdict.substeps_per_contact == c.substeps_per_contact
         }) {
             let short = m.short_of(c.target);
+            // Where runs collapse, the collapse time's error is in the p99 too.
+            let collapses = match m.verdict.collapses_compared {
+                Some(n) => format!(
+                    " and the collapse time (relative to the reference's collapse time; {n} collapse(s) compared, {} run(s) whose collapse differs)",
+                    m.verdict.collapse_differs
+                ),
+                None => String::new(),
+            };
+            // A statistic over zero runs is no figure: named, not printed as NaN.
+            let p99 = if m.verdict.over_no_run.is_empty() {
+                format!("{:.2e}", m.verdict.p99)
+            } else {
+                format!(
+                    "none (the {} error over zero runs)",
+                    m.verdict.over_no_run.join(", ")
+                )
+            };
             say!(
-                "--target-error {:e}: {} substeps per contact, {}: {} {:.2e} over {} runs compared, {} failed ({})",
+                "--target-error {:e}: {} substeps per contact, {}: {}{collapses} {p99} over {} runs compared, {} failed ({})",
                 c.target,
                 c.substeps_per_contact,
                 m.verdict.path,
                 suite.measure(),
-                m.verdict.p99,
                 m.verdict.compared,
                 m.verdict.failed,
                 match &short {

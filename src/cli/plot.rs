@@ -4,7 +4,7 @@ use super::{check_study_outputs, Holds};
 use anyhow::{bail, Result};
 use clap::ValueEnum;
 use pounding::io::table::{Filter, Table};
-use pounding::studies::sensitivity::{panel, Aggregate, PlotSpec};
+use pounding::studies::sensitivity::{panel_with, Aggregate, Collapsed, PlotSpec};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
@@ -27,6 +27,13 @@ pub struct Args {
     /// aggregated. `none` draws every row as a point.
     #[arg(long, value_enum, default_value = "max")]
     agg: AggArg,
+    /// Runs that collapsed (`status` collapsed; for a building's column, `bK_...`, that
+    /// building's `bK_collapsed` where the CSV has it): `omit` leaves them out, `mark` draws
+    /// their peaks before the collapse apart, as crossed squares. Either way the figure's
+    /// caption counts them per x value (and series), and an x value where every run collapsed
+    /// stays on the axis, marked.
+    #[arg(long, value_enum, default_value = "omit")]
+    collapsed: CollapsedArg,
     #[arg(long)]
     log_x: bool,
     #[arg(long)]
@@ -39,6 +46,12 @@ pub struct Args {
     /// (default: plot.svg, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum CollapsedArg {
+    Omit,
+    Mark,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -69,9 +82,16 @@ pub fn run(a: Args) -> Result<()> {
         log_x: a.log_x,
         log_y: a.log_y,
     };
-    let (mut p, left_out) = panel(&table, &spec)?;
+    let collapsed = match a.collapsed {
+        CollapsedArg::Omit => Collapsed::Omit,
+        CollapsedArg::Mark => Collapsed::Mark,
+    };
+    let (mut p, left_out) = panel_with(&table, &spec, collapsed)?;
     a.figure.apply(std::slice::from_mut(&mut p))?;
     for line in left_out.lines() {
+        note!("{}: {line}", a.results.display());
+    }
+    for line in &p.notes.caption {
         note!("{}: {line}", a.results.display());
     }
     // A log axis cannot show a value <= 0: such points are left out, with a count, and a
@@ -89,24 +109,45 @@ pub fn run(a: Args) -> Result<()> {
             a.results.display()
         );
     }
-    p.series.retain(|s| {
-        let drawn = s.points.iter().any(|q| !off(q));
-        if !drawn {
-            note!(
-                "{}: no series drawn for {}: every one of its points is <= 0 on a log axis",
-                a.results.display(),
-                s.name
-            );
-        }
-        drawn
+    let marked = |i: usize| p.notes.collapsed.iter().any(|(k, q)| *k == i && !off(q));
+    let kept: Vec<bool> = (p.series.iter().enumerate())
+        .map(|(i, s)| {
+            let drawn = s.points.iter().any(|q| !off(q)) || marked(i);
+            if !drawn {
+                note!(
+                    "{}: no series drawn for {}: every one of its points is <= 0 on a log axis",
+                    a.results.display(),
+                    s.name
+                );
+            }
+            drawn
+        })
+        .collect();
+    // The collapsed runs' marks follow their series to its place among those kept.
+    let place: Vec<Option<usize>> = kept
+        .iter()
+        .scan(0, |n, &k| {
+            *n += usize::from(k);
+            Some(k.then(|| *n - 1))
+        })
+        .collect();
+    let mut k = 0;
+    p.series.retain(|_| {
+        k += 1;
+        kept[k - 1]
     });
+    p.notes.collapsed = std::mem::take(&mut p.notes.collapsed)
+        .into_iter()
+        .filter_map(|(i, q)| Some((place[i]?, q)))
+        .collect();
     let points: usize = p.series.iter().map(|s| s.points.len()).sum::<usize>()
         - p.series
             .iter()
             .flat_map(|s| &s.points)
             .filter(|q| off(q))
             .count();
-    if points == 0 {
+    let marks = p.notes.collapsed.iter().filter(|(_, q)| !off(q)).count();
+    if points + marks == 0 && p.notes.x_marks.is_empty() {
         let why = if table.rows.is_empty() {
             "the file has a header but no rows".to_string()
         } else if spec.filters.is_empty() {
@@ -121,8 +162,13 @@ pub fn run(a: Args) -> Result<()> {
     }
     // The line below says what was written.
     a.figure.save(&output, std::slice::from_ref(&p), 1)?;
+    let apart = if marks > 0 {
+        format!(", {marks} collapsed marked")
+    } else {
+        String::new()
+    };
     note!(
-        "{} series, {points} points -> {}",
+        "{} series, {points} points{apart} -> {}",
         p.series.len(),
         output.display()
     );

@@ -230,6 +230,7 @@ fn spectrum(
                 style: None,
             }],
             y_span: None,
+            ..Default::default()
         };
         (p, vec![panel], 1)
     });

@@ -6,6 +6,7 @@
 use crate::engine::gpu::{GpuContext, GpuError, GpuOptions, Precision};
 use crate::engine::{Backend, Engine, EngineError};
 use crate::physics::model::{RunOutput, Status};
+use crate::physics::row::{Collapse, RowOutput};
 use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
 use crate::plan::{PairPlan, Plan};
 use crate::studies::plot::{Panel, Series};
@@ -41,6 +42,8 @@ pub struct Errors {
     pub energy_median: f64,
     pub energy_p99: f64,
     pub impact_count_differs: f64,
+    /// The runs whose impact count differs (of which `impact_count_differs` is the share).
+    pub impacts_differ: u64,
     /// Runs that failed (`status` not `ok`) on this path or in the reference: evidence against
     /// any accuracy claim, never left out silently.
     pub failed: u64,
@@ -100,6 +103,7 @@ pub fn errors(truth: &[RunOutput], out: &[RunOutput]) -> Errors {
         energy_median: quantile(&mut w, 0.5),
         energy_p99: quantile(&mut w, 0.99),
         impact_count_differs: differ as f64 / truth.len().max(1) as f64,
+        impacts_differ: differ as u64,
         failed,
         residual_median: quantile(&mut r, 0.5),
         residual_p99: quantile(&mut r, 0.99),
@@ -280,6 +284,7 @@ pub fn panels(points: &[Point]) -> Vec<Panel> {
             log_y: true,
             series: lines.chain(marks).collect(),
             y_span: None,
+            ..Default::default()
         }
     };
     vec![
@@ -359,6 +364,113 @@ pub struct RowPoint {
     /// of the peak ductility's relative error, over the yielding buildings of the runs
     /// compared; a run whose residual is not settled on either side is left out.
     pub yielding: Option<[f64; 4]>,
+    /// Runs whose impact counts differ from the reference's (left out of the errors).
+    pub impacts_differ: u64,
+    /// Runs compared: neither failed, their collapses agree and so do their impact counts
+    /// (the errors but the peak force's, which is over those that pound, are over these).
+    pub runs_compared: u64,
+    /// The buildings' collapses against the reference's, where a run collapsed on either
+    /// side (None where none did: the point is what it was before collapses were compared).
+    pub collapse: Option<Collapses>,
+}
+
+/// A point's collapses against the reference's, building by building
+/// ([`building_collapses`]). Agreement is a collapse on both sides in the same storey; its
+/// time's error, `|t - t_ref| / t_ref` (relative to the reference's collapse time, as the
+/// convergence check takes it), enters the run's error. A collapse on one side only, or in
+/// another storey, is a named difference, and the run fails `--target-error`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Collapses {
+    /// Collapses compared (both sides, the same building and storey).
+    pub compared: u64,
+    /// Median and p99 of the collapse time's relative error over them (NaN where none).
+    pub time: [f64; 2],
+    /// The collapses the two sides disagree on, by run and building.
+    pub differs: Vec<CollapseDiff>,
+}
+
+/// One building of one run that collapsed on one side only, or in another storey.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CollapseDiff {
+    /// The run's number, as in the sweep's `run` column.
+    pub run: u64,
+    pub record: String,
+    /// The run's intensity in words (`Sa(T) 1.25 g`).
+    pub intensity: String,
+    /// From 1.
+    pub building: u32,
+    /// This path's collapse and the reference's.
+    pub here: Option<Collapse>,
+    pub reference: Option<Collapse>,
+}
+
+impl CollapseDiff {
+    /// The difference in words, for `path` at `setting` substeps per contact.
+    pub fn words(&self, path: &str, setting: f64) -> String {
+        let at = |c: &Collapse| format!("storey {} at {:.4} s", c.storey, c.time);
+        let what = match (&self.here, &self.reference) {
+            (Some(h), None) => format!("collapsed on {path} only ({})", at(h)),
+            (None, Some(r)) => format!("collapsed in the reference only ({})", at(r)),
+            (Some(h), Some(r)) => format!(
+                "collapsed in another storey: {} on {path}, {} in the reference",
+                at(h),
+                at(r)
+            ),
+            (None, None) => "no collapse on either side".into(),
+        };
+        format!(
+            "collapse differs at {setting} substeps per contact: run {} (record {}, {}), building {}: {what}",
+            self.run, self.record, self.intensity, self.building
+        )
+    }
+}
+
+/// Each building's collapse (None where it stood): the building's own where the run gives
+/// them, else the run's first collapse on its building (a run that ended at its first collapse
+/// gives no building's own).
+pub fn building_collapses(o: &RowOutput) -> Vec<Option<Collapse>> {
+    let mut each: Vec<Option<Collapse>> = o.buildings.iter().map(|b| b.collapse).collect();
+    if each.iter().all(Option::is_none) {
+        if let Some(c) = o.collapse {
+            if let Some(slot) = (c.building as usize)
+                .checked_sub(1)
+                .and_then(|k| each.get_mut(k))
+            {
+                *slot = Some(c);
+            }
+        }
+    }
+    each
+}
+
+/// The collapses of `o` against the reference's `t`: the relative time errors of those they
+/// agree on, and the buildings (from 1) they disagree on, with each side's collapse.
+#[allow(clippy::type_complexity)]
+fn compare_collapses(
+    t: &RowOutput,
+    o: &RowOutput,
+) -> (Vec<f64>, Vec<(u32, Option<Collapse>, Option<Collapse>)>) {
+    let (mut times, mut differ) = (Vec::new(), Vec::new());
+    let (ct, co) = (building_collapses(t), building_collapses(o));
+    for (k, (a, b)) in co.iter().zip(&ct).enumerate() {
+        match (a, b) {
+            (None, None) => {}
+            (Some(a), Some(b)) if a.storey == b.storey => times.push(rel(a.time, b.time)),
+            _ => differ.push((k as u32 + 1, *a, *b)),
+        }
+    }
+    (times, differ)
+}
+
+/// An intensity in words: `PGA 0.3 g`, `scale factor 2`, `Sa(T) 1.25 g`, `Sa_avg 0.8 g`.
+fn intensity_words(i: &crate::plan::intensity::Intensity) -> String {
+    use crate::plan::intensity::Intensity;
+    match i {
+        Intensity::PgaG(g) => format!("PGA {g} g"),
+        Intensity::Scale(s) => format!("scale factor {s}"),
+        Intensity::Spectral { g, im } if im.average => format!("Sa_avg {g} g"),
+        Intensity::Spectral { g, .. } => format!("Sa(T) {g} g"),
+    }
 }
 
 /// A run whose error rose from one setting to the next (`pound accuracy` names each).
@@ -384,15 +496,17 @@ pub fn rise_floor(tol: f64) -> f64 {
     (100.0 * tol).max(1e-6)
 }
 
-/// A run's worst relative error against the reference's run: peak force (where it pounds) and
+/// A run's worst relative error against the reference's run: peak force (where it pounds),
 /// each building's peak roof displacement, drift ratio and, where storeys yield, ductility
-/// and residual drift (against the peak drift). None where it cannot be compared: either run
-/// failed, or their impact counts differ.
-pub fn run_error(
-    t: &crate::physics::row::RowOutput,
-    o: &crate::physics::row::RowOutput,
-) -> Option<f64> {
-    if o.status != Status::Ok || t.status != Status::Ok || t.impacts != o.impacts {
+/// and residual drift (against the peak drift), and each collapse's time (relative to the
+/// reference's). None where it cannot be compared: either run failed, their collapses differ
+/// ([`Collapses`]), or their impact counts do.
+pub fn run_error(t: &RowOutput, o: &RowOutput) -> Option<f64> {
+    if o.status.failed() || t.status.failed() || t.impacts != o.impacts {
+        return None;
+    }
+    let (times, differ) = compare_collapses(t, o);
+    if !differ.is_empty() {
         return None;
     }
     let mut e = if t.impacts > 0 {
@@ -400,6 +514,7 @@ pub fn run_error(
     } else {
         0.0
     };
+    e = times.into_iter().fold(e, f64::max);
     for (bt, bo) in t.buildings.iter().zip(&o.buildings) {
         e = e
             .max(rel(bo.peak_roof, bt.peak_roof))
@@ -453,20 +568,43 @@ pub const ROW_MARKDOWN_HEADER: &str = "| path | substeps/contact | runs/s | forc
 impl RowPoint {
     /// The p99 that `--target-error` calibrates on rows: the peak force's, and where storeys
     /// yield the largest of the peak force's, drift's, residual drift's and ductility's
-    /// (`calibration::Suite::YieldingRows`).
+    /// (`calibration::Suite::YieldingRows`); where collapses were compared, and the collapse
+    /// time's.
     pub fn calibrated_p99(&self) -> f64 {
-        match self.yielding {
-            // NaN (a statistic over no run) wins: no evidence is not a small error.
-            Some([_, residual, _, ductility]) => {
-                let p99s = [self.force[1], self.drift[1], residual, ductility];
-                if p99s.iter().any(|x| x.is_nan()) {
-                    f64::NAN
-                } else {
-                    p99s.into_iter().fold(f64::NEG_INFINITY, f64::max)
-                }
-            }
-            None => self.force[1],
+        let p99s = self.calibrated();
+        // NaN (a statistic over no run) wins: no evidence is not a small error.
+        if p99s.iter().any(|(_, x)| x.is_nan()) {
+            f64::NAN
+        } else {
+            p99s.into_iter()
+                .map(|(_, x)| x)
+                .fold(f64::NEG_INFINITY, f64::max)
         }
+    }
+
+    /// The statistics [`RowPoint::calibrated_p99`] takes, each named.
+    fn calibrated(&self) -> Vec<(&'static str, f64)> {
+        let mut p99s = vec![("peak force", self.force[1])];
+        if let Some([_, residual, _, ductility]) = self.yielding {
+            p99s.extend([
+                ("drift", self.drift[1]),
+                ("residual drift", residual),
+                ("ductility", ductility),
+            ]);
+        }
+        if let Some(c) = self.collapse.as_ref().filter(|c| c.compared > 0) {
+            p99s.push(("collapse time", c.time[1]));
+        }
+        p99s
+    }
+
+    /// The statistics of [`RowPoint::calibrated_p99`] over zero runs (no run compared pounded,
+    /// or none's residual drift settled), by name.
+    pub fn over_no_run(&self) -> Vec<&'static str> {
+        (self.calibrated().into_iter())
+            .filter(|(_, x)| x.is_nan())
+            .map(|(name, _)| name)
+            .collect()
     }
 
     /// The numbers of a table line and a CSV line, in column order after the path.
@@ -547,14 +685,35 @@ pub fn row_study(
         let (mut res, mut mu) = (vec![], vec![]);
         let (mut differ, mut failed) = (0usize, 0u64);
         let (mut gap_max, mut differing_force) = (0u32, 0.0f64);
-        for (t, o) in truth.iter().zip(out) {
+        let (mut collapse_times, mut collapse_differs) = (Vec::new(), Vec::new());
+        let (mut any_collapse, mut runs_compared) = (false, 0u64);
+        for (i, (t, o)) in truth.iter().zip(out).enumerate() {
             if o.status == Status::Ok {
                 r.extend(o.energy.map(|e| e.residual.abs()));
             }
-            if o.status != Status::Ok || t.status != Status::Ok {
+            if o.status.failed() || t.status.failed() {
                 failed += 1;
                 continue;
             }
+            // Collapses first: one on one side only is a difference whatever the impacts.
+            any_collapse |= o.status == Status::Collapsed || t.status == Status::Collapsed;
+            let (times, differs) = compare_collapses(t, o);
+            if !differs.is_empty() {
+                let run = plan.run(i as u64);
+                let c = &run.contact;
+                collapse_differs.extend(differs.into_iter().map(|(building, here, reference)| {
+                    CollapseDiff {
+                        run: i as u64,
+                        record: plan.contact.spec.records[c.record].name.clone(),
+                        intensity: intensity_words(&c.intensity),
+                        building,
+                        here,
+                        reference,
+                    }
+                }));
+                continue;
+            }
+            collapse_times.extend(times);
             if t.impacts != o.impacts {
                 differ += 1;
                 gap_max = gap_max.max(t.impacts.abs_diff(o.impacts));
@@ -580,6 +739,7 @@ pub fn row_study(
                     }
                 }
             }
+            runs_compared += 1;
         }
         let compared = f.len() as u64;
         RowPoint {
@@ -600,6 +760,13 @@ pub fn row_study(
             yielding: yields.then(|| {
                 let ([r0, r1], [m0, m1]) = (med_p99(res), med_p99(mu));
                 [r0, r1, m0, m1]
+            }),
+            impacts_differ: differ as u64,
+            runs_compared,
+            collapse: any_collapse.then(|| Collapses {
+                compared: collapse_times.len() as u64,
+                time: med_p99(collapse_times),
+                differs: collapse_differs,
             }),
         }
     };
@@ -696,6 +863,7 @@ pub fn row_panels(points: &[RowPoint]) -> Vec<Panel> {
             log_y: true,
             series: lines.chain(marks).collect(),
             y_span: None,
+            ..Default::default()
         }
     };
     vec![panel("median error", 0), panel("99th percentile error", 1)]
@@ -707,14 +875,29 @@ pub fn row_csv(points: &[RowPoint]) -> String {
     if points.iter().any(|p| p.yielding.is_some()) {
         s.push_str(",residual_drift_median,residual_drift_p99,ductility_median,ductility_p99");
     }
+    // Where a run collapsed on either side: the collapses compared, their time's relative
+    // error (median, p99) and the collapses that differ.
+    let collapses = points.iter().any(|p| p.collapse.is_some());
+    if collapses {
+        s.push_str(",collapses_compared,collapse_time_median,collapse_time_p99,collapses_differ");
+    }
     s.push('\n');
     for p in points {
-        let cells: Vec<String> = p
+        let mut cells: Vec<String> = p
             .numbers()
             .iter()
             .chain(p.yielding.iter().flatten())
             .map(|x| shown(*x, "", |x| x.to_string()))
             .collect();
+        if collapses {
+            let c = p.collapse.clone().unwrap_or(Collapses {
+                time: [f64::NAN; 2],
+                ..Collapses::default()
+            });
+            cells.push(c.compared.to_string());
+            cells.extend(c.time.map(|x| shown(x, "", |x| x.to_string())));
+            cells.push(c.differs.len().to_string());
+        }
         s.push_str(&format!("{},{}\n", p.path, cells.join(",")));
     }
     s
@@ -727,9 +910,10 @@ pub enum Points {
 }
 
 /// One path at one setting as `--target-error` judges it: the p99 of what the scene's
-/// calibration measures (NaN over no compared run;
-/// [`crate::physics::solver::calibration::Suite::measure`]), the runs that failed here or in
-/// the reference, the runs compared.
+/// calibration measures (NaN where one of its statistics is over no run, named in
+/// `over_no_run`; [`crate::physics::solver::calibration::Suite::measure`]), the runs that failed
+/// here or in the reference, the runs compared that pound (the peak-force errors are over
+/// these).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Verdict {
     pub path: String,
@@ -737,6 +921,35 @@ pub struct Verdict {
     pub p99: f64,
     pub failed: u64,
     pub compared: u64,
+    /// The runs compared, pounding or not (a row's drift errors are over these; a pair's
+    /// only error is the peak force's: its `compared`). 0: no error has a run.
+    pub runs_compared: u64,
+    /// The runs left out of the errors, by reason: impact counts that differ from the
+    /// reference's, and collapses that do ([`Collapses`]; each such run fails the target).
+    pub impacts_differ: u64,
+    pub collapse_differs: u64,
+    /// The collapses compared (both sides, the same building and storey), where a run
+    /// collapsed on either side: the p99 above includes their time's error.
+    pub collapses_compared: Option<u64>,
+    /// The statistics of `p99` over zero runs (then `p99` is NaN), by name.
+    pub over_no_run: Vec<&'static str>,
+}
+
+impl Verdict {
+    /// Why no run was compared, of `runs`: the counts by reason, in words.
+    pub fn why_none(&self, runs: u64) -> String {
+        let rest = runs.saturating_sub(self.failed + self.impacts_differ + self.collapse_differs);
+        let mut why = format!(
+            "of {runs} runs, {} failed (here or in the reference), {} collapsed otherwise than in the reference, {} differ from the reference in impact count",
+            self.failed, self.collapse_differs, self.impacts_differ
+        );
+        if rest > 0 {
+            why.push_str(&format!(
+                ", and the other {rest} did not pound (the peak-force errors are over the runs that pound)"
+            ));
+        }
+        why
+    }
 }
 
 impl Points {
@@ -756,6 +969,41 @@ impl Points {
                 })
             })
             .collect()
+    }
+
+    /// Where runs collapsed: per path and setting, the collapses compared and their time's
+    /// error, then each collapse the two sides disagree on, in words (none where no run
+    /// collapsed on either side).
+    pub fn collapses(&self) -> Vec<String> {
+        let Points::Rows(points) = self else {
+            return Vec::new();
+        };
+        let mut lines = Vec::new();
+        for p in points.iter().filter(|p| p.path != "reference") {
+            let Some(c) = &p.collapse else { continue };
+            let times = if c.compared > 0 {
+                format!(
+                    ", collapse time error median {}, p99 {} (relative to the reference's collapse time)",
+                    figure(c.time[0]),
+                    figure(c.time[1])
+                )
+            } else {
+                String::new()
+            };
+            lines.push(format!(
+                "collapses at {} substeps per contact, {}: {} compared with the reference's (both sides, the same building and storey){times}; {} differ",
+                p.substeps_per_contact,
+                p.path,
+                c.compared,
+                c.differs.len()
+            ));
+        }
+        for p in points {
+            for d in p.collapse.iter().flat_map(|c| &c.differs) {
+                lines.push(d.words(&p.path, p.substeps_per_contact));
+            }
+        }
+        lines
     }
 
     pub fn csv(&self) -> String {
@@ -782,6 +1030,15 @@ impl Points {
                     p99: p.errors.force_p99,
                     failed: p.errors.failed,
                     compared: p.errors.compared,
+                    runs_compared: p.errors.compared,
+                    impacts_differ: p.errors.impacts_differ,
+                    collapse_differs: 0,
+                    collapses_compared: None,
+                    over_no_run: if p.errors.force_p99.is_nan() {
+                        vec!["peak force"]
+                    } else {
+                        Vec::new()
+                    },
                 })
                 .collect(),
             Points::Rows(p) => p
@@ -792,6 +1049,15 @@ impl Points {
                     p99: p.calibrated_p99(),
                     failed: p.failed,
                     compared: p.compared,
+                    runs_compared: p.runs_compared,
+                    impacts_differ: p.impacts_differ,
+                    collapse_differs: p.collapse.as_ref().map_or(0, |c| {
+                        let mut runs: Vec<u64> = c.differs.iter().map(|d| d.run).collect();
+                        runs.dedup();
+                        runs.len() as u64
+                    }),
+                    collapses_compared: p.collapse.as_ref().map(|c| c.compared),
+                    over_no_run: p.over_no_run(),
                 })
                 .collect(),
         }
@@ -897,6 +1163,75 @@ mod tests {
         longer.insert(0, (4.0, vec![Some(1.0); 4]));
         assert_eq!(rises(&longer, &now, floor), r);
         assert!(rises(&[], &now, floor).is_empty());
+    }
+
+    /// Collapses are compared building by building: the same storey on both sides is
+    /// agreement, its time's error (relative to the reference's collapse time) in the run's
+    /// error; one side only, or another storey, leaves the run uncompared, and is named.
+    #[test]
+    fn collapses_are_compared_building_by_building() {
+        let c = |building: u32, storey: u32, time: f64| Collapse {
+            time,
+            building,
+            storey,
+        };
+        let run = |first: Option<Collapse>, each: [Option<Collapse>; 2]| RowOutput {
+            status: if first.is_some() {
+                Status::Collapsed
+            } else {
+                Status::Ok
+            },
+            impacts: 2,
+            peak_force: 1e6,
+            buildings: each
+                .iter()
+                .map(|&collapse| BuildingOutput {
+                    peak_roof: 0.1,
+                    peak_drift_ratio: 0.05,
+                    peak_accel: 3.0,
+                    collapse,
+                    ..BuildingOutput::default()
+                })
+                .collect(),
+            collapse: first,
+            ..RowOutput::default()
+        };
+        // A run that ended at its first collapse gives no building's own: the run's goes on
+        // its building.
+        let ended = run(Some(c(2, 3, 5.0)), [None, None]);
+        assert_eq!(building_collapses(&ended), [None, Some(c(2, 3, 5.0))]);
+        let t = run(Some(c(1, 2, 8.0)), [Some(c(1, 2, 8.0)), None]);
+        assert_eq!(run_error(&t, &t), Some(0.0));
+        let late = run(Some(c(1, 2, 8.0008)), [Some(c(1, 2, 8.0008)), None]);
+        let e = run_error(&t, &late).unwrap();
+        assert!((e - 1e-4).abs() < 1e-12, "{e}");
+        // One side only, another storey, or the neighbour on one side only.
+        let stood = run(None, [None, None]);
+        let other = run(Some(c(1, 3, 8.0)), [Some(c(1, 3, 8.0)), None]);
+        let both = run(Some(c(1, 2, 8.0)), [Some(c(1, 2, 8.0)), Some(c(2, 1, 9.0))]);
+        for o in [&stood, &other, &both] {
+            assert_eq!(run_error(&t, o), None);
+        }
+        assert_eq!(
+            compare_collapses(&t, &stood),
+            (vec![], vec![(1, None, Some(c(1, 2, 8.0)))])
+        );
+        assert_eq!(
+            compare_collapses(&t, &both),
+            (vec![0.0], vec![(2, Some(c(2, 1, 9.0)), None)])
+        );
+        let d = CollapseDiff {
+            run: 7,
+            record: "kobe".into(),
+            intensity: "Sa(T) 1.25 g".into(),
+            building: 1,
+            here: None,
+            reference: Some(c(1, 2, 8.0)),
+        };
+        assert_eq!(
+            d.words("cpu-fast-f64", 16.0),
+            "collapse differs at 16 substeps per contact: run 7 (record kobe, Sa(T) 1.25 g), building 1: collapsed in the reference only (storey 2 at 8.0000 s)"
+        );
     }
 
     #[test]

@@ -75,6 +75,7 @@ pub fn zeta_panels(es: &[f64]) -> Result<Vec<Panel>, RestitutionError> {
         log_y,
         series: series.clone(),
         y_span: None,
+        ..Default::default()
     };
     Ok(vec![panel(false), panel(true)])
 }

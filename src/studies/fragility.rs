@@ -1159,6 +1159,7 @@ pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, No
         log_y: false,
         series,
         y_span: Some((0.0, 1.0)),
+        ..Default::default()
     }
 }
 

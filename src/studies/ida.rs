@@ -456,6 +456,7 @@ impl Ida {
             log_y: false,
             series,
             y_span: None,
+            ..Default::default()
         }
     }
 
@@ -491,6 +492,7 @@ impl Ida {
                 style: None,
             }],
             y_span: Some((0.0, 1.0)),
+            ..Default::default()
         })
     }
 }

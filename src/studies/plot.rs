@@ -193,13 +193,17 @@ pub fn relabel(panels: &mut [Panel], axis: Axis, asked: &str) -> Result<(), Stri
         Axis::Y => p.y_label.clone(),
     };
     let set = |p: &mut Panel, f: f64| {
-        for s in &mut p.series {
-            for q in &mut s.points {
-                match axis {
-                    Axis::X => q.0 *= f,
-                    Axis::Y => q.1 *= f,
-                }
-            }
+        let scale = |q: &mut (f64, f64)| match axis {
+            Axis::X => q.0 *= f,
+            Axis::Y => q.1 *= f,
+        };
+        p.series
+            .iter_mut()
+            .flat_map(|s| &mut s.points)
+            .for_each(scale);
+        p.notes.collapsed.iter_mut().for_each(|(_, q)| scale(q));
+        if axis == Axis::X {
+            p.notes.x_marks.iter_mut().for_each(|(x, _)| *x *= f);
         }
         match axis {
             Axis::X => p.x_label = asked.to_string(),
@@ -269,8 +273,14 @@ fn fit_title(
         }
     }
     let size = 14.0 * scale;
+    (wrap(title, width, size, measure), size)
+}
+
+/// `text`'s words in lines at most `width` wide at font size `size` (a word wider than that
+/// stands on a line of its own).
+fn wrap(text: &str, width: f64, size: f64, measure: impl Fn(&str, f64) -> f64) -> Vec<String> {
     let mut lines: Vec<String> = Vec::new();
-    for word in title.split_whitespace() {
+    for word in text.split_whitespace() {
         match lines.last_mut() {
             Some(line) if measure(&format!("{line} {word}"), size) <= width => {
                 line.push(' ');
@@ -279,7 +289,44 @@ fn fit_title(
             _ => lines.push(word.to_string()),
         }
     }
-    (lines, size)
+    lines
+}
+
+/// Draw the collapse marker on `area`, centred on its pixel `(x, y)`: a square crossed, as a
+/// run that collapsed is marked apart from the points of the runs that did not (its value is
+/// its peak before the collapse).
+fn collapse_marker<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    (x, y): (i32, i32),
+    color: RGBAColor,
+    scale: f64,
+) -> Result<(), String> {
+    // Larger than the other markers and thin-lined, so that its cross reads at 96 dpi.
+    let r = (5.0 * scale).round().max(1.0) as i32;
+    let width = scale.round().max(1.0) as u32;
+    let style = color.stroke_width(width);
+    let e = |e: &dyn std::fmt::Display| e.to_string();
+    // Each stroke a segment of its own: a path that turns at the corners joins badly (mitre
+    // spikes where a diagonal meets a side; sides lost in the bitmap), and an SVG
+    // rectangle drops the stroke's width. The top and bottom run on by half the width, to
+    // close the corners.
+    let h = (width / 2) as i32;
+    let strokes = [
+        [(-r - h, -r), (r + h, -r)],
+        [(-r - h, r), (r + h, r)],
+        [(-r, -r), (-r, r)],
+        [(r, -r), (r, r)],
+        [(-r, -r), (r, r)],
+        [(-r, r), (r, -r)],
+    ];
+    for [a, b] in strokes {
+        area.draw(&PathElement::new(
+            vec![(x + a.0, y + a.1), (x + b.0, y + b.1)],
+            style,
+        ))
+        .map_err(|x| e(&x))?;
+    }
+    Ok(())
 }
 
 /// The legend's corners, in the order they are tried.
@@ -332,6 +379,32 @@ pub struct Panel {
     /// Values the y axis shows whatever the data (a probability's 0 and 1, so that its axis
     /// does not start at 0.82); None: the data's range.
     pub y_span: Option<(f64, f64)>,
+    /// What the panel says beside its series; empty (the default): nothing, and the panel is
+    /// drawn as it was before notes were added, bit for bit.
+    pub notes: Notes,
+}
+
+/// What a panel says beside its series: the runs a figure left out or marked apart (`pound
+/// plot`'s collapsed runs), where a reader would otherwise take the points drawn for all.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Notes {
+    /// Paragraphs set small under the plot, each wrapped to the panel's width.
+    pub caption: Vec<String>,
+    /// x values the axis shows whatever the data, each drawn as a thin vertical line with its
+    /// text along it (an intensity at which every run collapsed: `all 80 collapsed`), so that
+    /// they do not vanish from the axis.
+    pub x_marks: Vec<(f64, String)>,
+    /// Points drawn with the collapse marker (a crossed square), each in the colour of the
+    /// series it belongs to (its index in [`Panel::series`]), and listed once in the legend
+    /// as `collapsed_name`.
+    pub collapsed: Vec<(usize, (f64, f64))>,
+    pub collapsed_name: String,
+}
+
+impl Notes {
+    pub fn is_empty(&self) -> bool {
+        self.caption.is_empty() && self.x_marks.is_empty() && self.collapsed.is_empty()
+    }
 }
 
 /// The label of the power of ten `10^k`: `0.01` to `1000` plainly, else `1e-5`, `1e6`.
@@ -577,10 +650,13 @@ fn draw<DB: DrawingBackend>(
     let px = |v: u32| (v as f64 * scale).round().max(1.0) as u32;
     let e = |e: &dyn std::fmt::Display| e.to_string();
     // Linear axes in engineering units: forces in kN or MN, small lengths in mm.
+    let notes = &p.notes;
     let biggest = |f: fn(&(f64, f64)) -> f64| {
         p.series
             .iter()
             .flat_map(|s| s.points.iter().map(f))
+            .chain(notes.collapsed.iter().map(|(_, q)| f(q)))
+            .chain(notes.x_marks.iter().map(|&(x, _)| f(&(x, 0.0))))
             .filter(|v| v.is_finite())
             .fold(0.0f64, |m, v| m.max(v.abs()))
     };
@@ -595,8 +671,26 @@ fn draw<DB: DrawingBackend>(
             .filter(|(x, y)| x.is_finite() && y.is_finite())
             .collect()
     };
-    let all: Vec<(f64, f64)> = p.series.iter().flat_map(pts).collect();
-    let (x0, x1) = range(all.iter().map(|q| q.0));
+    // The collapsed runs' points, each with its series, where they can be drawn.
+    let collapsed: Vec<(usize, (f64, f64))> = notes
+        .collapsed
+        .iter()
+        .map(|&(i, (x, y))| (i, (tx(x), ty(y))))
+        .filter(|(_, (x, y))| x.is_finite() && y.is_finite())
+        .collect();
+    let x_marks: Vec<(f64, &str)> = notes
+        .x_marks
+        .iter()
+        .map(|(x, t)| (tx(*x), t.as_str()))
+        .filter(|(x, _)| x.is_finite())
+        .collect();
+    let all: Vec<(f64, f64)> = p
+        .series
+        .iter()
+        .flat_map(pts)
+        .chain(collapsed.iter().map(|c| c.1))
+        .collect();
+    let (x0, x1) = range(all.iter().map(|q| q.0).chain(x_marks.iter().map(|m| m.0)));
     let span = p.y_span.iter().flat_map(|&(a, b)| [ty(a), ty(b)]);
     let (y0, y1) = range(all.iter().map(|q| q.1).chain(span));
     // A series is a legend entry where it has a name, unless an earlier one of its style and
@@ -609,18 +703,17 @@ fn draw<DB: DrawingBackend>(
             .collect()
     };
     let entry = |i: usize| listed[i];
-    let named: Vec<&Series> = (0..p.series.len())
+    let mut named: Vec<&str> = (0..p.series.len())
         .filter(|&i| entry(i))
-        .map(|i| &p.series[i])
+        .map(|i| p.series[i].name.as_str())
         .collect();
+    if !collapsed.is_empty() {
+        named.push(&notes.collapsed_name);
+    }
     // The legend box as a share of the plot area (the panel less about 105 x 100 px of axis
     // labels, caption and margins: 535 x 380 px in a 640 x 480 panel): 7 px a character at
     // the legend's 12 px font, 40 px of marker and margins; 20 px a line.
-    let longest = named
-        .iter()
-        .map(|s| s.name.chars().count())
-        .max()
-        .unwrap_or(0);
+    let longest = named.iter().map(|s| s.chars().count()).max().unwrap_or(0);
     let (panel_w, panel_h) = area.dim_in_pixel();
     // A title too wide for the panel is set smaller, or wrapped: plotters would clip it.
     let measure = |text: &str, size: f64| {
@@ -651,9 +744,39 @@ fn draw<DB: DrawingBackend>(
         }
         last.push_str(" …");
     }
+    // The caption: its paragraphs wrapped to the panel's width at 11 px, at most a quarter of
+    // the panel's height (the last line kept ends in an ellipsis).
+    let caption_size = 11.0 * scale;
+    let caption_w = panel_w as f64 - 2.0 * px(10) as f64;
+    let mut caption: Vec<String> = notes
+        .caption
+        .iter()
+        .flat_map(|c| wrap(c, caption_w, caption_size, measure))
+        .collect();
+    let caption_line = (caption_size * 1.3).ceil();
+    let most = (panel_h as f64 / 4.0 / caption_line).floor().max(1.0) as usize;
+    if caption.len() > most {
+        caption.truncate(most);
+        let last = caption.last_mut().expect("a line");
+        while measure(&format!("{last} …"), caption_size) > caption_w {
+            match last.rfind(' ') {
+                Some(k) => last.truncate(k),
+                None => break,
+            }
+        }
+        last.push_str(" …");
+    }
+    let caption_h = if caption.is_empty() {
+        0
+    } else {
+        (caption.len() as f64 * caption_line).ceil() as u32 + px(4)
+    };
     let plot_w = (panel_w as f64 - 105.0 * scale).max(1.0);
-    let plot_h =
-        (panel_h as f64 - 100.0 * scale - (title.len() as f64 - 1.0) * line_h * 1.4).max(1.0);
+    let plot_h = (panel_h as f64
+        - 100.0 * scale
+        - (title.len() as f64 - 1.0) * line_h * 1.4
+        - caption_h as f64)
+        .max(1.0);
     let (w, h) = (
         (longest as f64 * 7.0 + 40.0) * scale / plot_w,
         (named.len() as f64 * 20.0 + 20.0) * scale / plot_h,
@@ -671,6 +794,13 @@ fn draw<DB: DrawingBackend>(
                 }));
             }
         }
+        // A marked x value's line and its text, from the foot of the plot to the top.
+        for &(x, _) in &x_marks {
+            occupied.extend((0..=LINE_SAMPLES).map(|k| {
+                let f = k as f64 / LINE_SAMPLES as f64;
+                (x, y0 + f * (y1 - y0))
+            }));
+        }
         legend_place(&occupied, (x0, x1), (y0, y1), w, h)
     } else {
         None
@@ -678,15 +808,19 @@ fn draw<DB: DrawingBackend>(
     // A legend that would cover data in every corner goes beside the plot, in a margin kept
     // for it: to the right where it takes at most 40 % of the panel's width, else below.
     let legend_font = 12.0 * scale;
-    let outside = (named.len() > 1 && corner.is_none()).then(|| {
+    // A legend drawn by hand: its box's width and height.
+    let box_size = || {
         let widest = named
             .iter()
-            .map(|s| measure(&s.name, legend_font))
+            .map(|s| measure(s, legend_font))
             .fold(0.0, f64::max);
-        let size = (
+        (
             (widest + 40.0 * scale).ceil() as i32,
             ((named.len() as f64 * 20.0 + 10.0) * scale).ceil() as i32,
-        );
+        )
+    };
+    let outside = (named.len() > 1 && corner.is_none()).then(|| {
+        let size = box_size();
         let right = size.0 as f64 + px(20) as f64 <= 0.4 * panel_w as f64;
         (right, size)
     });
@@ -756,6 +890,16 @@ fn draw<DB: DrawingBackend>(
         Some((false, (_, h))) => builder.margin_bottom(h as u32 + px(20)),
         None => &mut builder,
     };
+    if caption_h > 0 {
+        // The caption goes under the chart, above the panel's bottom margin (the one-line
+        // title's builder keeps that margin itself; the others' area is inside it).
+        let below = match (outside, &title[..]) {
+            (Some((false, (_, h))), _) => h as u32 + px(20),
+            (None, [_]) => px(10),
+            _ => 0,
+        };
+        builder.margin_bottom(below + caption_h);
+    }
     let mut chart = builder
         .x_label_area_size(px(40))
         .y_label_area_size(px(75))
@@ -776,9 +920,32 @@ fn draw<DB: DrawingBackend>(
             .light_line_style(BLACK.mix(0.05).stroke_width(px(1)));
     }
     mesh.draw().map_err(|x| e(&x))?;
+    // Each marked x value: a thin line across the plot, and its text along it, reading
+    // upwards from the foot of the plot just right of the line.
+    for &(x, text) in &x_marks {
+        chart
+            .draw_series(LineSeries::new(
+                [(x, y0), (x, y1)],
+                RGBColor(120, 120, 120).stroke_width(px(1)),
+            ))
+            .map_err(|x| e(&x))?;
+        let font = ("sans-serif", 11.0 * scale)
+            .into_font()
+            .transform(FontTransform::Rotate270)
+            .color(&RGBColor(60, 60, 60));
+        let at = (px(3) as i32, -(px(6) as i32));
+        chart
+            .draw_series(std::iter::once(
+                EmptyElement::at((x, y0)) + Text::new(text.to_string(), at, font),
+            ))
+            .map_err(|x| e(&x))?;
+    }
     // Style slots in order of first appearance: a curve and its points share one.
     let mut slots: Vec<usize> = Vec::new();
-    let mut entries: Vec<(&str, usize, RGBAColor)> = Vec::new();
+    // Legend entries: a name, its style slot (None: the collapse marker) and its colour.
+    let mut entries: Vec<(&str, Option<usize>, RGBAColor)> = Vec::new();
+    // Each series' colour, for its collapsed runs' markers.
+    let mut colors: Vec<RGBAColor> = Vec::with_capacity(p.series.len());
     for (i, s) in p.series.iter().enumerate() {
         let slot = {
             let key = s.style.unwrap_or(usize::MAX - i);
@@ -791,9 +958,10 @@ fn draw<DB: DrawingBackend>(
             }
         };
         let color = PALETTE[slot % PALETTE.len()].to_rgba();
+        colors.push(color);
         let listed = entry(i);
         if listed {
-            entries.push((&s.name, slot, color));
+            entries.push((&s.name, Some(slot), color));
         }
         let data = pts(s);
         if s.name.is_empty() {
@@ -839,14 +1007,59 @@ fn draw<DB: DrawingBackend>(
                 .map_err(|x| e(&x))?;
         }
     }
-    if let Some((right, (w, h))) = outside {
-        let (xs, ys) = chart.plotting_area().get_pixel_range();
-        let (bx, by) = area.get_base_pixel();
-        let (x, y) = if right {
-            (panel_w as i32 - px(10) as i32 - w, ys.start - by)
-        } else {
-            (xs.start - bx, panel_h as i32 - px(10) as i32 - h)
-        };
+    let (xs, ys) = chart.plotting_area().get_pixel_range();
+    let (bx, by) = area.get_base_pixel();
+    if !collapsed.is_empty() {
+        // Over the series, in the panel's pixels: each in its series' colour, one legend
+        // entry in black.
+        let black = BLACK.to_rgba();
+        for &(i, q) in &collapsed {
+            let (x, y) = chart.backend_coord(&q);
+            let color = colors.get(i).copied().unwrap_or(black);
+            collapse_marker(area, (x - bx, y - by), color, scale)?;
+        }
+        entries.push((&notes.collapsed_name, None, black));
+    }
+    // The legend drawn by hand, its box's corner and size: beside the plot, or in the corner
+    // chosen where collapsed runs are marked (plotters' legend takes one element an entry,
+    // and the collapse marker is three).
+    let by_hand = match (outside, &corner) {
+        (Some((true, (w, h))), _) => {
+            Some(((panel_w as i32 - px(10) as i32 - w, ys.start - by), (w, h)))
+        }
+        (Some((false, (w, h))), _) => Some((
+            (
+                xs.start - bx,
+                panel_h as i32 - px(10) as i32 - caption_h as i32 - h,
+            ),
+            (w, h),
+        )),
+        (None, Some(c)) if !collapsed.is_empty() => {
+            let (w, h) = box_size();
+            let m = px(5) as i32;
+            let left = matches!(
+                c,
+                SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerLeft
+            );
+            let upper = matches!(
+                c,
+                SeriesLabelPosition::UpperLeft | SeriesLabelPosition::UpperRight
+            );
+            let x = if left {
+                xs.start - bx + m
+            } else {
+                xs.end - bx - m - w
+            };
+            let y = if upper {
+                ys.start - by + m
+            } else {
+                ys.end - by - m - h
+            };
+            Some(((x, y), (w, h)))
+        }
+        _ => None,
+    };
+    if let Some(((x, y), (w, h))) = by_hand {
         let corners = [(x, y), (x + w, y + h)];
         area.draw(&Rectangle::new(corners, WHITE.mix(0.85).filled()))
             .map_err(|x| e(&x))?;
@@ -860,13 +1073,13 @@ fn draw<DB: DrawingBackend>(
         );
         for (k, (name, slot, color)) in entries.iter().enumerate() {
             let at = y + ((k as f64 * 20.0 + 15.0) * scale).round() as i32;
-            area.draw(&marker::<DB, (i32, i32)>(
-                *slot,
-                (x + px(14) as i32, at),
-                *color,
-                scale,
-            ))
-            .map_err(|x| e(&x))?;
+            let glyph = (x + px(14) as i32, at);
+            match slot {
+                Some(slot) => area
+                    .draw(&marker::<DB, (i32, i32)>(*slot, glyph, *color, scale))
+                    .map_err(|x| e(&x))?,
+                None => collapse_marker(area, glyph, *color, scale)?,
+            }
             area.draw(&Text::new(*name, (x + px(28) as i32, at), font.clone()))
                 .map_err(|x| e(&x))?;
         }
@@ -883,6 +1096,16 @@ fn draw<DB: DrawingBackend>(
                 .legend_area_size(px(30));
         }
         legend.draw().map_err(|x| e(&x))?;
+    }
+    // The caption, at the foot of the panel.
+    let font = ("sans-serif", caption_size)
+        .into_font()
+        .color(&RGBColor(40, 40, 40));
+    let top = panel_h as i32 - px(10) as i32 - caption_h as i32 + px(4) as i32;
+    for (k, line) in caption.iter().enumerate() {
+        let at = (px(10) as i32, top + (k as f64 * caption_line) as i32);
+        area.draw(&Text::new(line.as_str(), at, font.clone()))
+            .map_err(|x| e(&x))?;
     }
     Ok(())
 }

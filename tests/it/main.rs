@@ -7,6 +7,7 @@ mod collapse;
 mod collapse_by_building;
 mod collapse_limits;
 mod collapse_opensees;
+mod collapse_outputs;
 mod collapse_scene;
 mod collapse_studies;
 mod config;
