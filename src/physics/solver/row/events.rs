@@ -1,7 +1,7 @@
 //! A row run's events: each level's contact mode and each yielding storey's spring state
 //! ending, located within a step, and the transitions they call for; the acceptance of a step.
 
-use super::yielding::{may_reach, StoreyMode};
+use super::yielding::{band_edges, may_reach, StoreyMode};
 use super::RowRun;
 use crate::physics::solver::events::{hidden_rise, locate, touch};
 use crate::physics::solver::{Mode, Segment};
@@ -70,8 +70,7 @@ impl<'m> RowRun<'m> {
             let ([d0, r0, d1, r1], bound) =
                 self.m.drift_over_step(k, &d.modal_row, (z, z1), bounds);
             let top = limit * d.height;
-            let edges = |x: f64, r: f64| [(x - top, r), (-x - top, -r)];
-            if may_reach(edges(d0, r0), edges(d1, r1), bound, h) {
+            if may_reach(band_edges(d0, r0, top), band_edges(d1, r1, top), bound, h) {
                 out[k] = true;
                 any = true;
             }
@@ -170,10 +169,7 @@ impl<'m> RowRun<'m> {
                 continue;
             }
             let top = limit * d.height;
-            let edges = |z: &[f64]| {
-                let (x, r) = (d.drift(z, 0), d.drift(z, n));
-                [(x - top, r), (-x - top, -r)]
-            };
+            let edges = |z: &[f64]| band_edges(d.drift(z, 0), d.drift(z, n), top);
             for (a, b) in edges(z0).iter().zip(&edges(z1)) {
                 if let Some(x) = hidden_rise(a.0, a.1, b.0, b.1, h) {
                     first = Some(first.map_or(x, |f| f.min(x)));
@@ -337,7 +333,7 @@ impl<'m> RowRun<'m> {
             // collapse is where it crossed, located on its own.
             if !self.m.drifts.is_empty() {
                 let c = self.collapse_max(&zb);
-                let c0 = self.collapse_max(&z0);
+                let c0 = if c > 0.0 { self.collapse_max(&z0) } else { 0.0 };
                 if c > 0.0 && c0 <= 0.0 {
                     (x, zb) = locate(x, c0, zb, c, tol, max_iter, &mut step, |s: &Vec<f64>| {
                         self.collapse_max(s)

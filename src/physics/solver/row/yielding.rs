@@ -104,10 +104,16 @@ impl StoreyModel {
     /// their rates, for the hidden-yield checks of a step.
     #[inline]
     pub fn edges(&self, d: f64, rate: f64, p: f64) -> [(f64, f64); 2] {
-        let s = self.back_drift(d, p);
-        let dy = self.d_y * (1.0 + YIELD_SLACK);
-        [(s - dy, rate), (-s - dy, -rate)]
+        band_edges(self.back_drift(d, p), rate, self.d_y * (1.0 + YIELD_SLACK))
     }
+}
+
+/// The edges of the band `|x| <= half` as functions that reach 0 on them, `[x - half, -x -
+/// half]`, with their rates from `x`'s `rate`: a yielding storey's band in its back drift, a
+/// drift's collapse limit.
+#[inline]
+pub(crate) fn band_edges(x: f64, rate: f64, half: f64) -> [(f64, f64); 2] {
+    [(x - half, rate), (-x - half, -rate)]
 }
 
 /// Could an edge function (value and rate at both ends of a free step of length `h`, `bound`
