@@ -43,6 +43,17 @@ pub fn show(x: f64) -> String {
     }
 }
 
+/// A number derived by arithmetic (a sample interval from a time column's differences), as
+/// [`show`] draws it once rounded to 12 significant digits: `0.02`, not the
+/// `0.019999999999999997` that `0.04 - 0.02` leaves. Values as typed keep [`show`].
+pub fn show_derived(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return show(x);
+    }
+    let rounded: f64 = format!("{x:.11e}").parse().unwrap_or(x);
+    show(rounded)
+}
+
 /// `x` to `places` decimals where that reads (a table's fixed columns), in exponent form with
 /// as many beyond, as [`show`] draws the line: bounded however large or small `x` is.
 pub fn show_places(x: f64, places: usize) -> String {

@@ -210,14 +210,14 @@ fn spectrum(
         places(peak.1, 4),
         places(peak.0, 3),
         periods.len(),
-        pounding::show(100.0 * damping)
+        pounding::show_derived(100.0 * damping)
     );
     let plot = plot.map(|p| {
         let panel = pounding::studies::plot::Panel {
             title: format!(
                 "{}: {} % damped spectrum",
                 rec.name,
-                pounding::show(100.0 * damping)
+                pounding::show_derived(100.0 * damping)
             ),
             x_label: "period T (s)".into(),
             y_label: "Sa (g)".into(),
@@ -242,14 +242,16 @@ fn info(record: &FileArgs) -> Result<()> {
     let rec = record.read()?;
     let pga = rec.pga();
     // Bounded however large or small the record's numbers are.
-    let (show, places) = (pounding::show, pounding::show_places);
+    let places = pounding::show_places;
     say!("file      {}", file.display());
     if let Some(w) = &record.window {
         say!("window    {w} s (the samples a config's window_s reads)");
     }
     say!("npts      {}", rec.npts());
-    say!("dt        {} s", show(rec.dt));
-    say!("t0        {} s", show(rec.t0));
+    // A time column's dt is a difference of two times: shown as derived, not to the last ulp.
+    let derived = pounding::show_derived;
+    say!("dt        {} s", derived(rec.dt));
+    say!("t0        {} s", derived(rec.t0));
     say!("duration  {} s", places(rec.duration(), 3));
     say!(
         "pga       {} g  ({} m/s^2, {} cm/s^2)",

@@ -222,7 +222,7 @@ impl ContactPlan {
                         "{}: all zeros from {} s to {} s (the part simulated): no {measure} to scale to {key}",
                         rec.name,
                         crate::plan::limits::show(rec.t0),
-                        crate::plan::limits::show(rec.t0 + (rec.npts() - 1) as f64 * rec.dt),
+                        crate::show_derived(rec.t0 + (rec.npts() - 1) as f64 * rec.dt),
                     ),
                 ));
             }

@@ -94,7 +94,7 @@ pub fn synthetic(spec: &SyntheticSpec) -> Result<Record, RecordError> {
             "synthetic.fg_hz = {} is above the Nyquist frequency of dt_s = {} ({} Hz)",
             crate::show(spec.fg_hz),
             crate::show(spec.dt),
-            crate::show(0.5 / spec.dt)
+            crate::show_derived(0.5 / spec.dt)
         )));
     }
     if spec.zeta_g > 2.0 {

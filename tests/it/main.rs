@@ -29,6 +29,7 @@ mod im_columns;
 mod inelastic;
 mod intensity;
 mod layers;
+mod messages;
 pub mod multistorey;
 mod oracles;
 mod records;
