@@ -28,6 +28,7 @@ mod hostile;
 mod im_columns;
 mod inelastic;
 mod intensity;
+mod kept_outputs;
 mod layers;
 pub mod multistorey;
 mod oracles;
