@@ -145,6 +145,25 @@ impl CsvOut {
         Ok((self.hasher.bytes(), self.hasher.digest()))
     }
 
+    /// fsync what was handed to the OS, without flushing the buffer: after a failed write,
+    /// every row written whole before it ([`CsvOut::write_encoded`] flushes each chunk).
+    pub fn sync_written(&self) -> std::io::Result<()> {
+        match &self.file {
+            Some((_, f)) => f.sync_data(),
+            None => Ok(()),
+        }
+    }
+
+    /// Bytes written so far, header included.
+    pub fn bytes(&self) -> u64 {
+        self.hasher.bytes()
+    }
+
+    /// The hash of the bytes written so far.
+    pub fn digest(&self) -> String {
+        self.hasher.digest()
+    }
+
     /// Append rows already encoded as CSV lines ([`encode_csv`]), pushed to the OS so a crash
     /// keeps them; refused if they do not hold the next runs in order.
     pub fn write_encoded(&mut self, lines: &[u8]) -> std::io::Result<()> {

@@ -141,6 +141,11 @@ pub fn check_outputs(
     inputs: &[(&str, &Path)],
     outputs: &[(&str, &Target)],
 ) -> Result<(), TargetError> {
+    for (what, t) in outputs {
+        if t.is_file() {
+            refuse_bookkeeping(what, t.path())?;
+        }
+    }
     let mut files: Vec<(String, PathBuf)> = Vec::new();
     for (what, t) in outputs {
         files.push((what.to_string(), t.path().to_path_buf()));
@@ -162,6 +167,54 @@ pub fn check_outputs(
         .map(|(w, p)| (w.as_str(), p.as_path()))
         .collect();
     check_distinct(inputs, &files)
+}
+
+/// Refuse an output named like the bookkeeping of another output that holds something: the
+/// `.partial` of an unfinished sweep (its journal exists), that journal, or the sidecar of an
+/// existing output (`pound sweep b.toml -o r.csv.partial` would replace the rows `--resume` of
+/// r.csv continues).
+fn refuse_bookkeeping(what: &str, path: &Path) -> Result<(), TargetError> {
+    let name = path.as_os_str().to_string_lossy();
+    let owner = |suffix: &str| name.strip_suffix(suffix).map(PathBuf::from);
+    if let Some(out) = owner(".partial") {
+        let journal = crate::io::provenance::progress_path(&out);
+        if journal.exists() {
+            return Err(refused(
+                what,
+                path,
+                format!(
+                    "is the .partial of {}, where an unfinished sweep keeps its rows (its journal {} exists): choose another output, or finish that sweep with --resume",
+                    out.display(),
+                    journal.display()
+                ),
+            ));
+        }
+    }
+    if let Some(out) = owner(".progress.toml") {
+        if path.exists() {
+            return Err(refused(
+                what,
+                path,
+                format!(
+                    "is the journal of an unfinished sweep of {}: choose another output",
+                    out.display()
+                ),
+            ));
+        }
+    }
+    if let Some(out) = owner(".meta.toml") {
+        if out.exists() {
+            return Err(refused(
+                what,
+                path,
+                format!(
+                    "is the sidecar of {}, which vouches for its rows: choose another output",
+                    out.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The identity of an existing file: device and inode on Unix, the canonical path elsewhere.

@@ -28,6 +28,7 @@ mod hostile;
 mod im_columns;
 mod inelastic;
 mod intensity;
+mod kept_outputs;
 mod layers;
 mod messages;
 pub mod multistorey;

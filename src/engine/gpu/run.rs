@@ -651,6 +651,7 @@ impl WorkLists {
             let v = map_read(ctx, &staging)?;
             let word =
                 |i: usize| u32::from_le_bytes([v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]]);
+            ran(label, d.nactive, word(1), word(0))?;
             d.nactive = word(0);
             times.lane_units += word(1) as u64;
             times.lane_slots += word(2) as u64;
@@ -661,6 +662,29 @@ impl WorkLists {
         times.kernel += t.elapsed();
         Ok(())
     }
+}
+
+/// Check a dispatch's tally: every run it was given does at least one unit of work (its budget
+/// is at least 1 and only unfinished runs are listed), and leaves at most as many runs active.
+/// A tally of no work (a device that did not run the kernel and left the tally as it was
+/// cleared) would otherwise read as "no run active" and end the chunk with unfinished runs
+/// taken for finished ones, and more runs than it was given is not a tally at all.
+pub(super) fn ran(label: &str, given: u32, units: u32, active: u32) -> Result<(), GpuError> {
+    if given > 0 && units == 0 {
+        return Err(GpuError::Other {
+            message: format!(
+                "the {label} kernel did no work in a dispatch of {given} unfinished runs (the device did not run it); its results cannot be trusted"
+            ),
+        });
+    }
+    if active > given {
+        return Err(GpuError::Other {
+            message: format!(
+                "the {label} kernel reported {active} runs still active of the {given} it was given; its results cannot be trusted"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Each run's state and counters before the first dispatch, the state in `precision`'s bytes:
@@ -700,6 +724,27 @@ fn initial_states(runs: &[Packed], precision: Precision) -> (Vec<u8>, Vec<Counte
     (bytes, counters)
 }
 
+/// Every run of a chunk read back must have ended (its record integrated, or a status that
+/// ends it): one still running would be written as a finished run with part of its record.
+pub(super) fn unfinished(cs: &[Counters], runs: &[Packed]) -> Result<(), GpuError> {
+    let left = cs
+        .iter()
+        .zip(runs)
+        .filter(|(c, r)| c.status == STATUS_OK && c.i < r.meta.intervals)
+        .count();
+    match cs.iter().zip(runs).position(|(c, r)| c.status == STATUS_OK && c.i < r.meta.intervals) {
+        Some(k) => Err(GpuError::Other {
+            message: format!(
+                "{left} runs of a chunk of {} came back from the device unfinished (the first, chunk run {k}, at record interval {} of {}); their results cannot be trusted",
+                runs.len(),
+                cs[k].i,
+                runs[k].meta.intervals
+            ),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Each run's results from its final state, in input order (None: handed back); `accel`: the
 /// runs tracked their peak accelerations.
 pub fn read_outputs(
@@ -713,6 +758,7 @@ pub fn read_outputs(
     let sbytes = read(ctx, &done.states)?;
     let cbytes = read(ctx, &done.counters)?;
     let cs: &[Counters] = bytemuck::cast_slice(&cbytes);
+    unfinished(cs, runs)?;
     let out: Vec<Option<RunOutput>> = match opts.precision {
         Precision::F64 => {
             let ss: &[State64] = bytemuck::cast_slice(&sbytes);
@@ -732,4 +778,62 @@ pub fn read_outputs(
         }
     };
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A dispatch that did no work for runs it was given, or a tally of more active runs than
+    /// given, is an error, not "every run finished".
+    #[test]
+    fn a_tally_of_no_work_is_an_error() {
+        ran("fast", 5, 5, 3).unwrap();
+        ran("fast", 5, 40, 0).unwrap();
+        ran("fast", 0, 0, 0).unwrap();
+        let e = ran("fast", 5, 0, 0).unwrap_err().to_string();
+        assert!(
+            e.contains("did no work") && e.contains("--backend cpu"),
+            "{e}"
+        );
+        let e = ran("row", 5, 9, 6).unwrap_err().to_string();
+        assert!(e.contains("6 runs still active of the 5"), "{e}");
+    }
+
+    /// A run read back with its status OK before its record's end is refused, named.
+    #[test]
+    fn a_run_read_back_unfinished_is_an_error() {
+        let run = |intervals| Packed {
+            params: Params64::default(),
+            meta: Meta {
+                intervals,
+                ..Meta::default()
+            },
+            forms: None,
+            start: None,
+        };
+        let c = |status, i| Counters {
+            status,
+            i,
+            ..Counters::default()
+        };
+        let runs = [run(10), run(10), run(10)];
+        unfinished(
+            &[
+                c(STATUS_OK, 10),
+                c(STATUS_NON_FINITE, 3),
+                c(STATUS_HANDOFF, 0),
+            ],
+            &runs,
+        )
+        .unwrap();
+        let e = unfinished(&[c(STATUS_OK, 10), c(STATUS_OK, 4), c(STATUS_OK, 0)], &runs)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("2 runs of a chunk of 3")
+                && e.contains("chunk run 1, at record interval 4 of 10"),
+            "{e}"
+        );
+    }
 }
