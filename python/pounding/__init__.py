@@ -17,6 +17,7 @@ the GIL released, and Ctrl-C stops it and raises ``KeyboardInterrupt``.
 
 from __future__ import annotations
 
+import math
 import numbers
 import os
 import sys
@@ -34,6 +35,9 @@ from ._pounding import (
 )
 
 __version__ = _engine.__version__
+
+# The engine's bounds on the keywords that have one (threads, chunk, bootstrap).
+_LIMITS = dict(_engine.LIMITS)
 
 __all__ = [
     "sweep",
@@ -168,33 +172,87 @@ class Record:
         )
 
 
-def _config(config: Config) -> tuple:
-    """A config as the engine takes it: (value, kind)."""
+def _config(config: Config, name: str = "config") -> tuple:
+    """A config as the engine takes it: (value, kind).
+
+    A string is a path unless it holds a line break (a config's TOML has several lines, a
+    path none) or names a file that exists: decided by the string alone, so a missing path
+    (``runs/pga=0.3/cfg.toml``) is said to be missing rather than read as TOML."""
     if isinstance(config, dict):
         return config, "dict"
     if isinstance(config, os.PathLike):
-        return os.fspath(config), "path"
-    if isinstance(config, str):
-        # A file that exists is a path (a folder may be named pga=0.3); else a TOML text has a
-        # line break, a key (=) or a table ([...]), and a path has none of them.
-        if os.path.isfile(config):
+        config = os.fspath(config)
+        if isinstance(config, str):
             return config, "path"
-        if "\n" in config or "=" in config or config.lstrip().startswith("["):
+    if isinstance(config, str):
+        if "\n" in config and not os.path.isfile(config):
             return config, "text"
+        if not os.path.exists(config) and ("=" in config or config.lstrip().startswith("[")):
+            raise ConfigError(
+                f"{name}={config!r}: no such file (a string is read as a config's TOML only "
+                "where it spans lines; else it is a path)"
+            )
         return config, "path"
-    raise TypeError(
-        f"config: a {type(config).__name__} is not a config: expected a path, a TOML string or a dict"
+    raise ConfigError(
+        f"{name}: a {type(config).__name__} is not a config: expected a path, a TOML string "
+        "or a dict"
     )
 
 
+def _refuse(name: str, value: Any, expected: str) -> SettingsError:
+    return SettingsError(f"{name}={value!r}: expected {expected}")
+
+
+def _text(name: str, value: Any, optional: bool = True) -> Optional[str]:
+    """A keyword that takes a name (None stays None where `optional`)."""
+    if value is None and optional:
+        return None
+    if not isinstance(value, str):
+        raise _refuse(name, value, "a string" + (" or None" if optional else ""))
+    return value
+
+
+def _flag(name: str, value: Any) -> bool:
+    """A yes-or-no keyword: a bool (numpy's too), not a number or a string."""
+    if isinstance(value, bool) or type(value).__name__ == "bool_":
+        return bool(value)
+    raise _refuse(name, value, "True or False")
+
+
+def _real(name: str, value: Any, optional: bool = True) -> Optional[float]:
+    """A number keyword (numpy's numbers too; not a bool), finite (None stays None where
+    `optional`)."""
+    if value is None and optional:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise _refuse(name, value, "a number")
+    try:
+        x = float(value)
+    except OverflowError:
+        x = float("inf")
+    if not math.isfinite(x):
+        raise _refuse(name, value, "a finite number")
+    return x
+
+
 def _names(value: Union[None, str, Iterable[str]], what: str) -> Optional[list]:
+    """Column names: a list of strings or one string "a,b"; an empty one is refused (leave the
+    keyword out for the default), as the command line refuses an empty flag."""
     if value is None:
         return None
     if isinstance(value, str):
-        return [v.strip() for v in value.split(",") if v.strip()]
-    names = list(value)
-    if not all(isinstance(v, str) for v in names):
-        raise TypeError(f"{what}: expected column names (strings)")
+        names = [v.strip() for v in value.split(",")]
+    elif isinstance(value, Iterable):
+        names = list(value)
+        if not all(isinstance(v, str) for v in names):
+            raise _refuse(what, value, "column names (strings, or one string a,b)")
+        names = [v.strip() for v in names]
+    else:
+        raise _refuse(what, value, "column names (a list of strings, or one string a,b)")
+    if not names or not any(names):
+        raise _refuse(what, value, "at least one column name (leave it out for the default)")
+    if not all(names):
+        raise _refuse(what, value, "column names, none empty")
     return names
 
 
@@ -202,14 +260,24 @@ def _exceed(exceed: Union[None, str, dict, Iterable[str]]) -> list:
     if exceed is None:
         return []
     if isinstance(exceed, dict):
-        # numpy's numbers too: as the int or float they hold, in Python's own spelling.
-        return [
-            f"{k}={int(v)}" if isinstance(v, numbers.Integral) else f"{k}={float(v)!r}"
-            for k, v in exceed.items()
-        ]
+        out = []
+        for k, v in exceed.items():
+            if not isinstance(k, str):
+                raise _refuse("exceed", exceed, "{column: threshold} with column names as keys")
+            if isinstance(v, bool) or not isinstance(v, numbers.Real):
+                raise _refuse("exceed", exceed, "{column: threshold} with numbers as thresholds")
+            # numpy's numbers too: as the int or float they hold, in Python's own spelling.
+            out.append(f"{k}={int(v)}" if isinstance(v, numbers.Integral) else f"{k}={float(v)!r}")
+        return out
     if isinstance(exceed, str):
         return [exceed]
-    return list(exceed)
+    if isinstance(exceed, Iterable):
+        items = list(exceed)
+        if all(isinstance(v, str) for v in items):
+            return items
+    raise _refuse(
+        "exceed", exceed, "{column: threshold}, \"column=threshold\" or a list of such strings"
+    )
 
 
 class _QuietVulkanProbe:
@@ -234,14 +302,19 @@ class _QuietVulkanProbe:
             os.environ.pop("WAYLAND_DISPLAY", None)
 
 
-def _count(name: str, value: Any, least: int = 0) -> Optional[int]:
-    """A whole number keyword (None stays None), at least `least`."""
+# The largest whole number the engine takes where no tighter bound is known (64 bits).
+_U64 = 2**64 - 1
+
+
+def _count(name: str, value: Any, least: int = 0, most: int = _U64) -> Optional[int]:
+    """A whole number keyword (numpy's integers too; not a bool), from `least` to `most`
+    (None stays None)."""
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise SettingsError(f"{name}={value!r}: expected a whole number")
-    if value < least:
-        raise SettingsError(f"{name}={value}: expected a whole number from {least}")
+        raise _refuse(name, value, "a whole number")
+    if not least <= value <= most:
+        raise SettingsError(f"{name}={value}: expected a whole number from {least} to {most}")
     return int(value)
 
 
@@ -319,24 +392,25 @@ def sweep(
     runs_with_impacts, failures, collapsed, engine, kernel, scene).
     """
     value, kind = _config(config)
-    bar = _Progress("sweep", bool(progress))
+    args = (
+        value,
+        kind,
+        _text("backend", backend, optional=False),
+        _text("precision", precision),
+        _count("threads", threads, 1, _LIMITS["threads"]),
+        _real("target_error", target_error),
+        _names(columns, "columns"),
+        _names(aggregate, "aggregate"),
+        _exceed(exceed),
+        _text("scheme", scheme),
+        _flag("energy", energy),
+        _count("chunk", chunk, 1, max(_LIMITS["cpu_chunk"], _LIMITS["gpu_chunk"])),
+    )
+    progress = _flag("progress", progress)
+    bar = _Progress("sweep", progress)
     try:
         with _QuietVulkanProbe(backend):
-            inner, totals, notices, warned = _engine.sweep(
-                value,
-                kind,
-                backend,
-                precision,
-                _count("threads", threads, 1),
-                target_error,
-                _names(columns, "columns"),
-                _names(aggregate, "aggregate"),
-                _exceed(exceed),
-                scheme,
-                bool(energy),
-                _count("chunk", chunk, 1),
-                bar if progress else None,
-            )
+            inner, totals, notices, warned = _engine.sweep(*args, bar if progress else None)
     finally:
         bar.close()
     _say(notices)
@@ -360,7 +434,7 @@ def trace(config: Config, run: int) -> Trace:
     step and located event: displacements, velocities, accelerations, each level's
     penetration, force and mode, yielding storeys' drifts) and its row as the sweep writes it."""
     value, kind = _config(config)
-    history, row = _engine.trace(value, kind, _count("run", run))
+    history, row = _engine.trace(value, kind, _count("run", run, 0, _U64))
     return Trace(Table(history), Table(row))
 
 
@@ -369,13 +443,13 @@ def gap(config: Config, *, threads: Optional[int] = None) -> Table:
     ``pound gap`` writes it: exactly from the time histories, and by the ABS, SRSS and DDC
     rules, with their ratios to the exact gap."""
     value, kind = _config(config)
-    inner, warned = _engine.gap(value, kind, _count("threads", threads, 1))
+    inner, warned = _engine.gap(value, kind, _count("threads", threads, 1, _LIMITS["threads"]))
     _warn(warned)
     return Table(inner)
 
 
 def _study_input(table: Any) -> Any:
-    if isinstance(table, (str, os.PathLike)):
+    if isinstance(table, (str, os.PathLike)) and isinstance(os.fspath(table), str):
         return os.fspath(table), "path"
     if isinstance(table, Table):
         return table._inner, "arrow"
@@ -400,20 +474,38 @@ def _where(where: Union[None, str, Iterable[str]]) -> list:
         return []
     if isinstance(where, str):
         return [where]
-    return list(where)
+    if isinstance(where, Iterable):
+        filters = list(where)
+        if all(isinstance(w, str) for w in filters):
+            return filters
+    raise _refuse("where", where, 'row filters: "COLUMN=VALUE" or a list of them')
 
 
-def _list(value: Union[None, float, str, Iterable[Any]]) -> list:
+def _list(name: str, value: Union[None, float, str, Iterable[Any]]) -> list:
+    """Numbers: one, a list (a numpy array too) or a string a,b,c; each finite, none a bool."""
     if value is None:
         return []
-    try:
-        if isinstance(value, numbers.Real):
-            return [float(value)]
-        if isinstance(value, str):
-            return [float(v) for v in value.split(",") if v.strip()]
-        return [float(v) for v in value]
-    except (TypeError, ValueError):
-        raise SettingsError(f"{value!r}: expected numbers (a number, a list, or a,b,c)") from None
+    if hasattr(value, "tolist") and not isinstance(value, (str, numbers.Number)):
+        value = value.tolist()  # a numpy array (a 0-d one is its number)
+    expected = "finite numbers (a number, a list of numbers, or a string a,b,c)"
+    if isinstance(value, str):
+        items: list = [v for v in value.split(",") if v.strip()]
+    elif isinstance(value, Iterable):
+        items = list(value)
+    else:
+        items = [value]
+    out = []
+    for v in items:
+        if isinstance(v, bool) or not isinstance(v, (numbers.Real, str)):
+            raise _refuse(name, value, expected)
+        try:
+            x = float(v)
+        except (ValueError, OverflowError):
+            raise _refuse(name, value, expected) from None
+        if not math.isfinite(x):
+            raise _refuse(name, value, expected)
+        out.append(x)
+    return out
 
 
 def fragility(
@@ -436,19 +528,18 @@ def fragility(
     ``table``: a table from :func:`sweep` (or any Arrow table or DataFrame) or a results CSV's
     path. ``info["report"]`` holds the command's report (the fits as a Markdown table).
     """
-    source, kind = _study_input(table)
-    inner, report, notices = _engine.fragility(
-        source,
-        kind,
-        im,
-        edp,
-        _list(thresholds),
-        damage_states,
-        _count("bootstrap", bootstrap),
-        _count("seed", seed),
-        by,
+    args = (
+        _text("im", im),
+        _text("edp", edp, optional=False),
+        _list("thresholds", thresholds),
+        _text("damage_states", damage_states),
+        _count("bootstrap", bootstrap, 0, _LIMITS["bootstrap"]),
+        _count("seed", seed, 0, _U64),
+        _text("by", by),
         _where(where),
     )
+    source, kind = _study_input(table)
+    inner, report, notices = _engine.fragility(source, kind, *args)
     _say(notices)
     return Table(inner, {"report": report, "notices": notices})
 
@@ -465,10 +556,9 @@ def ida(
     the columns ``by`` names) the demand ``edp`` against the intensity ``im``, and the 16, 50
     and 84 % fractiles across the curves at each intensity level (a collapse is an infinite
     demand). ``info["report"]`` holds the command's report."""
+    args = (_text("im", im), _text("edp", edp, optional=False), _names(by, "by") or [])
     source, kind = _study_input(table)
-    inner, report, notices = _engine.ida(
-        source, kind, im, edp, _names(by, "by") or [], _where(where)
-    )
+    inner, report, notices = _engine.ida(source, kind, *args, _where(where))
     _say(notices)
     return Table(inner, {"report": report, "notices": notices})
 
@@ -486,13 +576,13 @@ def record(
     values or two_column; units: g, m/s2 or cm/s2; window: (start, end) s on the record's
     clock, as a config's ``window_s``)."""
     # Absolute: spectrum() reads the file again, perhaps from another working folder.
-    path = os.path.abspath(os.fspath(path))
+    path = os.path.abspath(_path("path", path))
     options = {
-        "format": format,
-        "dt": dt,
-        "units": units,
-        "skip_lines": _count("skip_lines", skip_lines),
-        "window": tuple(window) if window is not None else None,
+        "format": _text("format", format, optional=False),
+        "dt": _real("dt", dt),
+        "units": _text("units", units),
+        "skip_lines": _count("skip_lines", skip_lines, 0, _U64),
+        "window": _window(window),
     }
     info, samples = _engine.record(path, **options)
     return Record(path, options, info, samples)
@@ -509,5 +599,31 @@ def spectrum(
     if isinstance(record, Record):
         path, options = record.path, record._options
     else:
-        path, options = os.fspath(record), {}
-    return Table(_engine.spectrum(path, _list(periods), float(damping), **options))
+        path, options = _path("record", record), {}
+    periods = _list("periods", periods)
+    return Table(_engine.spectrum(path, periods, _real("damping", damping, False), **options))
+
+
+def _path(name: str, value: Any) -> str:
+    """A file's path: a string or an os.PathLike naming one."""
+    if isinstance(value, (str, os.PathLike)):
+        value = os.fspath(value)
+        if isinstance(value, str):
+            return value
+    raise _refuse(name, value, "a file's path (a string or a pathlib.Path)")
+
+
+def _window(window: Any) -> Optional[tuple]:
+    """A record's window: (start, end) s, two finite numbers."""
+    if window is None:
+        return None
+    if hasattr(window, "tolist") and not isinstance(window, numbers.Number):
+        window = window.tolist()
+    if isinstance(window, Iterable) and not isinstance(window, str):
+        pair = list(window)
+        if len(pair) == 2 and all(
+            not isinstance(v, bool) and isinstance(v, numbers.Real) and math.isfinite(v)
+            for v in pair
+        ):
+            return (float(pair[0]), float(pair[1]))
+    raise _refuse("window", window, "(start, end): two finite numbers of seconds")

@@ -143,6 +143,18 @@ fn toml_value(v: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
                 .map(|(i, x)| toml_value(x, &format!("{at}[{i}]")))
                 .collect::<PyResult<_>>()?,
         )
+    } else if v.hasattr("tolist")? {
+        // numpy's arrays and numbers (pandas' series): as the list or number they hold.
+        let plain = v.call_method0("tolist").map_err(|e| {
+            ConfigError::new_err(format!("<config dict>: {at}: {v}.tolist() failed: {e}"))
+        })?;
+        if plain.get_type().is(v.get_type()) {
+            return Err(ConfigError::new_err(format!(
+                "<config dict>: {at}: a {} is not a config value (expected a string, number, bool, list or dict)",
+                v.get_type().name()?
+            )));
+        }
+        toml_value(&plain, at)?
     } else if matches!(v.get_type().name()?.to_string().as_str(), "bool_" | "bool") {
         // numpy's bool: as the bool it holds (before __index__, which numpy refuses on it).
         toml::Value::Boolean(v.is_truthy()?)
@@ -157,9 +169,8 @@ fn toml_value(v: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
         // numpy's floats and the like: as the float they hold.
         toml::Value::Float(v.extract().map_err(|_| {
             ConfigError::new_err(format!(
-                "<config dict>: {at}: a {} is not a config value (expected a string, number, bool, list or dict{})",
+                "<config dict>: {at}: a {} is not a config value (expected a string, number, bool, list or dict)",
                 v.get_type().name().map(|n| n.to_string()).unwrap_or_default(),
-                if v.hasattr("tolist").unwrap_or(false) { "; an array's .tolist() is a list" } else { "" }
             ))
         })?)
     })
@@ -215,7 +226,7 @@ enum Said {
 
 /// Run `work` on `pool` in another thread while this (the Python) thread waits with the GIL
 /// released, calls `progress` with the runs done, and watches for Ctrl-C: an interrupt sets
-/// `stop` (the work ends after its current batch) and is raised once the work has stopped.
+/// `stop` (the work looks at it between runs) and is raised once the work has stopped.
 fn run_watched<T: Send>(
     py: Python<'_>,
     pool: &rayon::ThreadPool,
@@ -382,9 +393,10 @@ fn sweep<'py>(
                 Some(agg) if on_device => engine
                     .summarise(plan, 0..runs, agg, tell)
                     .map_err(Stopped::Gpu),
-                _ => engine.sweep(
+                _ => engine.sweep_until(
                     plan,
                     0..runs,
+                    stop,
                     |c: Chunk<'_>| -> Result<(), Stopped> {
                         if stop.load(Ordering::Relaxed) {
                             return Err(Stopped::Interrupted);
@@ -403,6 +415,11 @@ fn sweep<'py>(
                     },
                     tell,
                 ),
+            };
+            // A stopped CPU sweep ends early without an error: its table is not whole.
+            let report = match report {
+                Ok(_) if stop.load(Ordering::Relaxed) => Err(Stopped::Interrupted),
+                r => r,
             };
             ((report, cols, above, past), describe)
         },
@@ -550,8 +567,8 @@ fn gap(
         .map(|w| format!("{}: {w}", path.display()))
         .collect();
     let plan = &plan;
-    let csv = run_watched(py, &pool, None, move |_, _| {
-        GapStudy::run(plan).map(|s| s.csv())
+    let csv = run_watched(py, &pool, None, move |stop, _| {
+        GapStudy::run_until(plan, stop).map(|s| s.csv())
     })?
     .map_err(|e| PoundingError::new_err(format!("{}: {e}", path.display())))?;
     let text = String::from_utf8(csv).map_err(|e| PoundingError::new_err(e.to_string()))?;
@@ -801,5 +818,12 @@ fn _pounding(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fragility, m)?)?;
     m.add_function(wrap_pyfunction!(ida, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // The bounds the Python layer names when a keyword is past them (the engine checks too).
+    let limits = PyDict::new(py);
+    limits.set_item("threads", pounding::plan::limits::MAX_THREADS)?;
+    limits.set_item("cpu_chunk", pounding::plan::limits::MAX_CPU_CHUNK)?;
+    limits.set_item("gpu_chunk", pounding::plan::limits::MAX_GPU_CHUNK)?;
+    limits.set_item("bootstrap", pounding::studies::fragility::MAX_BOOTSTRAP)?;
+    m.add("LIMITS", limits)?;
     Ok(())
 }

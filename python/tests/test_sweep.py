@@ -142,7 +142,7 @@ def test_bad_input_raises_the_command_lines_messages(tmp_path):
         pounding.sweep(CONFIGS / "quickstart.toml", target_error=-1, progress=False)
     with pytest.raises(pounding.ConfigError, match="config dict"):
         pounding.sweep({"run": {"substeps_per_contact": object()}}, progress=False)
-    with pytest.raises(TypeError):
+    with pytest.raises(pounding.ConfigError, match="^config: a int is not a config"):
         pounding.sweep(42)
 
 

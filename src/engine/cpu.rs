@@ -12,7 +12,15 @@ use crate::physics::solver::{
 use crate::plan::row::{RowPlan, RowRunSpec};
 use crate::plan::{PairPlan, RunSpec};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
+
+/// A stop flag never raised: for the callers that run to the end.
+pub(crate) static NEVER: AtomicBool = AtomicBool::new(false);
+
+fn stopped(stop: &AtomicBool) -> bool {
+    stop.load(Ordering::Relaxed)
+}
 
 /// Run one plan entry.
 pub fn run_one(plan: &PairPlan, spec: &RunSpec, scheme: &Scheme) -> RunOutput {
@@ -55,6 +63,17 @@ pub(crate) fn free_motion_stretches<S: std::borrow::Borrow<RunSpec>>(
 /// Run `specs` in order; the fast scheme shares one free response ([`FreeResponse`]) among each
 /// stretch of at least [`MIN_SHARED_RUNS`] consecutive runs with the same free motion.
 pub fn run_many(plan: &PairPlan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunOutput> {
+    run_many_until(plan, specs, scheme, &NEVER)
+}
+
+/// [`run_many`], ending early (the outputs of the runs before) once `stop` is raised: it is
+/// looked at before each run, so a stop waits for one run per thread, not a chunk.
+fn run_many_until(
+    plan: &PairPlan,
+    specs: &[RunSpec],
+    scheme: &Scheme,
+    stop: &AtomicBool,
+) -> Vec<RunOutput> {
     let mut out = Vec::with_capacity(specs.len());
     for ks in free_motion_stretches(specs) {
         let group = &specs[ks];
@@ -63,11 +82,19 @@ pub fn run_many(plan: &PairPlan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunO
             let forcing = plan.forcing(first);
             let pair = first.pair();
             let shared = FreeResponse::new(&pair.b1, &pair.b2, &forcing);
-            out.extend(group.iter().map(|s| {
+            out.extend(group.iter().take_while(|_| !stopped(stop)).map(|s| {
                 simulate_shared(&s.pair(), &forcing, &Initial::default(), scheme, &shared)
             }));
         } else {
-            out.extend(group.iter().map(|s| run_one(plan, s, scheme)));
+            out.extend(
+                group
+                    .iter()
+                    .take_while(|_| !stopped(stop))
+                    .map(|s| run_one(plan, s, scheme)),
+            );
+        }
+        if stopped(stop) {
+            break;
         }
     }
     out
@@ -79,15 +106,29 @@ pub fn run_many(plan: &PairPlan, specs: &[RunSpec], scheme: &Scheme) -> Vec<RunO
 /// near the plan's collapse limit ([`near_collapse`]) is run again on the row's kernel, which
 /// models collapse.
 pub fn run_row_pairs(plan: &RowPlan, specs: &[RowRunSpec], o: &FastOptions) -> Vec<RowOutput> {
+    run_row_pairs_until(plan, specs, o, &NEVER)
+}
+
+/// [`run_row_pairs`], ending early once `stop` is raised (looked at before each run).
+fn run_row_pairs_until(
+    plan: &RowPlan,
+    specs: &[RowRunSpec],
+    o: &FastOptions,
+    stop: &AtomicBool,
+) -> Vec<RowOutput> {
     let pairs: Vec<RunSpec> = specs.iter().map(|s| plan.pair_run(s)).collect();
     let mut out = Vec::with_capacity(specs.len());
     for ks in free_motion_stretches(&pairs) {
+        if stopped(stop) {
+            break;
+        }
         let group = &pairs[ks.clone()];
         let forcing = plan.forcing(&specs[ks.start]);
         let pair = group[0].pair();
         let shared = (group.len() >= MIN_SHARED_RUNS)
             .then(|| FreeResponse::with_accel(&pair.b1, &pair.b2, &forcing));
-        out.extend(group.iter().zip(&specs[ks]).map(|(s, spec)| {
+        let todo = group.iter().zip(&specs[ks]).take_while(|_| !stopped(stop));
+        out.extend(todo.map(|(s, spec)| {
             let run = simulate_tracking_accel(&s.pair(), &forcing, o, shared.as_ref(), None);
             row_of_pair(plan, spec, &run, o)
         }));
@@ -122,12 +163,25 @@ pub fn run_range<E>(
     sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
     progress: impl FnMut(u64),
 ) -> Result<Summary, E> {
+    run_range_until(plan, runs, scheme, chunk, &NEVER, sink, progress)
+}
+
+/// [`run_range`] until `stop` is raised (see [`in_batches`]).
+pub fn run_range_until<E>(
+    plan: &PairPlan,
+    runs: std::ops::Range<u64>,
+    scheme: &Scheme,
+    chunk: usize,
+    stop: &AtomicBool,
+    sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<Summary, E> {
     let solve = |ids: std::ops::Range<u64>| {
         let specs: Vec<RunSpec> = ids.map(|i| plan.run(i)).collect();
-        let outs = run_many(plan, &specs, scheme);
+        let outs = run_many_until(plan, &specs, scheme, stop);
         specs.into_iter().zip(outs).collect()
     };
-    in_batches(runs, chunk, solve, Summary::count, sink, progress)
+    in_batches(runs, chunk, stop, solve, Summary::count, sink, progress)
 }
 
 /// Run the runs `runs` of the row plan `plan`, `chunk` runs per task, on the current rayon pool;
@@ -140,6 +194,18 @@ pub fn run_rows<E>(
     sink: impl FnMut(&[(RowRunSpec, RowOutput)]) -> Result<(), E>,
     progress: impl FnMut(u64),
 ) -> Result<Summary, E> {
+    run_rows_until(plan, runs, chunk, &NEVER, sink, progress)
+}
+
+/// [`run_rows`] until `stop` is raised (see [`in_batches`]).
+pub fn run_rows_until<E>(
+    plan: &RowPlan,
+    runs: std::ops::Range<u64>,
+    chunk: usize,
+    stop: &AtomicBool,
+    sink: impl FnMut(&[(RowRunSpec, RowOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<Summary, E> {
     let scheme = plan.scheme();
     let as_pair = match scheme {
         RowScheme::Fast(o) if plan.runs_as_pair() => Some(o),
@@ -148,26 +214,32 @@ pub fn run_rows<E>(
     let solve = |ids: std::ops::Range<u64>| {
         if let Some(o) = &as_pair {
             let specs: Vec<RowRunSpec> = ids.map(|i| plan.run(i)).collect();
-            let outs = run_row_pairs(plan, &specs, o);
+            let outs = run_row_pairs_until(plan, &specs, o, stop);
             return specs.into_iter().zip(outs).collect();
         }
-        ids.map(|i| {
-            let spec = plan.run(i);
-            let model = RowModel::new(&plan.row(&spec));
-            let out = simulate_row(&model, &plan.forcing(&spec), model.at_rest(), &scheme);
-            (spec, out)
-        })
-        .collect()
+        ids.take_while(|_| !stopped(stop))
+            .map(|i| {
+                let spec = plan.run(i);
+                let model = RowModel::new(&plan.row(&spec));
+                let out = simulate_row(&model, &plan.forcing(&spec), model.at_rest(), &scheme);
+                (spec, out)
+            })
+            .collect()
     };
-    in_batches(runs, chunk, solve, Summary::count_row, sink, progress)
+    in_batches(runs, chunk, stop, solve, Summary::count_row, sink, progress)
 }
 
 /// The runs `runs` in chunks of `chunk`, `solve`d in parallel a batch of chunks at a time (a few
 /// per thread, so uneven runs balance); `sink` gets each chunk in run order, `count` adds each
 /// output to the summary, `progress` gets the runs done after each batch.
+///
+/// Once `stop` is raised the sweep ends within a run per thread (`solve` looks at it before
+/// each run): the batch in flight is dropped whole, so the sink has had whole chunks in run
+/// order, and the summary counts those; the caller, who raised the flag, knows it stopped.
 fn in_batches<S: Send, O: Send, E>(
     runs: std::ops::Range<u64>,
     chunk: usize,
+    stop: &AtomicBool,
     solve: impl Fn(std::ops::Range<u64>) -> Vec<(S, O)> + Sync,
     count: impl Fn(&mut Summary, &O),
     mut sink: impl FnMut(&[(S, O)]) -> Result<(), E>,
@@ -180,12 +252,15 @@ fn in_batches<S: Send, O: Send, E>(
     let batch = (rayon::current_num_threads() as u64 * 4).max(1);
     let mut s = Summary::default();
     let mut c0 = 0;
-    while c0 < nchunks {
+    while c0 < nchunks && !stopped(stop) {
         let c1 = (c0 + batch).min(nchunks);
         let results: Vec<Vec<(S, O)>> = (c0..c1)
             .into_par_iter()
             .map(|c| solve(first + c * chunk..(first + (c + 1) * chunk).min(n)))
             .collect();
+        if stopped(stop) {
+            break;
+        }
         for r in &results {
             for (_, o) in r {
                 count(&mut s, o);

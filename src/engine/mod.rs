@@ -21,6 +21,7 @@ use crate::plan::{PairPlan, Plan, RunSpec};
 use aggregate::Aggregator;
 use gpu::{GpuContext, GpuError, GpuOptions, GpuTimes, Precision};
 use std::ops::Range;
+use std::sync::atomic::AtomicBool;
 
 /// Runs per parallel task on the CPU: small enough to balance uneven runs over the threads.
 pub const CPU_CHUNK: usize = 64;
@@ -438,12 +439,28 @@ impl<'c> Engine<'c> {
         &self,
         plan: &Plan,
         runs: Range<u64>,
+        sink: impl FnMut(Chunk<'_>) -> Result<(), E>,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, E> {
+        self.sweep_until(plan, runs, &cpu::NEVER, sink, progress)
+    }
+
+    /// [`Engine::sweep`] until `stop` is raised: on the CPU the sweep then ends within a run
+    /// per thread, the batch in flight dropped (the sink has had whole chunks, in run order);
+    /// the GPU finishes its chunk in flight (the sink may look at `stop` between chunks). The
+    /// caller, who raises the flag, knows the sweep stopped.
+    pub fn sweep_until<E: From<GpuError>>(
+        &self,
+        plan: &Plan,
+        runs: Range<u64>,
+        stop: &AtomicBool,
         mut sink: impl FnMut(Chunk<'_>) -> Result<(), E>,
         progress: impl FnMut(u64),
     ) -> Result<Report, E> {
         let row = match plan {
             Plan::Pair(p) => {
-                return self.run(p, runs, |rows: &[_]| sink(Chunk::Pairs(p, rows)), progress)
+                let sink = |rows: &[_]| sink(Chunk::Pairs(p, rows));
+                return self.run_until(p, runs, stop, sink, progress);
             }
             Plan::Row(r) => r,
         };
@@ -451,7 +468,7 @@ impl<'c> Engine<'c> {
         let (summary, gpu) = match self {
             Engine::Cpu { scheme, chunk } => {
                 debug_assert_eq!(*scheme, plan.scheme(), "the engine runs the plan's scheme");
-                let summary = cpu::run_rows(row, runs, *chunk, sink, progress)?;
+                let summary = cpu::run_rows_until(row, runs, *chunk, stop, sink, progress)?;
                 (summary, GpuTimes::default())
             }
             Engine::Gpu { ctx, opts, chunk } if Kernel::of(plan) == Kernel::Pair => {
@@ -498,9 +515,21 @@ impl<'c> Engine<'c> {
         sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
         progress: impl FnMut(u64),
     ) -> Result<Report, E> {
+        self.run_until(plan, runs, &cpu::NEVER, sink, progress)
+    }
+
+    /// [`Engine::run`] until `stop` is raised (as [`Engine::sweep_until`]).
+    pub fn run_until<E: From<GpuError>>(
+        &self,
+        plan: &PairPlan,
+        runs: Range<u64>,
+        stop: &AtomicBool,
+        sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, E> {
         match self {
             Engine::Cpu { scheme, chunk } => Ok(Report {
-                summary: cpu::run_range(plan, runs, scheme, *chunk, sink, progress)?,
+                summary: cpu::run_range_until(plan, runs, scheme, *chunk, stop, sink, progress)?,
                 gpu: GpuTimes::default(),
             }),
             Engine::Gpu { ctx, opts, chunk } => {

@@ -379,6 +379,9 @@ pub struct GapStudy<'a> {
     level_pairs: Vec<usize>,
 }
 
+/// Why a study stopped by its flag ([`GapStudy::run_until`]) gave no result.
+pub const STOPPED: &str = "the gap study was stopped";
+
 impl<'a> GapStudy<'a> {
     /// Why `plan` has no separation gap to give, if it has none: one building alone, or a pair
     /// of neighbours whose floors never meet.
@@ -400,6 +403,16 @@ impl<'a> GapStudy<'a> {
     /// Compute every response (in parallel on the current rayon pool). Err: the first run
     /// whose response could not be computed, and why (only where storeys yield).
     pub fn run(plan: &'a Plan) -> Result<GapStudy<'a>, String> {
+        Self::run_until(plan, &std::sync::atomic::AtomicBool::new(false))
+    }
+
+    /// [`GapStudy::run`] until `stop` is raised: each response and each run looks at it first,
+    /// so a stop waits for one response per thread; a stopped study is an error.
+    pub fn run_until(
+        plan: &'a Plan,
+        stop: &std::sync::atomic::AtomicBool,
+    ) -> Result<GapStudy<'a>, String> {
+        let stopped = || stop.load(std::sync::atomic::Ordering::Relaxed);
         let scenes = Scenes(plan);
         let motions = scenes.motions();
         let per_run = plan.yields();
@@ -413,6 +426,9 @@ impl<'a> GapStudy<'a> {
         let (responses, outcomes): (Vec<Separation>, Vec<Option<Outcome>>) = (0..count)
             .into_par_iter()
             .map(|u| {
+                if stopped() {
+                    return (Separation::default(), None);
+                }
                 // Elastic: the response's first intensity, at unit scale.
                 let (m, record) = if per_run {
                     (u, motions.record_and_intensity(u).0)
@@ -422,6 +438,9 @@ impl<'a> GapStudy<'a> {
                 scenes.response(m, record)
             })
             .unzip();
+        if stopped() {
+            return Err(STOPPED.into());
+        }
         let outcomes: Vec<Outcome> = outcomes.into_iter().flatten().collect();
         // A failed run has no levels: the names are any other's (every run has the same).
         let first = responses.iter().find(|s| !s.levels.is_empty());
@@ -452,6 +471,9 @@ impl<'a> GapStudy<'a> {
         study.pair_gaps = (0..study.len())
             .into_par_iter()
             .map(|m| {
+                if stopped() {
+                    return Vec::new();
+                }
                 let outcome = study.outcome(m);
                 if outcome.is_some_and(|o| matches!(o.end, RunEnd::Failed(_))) {
                     return vec![None; study.pairs()];
@@ -462,6 +484,9 @@ impl<'a> GapStudy<'a> {
                 study.pairs_of(&study.scaled(m, scale), &periods, censors)
             })
             .collect();
+        if stopped() {
+            return Err(STOPPED.into());
+        }
         Ok(study)
     }
 
