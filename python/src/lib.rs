@@ -282,6 +282,38 @@ fn run_watched<T: Send>(
     out.map_err(|_| PoundingError::new_err("the engine's thread panicked"))
 }
 
+/// Run `work`, which takes no stop flag (a trace's one run, a study of a table), in a thread of
+/// its own while this (the Python) thread waits with the GIL released and watches for Ctrl-C:
+/// an interrupt is raised at once, and the work, which writes nothing, ends unseen in the
+/// background and its result is dropped.
+fn run_detached<T: Send + 'static>(
+    py: Python<'_>,
+    work: impl FnOnce() -> T + Send + 'static,
+) -> PyResult<T> {
+    let (tx, rx) = std::sync::mpsc::channel::<T>();
+    let rx = std::sync::Mutex::new(rx);
+    std::thread::Builder::new()
+        .name("pounding-study".into())
+        .spawn(move || {
+            let _ = tx.send(work());
+        })
+        .map_err(|e| PoundingError::new_err(format!("starting a worker thread: {e}")))?;
+    loop {
+        let got = py.detach(|| {
+            rx.lock()
+                .expect("one receiver")
+                .recv_timeout(Duration::from_millis(50))
+        });
+        match got {
+            Ok(out) => return Ok(out),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => py.check_signals()?,
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                return Err(PoundingError::new_err("the engine's thread panicked"))
+            }
+        }
+    }
+}
+
 /// Why a sweep stopped early.
 enum Stopped {
     Gpu(pounding::engine::gpu::GpuError),
@@ -531,9 +563,10 @@ fn trace(
 ) -> PyResult<(Table, Table)> {
     let (text, path) = config_text(config, config_kind)?;
     let plan = config::load_text(&text, &path).map_err(config_err)?;
-    let t = py
-        .detach(|| pounding::studies::trace::trace(&plan, run))
-        .map_err(|e| SettingsError::new_err(format!("{}: {e}", path.display())))?;
+    let t = run_detached(py, move || {
+        pounding::studies::trace::trace(&plan, run).map_err(|e| e.to_string())
+    })?
+    .map_err(|e| SettingsError::new_err(format!("{}: {e}", path.display())))?;
     let history = py
         .detach(|| study_table(&t.csv(), &[]))
         .map_err(PoundingError::new_err)?;
@@ -707,17 +740,18 @@ type Studied = (Table, String, Vec<String>);
 
 /// A study of a table of results, as its command runs it: its settings `check`ed before the
 /// table is read, then the `study` (the GIL released), its refusals `refused` as exceptions.
-fn run_study<E: Send>(
+fn run_study<E: Send + 'static>(
     py: Python<'_>,
     table: &Bound<'_, PyAny>,
     table_kind: &str,
     check: impl FnOnce() -> Result<(), E>,
-    study: impl FnOnce(&pounding::io::table::Table) -> Result<StudyReport, E> + Send,
+    study: impl FnOnce(&pounding::io::table::Table) -> Result<StudyReport, E> + Send + 'static,
     refused: impl Fn(E) -> PyErr,
 ) -> PyResult<Studied> {
     check().map_err(&refused)?;
     let rows = study_input(table, table_kind)?;
-    let r = py.detach(|| study(&rows)).map_err(&refused)?;
+    // A bootstrap of many replicates takes seconds: Ctrl-C is answered at once.
+    let r = run_detached(py, move || study(&rows))?.map_err(&refused)?;
     let t = py
         .detach(|| study_table(&r.csv, &[]))
         .map_err(PoundingError::new_err)?;
@@ -756,12 +790,13 @@ fn fragility(
         FragilityError::Table(e) => TableError::new_err(e.to_string()),
         e => SettingsError::new_err(e.to_string()),
     };
+    let checked = options.check();
     run_study(
         py,
         table,
         table_kind,
-        || options.check(),
-        |rows| study(rows, &options),
+        || checked,
+        move |rows| study(rows, &options),
         refused,
     )
 }
@@ -789,12 +824,13 @@ fn ida(
         IdaError::Refused(m) => SettingsError::new_err(m),
         e => TableError::new_err(e.to_string()),
     };
+    let checked = options.check();
     run_study(
         py,
         table,
         table_kind,
-        || options.check(),
-        |rows| study(rows, &options),
+        || checked,
+        move |rows| study(rows, &options),
         refused,
     )
 }
