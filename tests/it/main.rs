@@ -39,4 +39,5 @@ mod shared;
 mod start;
 mod studies;
 pub mod support;
+mod table_columns;
 mod trace;
