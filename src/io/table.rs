@@ -23,6 +23,13 @@ pub enum TableError {
     },
     #[error("--where `{text}`: {message}")]
     Filter { text: String, message: String },
+    #[error("{}: the column `{column}` appears {count} times (columns {positions}): a study reads a column by its name, and which of them is meant cannot be told; rename or drop all but one", path.display())]
+    DuplicateColumn {
+        path: PathBuf,
+        column: String,
+        count: usize,
+        positions: String,
+    },
 }
 
 /// A CSV with a header row, held in memory as text.
@@ -65,23 +72,59 @@ impl Table {
                     .map_err(|e| fail(e.to_string()))
             })
             .collect::<Result<_, _>>()?;
-        Ok(Table {
+        let table = Table {
             path: path.into(),
             header,
             rows,
-        })
+        };
+        table.check_columns()?;
+        Ok(table)
     }
 
-    /// Index of the column `name`.
+    /// Refuse a header that names a column twice: a study reads a column by its name, and the
+    /// first of two would be read silently (a column of zeros put first would stand for the
+    /// other). [`Table::read`] checks it; a table built otherwise (the Python package's, from an
+    /// Arrow table, whose names need not differ) is checked by the studies.
+    pub fn check_columns(&self) -> Result<(), TableError> {
+        match duplicate_column(&self.header) {
+            Some((column, at)) => Err(TableError::DuplicateColumn {
+                path: self.path.clone(),
+                column,
+                count: at.len(),
+                // Columns numbered from 1, as a person counts them in the header.
+                positions: at
+                    .iter()
+                    .map(|i| (i + 1).to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// Index of the column `name`; refused where the header names it twice.
     pub fn col(&self, name: &str) -> Result<usize, TableError> {
-        self.header
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| TableError::NoColumn {
+        let at: Vec<usize> = (0..self.header.len())
+            .filter(|&i| self.header[i] == name)
+            .collect();
+        match at[..] {
+            [i] => Ok(i),
+            [] => Err(TableError::NoColumn {
                 path: self.path.clone(),
                 column: name.into(),
                 available: self.header.join(", "),
-            })
+            }),
+            _ => Err(TableError::DuplicateColumn {
+                path: self.path.clone(),
+                column: name.into(),
+                count: at.len(),
+                positions: at
+                    .iter()
+                    .map(|i| (i + 1).to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }),
+        }
     }
 
     /// The number in row `i` (0-based, after the header), column `c`; None for an empty cell.
@@ -113,6 +156,17 @@ impl Table {
             })
             .collect())
     }
+}
+
+/// The first name that `header` holds more than once, and where it stands (0-based); None
+/// where every name differs.
+pub fn duplicate_column<S: AsRef<str>>(header: &[S]) -> Option<(String, Vec<usize>)> {
+    let mut seen: std::collections::HashSet<&str> = std::collections::HashSet::new();
+    let first = header.iter().map(AsRef::as_ref).find(|h| !seen.insert(h))?;
+    let at = (0..header.len())
+        .filter(|&i| header[i].as_ref() == first)
+        .collect();
+    Some((first.to_string(), at))
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -42,15 +42,33 @@ pub struct Fit {
     pub deviance: f64,
     pub dof: usize,
     /// `P(chi^2_dof > deviance)`: small (say below 0.05) where the shares do not follow a
-    /// lognormal curve; None with two levels (no degree of freedom left).
+    /// lognormal curve; None with two levels (no degree of freedom left), and where
+    /// [`Fit::no_power`].
     pub p_fit: Option<f64>,
+    /// Every level's share is 0 or 1 (`0/n` or `n/n`): the saturated model is certain at every
+    /// level, the deviance is the fit's own shortfall from certainty and no chi-square law
+    /// describes it (a p near 1 would say the curve fits where the test cannot tell): no p.
+    pub no_power: bool,
 }
 
 impl Fit {
     pub fn probability(&self, im: f64) -> f64 {
         phi((im / self.median).ln() / self.beta)
     }
+
+    /// The goodness of fit's p as a table prints it: `-` with no degree of freedom, and where
+    /// every level is `0/n` or `n/n` the words that say the test has no power there.
+    pub fn p_text(&self) -> String {
+        match self.p_fit {
+            Some(p) => format!("{p:.3}"),
+            None if self.no_power => NO_POWER.to_string(),
+            None => "-".to_string(),
+        }
+    }
 }
+
+/// [`Fit::p_text`] of a fit whose levels are all `0/n` or `n/n` ([`Fit::no_power`]).
+pub const NO_POWER: &str = "n/a: every level is 0/n or n/n, the test has no power";
 
 /// Why no curve could be fitted.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -213,6 +231,7 @@ pub fn fit(levels: &[Level]) -> Result<Fit, NoFit> {
         .sum();
     let deviance = (2.0 * (saturated - log_likelihood)).max(0.0);
     let dof = lv.len() - 2;
+    let no_power = lv.iter().all(|l| l.exceed == 0 || l.exceed == l.n);
     Ok(Fit {
         median: (-a / b).exp(),
         beta: 1.0 / b,
@@ -221,7 +240,8 @@ pub fn fit(levels: &[Level]) -> Result<Fit, NoFit> {
         log_likelihood,
         deviance,
         dof,
-        p_fit: (dof > 0).then(|| chi_square_sf(deviance, dof as f64)),
+        p_fit: (dof > 0 && !no_power).then(|| chi_square_sf(deviance, dof as f64)),
+        no_power,
     })
 }
 
@@ -449,13 +469,30 @@ impl FragilitySpec {
     }
 }
 
+/// Whether `table` shows that its sweep had a collapse limit: a collapse column
+/// ([`crate::plan::row::COLLAPSE_OUTPUTS`], a building's `bK_collapsed`), or a row whose status
+/// is `collapsed` (a table written with `--columns` that left the collapse columns out still
+/// says so in its status). False says only that the table does not tell.
+pub fn shows_collapse_limit(table: &Table) -> bool {
+    let column = |c: &String| {
+        crate::plan::row::COLLAPSE_OUTPUTS.contains(&c.as_str()) || collapse_building(c).is_some()
+    };
+    table.header.iter().any(column)
+        || table
+            .col("status")
+            .is_ok_and(|c| table.rows.iter().any(|r| r[c] == "collapsed"))
+}
+
 /// Whether `table` can give the collapse fragility of `edp` ([`is_collapse_edp`]), or why not
 /// (named). The run's (`collapsed`) needs a status column (whose `collapsed` runs it counts) and
-/// some collapse column that a sweep with a collapse limit writes
-/// ([`crate::plan::row::COLLAPSE_OUTPUTS`], or a building's `bK_collapsed`: without any its runs
-/// could not collapse, and a curve of none would be no result); building K's needs its
-/// `bK_collapsed`. Both need rows.
+/// a sign that the sweep had a collapse limit: a run whose status is `collapsed`, or some
+/// collapse column such a sweep writes ([`crate::plan::row::COLLAPSE_OUTPUTS`], or a building's
+/// `bK_collapsed`); with neither, the table cannot tell a sweep whose runs could not collapse (a
+/// curve of none would be no result) from one written with `--columns` that left them out, and
+/// says both. Building K's needs its `bK_collapsed`: a missing one is named as missing, never
+/// read as runs that did not collapse. Both need rows.
 pub fn check_collapse_table(table: &Table, edp: &str) -> Result<(), TableError> {
+    table.check_columns()?;
     let refuse = |message: String| {
         Err(TableError::Read {
             path: table.path.clone(),
@@ -471,6 +508,11 @@ pub fn check_collapse_table(table: &Table, edp: &str) -> Result<(), TableError> 
         .filter(|c| collapse_building(c).is_some())
         .collect();
     let limit = "a sweep writes them where its runs can collapse: rows of buildings with storey heights under a collapse limit, [run] collapse_drift_ratio, default 0.10";
+    // Rows whose status says they collapsed show a collapse limit whatever columns are missing:
+    // the columns were left out (--columns), not the collapses.
+    let status_collapsed = table.col("status").map_or(0, |c| {
+        table.rows.iter().filter(|r| r[c] == "collapsed").count()
+    });
     let none = |missing: &[String]| {
         format!("this table has no collapse columns ({} missing; {limit}): either its sweep had no collapse limit (a pair, or a row with collapse_drift_ratio = \"none\"), so a collapse fragility of it would be no result, or it was written with --columns that left them out (give them to --columns)", missing.join(", "))
     };
@@ -481,8 +523,10 @@ pub fn check_collapse_table(table: &Table, edp: &str) -> Result<(), TableError> 
                     "--edp {COLLAPSED} counts the runs whose status is `collapsed`, and this table has no status column (the runs of a `pound sweep` table have one; a table of --aggregate or of a study has none)"
                 ));
             }
-            // Any collapse column shows a collapse limit: the status is what is counted.
-            if buildings.is_empty() && !run_columns.iter().any(|c| has(c)) {
+            // Any collapse column, or a run whose status is `collapsed`, shows a collapse limit:
+            // the status is what is counted.
+            if status_collapsed == 0 && buildings.is_empty() && !run_columns.iter().any(|c| has(c))
+            {
                 let mut missing: Vec<String> = run_columns.iter().map(|c| c.to_string()).collect();
                 missing.push("bK_collapsed".into());
                 return refuse(format!("--edp {COLLAPSED}: {}", none(&missing)));
@@ -494,6 +538,8 @@ pub fn check_collapse_table(table: &Table, edp: &str) -> Result<(), TableError> 
                 format!("this table has no column {edp} (it has {}): no building {k} in its rows, or it was written with --columns that left {edp} out (give it to --columns)", buildings.join(", "))
             } else if !present.is_empty() {
                 format!("this table has the run's collapse columns ({}) but no building's (bK_collapsed): an output from before each building's collapse was written, or of --columns that left them out (give {edp} to --columns); --edp {COLLAPSED} gives the run's collapse fragility (any building)", present.join(", "))
+            } else if status_collapsed > 0 {
+                format!("{status_collapsed} rows have status `collapsed`, but this table has no column {edp} (nor any collapse column): it was written with --columns that left them out, and the status does not say which building collapsed; rerun the sweep with {edp} in --columns, or --edp {COLLAPSED} gives the run's collapse fragility (any building) from the status")
             } else {
                 let mut missing = vec![edp.to_string()];
                 missing.extend(run_columns.iter().map(|c| c.to_string()));
@@ -747,6 +793,7 @@ impl Grouped {
         spec: &FragilitySpec,
         group: Option<&str>,
     ) -> Result<(Grouped, LeftOut), TableError> {
+        table.check_columns()?;
         if let Some(t) = spec.thresholds.iter().find(|t| !t.is_finite()) {
             return Err(TableError::Read {
                 path: table.path.clone(),
@@ -887,9 +934,20 @@ pub struct Band {
     /// At each of `ims`: the 5 and 95 % percentiles of the fitted probability.
     pub ims: Vec<f64>,
     pub curve: Vec<[f64; 2]>,
-    /// Replicates fitted, and those where no curve could be (left out of the band).
+    /// Replicates fitted, and those where no curve could be (left out of the band, which is
+    /// then conditional on a fit: [`Band::conditional`]).
     pub fitted: usize,
     pub unfitted: usize,
+    /// Of `unfitted`, how many for each reason, in the order first met.
+    pub why_unfitted: Vec<(NoFit, usize)>,
+}
+
+impl Band {
+    /// Whether replicates were left out: the band is then the percentiles of the replicates
+    /// fitted, conditional on a fit, and not of the bootstrap distribution.
+    pub fn conditional(&self) -> bool {
+        self.unfitted > 0
+    }
 }
 
 /// Per threshold, `replicates` bootstrap fits of `grouped` (groups drawn with replacement,
@@ -905,6 +963,7 @@ pub fn bootstrap(
     let mut rng = crate::plan::sample::Rng::new(seed);
     let mut fits: Vec<Vec<Fit>> = vec![Vec::new(); thresholds];
     let mut unfitted = vec![0usize; thresholds];
+    let mut why: Vec<Vec<(NoFit, usize)>> = vec![Vec::new(); thresholds];
     for _ in 0..replicates {
         let mut weights = vec![0u32; ng];
         for _ in 0..ng {
@@ -913,7 +972,13 @@ pub fn bootstrap(
         for (t, lv) in grouped.pooled(&weights).iter().enumerate() {
             match fit(lv) {
                 Ok(f) => fits[t].push(f),
-                Err(_) => unfitted[t] += 1,
+                Err(e) => {
+                    unfitted[t] += 1;
+                    match why[t].iter_mut().find(|(w, _)| *w == e) {
+                        Some((_, n)) => *n += 1,
+                        None => why[t].push((e, 1)),
+                    }
+                }
             }
         }
     }
@@ -923,7 +988,8 @@ pub fn bootstrap(
     };
     fits.into_iter()
         .zip(unfitted)
-        .map(|(f, unfitted)| {
+        .zip(why)
+        .map(|((f, unfitted), why_unfitted)| {
             (!f.is_empty()).then(|| Band {
                 median: band(f.iter().map(|x| x.median).collect()),
                 beta: band(f.iter().map(|x| x.beta).collect()),
@@ -934,6 +1000,7 @@ pub fn bootstrap(
                     .collect(),
                 fitted: f.len(),
                 unfitted,
+                why_unfitted,
             })
         })
         .collect()
@@ -1012,9 +1079,13 @@ pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -
             String::new()
         }
     };
-    let mut s = String::new();
+    let mut s = csv_header(spec, states.is_some())
+        .iter()
+        .map(|h| quote(h))
+        .collect::<Vec<_>>()
+        .join(",");
+    s.push('\n');
     if spec.is_collapse() {
-        s.push_str(&format!("{},runs,collapsed,fraction\n", quote(&spec.im)));
         for l in grouped.pooled(&[1]).first().into_iter().flatten() {
             s.push_str(&format!(
                 "{},{},{},{}\n",
@@ -1026,13 +1097,6 @@ pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -
         }
         return s;
     }
-    if states.is_some() {
-        s.push_str("state,");
-    }
-    s.push_str(&format!(
-        "threshold,{},runs,exceed,collapsed,fraction,undecided,fraction_if_none_exceed,fraction_if_all_exceed\n",
-        quote(&spec.im)
-    ));
     for (t, &limit) in spec.thresholds.iter().enumerate() {
         let undecided = grouped.undecided_at(t);
         for (l, &im) in grouped.ims.iter().enumerate() {
@@ -1059,6 +1123,35 @@ pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -
         }
     }
     s
+}
+
+/// The names of [`csv`]'s columns (`states`: with damage states' names).
+pub fn csv_header(spec: &FragilitySpec, states: bool) -> Vec<String> {
+    let im = spec.im.clone();
+    fn rest<'a>(names: &'a [&'a str]) -> impl Iterator<Item = String> + 'a {
+        names.iter().map(|n| n.to_string())
+    }
+    if spec.is_collapse() {
+        return std::iter::once(im)
+            .chain(rest(&["runs", "collapsed", "fraction"]))
+            .collect();
+    }
+    let mut h: Vec<String> = Vec::new();
+    if states {
+        h.push("state".into());
+    }
+    h.push("threshold".into());
+    h.push(im);
+    h.extend(rest(&[
+        "runs",
+        "exceed",
+        "collapsed",
+        "fraction",
+        "undecided",
+        "fraction_if_none_exceed",
+        "fraction_if_all_exceed",
+    ]));
+    h
 }
 
 /// A number as a person reads it: its shortest round-trip text, in exponent form where the
@@ -1363,6 +1456,8 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
         by,
         seed,
     } = o.settle()?;
+    // Before any column is looked up: a name given twice would read the first silently.
+    table.check_columns()?;
     let spec = FragilitySpec {
         im: o.im.clone().unwrap_or_else(|| default_im(table)),
         edp: o.edp.clone(),
@@ -1371,6 +1466,16 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
     };
     if collapse {
         check_collapse_table(table, &spec.edp)?;
+    }
+    // The intensity is a column of the table written, beside its own: one of theirs (`--im
+    // runs`, `--im collapsed`) would be a column named twice, the one read for the other.
+    let head = csv_header(&spec, states.is_some());
+    if let Some((column, _)) = crate::io::table::duplicate_column(&head) {
+        return Err(FragilityError::Refused(format!(
+            "--im {}: the fragility table has its own column `{column}` ({}), which the intensity's column would name twice: give another intensity column to --im",
+            spec.im,
+            head.join(", ")
+        )));
     }
     let group = (o.bootstrap > 0).then_some(by.as_str());
     let (grouped, skipped) = Grouped::read(table, &spec, group)?;
@@ -1483,15 +1588,38 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
         };
         let band = match (&bands[i], o.bootstrap > 0) {
             (Some(b), _) => {
-                if b.unfitted > 0 {
+                // A band of the replicates fitted alone says so in its cells, not only in a
+                // notice: it is conditional on a fit, and narrower than the spread it stands for.
+                let (of_median, of_beta) = if b.conditional() {
+                    let why: Vec<String> = (b.why_unfitted.iter())
+                        .map(|(e, n)| {
+                            let w = if collapse {
+                                e.short_collapse()
+                            } else {
+                                e.short()
+                            };
+                            format!("{n} {w}")
+                        })
+                        .collect();
                     unfitted.push(format!(
-                        "{label}: {} of {}",
+                        "{label}: {} of {} ({})",
                         b.unfitted,
-                        b.unfitted + b.fitted
+                        b.unfitted + b.fitted,
+                        why.join(", ")
                     ));
-                }
+                    (
+                        format!(
+                            " (conditional: {} of {} replicates fitted)",
+                            b.fitted,
+                            b.fitted + b.unfitted
+                        ),
+                        " (conditional)".to_string(),
+                    )
+                } else {
+                    (String::new(), String::new())
+                };
                 format!(
-                    " {:.4}-{:.4} | {:.4}-{:.4} |",
+                    " {:.4}-{:.4}{of_median} | {:.4}-{:.4}{of_beta} |",
                     b.median[0], b.median[1], b.beta[0], b.beta[1],
                 )
             }
@@ -1509,7 +1637,7 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
                     f.log_likelihood,
                     f.deviance,
                     f.dof,
-                    f.p_fit.map_or("-".into(), |p| format!("{p:.3}"))
+                    f.p_text()
                 ));
                 // A median outside the levels this fit counted is read off the curve's tail.
                 let (lowest, highest) = (lv[i][0].im, lv[i][lv[i].len() - 1].im);
@@ -1573,7 +1701,7 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
     }
     if !unfitted.is_empty() {
         t.note(format_args!(
-            "notice: bootstrap replicates with no fit (left out of the bands): {}",
+            "notice: the 90 % bands marked conditional are the percentiles of the bootstrap replicates that could be fitted, not of all: replicates with no fit were left out, {}. A replicate with no fit is an extreme draw of the {by} groups (a median beyond the levels run, where none or every run exceeds, or a dispersion of 0, where the counts separate), so a band of the others is narrower than the uncertainty it stands for: read it as a lower bound on that spread, or add {by} groups or levels (docs/fragility.md, \"Bootstrap bands\")",
             unfitted.join("; ")
         ));
     }
@@ -1620,7 +1748,10 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
     for b in bands.iter().flatten() {
         pl.series.extend(band_series(b));
     }
-    if bands.iter().any(|b| b.is_some()) {
+    if bands.iter().flatten().any(Band::conditional) {
+        pl.title
+            .push_str(" (grey: 90 % bands, conditional on a fit: some replicates left out)");
+    } else if bands.iter().any(|b| b.is_some()) {
         pl.title.push_str(" (grey: 90 % bands)");
     }
     Ok(StudyReport {
@@ -1816,6 +1947,7 @@ mod tests {
                 deviance: 0.0,
                 dof: 0,
                 p_fit: None,
+                no_power: false,
             })
         };
         assert!(crossings(&[curve(0.5, 0.4), curve(0.8, 0.4)], 0.05, 3.0).is_empty());

@@ -122,6 +122,7 @@ pub fn quantile(sorted: &[f64], q: f64) -> f64 {
 /// Read the curves of `table` under `spec`, and the rows left out (failed, no value, a value not
 /// finite; the collapsed runs, kept, counted in `collapsed`).
 pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
+    table.check_columns()?;
     let (ci, ce) = (table.col(&spec.im)?, table.col(&spec.edp)?);
     let by: Vec<usize> = spec
         .by
@@ -131,7 +132,10 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
     let mut skipped = LeftOut::default();
     let mut ims: BTreeMap<u64, f64> = BTreeMap::new();
     let mut names: Vec<String> = Vec::new();
-    let mut curve_of: HashMap<String, usize> = HashMap::new();
+    let mut curve_of: HashMap<Vec<&str>, usize> = HashMap::new();
+    // A curve's name is its cells joined by `/`: two curves whose cells join alike (`a/b`, `c`
+    // and `a`, `b/c`) would be one column of the table, and one curve in its counts.
+    let mut named: HashMap<String, Vec<&str>> = HashMap::new();
     // (curve, level key) -> (row, demand: infinite where the run collapsed)
     let mut points: HashMap<(usize, u64), (usize, f64)> = HashMap::new();
     // Runs kept out at a level: failed, and with no value of the demand.
@@ -150,12 +154,19 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
                 continue;
             }
         };
-        let name = by
-            .iter()
-            .map(|&c| table.rows[i][c].as_str())
-            .collect::<Vec<_>>()
-            .join("/");
-        let c = *curve_of.entry(name.clone()).or_insert_with(|| {
+        let cells: Vec<&str> = by.iter().map(|&c| table.rows[i][c].as_str()).collect();
+        let name = cells.join("/");
+        if let Some(other) = named.get(&name).filter(|o| **o != cells) {
+            return Err(IdaError::Refused(format!(
+                "{}: the curves of --by {} cells `{}` and `{}` would both be named `{name}` (a curve is named by its cells joined by `/`): name the curves by other columns with --by, or rename the records",
+                table.path.display(),
+                spec.by.join(","),
+                other.join("`, `"),
+                cells.join("`, `"),
+            )));
+        }
+        named.insert(name.clone(), cells.clone());
+        let c = *curve_of.entry(cells).or_insert_with(|| {
             names.push(name.clone());
             names.len() - 1
         });
@@ -272,6 +283,51 @@ impl Ida {
         (self.counts[l] > 0).then(|| self.collapsed[l] as f64 / self.counts[l] as f64)
     }
 
+    /// The names of [`Ida::csv`]'s columns: the intensity, `curves`, the demand's fractiles,
+    /// `collapsed`, `collapsed_fraction`, then each curve's name.
+    pub fn header(&self, spec: &IdaSpec) -> Vec<String> {
+        let mut h = vec![spec.im.clone(), "curves".to_string()];
+        h.extend(FRACTILES.map(|f| format!("{}_p{f}", spec.edp)));
+        h.extend(["collapsed", "collapsed_fraction"].map(String::from));
+        h.extend(self.curves.iter().map(|(n, _)| n.clone()));
+        h
+    }
+
+    /// Refuse a table whose columns [`Ida::header`] would name twice: a curve is a column named
+    /// by its `--by` cells (a record's label), which may spell a fixed column's name
+    /// (`collapsed`, the intensity's `pga_g`); a reader of the table would then take one for the
+    /// other (polars refuses it).
+    pub fn check_header(&self, spec: &IdaSpec) -> Result<(), IdaError> {
+        let header = self.header(spec);
+        let Some((column, at)) = crate::io::table::duplicate_column(&header) else {
+            return Ok(());
+        };
+        let fixed = header.len() - self.curves.len();
+        let what = if at[0] < fixed && at.len() > 1 && at[1] >= fixed {
+            format!(
+                "the curve `{column}` (its {} cells) is named like the table's own column `{column}` ({}), and each curve is a column named by its {}",
+                spec.by.join("/"),
+                match at[0] {
+                    0 => "the intensity",
+                    1 => "the curves at a level",
+                    i if i < 5 => "a fractile of the demand",
+                    5 => "the curves collapsed at a level",
+                    _ => "their share",
+                },
+                spec.by.join("/")
+            )
+        } else {
+            format!(
+                "`{column}` names two of its fixed columns (--im {} and --edp {})",
+                spec.im, spec.edp
+            )
+        };
+        Err(IdaError::Refused(format!(
+            "the IDA table would have two columns `{column}` (columns {}): {what}; rename the record (its `name` in the config's [[record]]) and rerun the sweep, or name the curves by other columns with --by",
+            at.iter().map(|i| (i + 1).to_string()).collect::<Vec<_>>().join(", ")
+        )))
+    }
+
     /// One row per level: the intensity, the curves there, the fractiles, the curves collapsed
     /// there and their share, each curve's demand. A collapse is an infinite demand, written
     /// `inf` (a fractile it reaches too); an empty cell is no value (no run there, or none left).
@@ -283,15 +339,8 @@ impl Ida {
                 s.to_string()
             }
         };
-        let mut s = format!("{},curves", quote(&spec.im));
-        for f in FRACTILES {
-            s.push_str(&format!(",{}_p{f}", quote(&spec.edp)));
-        }
-        s.push_str(",collapsed,collapsed_fraction");
-        for (n, _) in &self.curves {
-            s.push(',');
-            s.push_str(&quote(n));
-        }
+        let head: Vec<String> = self.header(spec).iter().map(|h| quote(h)).collect();
+        let mut s = head.join(",");
         s.push('\n');
         for (l, im) in self.ims.iter().enumerate() {
             s.push_str(&format!("{im},{}", self.counts[l]));
@@ -541,6 +590,7 @@ impl IdaOptions {
 /// flatline, runs counted as collapsed above a curve's first collapse).
 pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
     o.check()?;
+    table.check_columns()?;
     let by = if o.by.is_empty() {
         let sampled = table
             .col("sample")
@@ -571,6 +621,7 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
         return Err(IdaError::Refused(format!("--edp {}: an IDA reads a demand column (e.g. b1_peak_drift_ratio), where the building's collapse is an infinite demand; its collapse fragility {} is `pound fragility --edp {}`", spec.edp, collapse_probability(&spec.edp), spec.edp)));
     }
     let (ida, skipped) = read(table, &spec)?;
+    ida.check_header(&spec)?;
     let whose = CollapseOf::of(table, &spec.edp);
     let mut t = Telling::default();
     let collapsed_runs = skipped.collapsed;
@@ -599,9 +650,10 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
     }
     // Failed runs are left out of the fractiles. Where the table has no collapse criterion a
     // failed run may be a collapse, so the fractiles over the others are collapse-free; where it
-    // has one, they are over the runs that did not fail.
+    // has one, they are over the runs that did not fail. A table written with --columns that
+    // left out collapse_time_s still shows its criterion (a status `collapsed`, a bK_collapsed).
     let failed: usize = ida.failed.iter().sum();
-    let can_collapse = table.col("collapse_time_s").is_ok();
+    let can_collapse = crate::studies::fragility::shows_collapse_limit(table);
     let over = match (failed > 0, can_collapse) {
         (false, _) => "",
         (true, false) => " (collapse-free)",

@@ -263,6 +263,7 @@ pub fn panel_with(
     spec: &PlotSpec,
     collapsed: Collapsed,
 ) -> Result<(Panel, LeftOut), TableError> {
+    table.check_columns()?;
     let (cx, cy) = (table.col(&spec.x)?, table.col(&spec.y)?);
     let cby = spec.by.as_deref().map(|b| table.col(b)).transpose()?;
     let collapse = CollapseOf::new(table, &spec.y);

@@ -343,7 +343,8 @@ fn tables_that_do_not_say_which_building_collapsed_keep_the_runs_collapse() {
 }
 
 /// Tables that cannot give a collapse fragility name the columns they lack: one written with
-/// `--columns` that left every collapse column out, one that left out building 1's but kept
+/// `--columns` that left every collapse column out (its status naming the runs that collapsed,
+/// or none), one that left out building 1's but kept
 /// building 2's, an older one with the run's columns only; a building's column alone is
 /// enough for the run's collapse fragility (the status is what it counts).
 #[test]
@@ -365,14 +366,24 @@ fn missing_collapse_columns_are_named() {
         stderr(&o)
     };
     let bare = keep_columns(&full, &|c| !c.contains("collapse"));
-    let e = refused("bare.csv", &bare, "collapsed");
+    // Its status still says which runs collapsed: the run's collapse fragility is counted from
+    // it (issue 65), and building 1's names the column missing, not a sweep without collapses.
+    let e = refused("bare.csv", &bare, "b1_collapsed");
+    assert!(
+        e.contains("rows have status `collapsed`, but this table has no column b1_collapsed (nor any collapse column): it was written with --columns that left them out"),
+        "{e}"
+    );
+    // With no run collapsed either, nothing tells a sweep without a collapse limit from one
+    // written with --columns that left the columns out: both are named.
+    let never = bare.replace(",collapsed,", ",ok,");
+    let e = refused("never.csv", &never, "collapsed");
     assert!(
         e.contains("no collapse columns (collapse_time_s, collapse_building, collapse_storey, bK_collapsed missing")
             && e.contains("--columns that left them out")
             && !e.contains("its runs could not collapse"),
         "{e}"
     );
-    let e = refused("bare.csv", &bare, "b1_collapsed");
+    let e = refused("never.csv", &never, "b1_collapsed");
     assert!(
         e.contains("no collapse columns (b1_collapsed, collapse_time_s, collapse_building, collapse_storey missing"),
         "{e}"

@@ -41,4 +41,5 @@ mod shared;
 mod start;
 mod studies;
 pub mod support;
+mod table_columns;
 mod trace;
