@@ -177,8 +177,8 @@ impl Coupled {
         for i in 0..n {
             x[i] = m.q[i] + (l[i] * f + self.damp(v, i)) / self.w2[i];
         }
-        for i in 0..n {
-            v[i] = m.qd[i] - v[i];
+        for (v, qd) in v.iter_mut().zip(&m.qd) {
+            *v = qd - *v;
         }
         for _ in 0..6 {
             for i in 0..n {
