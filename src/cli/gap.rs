@@ -75,7 +75,12 @@ pub fn run(a: Args) -> Result<()> {
     let rate = runs as f64 / seconds.max(1e-9);
     if study.per_run() {
         say!(
-            "{runs} runs (yielding storeys: one response per run, by the row scheme; no error bound) in {seconds:.3} s on {threads} threads: {rate:.0} runs/s; {} substeps",
+            "{runs} runs ({}: one response per run, by the row scheme; no error bound) in {seconds:.3} s on {threads} threads: {rate:.0} runs/s; {} substeps",
+            if study.nears_collapse() {
+                "a run nears the collapse limit, watched as the sweep watches it"
+            } else {
+                "yielding storeys"
+            },
             study.substeps()
         );
     } else {

@@ -18,7 +18,9 @@ use crate::physics::model::{Oscillator, Status};
 use crate::physics::row::{Collapse, LevelRule};
 use crate::physics::separation::{cqc_rho, Rule};
 use crate::physics::shear::ShearBuilding;
-use crate::physics::solver::separation::{separation_with, LevelSeparation, Separation};
+use crate::physics::solver::separation::{
+    sampled_peak_drift_ratios, separation_with, LevelSeparation, Separation,
+};
 use crate::plan::columns::{at, contact_and_motion, num, RECORD_IMS};
 use crate::plan::intensity::TARGET_COLUMNS;
 use crate::plan::row::level_name;
@@ -26,6 +28,11 @@ use crate::plan::sample::phi;
 use crate::plan::{Motions, Plan};
 use crate::studies::plot::{Panel, Series};
 use rayon::prelude::*;
+
+/// The share of the collapse limit at which the sweep's row kernel starts watching a building
+/// for collapse (`physics::solver::row`'s `COLLAPSE_WATCH`, with which a row that ran on the
+/// pair's kernel is run again on the row's).
+const COLLAPSE_WATCH: f64 = 0.5;
 
 /// Runs per CSV chunk encoded in parallel.
 const CSV_CHUNK: u64 = 4096;
@@ -153,10 +160,10 @@ impl Scenes<'_> {
     }
 
     /// Motion `m`'s response: its separation at unit scale where the buildings are elastic,
-    /// else at its own scale, with how that run ended ([`uncoupled`]).
-    fn response(&self, m: u64, record: usize) -> (Separation, Option<Outcome>) {
+    /// else (`per_run`) at its own scale, with how that run ended ([`uncoupled`]).
+    fn response(&self, m: u64, record: usize, per_run: bool) -> (Separation, Option<Outcome>) {
         match self.0 {
-            Plan::Row(plan) if self.0.yields() => {
+            Plan::Row(plan) if per_run => {
                 let run = plan.motion_run(m);
                 let (sep, outcome) = uncoupled(
                     plan.row(&run).buildings,
@@ -177,6 +184,38 @@ impl Scenes<'_> {
                 (sep, None)
             }
         }
+    }
+
+    /// Would the sweep watch some run of this plan's elastic buildings for collapse (a
+    /// building's storey drift ratio reaching [`COLLAPSE_WATCH`] of the limit)? Then the
+    /// study steps every run on its own as the sweep does, collapse and all ([`uncoupled`]):
+    /// a response at unit scale knows no collapse, and a sweep's building that collapses
+    /// leaves the scene, so its pair's threshold is the closing before it. The drifts are
+    /// those at the record's samples, with the sweep's margin.
+    fn nears_collapse(&self, motions: &Motions) -> bool {
+        let Plan::Row(plan) = self.0 else {
+            return false;
+        };
+        if self.0.yields() || !plan.collapse_drift_ratio.is_finite() {
+            return false;
+        }
+        let spec = &self.base().spec;
+        let inner = motions.inner;
+        let per_record = inner * motions.intensities as u64;
+        let peaks: Vec<f64> = (0..motions.records as u64 * inner)
+            .into_par_iter()
+            .map(|u| {
+                let (m, record) = ((u / inner) * per_record + u % inner, (u / inner) as usize);
+                let forcing = spec.records[record].forcing(1.0, spec.tail);
+                sampled_peak_drift_ratios(&self.buildings(m), &forcing)
+                    .into_iter()
+                    .fold(0.0, f64::max)
+            })
+            .collect();
+        let watch = COLLAPSE_WATCH * plan.collapse_drift_ratio;
+        (0..motions.len())
+            .into_par_iter()
+            .any(|m| peaks[motions.response(m) as usize] * self.periods(m).1 >= watch)
     }
 
     /// The drift ratio at which a building collapses (infinite: never, and for a pair).
@@ -371,6 +410,10 @@ pub struct GapStudy<'a> {
     responses: Vec<Separation>,
     /// Where storeys yield, how each run ended (empty otherwise: every run is whole).
     outcomes: Vec<Outcome>,
+    /// Every run is stepped on its own ([`GapStudy::per_run`]).
+    per_run: bool,
+    /// ... because a run of elastic buildings nears the collapse limit.
+    nears_collapse: bool,
     /// Per run, what each adjacent pair needs.
     pair_gaps: Vec<Vec<Option<PairGap>>>,
     /// The contact levels' column prefixes (the same in every run).
@@ -415,7 +458,8 @@ impl<'a> GapStudy<'a> {
         let stopped = || stop.load(std::sync::atomic::Ordering::Relaxed);
         let scenes = Scenes(plan);
         let motions = scenes.motions();
-        let per_run = plan.yields();
+        let nears_collapse = scenes.nears_collapse(&motions);
+        let per_run = plan.yields() || nears_collapse;
         let inner = motions.inner;
         let per_record = inner * motions.intensities as u64;
         let count = if per_run {
@@ -435,7 +479,7 @@ impl<'a> GapStudy<'a> {
                 } else {
                     ((u / inner) * per_record + u % inner, (u / inner) as usize)
                 };
-                scenes.response(m, record)
+                scenes.response(m, record, per_run)
             })
             .unzip();
         if stopped() {
@@ -456,6 +500,8 @@ impl<'a> GapStudy<'a> {
             motions,
             responses,
             outcomes,
+            per_run,
+            nears_collapse,
             level_names,
             level_pairs,
             pair_gaps: Vec::new(),
@@ -563,9 +609,16 @@ impl<'a> GapStudy<'a> {
         }
     }
 
-    /// Does every run have its own response (storeys yield: not linear in the scale)?
+    /// Does every run have its own response (storeys yield: not linear in the scale; or a run
+    /// of elastic buildings nears the collapse limit, [`GapStudy::nears_collapse`])?
     pub fn per_run(&self) -> bool {
-        self.scenes.0.yields()
+        self.per_run
+    }
+
+    /// Are the runs stepped on their own because a run of elastic buildings nears the
+    /// collapse limit (where the sweep watches it for collapse)?
+    pub fn nears_collapse(&self) -> bool {
+        self.nears_collapse
     }
 
     /// Substeps taken where storeys yield, over all responses.

@@ -20,6 +20,7 @@ mod figures;
 mod floor_column;
 mod gap;
 mod gap_collapse;
+mod gap_threshold;
 mod gpu;
 mod gpu_collapse;
 mod gpu_rows;

@@ -12,7 +12,10 @@
 //! [`REFINE_SUBSTEPS`] parts, whose quintics are `REFINE_SUBSTEPS^6` (1.7e7) times closer. So
 //! every extremum is exact to [`Separation::error_bound`], which is reported. The result is
 //! linear in the record's scale: a response at one scale serves every intensity
-//! ([`Separation::scaled`]).
+//! ([`Separation::scaled`]). Modes whose damping couples them (Rayleigh damping of a P-Delta
+//! building whose storeys lean unequally) are stepped together by the exact coupled propagator,
+//! as the sweep's free steps take them, with one bound for them all
+//! (`Coupled::sixth_derivative_bound`).
 //!
 //! Buildings with yielding storeys are not linear: [`yielding_separation`] runs the row scheme
 //! with the levels out of reach, once per intensity, and takes the same quantities from its
@@ -24,7 +27,7 @@ use super::row::{simulate_uncoupled, RowModel, RowScheme, UNCOUPLED_GAP_M};
 use super::Segment;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
-use crate::physics::propagator::Propagator;
+use crate::physics::propagator::{CoupledPropagator, Propagator};
 use crate::physics::row::{contact_points, LevelRule, LevelSide, Row};
 use crate::physics::shear::{Modes, ShearBuilding};
 
@@ -101,6 +104,94 @@ struct Stepped {
     free: Vec<FreeMode>,
     /// Per entry of [`PART_COUNTS`], the propagators of one part.
     parts: Vec<Vec<Propagator>>,
+    /// Where its damping couples its modes (Rayleigh damping of a P-Delta building whose
+    /// storeys lean unequally), their exact coupled steps, as the sweep's free steps take them.
+    coupled: Option<Coupled>,
+}
+
+/// The modes of a building whose damping couples them: `q'' + D q' + W^2 q = -L ag` with `D`
+/// the full modal damping (`2 xi w` on its diagonal, the coupling `E` off it).
+struct Coupled {
+    whole: CoupledPropagator,
+    /// Per entry of [`PART_COUNTS`], the propagator of one part.
+    parts: Vec<CoupledPropagator>,
+    /// `D`, row-major.
+    damping: Vec<f64>,
+    /// `w_i^2`
+    w2: Vec<f64>,
+}
+
+impl Coupled {
+    fn new(modes: &Modes, e: &[Vec<f64>], dt: f64) -> Coupled {
+        let n = modes.count();
+        let w2: Vec<f64> = modes.omega.iter().map(|w| w * w).collect();
+        let c: Vec<f64> = (0..n).map(|i| 2.0 * modes.xi[i] * modes.omega[i]).collect();
+        let at = |h: f64| CoupledPropagator::new(&w2, &c, e, &modes.participation, h);
+        let damping = (0..n)
+            .flat_map(|i| (0..n).map(move |k| (i, k)))
+            .map(|(i, k)| if i == k { c[i] } else { e[i][k] })
+            .collect();
+        Coupled {
+            whole: at(dt),
+            parts: PART_COUNTS.iter().map(|&p| at(dt / p as f64)).collect(),
+            damping,
+            w2,
+        }
+    }
+
+    /// `(D v)_i`
+    #[inline]
+    fn damp(&self, v: &[f64], i: usize) -> f64 {
+        let n = v.len();
+        self.damping[i * n..(i + 1) * n]
+            .iter()
+            .zip(v)
+            .map(|(d, v)| d * v)
+            .sum()
+    }
+
+    /// A bound on the energy norm `|y|_E = sqrt(sum w_i^2 x_i^2 + x_i'^2)` of the sixth
+    /// derivative of the modes' homogeneous motion `y = (x, x')` over a step from `m` under
+    /// `L ag`, `ag = f + g t`.
+    ///
+    /// The load's particular response `q_p = alpha + beta t` is linear (`W^2 beta = -L g`,
+    /// `W^2 alpha = -L f - D beta`), so the sixth derivative is the homogeneous part's, whose
+    /// derivatives all solve the free equation `y' = A y`. There `d|y|_E^2 / dt = -2 x'^T D x'
+    /// <= 0` (`D = Phi^T (a0 M + a1 K0) Phi` is positive semi-definite): free motion never
+    /// gains energy, so over the whole step `|y^(6)|_E <= |A^6 y(0)|_E`, computed exactly.
+    fn sixth_derivative_bound(
+        &self,
+        m: &Modal,
+        l: &[f64],
+        f: f64,
+        g: f64,
+        scratch: &mut [f64],
+    ) -> f64 {
+        let n = self.w2.len();
+        let (x, rest) = scratch.split_at_mut(n);
+        let (v, rest) = rest.split_at_mut(n);
+        let (dv, _) = rest.split_at_mut(n);
+        for i in 0..n {
+            v[i] = -l[i] * g / self.w2[i];
+        }
+        for i in 0..n {
+            x[i] = m.q[i] + (l[i] * f + self.damp(v, i)) / self.w2[i];
+        }
+        for (v, qd) in v.iter_mut().zip(&m.qd) {
+            *v = qd - *v;
+        }
+        for _ in 0..6 {
+            for i in 0..n {
+                dv[i] = -self.w2[i] * x[i] - self.damp(v, i);
+            }
+            x.copy_from_slice(v);
+            v.copy_from_slice(dv);
+        }
+        (0..n)
+            .map(|i| self.w2[i] * x[i] * x[i] + v[i] * v[i])
+            .sum::<f64>()
+            .sqrt()
+    }
 }
 
 impl Stepped {
@@ -116,18 +207,33 @@ impl Stepped {
                     .collect()
             })
             .collect();
+        let coupled = modes.coupling.as_ref().map(|e| Coupled::new(&modes, e, dt));
         Stepped {
             free: osc.iter().map(FreeMode::new).collect(),
             modes,
             osc,
             whole,
             parts,
+            coupled,
         }
     }
 
-    /// Step the modes `q`, `q'` over `ag` from `a0` to `a1` with the propagators `p`.
+    /// Step the modes `q`, `q'` over `ag` from `a0` to `a1` with the propagators `p` (or, where
+    /// the modes are coupled, with the coupled one of `part`: None for the whole step, else
+    /// the entry of [`PART_COUNTS`]).
     #[inline]
-    fn step(&self, m: &mut Modal, p: &[Propagator], a0: f64, a1: f64) {
+    fn step(&self, m: &mut Modal, p: &[Propagator], part: Option<usize>, a0: f64, a1: f64) {
+        if let Some(c) = &self.coupled {
+            let cp = part.map_or(&c.whole, |k| &c.parts[k]);
+            let n = m.q.len();
+            let (x0, x1) = m.scratch.split_at_mut(2 * n);
+            x0[..n].copy_from_slice(&m.q);
+            x0[n..].copy_from_slice(&m.qd);
+            cp.step(x0, a0, a1, &mut x1[..2 * n]);
+            m.q.copy_from_slice(&x1[..n]);
+            m.qd.copy_from_slice(&x1[n..2 * n]);
+            return;
+        }
         for (i, p) in p.iter().enumerate() {
             let l = self.modes.participation[i];
             (m.q[i], m.qd[i]) = p.step(m.q[i], m.qd[i], l * a0, l * a1);
@@ -135,13 +241,36 @@ impl Stepped {
     }
 
     /// Per mode, [`sixth_derivative_bound`] over a step from `m` with `ag` from `a0` to `a1`,
-    /// `inv_dt = 1 / dt`.
+    /// `inv_dt = 1 / dt`; where the modes are coupled, one bound for them all
+    /// ([`Coupled::sixth_derivative_bound`]), in `out[0]`.
     #[inline]
-    fn sixth_bounds(&self, m: &Modal, a0: f64, a1: f64, inv_dt: f64, out: &mut [f64]) {
+    fn sixth_bounds(&self, m: &mut Modal, a0: f64, a1: f64, inv_dt: f64, out: &mut [f64]) {
         let slope = (a1 - a0) * inv_dt;
+        if let Some(c) = &self.coupled {
+            let mut scratch = std::mem::take(&mut m.scratch);
+            out[0] =
+                c.sixth_derivative_bound(m, &self.modes.participation, a0, slope, &mut scratch);
+            m.scratch = scratch;
+            return;
+        }
         for (i, o) in self.free.iter().enumerate() {
             let l = self.modes.participation[i];
             out[i] = o.sixth_derivative_bound(m.q[i], m.qd[i], l * a0, l * slope);
+        }
+    }
+
+    /// Per mode, the weight of its sixth-derivative bound in that of the point whose mode-shape
+    /// row is `shape`: `|shape_i|`; where the modes are coupled, one weight for their energy
+    /// norm's bound, `sqrt(sum (shape_i / w_i)^2)` (Cauchy-Schwarz).
+    fn bound_row(&self, shape: &[f64]) -> Vec<f64> {
+        match &self.coupled {
+            None => shape.iter().map(|p| p.abs()).collect(),
+            Some(c) => vec![shape
+                .iter()
+                .zip(&c.w2)
+                .map(|(p, w2)| p * p / w2)
+                .sum::<f64>()
+                .sqrt()],
         }
     }
 
@@ -150,6 +279,15 @@ impl Stepped {
     #[inline]
     fn floor(&self, m: &Modal, shape: &[f64], ag: f64) -> [f64; 3] {
         let (mut u, mut v, mut a) = (0.0, 0.0, 0.0);
+        if let Some(c) = &self.coupled {
+            for (i, o) in self.osc.iter().enumerate() {
+                let qdd = -o.k * m.q[i] - c.damp(&m.qd, i) - self.modes.participation[i] * ag;
+                u += shape[i] * m.q[i];
+                v += shape[i] * m.qd[i];
+                a += shape[i] * qdd;
+            }
+            return [u, v, a];
+        }
         for (i, o) in self.osc.iter().enumerate() {
             let qdd = -o.c * m.qd[i] - o.k * m.q[i] - self.modes.participation[i] * ag;
             u += shape[i] * m.q[i];
@@ -207,6 +345,8 @@ impl FreeMode {
 struct Modal {
     q: Vec<f64>,
     qd: Vec<f64>,
+    /// Room for the coupled modes' steps and bounds (empty where the modes are not coupled).
+    scratch: Vec<f64>,
 }
 
 impl Modal {
@@ -360,6 +500,8 @@ struct Watched {
     side: LevelSide,
     /// Its mode-shape row.
     row: Vec<f64>,
+    /// Its building's sixth-derivative bounds' weights ([`Stepped::bound_row`]).
+    bound_row: Vec<f64>,
 }
 
 /// The separation `buildings` (left to right, on one ground) need under `forcing`, from rest,
@@ -388,6 +530,7 @@ pub fn separation_with(
             watched.push(Watched {
                 building: b,
                 side,
+                bound_row: stepped[b].bound_row(&row),
                 row,
             });
             watched.len() - 1
@@ -422,6 +565,14 @@ pub fn separation_with(
         .map(|s| Modal {
             q: vec![0.0; s.modes.count()],
             qd: vec![0.0; s.modes.count()],
+            scratch: vec![
+                0.0;
+                if s.coupled.is_some() {
+                    4 * s.modes.count()
+                } else {
+                    0
+                }
+            ],
         })
         .collect();
     let (mut z0, mut z1, mut zp) = (rest.clone(), rest.clone(), rest);
@@ -439,16 +590,16 @@ pub fn separation_with(
         let seg = Segment::of(forcing, i);
         for (b, s) in stepped.iter().enumerate() {
             z1[b].set(&z0[b]);
-            s.step(&mut z1[b], &s.whole, seg.a0, seg.a1);
-            s.sixth_bounds(&z0[b], seg.a0, seg.a1, 1.0 / dt, &mut sixth[b]);
+            s.step(&mut z1[b], &s.whole, None, seg.a0, seg.a1);
+            s.sixth_bounds(&mut z0[b], seg.a0, seg.a1, 1.0 / dt, &mut sixth[b]);
         }
         floors_at(&stepped, &watched, &z1, seg.a1, &mut ends1);
         for (e, w) in floor_error.iter_mut().zip(&watched) {
             *e = weight
-                * w.row
+                * w.bound_row
                     .iter()
                     .zip(&sixth[w.building])
-                    .map(|(p, s)| p.abs() * s)
+                    .map(|(p, s)| p * s)
                     .sum::<f64>();
         }
         let mut need = Need::Nothing;
@@ -498,7 +649,7 @@ pub fn separation_with(
                         seg.at(seg.t0 + k as f64 * h),
                     );
                     for (b, s) in stepped.iter().enumerate() {
-                        s.step(&mut zp[b], &s.parts[set], aa, ab);
+                        s.step(&mut zp[b], &s.parts[set], Some(set), aa, ab);
                     }
                     floors_at(
                         &stepped,
@@ -546,6 +697,38 @@ pub fn separation_with(
             .collect(),
         error_bound: Some(error_bound),
     }
+}
+
+/// Per building of `buildings` (elastic, on one ground), its largest storey drift ratio under
+/// `forcing` from rest at the record's samples, its modes stepped exactly as
+/// [`separation_with`] steps them: whether a run of them may near a collapse limit (the
+/// samples miss the crests between them, so a caller compares with a margin).
+pub fn sampled_peak_drift_ratios(buildings: &[ShearBuilding], forcing: &Forcing) -> Vec<f64> {
+    buildings
+        .iter()
+        .map(|b| {
+            let s = Stepped::new(b, forcing.dt);
+            let n = s.modes.count();
+            let rows: Vec<Vec<f64>> = (0..n)
+                .map(|j| crate::physics::shear::storey_drift_row(&s.modes.shape, j))
+                .collect();
+            let mut z = Modal {
+                q: vec![0.0; n],
+                qd: vec![0.0; n],
+                scratch: vec![0.0; if s.coupled.is_some() { 4 * n } else { 0 }],
+            };
+            let mut peak = 0.0f64;
+            for i in 0..forcing.intervals() {
+                let seg = Segment::of(forcing, i);
+                s.step(&mut z, &s.whole, None, seg.a0, seg.a1);
+                for (row, h) in rows.iter().zip(&b.heights) {
+                    let d: f64 = row.iter().zip(&z.q).map(|(r, q)| r * q).sum();
+                    peak = peak.max(d.abs() / h);
+                }
+            }
+            peak
+        })
+        .collect()
 }
 
 /// The separation `buildings` (left to right, on one ground; storeys may yield) need under
@@ -803,14 +986,32 @@ mod tests {
 
     /// Against the same scenes stepped 64 times as finely (where the quintic's error is
     /// 64^6 = 7e10 times smaller): the required gap, its time and the peaks agree to 1e-9, for
-    /// a stiff pair on a coarse record (omega h = 1.3), a 3 beside a 6 storey and a 20 beside a
-    /// 12 storey (highest modes with omega h up to 4).
+    /// a stiff pair on a coarse record (omega h = 1.3), a 3 beside a 6 storey, a 20 beside a
+    /// 12 storey (highest modes with omega h up to 4) and a P-Delta 4 storey whose Rayleigh
+    /// damping couples its modes beside a 3 storey.
     #[test]
     fn separation_is_that_of_steps_64_times_finer() {
-        let scenes: [(Vec<ShearBuilding>, f64); 3] = [
+        let leaning = ShearBuilding::from_period(
+            vec![3e5; 4],
+            &[1.0, 0.9, 0.8, 0.6],
+            vec![4.0, 3.5, 3.5, 3.5],
+            1.0,
+            Damping::Rayleigh(0.05),
+        )
+        .with_p_delta(2.0);
+        assert!(leaning.modes().coupling.is_some());
+        let stiff = ShearBuilding::from_period(
+            vec![2.5e5; 3],
+            &[1.0; 3],
+            vec![4.0, 3.5, 3.5],
+            0.3,
+            Damping::Rayleigh(0.05),
+        );
+        let scenes: [(Vec<ShearBuilding>, f64); 4] = [
             (vec![single(0.35, 0.05), single(0.1, 0.02)], 0.02),
             (vec![shear(3, 0.35, 0.05), shear(6, 0.8, 0.05)], 0.01),
             (vec![shear(20, 2.0, 0.05), shear(12, 1.1, 0.03)], 0.02),
+            (vec![leaning, stiff], 0.02),
         ];
         for (buildings, dt) in scenes {
             let accel = ground_motion(dt);
