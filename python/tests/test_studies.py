@@ -139,3 +139,16 @@ def test_categories_are_read_and_other_columns_left_out(pound, tmp_path):
     assert got.equals(expected)
     with pytest.raises(pounding.TableError, match="without when"):
         pounding.fragility(df, edp="when", thresholds=[1])
+
+
+def test_a_table_naming_a_column_twice_is_refused_naming_it():
+    # A zeros column placed first under the same name once turned a drift fit into another fit:
+    # the studies refuse the table instead of reading either column (issue 65, item 4).
+    runs = pa.table(pounding.sweep(CONFIGS / "inelastic-fragility.toml", backend="cpu", progress=False))
+    drift = runs.column("b1_peak_drift_ratio")
+    twice = runs.add_column(0, "b1_peak_drift_ratio", pa.array([0.0] * len(runs)))
+    assert twice.column_names.count("b1_peak_drift_ratio") == 2 and len(drift) == len(runs)
+    with pytest.raises(pounding.TableError, match="b1_peak_drift_ratio"):
+        pounding.fragility(twice, edp="b1_peak_drift_ratio", thresholds=[0.005])
+    with pytest.raises(pounding.TableError, match="b1_peak_drift_ratio"):
+        pounding.ida(twice, edp="b1_peak_drift_ratio")
