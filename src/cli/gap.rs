@@ -11,8 +11,9 @@ use std::time::Instant;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// A sweep config (pair or row): its contact and gap axes are left out; the gaps, where
-    /// the config has two or more, are where the probability of pounding is counted.
+    /// A sweep config (pair or row), whose contact and gap axes are left out: it may have no
+    /// [contact] and no gaps; a gap axis of two values or more is where the probability of
+    /// pounding is counted.
     config: PathBuf,
     /// One row per run: the required gap of each adjacent pair (and of each shared floor
     /// level of multi-storey buildings), the rules' gaps and their ratios to it.
@@ -55,7 +56,8 @@ pub fn run(a: Args) -> Result<()> {
         .threads
         .map(pounding::plan::settings::check_threads)
         .transpose()?;
-    let plan = config::load_text(&text, &a.config)?;
+    // The study runs no contact and computes the gaps: the config may leave both out.
+    let plan = config::load_text_for_gaps(&text, &a.config)?;
     if let Some(why) = GapStudy::refusal(&plan) {
         bail!("{}: {why}", a.config.display());
     }

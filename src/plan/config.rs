@@ -195,7 +195,18 @@ impl Axis {
                 )),
                 None => Ok(v.clone()),
             },
-            Axis::Range(r) => Self::range_values(r).map(|v| v.into_iter().map(tidy).collect()),
+            Axis::Range(r) => {
+                let v: Vec<f64> = Self::range_values(r)?.into_iter().map(tidy).collect();
+                // Points closer than the 12 digits they are written to would be runs repeated
+                // (a range is monotonic: a repeat is next to its twin, found without a sort).
+                match v.windows(2).find(|w| w[0] == w[1]).map(|w| w[0]) {
+                    Some(x) => Err(format!(
+                        "gives {} twice (its points are closer than 12 significant digits): a repeated value repeats its runs; give fewer points",
+                        crate::plan::limits::show(x)
+                    )),
+                    None => Ok(v),
+                }
+            }
         }
     }
 
@@ -775,7 +786,8 @@ pub struct RawConfig {
     pub run: RawRun,
     pub building1: RawBuilding,
     pub building2: RawBuilding,
-    pub contact: RawContact,
+    /// Required by a sweep; a gap study leaves the contact out ([`load_text_for_gaps`]).
+    pub contact: Option<RawContact>,
     #[serde(rename = "record", default)]
     pub records: Vec<RawRecord>,
     #[serde(default)]
@@ -856,15 +868,55 @@ fn refuse_yielding_pair(text: &str, path: &Path) -> Result<(), ConfigError> {
 /// Validate config `text` read from `path` (records resolved beside it and in
 /// [`records_dir`]): a pair's or a row's plan, as the config describes.
 pub fn load_text(text: &str, path: &Path) -> Result<Plan, ConfigError> {
+    load_text_as(text, path, Reading::Sweep)
+}
+
+/// [`load_text`] for a gap study (`pound gap`), which runs the config without its contact and
+/// gap axes: a config may leave out `[contact]` and its gaps (the study computes the gaps each
+/// pair needs); where it gives them, they are read as a sweep reads them (a gap axis of two
+/// values or more is where the study counts the probability of pounding).
+pub fn load_text_for_gaps(text: &str, path: &Path) -> Result<Plan, ConfigError> {
+    load_text_as(text, path, Reading::GapStudy)
+}
+
+/// What a config is read for: a sweep needs its contact and gaps; a gap study does not.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Reading {
+    Sweep,
+    GapStudy,
+}
+
+fn load_text_as(text: &str, path: &Path, reading: Reading) -> Result<Plan, ConfigError> {
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let records = records_dir_for(&base);
     Ok(if is_row_config(text) {
-        Plan::Row(crate::plan::row::parse_row(text, path, &base, &records)?)
+        Plan::Row(crate::plan::row::parse_row_as(
+            text, path, &base, &records, reading,
+        )?)
     } else {
         refuse_yielding_pair(text, path)?;
-        Plan::Pair(parse(text, path, &base, &records)?)
+        let raw: RawConfig = toml::from_str(text).map_err(|e| toml_error(path, e))?;
+        Plan::Pair(parse_raw(&raw, path, &base, &records, reading)?)
     })
 }
+
+/// The contact of a scene that has none to run (a building alone, or a gap study without
+/// `[contact]`): a linear law that no run uses.
+pub(crate) fn unused_contact() -> RawContact {
+    RawContact {
+        law: Names::One("linear".into()),
+        formula: None,
+        e: None,
+        gap_m: None,
+        k_n_per_m: Some(Axis::List(vec![1e9])),
+        beta_n_per_m1_5: None,
+    }
+}
+
+/// The gap a gap study takes for a pair whose gap the config leaves out: one value, so no run
+/// is repeated and no gap is counted at it (a gap study counts at a config's gap axis of two
+/// values or more only).
+pub(crate) const UNUSED_GAP_M: f64 = 0.0;
 
 /// The record files config `text` (read from `path`) reads, `file =` and `path =` records
 /// resolved, so a command can refuse to write over one of them. Text that does not parse lists
@@ -929,7 +981,7 @@ pub fn parse(
     records: &Path,
 ) -> Result<PairPlan, ConfigError> {
     let raw: RawConfig = toml::from_str(text).map_err(|e| toml_error(path, e))?;
-    parse_raw(&raw, path, base, records)
+    parse_raw(&raw, path, base, records, Reading::Sweep)
 }
 
 /// [`parse`] of a config already read into its raw form.
@@ -938,12 +990,29 @@ fn parse_raw(
     path: &Path,
     base: &Path,
     records: &Path,
+    reading: Reading,
 ) -> Result<PairPlan, ConfigError> {
     let invalid = |key: &str, message: String| ConfigError::Invalid {
         path: path.into(),
         key: key.into(),
         message,
     };
+    let mut rc = match (&raw.contact, reading) {
+        (Some(c), _) => c.clone(),
+        (None, Reading::GapStudy) => unused_contact(),
+        (None, Reading::Sweep) => {
+            return Err(invalid(
+                "contact",
+                "missing: a pair of buildings that may touch needs [contact] (law, its stiffness and gap_m)".into(),
+            ))
+        }
+    };
+    let gap_sampled =
+        (raw.sample.iter()).any(|s| s.axes.iter().any(|a| a.key == SampledAxis::Gap.key()));
+    if reading == Reading::GapStudy && rc.gap_m.is_none() && !gap_sampled {
+        rc.gap_m = Some(Axis::List(vec![UNUSED_GAP_M]));
+    }
+    let rc = &rc;
     let axis = |key: &str, a: &Axis| a.values().map_err(|m| invalid(key, m));
     if raw.run.collapse_drift_ratio.is_some() {
         return Err(invalid(
@@ -952,7 +1021,7 @@ fn parse_raw(
         ));
     }
     let scheme = parse_scheme(&raw.run, &invalid)?;
-    let (laws, formulas) = parse_laws(&raw.contact, &invalid)?;
+    let (laws, formulas) = parse_laws(rc, &invalid)?;
     let count = |key: &str, a: &Option<Axis>| -> Result<usize, ConfigError> {
         a.as_ref()
             .map_or(Ok(1), |a| a.count().map_err(|m| invalid(key, m)))
@@ -968,10 +1037,10 @@ fn parse_raw(
         samples: raw.sample.as_ref().map_or(1, |s| s.n.max(1)),
         building1: b("building1", &raw.building1)?,
         building2: b("building2", &raw.building2)?,
-        gaps: count("contact.gap_m", &raw.contact.gap_m)?,
+        gaps: count("contact.gap_m", &rc.gap_m)?,
     };
     check_size(
-        &raw.contact,
+        rc,
         raw.records.len(),
         &raw.intensity,
         &laws,
@@ -1006,9 +1075,9 @@ fn parse_raw(
             scheme,
             laws,
             formulas,
-            contact: &raw.contact,
-            k_linear: raw.contact.k_n_per_m.as_ref(),
-            beta: raw.contact.beta_n_per_m1_5.as_ref(),
+            contact: rc,
+            k_linear: rc.k_n_per_m.as_ref(),
+            beta: rc.beta_n_per_m1_5.as_ref(),
             records: &raw.records,
             intensity: &raw.intensity,
             buildings: 2,
@@ -1022,7 +1091,7 @@ fn parse_raw(
         contact,
         building1: building("building1", &raw.building1)?,
         building2: building("building2", &raw.building2)?,
-        gaps: grid("contact.gap_m", &raw.contact.gap_m)?,
+        gaps: grid("contact.gap_m", &rc.gap_m)?,
         samples,
     };
     PairPlan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
@@ -1186,6 +1255,19 @@ fn contact_spec(
                 format!(
                     "is labelled `{}`, as record[{j}] is: give each a distinct name = \"...\"",
                     rec.name
+                ),
+            ));
+        }
+        // The same motion under another label would repeat every run of the first.
+        if let Some(j) = recs
+            .iter()
+            .position(|r| r.dt == rec.dt && r.t0 == rec.t0 && r.accel == rec.accel)
+        {
+            return Err(invalid(
+                &key,
+                format!(
+                    "`{}` holds the same accelerations (same dt and start) as record[{j}] `{}`: its runs would repeat record[{j}]'s with the same physics; remove one",
+                    rec.name, recs[j].name
                 ),
             ));
         }

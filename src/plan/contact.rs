@@ -38,6 +38,82 @@ pub struct ContactSpec {
     pub warn_scale: f64,
 }
 
+impl ContactSpec {
+    /// Why none of the laws given takes the contact key `key` (`contact.e`,
+    /// `contact.formula`, `contact.k_n_per_m`, `contact.beta_n_per_m1_5`); None where one does.
+    pub(crate) fn unused(&self, key: &str) -> Option<String> {
+        let laws = self
+            .laws
+            .iter()
+            .map(|l| l.key())
+            .collect::<Vec<_>>()
+            .join(", ");
+        let takers = |f: fn(LawKind) -> bool| {
+            (LawKind::ALL.into_iter())
+                .filter(|l| f(*l))
+                .map(|l| l.key())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let (used, what, who) = match key {
+            "contact.e" => (
+                self.laws.iter().any(|l| l.is_damped()),
+                "a coefficient of restitution e",
+                takers(LawKind::is_damped),
+            ),
+            "contact.formula" => (
+                self.laws.iter().any(|l| l.uses_zeta()),
+                "a restitution formula",
+                takers(LawKind::uses_zeta),
+            ),
+            "contact.k_n_per_m" => (
+                self.laws.iter().any(|l| !l.is_hertzian()),
+                "k",
+                takers(|l| !l.is_hertzian()),
+            ),
+            "contact.beta_n_per_m1_5" => (
+                self.laws.iter().any(|l| l.is_hertzian()),
+                "beta",
+                takers(LawKind::is_hertzian),
+            ),
+            _ => return None,
+        };
+        (!used).then(|| format!("none of the laws given ({laws}) takes {what} (only {who} do)"))
+    }
+
+    /// Refuse a contact axis of two values or more that none of the laws given takes: it
+    /// cannot change a run, and its values would be dropped without a word.
+    pub(crate) fn refuse_unused(&self) -> Result<(), PlanError> {
+        for (key, n) in [
+            ("contact.formula", self.formulas.len()),
+            ("contact.e", self.e.len()),
+            ("contact.k_n_per_m", self.k_linear.len()),
+            ("contact.beta_n_per_m1_5", self.beta.len()),
+        ] {
+            if let (true, Some(why)) = (n > 1, self.unused(key)) {
+                return Err(err(
+                    key,
+                    format!("{n} values, but {why}: this axis cannot change a run (its values would be dropped); remove it or add a law that takes it"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuse sampled stiffness `key` (`sample.axis[j]`) that none of the laws given takes:
+    /// its draws cannot change a run (where nothing else is sampled, each run would be
+    /// repeated `n` times with the same physics).
+    pub(crate) fn refuse_unused_sample(&self, j: usize, key: &str) -> Result<(), PlanError> {
+        match self.unused(key) {
+            Some(why) => Err(err(
+                format!("sample.axis[{j}] ({key})"),
+                format!("is sampled, but {why}: its draws cannot change a run; remove it from [sample] or add a law that takes it"),
+            )),
+            None => Ok(()),
+        }
+    }
+}
+
 /// Axes of a contact block, outermost first: formula, e, stiffness, record, intensity.
 const NAXES: usize = 5;
 

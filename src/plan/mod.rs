@@ -594,6 +594,13 @@ impl PairPlan {
             periods(&spec.building2, SampledAxis::Period2),
         ];
         let mut contact = ContactPlan::new(spec.contact)?;
+        // A pair always may touch: only the laws decide which contact axes a run takes.
+        contact.spec.refuse_unused()?;
+        for (j, a) in spec.samples.iter().flat_map(|s| s.axes.iter().enumerate()) {
+            if matches!(a, SampledAxis::KLinear | SampledAxis::Beta) {
+                contact.spec.refuse_unused_sample(j, a.key())?;
+            }
+        }
         intensity::check_periods(&contact.spec.intensities, &taken).map_err(|(k, m)| err(k, m))?;
         contact.list_periods(&taken);
         let c = &contact.spec;

@@ -26,6 +26,7 @@ mod gpu_collapse;
 mod gpu_rows;
 mod hard;
 mod hostile;
+mod idle_axes;
 mod im_columns;
 mod inelastic;
 mod intensity;

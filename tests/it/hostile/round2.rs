@@ -191,7 +191,9 @@ fn no_silent_physics() {
     let apart = write(
         d.path(),
         "apart.toml",
-        &row(STOREYS3, &offset, "[levels]\nfloor_column = false\n"),
+        // One gap: a list would repeat each run (refused, `idle_axes`).
+        &row(STOREYS3, &offset, "[levels]\nfloor_column = false\n")
+            .replace("gap_m = [0.0, 0.01]", "gap_m = 0.0"),
     );
     warns(
         &super::sweep(&apart, &d.path().join("apart.csv"), &[]),
@@ -524,7 +526,8 @@ fn outputs_say_what_they_are() {
 }
 
 /// Class 6: `contact.gap_m` is one gap shared by the pairs it gives, in the grid as under
-/// `[sample]`; ignored when every pair has its own; `gap_right_m` is a pair's own axis.
+/// `[sample]`; one value is ignored when every pair has its own (a list refused);
+/// `gap_right_m` is a pair's own axis.
 #[test]
 fn a_shared_gap_means_one_gap() {
     let three = |extra_left: &str| {
@@ -566,6 +569,16 @@ fn a_shared_gap_means_one_gap() {
             &format!("[[building]]\n{STOREYS3}\ngap_right_m = 0.01\n[[building]]"),
             1,
         );
+    // A list no pair reads would be dropped: refused (`idle_axes`); one value is a leftover.
+    let e =
+        pounding::plan::row::parse_row(&all, Path::new("t.toml"), Path::new("."), Path::new("."))
+            .unwrap_err()
+            .to_string();
+    assert!(
+        e.contains("contact.gap_m: every pair has its own gap_right_m"),
+        "{e}"
+    );
+    let all = all.replace("gap_m = [0.0, 0.01, 0.02]", "gap_m = 0.02");
     let plan =
         pounding::plan::row::parse_row(&all, Path::new("t.toml"), Path::new("."), Path::new("."))
             .unwrap();

@@ -61,7 +61,7 @@ fn every_column_of_every_plan_has_a_meaning() {
     ];
     let contact_axes = [
         "gap_m = [0.0, 0.01]",
-        "e = [0.5, 0.8]\nformula = \"anagnostopoulos\"",
+        "law = \"kelvin_voigt\"\ne = [0.5, 0.8]\nformula = \"anagnostopoulos\"",
         "k_n_per_m = [1e9, 2e9]",
     ];
     let mut configs = Vec::new();
