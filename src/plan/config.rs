@@ -1094,7 +1094,13 @@ fn parse_raw(
         gaps: grid("contact.gap_m", &rc.gap_m)?,
         samples,
     };
-    PairPlan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))
+    let plan = PairPlan::new(spec).map_err(|PlanError { key, message }| invalid(&key, message))?;
+    // A gap study runs no contact axis: none can repeat its runs.
+    if reading == Reading::Sweep {
+        plan.refuse_unused()
+            .map_err(|PlanError { key, message }| invalid(&key, message))?;
+    }
+    Ok(plan)
 }
 
 /// The `[run]` section's scheme.

@@ -594,13 +594,6 @@ impl PairPlan {
             periods(&spec.building2, SampledAxis::Period2),
         ];
         let mut contact = ContactPlan::new(spec.contact)?;
-        // A pair always may touch: only the laws decide which contact axes a run takes.
-        contact.spec.refuse_unused()?;
-        for (j, a) in spec.samples.iter().flat_map(|s| s.axes.iter().enumerate()) {
-            if matches!(a, SampledAxis::KLinear | SampledAxis::Beta) {
-                contact.spec.refuse_unused_sample(j, a.key())?;
-            }
-        }
         intensity::check_periods(&contact.spec.intensities, &taken).map_err(|(k, m)| err(k, m))?;
         contact.list_periods(&taken);
         let c = &contact.spec;
@@ -644,6 +637,20 @@ impl PairPlan {
             dims,
             per_scene: dims.iter().map(|&d| d as u64).product(),
         })
+    }
+
+    /// Refuse the contact axes and sampled stiffnesses none of the laws takes: a pair always
+    /// may touch, so only the laws decide which contact axes a run takes
+    /// ([`ContactSpec::refuse_unused`]).
+    pub(crate) fn refuse_unused(&self) -> Result<(), PlanError> {
+        let spec = &self.contact.spec;
+        spec.refuse_unused()?;
+        for (j, a) in self.samples.iter().flat_map(|s| s.axes.iter().enumerate()) {
+            if matches!(a, SampledAxis::KLinear | SampledAxis::Beta) {
+                spec.refuse_unused_sample(j, a.key())?;
+            }
+        }
+        Ok(())
     }
 
     /// What the plan was built from (to rebuild it with records changed).
