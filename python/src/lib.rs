@@ -590,7 +590,7 @@ fn gap(
     use pounding::studies::gap::GapStudy;
     let (text, path) = config_text(config, config_kind)?;
     let pool = pool(threads)?;
-    let plan = config::load_text(&text, &path).map_err(config_err)?;
+    let plan = config::load_text_for_gaps(&text, &path).map_err(config_err)?;
     if let Some(why) = GapStudy::refusal(&plan) {
         return Err(settings_err(format!("{}: {why}", path.display())));
     }

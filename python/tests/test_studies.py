@@ -34,6 +34,22 @@ def test_gap_is_the_command_lines_table(pound, tmp_path):
     assert_same_cells(pounding.gap(CONFIGS / "gap-example.toml"), out)
 
 
+def test_gap_takes_a_row_config_without_its_gaps(pound, tmp_path):
+    # The gap study computes the gaps: a row config without gap_right_m or [contact] is taken,
+    # as `pound gap` takes it, and gives the table of the same config with them (issue 65).
+    text = (CONFIGS / "row-3-6.toml").read_text()
+    bare = "\n".join(
+        line for line in text.splitlines() if not line.startswith(("gap_right_m", "gap_m"))
+    )
+    assert "gap_right_m" not in bare and "gap_m" not in bare
+    cfg = tmp_path / "bare.toml"
+    cfg.write_text(bare)
+    out = tmp_path / "gaps.csv"
+    pound("gap", cfg, "-o", out)
+    assert_same_cells(pounding.gap(cfg), out)
+    assert pa.table(pounding.gap(cfg)).to_pylist() == pa.table(pounding.gap(CONFIGS / "row-3-6.toml")).to_pylist()
+
+
 def test_record_and_spectrum_are_the_command_lines(pound, tmp_path):
     assert RECORD.exists(), f"{RECORD}: the shared records sit beside the clone"
     rec = pounding.record(RECORD)
