@@ -207,8 +207,8 @@ def _text(name: str, value: Any, optional: bool = True) -> Optional[str]:
     """A keyword that takes a name (None stays None where `optional`)."""
     if value is None and optional:
         return None
-    if not isinstance(value, str):
-        raise _refuse(name, value, "a string" + (" or None" if optional else ""))
+    if not isinstance(value, str) or not value.strip():
+        raise _refuse(name, value, "a non-empty string" + (" or None" if optional else ""))
     return value
 
 
@@ -448,11 +448,29 @@ def gap(config: Config, *, threads: Optional[int] = None) -> Table:
     return Table(inner)
 
 
+def _named_once(table: Any) -> None:
+    """A DataFrame naming a column twice is refused naming it, as a CSV or an Arrow table is
+    (pandas' own conversion would raise a ValueError naming every column)."""
+    columns = getattr(table, "columns", None)
+    if columns is None or isinstance(columns, str) or not isinstance(columns, Iterable):
+        return
+    names = [str(c) for c in columns]
+    for name in dict.fromkeys(names):
+        at = [i + 1 for i, c in enumerate(names) if c == name]
+        if len(at) > 1:
+            raise TableError(
+                f"<table>: the column `{name}` appears {len(at)} times (columns "
+                f"{', '.join(map(str, at))}): a study cannot tell which to read; rename or drop "
+                "all but one"
+            )
+
+
 def _study_input(table: Any) -> Any:
     if isinstance(table, (str, os.PathLike)) and isinstance(os.fspath(table), str):
         return os.fspath(table), "path"
     if isinstance(table, Table):
         return table._inner, "arrow"
+    _named_once(table)
     if hasattr(table, "__arrow_c_stream__"):
         return table, "arrow"
     # A pandas DataFrame without the stream interface (pandas < 2.2): through pyarrow.

@@ -210,3 +210,25 @@ def test_numpy_numbers_are_taken_where_numbers_are(runs, record_path):
     sa = pounding.spectrum(rec, np.array([0.5, 1.0]), damping=np.float64(0.05))
     assert sa.num_rows == 2
     assert sweep(small_pair(), threads=np.int64(1), chunk=np.uint8(7)).num_rows == 2
+
+
+def test_a_dataframe_naming_a_column_twice_is_a_table_error_naming_it():
+    pd = pytest.importorskip("pandas")
+    df = pd.DataFrame({"a": [0.0] * 4, "record": ["a", "a", "b", "b"], "pga_g": [0.1, 0.2, 0.1, 0.2], "status": ["ok"] * 4, "b": [0, 1, 0, 1]})
+    df.columns = ["peak_force_n", "record", "pga_g", "status", "peak_force_n"]
+    for study in (
+        lambda: pounding.fragility(df, edp="peak_force_n", thresholds=[0.5]),
+        lambda: pounding.ida(df, edp="peak_force_n"),
+    ):
+        with pytest.raises(pounding.TableError, match=r"`peak_force_n` appears 2 times \(columns 1, 5\)"):
+            study()
+
+
+@pytest.mark.parametrize("name", ["im", "by", "damage_states"])
+def test_an_empty_name_is_a_settings_error_naming_the_keyword(name):
+    runs = pounding.sweep(CONFIGS / "inelastic-fragility.toml", backend="cpu", progress=False)
+    kwargs = {"edp": "b1_peak_drift_ratio", "thresholds": [0.01], name: ""}
+    if name == "damage_states":
+        kwargs.pop("thresholds")
+    with pytest.raises(pounding.SettingsError, match=rf"^{name}="):
+        pounding.fragility(runs, **kwargs)

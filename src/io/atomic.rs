@@ -37,6 +37,20 @@ pub fn partial_path(out: &Path) -> PathBuf {
     sibling(out, ".partial")
 }
 
+/// Refuse to write `path` where its `OUT.partial` holds an unfinished sweep's rows (running:
+/// locked; resumable: its journal exists): every writer of a file output asks first.
+pub fn refuse_unfinished(path: &Path) -> std::io::Result<()> {
+    let journal = crate::io::provenance::progress_path(path);
+    if journal.exists() {
+        return Err(std::io::Error::other(format!(
+            "{} holds the rows of an unfinished sweep (see {}): finish it with --resume, or delete both",
+            partial_path(path).display(),
+            journal.display()
+        )));
+    }
+    Ok(())
+}
+
 /// Write `bytes` to `path` atomically (temporary file, fsync, rename); standard output (`-`), a
 /// character device or a FIFO is written in place.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
@@ -48,15 +62,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     }
     let path = target.path();
     let tmp = partial_path(path);
-    // `OUT.partial` may be a sweep's: running (locked) or resumable (with its journal).
-    let journal = crate::io::provenance::progress_path(path);
-    if journal.exists() {
-        return Err(std::io::Error::other(format!(
-            "{} holds the rows of an unfinished sweep (see {}): finish it with --resume, or delete both",
-            tmp.display(),
-            journal.display()
-        )));
-    }
+    refuse_unfinished(path)?;
     let lock = PartialLock::acquire(&tmp).map_err(std::io::Error::other)?;
     let written = lock
         .file()

@@ -135,6 +135,8 @@ pub fn merge(out: &Path, inputs: &[PathBuf]) -> Result<u64, SidecarError> {
         }
     }
     let lock = if target.is_file() {
+        crate::io::atomic::refuse_unfinished(target.path())
+            .map_err(|e| fail(out, e.to_string()))?;
         Some(crate::io::target::PartialLock::acquire(
             &crate::io::atomic::partial_path(target.path()),
         )?)

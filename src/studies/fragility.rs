@@ -231,7 +231,15 @@ pub fn fit(levels: &[Level]) -> Result<Fit, NoFit> {
         .sum();
     let deviance = (2.0 * (saturated - log_likelihood)).max(0.0);
     let dof = lv.len() - 2;
-    let no_power = lv.iter().all(|l| l.exceed == 0 || l.exceed == l.n);
+    // Levels all 0/n or n/n in the order of a fragility (none exceeding below, all above) leave
+    // the deviance test no power; out of that order (n/n below a 0/n) they reject the curve, and
+    // its p says so.
+    let mut by_im = lv.clone();
+    by_im.sort_by(|x, y| x.im.total_cmp(&y.im));
+    let in_order = by_im
+        .windows(2)
+        .all(|w| !(w[0].exceed == w[0].n && w[1].exceed == 0));
+    let no_power = in_order && lv.iter().all(|l| l.exceed == 0 || l.exceed == l.n);
     Ok(Fit {
         median: (-a / b).exp(),
         beta: 1.0 / b,
@@ -481,6 +489,28 @@ pub fn shows_collapse_limit(table: &Table) -> bool {
         || table
             .col("status")
             .is_ok_and(|c| table.rows.iter().any(|r| r[c] == "collapsed"))
+}
+
+/// The notice for a table with no `status` column (a sweep written with `--columns` that left
+/// it out, or one made by hand): its runs that collapsed or failed cannot be told from the
+/// others, so they are read by their values (a collapsed building's peak drift is its limit,
+/// not a demand beyond every threshold). Said, never silent: the counts may understate.
+pub fn no_status_notice(table: &Table) -> Option<String> {
+    if table.col("status").is_ok() || table.rows.is_empty() {
+        return None;
+    }
+    let collapse_columns = table.header.iter().any(|c| {
+        crate::plan::row::COLLAPSE_OUTPUTS.contains(&c.as_str()) || collapse_building(c).is_some()
+    });
+    Some(format!(
+        "notice: {} has no `status` column (a sweep written with --columns that left it out?): {}; sweep with `--columns ...,status` to count them",
+        table.path.display(),
+        if collapse_columns {
+            "runs that failed cannot be told from the others and are read by their values"
+        } else {
+            "runs that collapsed or failed cannot be told from the others and are read by their values, a collapse as its peaks before it (not as exceeding every threshold)"
+        }
+    ))
 }
 
 /// Whether `table` can give the collapse fragility of `edp` ([`is_collapse_edp`]), or why not
@@ -1516,6 +1546,9 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
         }
     ));
     if let Some(n) = whose.notice(skipped.run_collapse, &spec.edp) {
+        t.note(n);
+    }
+    if let Some(n) = no_status_notice(table) {
         t.note(n);
     }
     if grouped.ims.len() * 2 > runs && runs >= 10 {

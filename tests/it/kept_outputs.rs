@@ -168,6 +168,12 @@ fn no_output_replaces_an_unfinished_sweeps_rows_or_a_sidecar() {
         &pound(&["merge", s(&whole), "-o", s(&partial)]),
         &["unfinished sweep keeps its rows"],
     );
+    // `merge -o OUT` where OUT's sweep is unfinished: refused as every writer refuses, its
+    // `.partial` kept (it was replaced without a word, the journal left vouching for nothing).
+    refused(
+        &pound(&["merge", s(&whole), "-o", s(&cut)]),
+        &["holds the rows of an unfinished sweep", "--resume"],
+    );
     refused(
         &pound(&["bench", "-o", s(&journal)]),
         &["is the journal of an unfinished sweep"],

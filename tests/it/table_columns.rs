@@ -336,9 +336,9 @@ fn collapse_columns_left_out_are_named_missing_not_read_as_no_collapse() {
     );
 }
 
-/// Records whose collapses are all or nothing at each level: a fit exists (the pattern is not
-/// monotone), but every level is `0/7` or `7/7`, where the deviance's chi-square law does not
-/// hold: no p is printed, the words say why. A bootstrap over four records leaves out the
+/// Records whose collapses are all or nothing at each level, out of a fragility's order (7/7
+/// at 0.4 g below 0/7 at 0.6 g): a fit exists and the goodness of fit rejects it, its p printed
+/// (never hidden as "no power", which is for levels in order). A bootstrap over four records leaves out the
 /// replicates with no fit: the band is named conditional, with its count, in its cells, its
 /// notice and its figure's title.
 #[test]
@@ -367,10 +367,15 @@ fn statistics_say_what_they_rest_on() {
         .lines()
         .find(|l| l.starts_with("| collapse |"))
         .unwrap();
-    assert!(
-        row.contains("| n/a: every level is 0/n or n/n, the test has no power |"),
-        "{said}"
-    );
+    let p_fit: f64 = row
+        .trim_end_matches('|')
+        .rsplit('|')
+        .next()
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap_or_else(|_| panic!("a p (fit) in {row}"));
+    assert!(p_fit < 0.01 && !row.contains("no power"), "{said}");
     // Four records whose shares differ: some replicates draw counts that give no fit.
     let mut t = String::from("record,pga_g,status,collapse_time_s\n");
     let collapses = [
@@ -428,4 +433,84 @@ fn statistics_say_what_they_rest_on() {
     );
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(svg.contains("conditional on a fit"), "title");
+}
+
+/// A table without `status` (a sweep written with --columns that left it out) cannot tell its
+/// collapsed runs from the others: fragility and ida say so, naming the column, rather than
+/// counting a collapse as a run that stood (the hostile pass's 16 collapses read as none).
+#[test]
+fn a_table_without_status_says_its_collapses_cannot_be_told() {
+    let dir = tempdir();
+    let d = dir.path();
+    let mut t = String::from("record,pga_g,b1_peak_drift_ratio\n");
+    for r in 0..4 {
+        for (l, pga) in [0.2, 0.4, 0.6, 0.8].iter().enumerate() {
+            t.push_str(&format!("rec{r},{pga},{}\n", 0.002 * (l + 1 + r) as f64));
+        }
+    }
+    let p = write(d, "nostatus.csv", &t);
+    for args in [
+        vec![
+            "fragility",
+            "--edp",
+            "b1_peak_drift_ratio",
+            "--threshold",
+            "0.006",
+        ],
+        vec!["ida", "--edp", "b1_peak_drift_ratio"],
+    ] {
+        let out = d.join(format!("{}.csv", args[0]));
+        let mut a = vec![args[0].to_string(), s(&p)];
+        a.extend(args[1..].iter().map(|x| x.to_string()));
+        a.extend(["-o".to_string(), s(&out)]);
+        let a: Vec<&str> = a.iter().map(|x| x.as_str()).collect();
+        let r = pound(&a);
+        let said = format!(
+            "{}{}",
+            String::from_utf8_lossy(&r.stdout),
+            String::from_utf8_lossy(&r.stderr)
+        );
+        assert!(r.status.success(), "{said}");
+        assert!(
+            said.contains("has no `status` column") && said.contains("runs that collapsed"),
+            "{}: {said}",
+            args[0]
+        );
+    }
+    // With the column, no such notice.
+    let with = write(
+        d,
+        "status.csv",
+        &t.replacen("b1_peak_drift_ratio\n", "b1_peak_drift_ratio,status\n", 1)
+            .lines()
+            .enumerate()
+            .map(|(i, l)| {
+                if i == 0 {
+                    l.to_string()
+                } else {
+                    format!("{l},ok")
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n"),
+    );
+    let r = pound(&[
+        "fragility",
+        &s(&with),
+        "--edp",
+        "b1_peak_drift_ratio",
+        "--threshold",
+        "0.006",
+        "-o",
+        &s(&d.join("w.csv")),
+    ]);
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&r.stdout),
+        String::from_utf8_lossy(&r.stderr)
+    );
+    assert!(
+        r.status.success() && !said.contains("no `status`"),
+        "{said}"
+    );
 }
