@@ -23,6 +23,7 @@ mod gap_collapse;
 mod gpu;
 mod gpu_collapse;
 mod gpu_rows;
+mod gpu_stop;
 mod hard;
 mod hostile;
 mod im_columns;
