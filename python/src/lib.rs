@@ -322,8 +322,12 @@ enum Stopped {
 }
 
 impl From<pounding::engine::gpu::GpuError> for Stopped {
+    /// The GPU's answer to the raised stop flag is the interrupt, not a fault of the device.
     fn from(e: pounding::engine::gpu::GpuError) -> Self {
-        Stopped::Gpu(e)
+        match e {
+            pounding::engine::gpu::GpuError::Interrupted => Stopped::Interrupted,
+            e => Stopped::Gpu(e),
+        }
     }
 }
 
@@ -423,8 +427,8 @@ fn sweep<'py>(
             let report = match agg.as_deref_mut() {
                 // A pair's runs fold on the device: only the groups' partials come back.
                 Some(agg) if on_device => engine
-                    .summarise(plan, 0..runs, agg, tell)
-                    .map_err(Stopped::Gpu),
+                    .summarise_until(plan, 0..runs, stop, agg, tell)
+                    .map_err(Stopped::from),
                 _ => engine.sweep_until(
                     plan,
                     0..runs,

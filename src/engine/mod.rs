@@ -442,25 +442,39 @@ impl<'c> Engine<'c> {
         sink: impl FnMut(Chunk<'_>) -> Result<(), E>,
         progress: impl FnMut(u64),
     ) -> Result<Report, E> {
-        self.sweep_until(plan, runs, &cpu::NEVER, sink, progress)
+        self.sweep_watching(plan, runs, None, sink, progress)
     }
 
     /// [`Engine::sweep`] until `stop` is raised: on the CPU the sweep then ends within a run
-    /// per thread, the batch in flight dropped (the sink has had whole chunks, in run order);
-    /// the GPU finishes its chunk in flight (the sink may look at `stop` between chunks). The
-    /// caller, who raises the flag, knows the sweep stopped.
+    /// per thread, the batch in flight dropped, and returns as if done; on the GPU within a
+    /// dispatch (each sized to about 0.2 s while a flag is watched) or a run finished on the
+    /// host, with `GpuError::Interrupted`. Either way the sink has had whole chunks, in run
+    /// order, and the caller, who raises the flag, knows the sweep stopped.
     pub fn sweep_until<E: From<GpuError>>(
         &self,
         plan: &Plan,
         runs: Range<u64>,
         stop: &AtomicBool,
+        sink: impl FnMut(Chunk<'_>) -> Result<(), E>,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, E> {
+        self.sweep_watching(plan, runs, Some(stop), sink, progress)
+    }
+
+    /// [`Engine::sweep`], watching `stop` if there is one (None: the GPU's dispatches keep
+    /// their whole budget, as the command line runs them).
+    fn sweep_watching<E: From<GpuError>>(
+        &self,
+        plan: &Plan,
+        runs: Range<u64>,
+        stop: gpu::Stop<'_>,
         mut sink: impl FnMut(Chunk<'_>) -> Result<(), E>,
         progress: impl FnMut(u64),
     ) -> Result<Report, E> {
         let row = match plan {
             Plan::Pair(p) => {
                 let sink = |rows: &[_]| sink(Chunk::Pairs(p, rows));
-                return self.run_until(p, runs, stop, sink, progress);
+                return self.run_watching(p, runs, stop, sink, progress);
             }
             Plan::Row(r) => r,
         };
@@ -468,14 +482,15 @@ impl<'c> Engine<'c> {
         let (summary, gpu) = match self {
             Engine::Cpu { scheme, chunk } => {
                 debug_assert_eq!(*scheme, plan.scheme(), "the engine runs the plan's scheme");
+                let stop = stop.unwrap_or(&cpu::NEVER);
                 let summary = cpu::run_rows_until(row, runs, *chunk, stop, sink, progress)?;
                 (summary, GpuTimes::default())
             }
             Engine::Gpu { ctx, opts, chunk } if Kernel::of(plan) == Kernel::Pair => {
-                gpu::sweep::run_row_pairs(row, runs, ctx, opts, *chunk, sink, progress)?
+                gpu::sweep::run_row_pairs_until(row, runs, ctx, opts, *chunk, stop, sink, progress)?
             }
             Engine::Gpu { ctx, opts, chunk } => {
-                gpu::row::sweep_rows(ctx, row, runs, *chunk, opts, sink, progress)?
+                gpu::row::sweep_rows_until(ctx, row, runs, *chunk, opts, stop, sink, progress)?
             }
         };
         Ok(Report { summary, gpu })
@@ -491,11 +506,36 @@ impl<'c> Engine<'c> {
         agg: &mut Aggregator,
         progress: impl FnMut(u64),
     ) -> Result<Report, GpuError> {
+        self.summarise_watching(plan, runs, None, agg, progress)
+    }
+
+    /// [`Engine::summarise`] until `stop` is raised (as [`Engine::sweep_until`]; `agg` then
+    /// holds part of the runs).
+    pub fn summarise_until(
+        &self,
+        plan: &Plan,
+        runs: Range<u64>,
+        stop: &AtomicBool,
+        agg: &mut Aggregator,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, GpuError> {
+        self.summarise_watching(plan, runs, Some(stop), agg, progress)
+    }
+
+    fn summarise_watching(
+        &self,
+        plan: &Plan,
+        runs: Range<u64>,
+        stop: gpu::Stop<'_>,
+        agg: &mut Aggregator,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, GpuError> {
         match plan {
-            Plan::Pair(p) => self.fold(p, runs, agg, progress),
-            Plan::Row(_) => self.sweep(
+            Plan::Pair(p) => self.fold_watching(p, runs, stop, agg, progress),
+            Plan::Row(_) => self.sweep_watching(
                 plan,
                 runs,
+                stop,
                 |c: Chunk<'_>| -> Result<(), GpuError> {
                     c.fold_into(agg);
                     Ok(())
@@ -515,7 +555,7 @@ impl<'c> Engine<'c> {
         sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
         progress: impl FnMut(u64),
     ) -> Result<Report, E> {
-        self.run_until(plan, runs, &cpu::NEVER, sink, progress)
+        self.run_watching(plan, runs, None, sink, progress)
     }
 
     /// [`Engine::run`] until `stop` is raised (as [`Engine::sweep_until`]).
@@ -527,14 +567,31 @@ impl<'c> Engine<'c> {
         sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
         progress: impl FnMut(u64),
     ) -> Result<Report, E> {
+        self.run_watching(plan, runs, Some(stop), sink, progress)
+    }
+
+    fn run_watching<E: From<GpuError>>(
+        &self,
+        plan: &PairPlan,
+        runs: Range<u64>,
+        stop: gpu::Stop<'_>,
+        sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, E> {
         match self {
-            Engine::Cpu { scheme, chunk } => Ok(Report {
-                summary: cpu::run_range_until(plan, runs, scheme, *chunk, stop, sink, progress)?,
-                gpu: GpuTimes::default(),
-            }),
+            Engine::Cpu { scheme, chunk } => {
+                let stop = stop.unwrap_or(&cpu::NEVER);
+                Ok(Report {
+                    summary: cpu::run_range_until(
+                        plan, runs, scheme, *chunk, stop, sink, progress,
+                    )?,
+                    gpu: GpuTimes::default(),
+                })
+            }
             Engine::Gpu { ctx, opts, chunk } => {
-                let (summary, gpu) =
-                    gpu::sweep::run_range(plan, runs, ctx, opts, *chunk, sink, progress)?;
+                let (summary, gpu) = gpu::sweep::run_range_until(
+                    plan, runs, ctx, opts, *chunk, stop, sink, progress,
+                )?;
                 Ok(Report { summary, gpu })
             }
         }
@@ -549,10 +606,22 @@ impl<'c> Engine<'c> {
         agg: &mut Aggregator,
         progress: impl FnMut(u64),
     ) -> Result<Report, GpuError> {
+        self.fold_watching(plan, runs, None, agg, progress)
+    }
+
+    fn fold_watching(
+        &self,
+        plan: &PairPlan,
+        runs: Range<u64>,
+        stop: gpu::Stop<'_>,
+        agg: &mut Aggregator,
+        progress: impl FnMut(u64),
+    ) -> Result<Report, GpuError> {
         match self {
-            Engine::Cpu { .. } => self.run(
+            Engine::Cpu { .. } => self.run_watching(
                 plan,
                 runs,
+                stop,
                 |rows: &[(RunSpec, RunOutput)]| -> Result<(), GpuError> {
                     agg.add_rows(plan, rows);
                     Ok(())
@@ -560,13 +629,14 @@ impl<'c> Engine<'c> {
                 progress,
             ),
             Engine::Gpu { ctx, opts, chunk } => {
-                let (summary, gpu) = gpu::fold::fold_range(
+                let (summary, gpu) = gpu::fold::fold_range_until(
                     plan,
                     runs,
                     ctx,
                     opts,
                     *chunk,
                     gpu::reduce::DEFAULT_SLOTS,
+                    stop,
                     agg,
                     progress,
                 )?;

@@ -24,6 +24,7 @@ mod gap_threshold;
 mod gpu;
 mod gpu_collapse;
 mod gpu_rows;
+mod gpu_stop;
 mod hard;
 mod hostile;
 mod idle_axes;

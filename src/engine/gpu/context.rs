@@ -29,6 +29,10 @@ pub enum GpuError {
     DeviceLost { reason: String },
     #[error("GPU error: {message}; run with --backend cpu")]
     Other { message: String },
+    /// The caller raised the stop flag it watches ([`crate::engine::Engine::sweep_until`]):
+    /// not a fault; the command line never raises it.
+    #[error("stopped: the sweep's stop flag was raised")]
+    Interrupted,
 }
 
 /// One adapter as `pound gpu info` lists it.

@@ -22,12 +22,29 @@ pub fn fold_range(
     chunk: usize,
     max_slots: u32,
     agg: &mut Aggregator,
+    progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), super::GpuError> {
+    fold_range_until(plan, runs, ctx, opts, chunk, max_slots, None, agg, progress)
+}
+
+/// [`fold_range`] watching `stop` (as [`super::sweep::run_range_until`]): `Err(Interrupted)`
+/// once it is raised, `agg` then holding part of the runs.
+#[allow(clippy::too_many_arguments)]
+pub fn fold_range_until(
+    plan: &PairPlan,
+    runs: std::ops::Range<u64>,
+    ctx: &super::GpuContext,
+    opts: &super::GpuOptions,
+    chunk: usize,
+    max_slots: u32,
+    stop: super::Stop<'_>,
+    agg: &mut Aggregator,
     mut progress: impl FnMut(u64),
 ) -> Result<(Summary, GpuTimes), super::GpuError> {
     use super::layout::{Segment, MAX_SEGMENT};
     use super::reduce::{reduce, Slots};
     use super::sweep::{pack_chunk, upload_records};
-    use super::{integrate, run_chunk};
+    use super::{integrate_until, run_chunk_until};
     let start = Instant::now();
     let mut times = GpuTimes::default();
     let (recs, chunk) = upload_records(plan, ctx, opts, chunk)?;
@@ -83,14 +100,14 @@ pub fn fold_range(
         let Some(slot) = slots.assign(ctx, &p.groups, agg)? else {
             // More groups than slots: read every run back and fold here.
             let (done, upcoming) = rayon::join(
-                || run_chunk(ctx, &recs, &p.packed, opts),
+                || run_chunk_until(ctx, &recs, &p.packed, opts, stop),
                 || (c1 < end).then(|| prep(c1, &mut *agg)),
             );
             next = upcoming;
             let (outs, ct) = done?;
             times.add_chunk(&ct);
             times.host_folded_chunks += 1;
-            let outs = times.finish(plan, &opts.fast, outs, |k| &p.specs[p.order[k]]);
+            let outs = times.finish(plan, &opts.fast, outs, |k| &p.specs[p.order[k]], stop)?;
             for (&i, o) in p.order.iter().zip(&outs) {
                 agg.add(p.gids[i], o);
                 s.count(o);
@@ -111,7 +128,7 @@ pub fn fold_range(
             .collect();
         let (done, upcoming) = rayon::join(
             || -> Result<_, super::GpuError> {
-                let (done, ct) = integrate(ctx, &recs, &p.packed, opts)?;
+                let (done, ct) = integrate_until(ctx, &recs, &p.packed, opts, stop)?;
                 let t = Instant::now();
                 let folded = reduce(ctx, &done, opts.precision, &segs, &thresholds, &slots)?;
                 Ok((ct, folded, t.elapsed().as_secs_f64()))
@@ -128,9 +145,13 @@ pub fn fold_range(
         }
         // Runs handed back: `handed` holds their places in the packed (sorted) chunk.
         let run = |k: usize| p.order[handed[k] as usize];
-        let outs = times.finish(plan, &opts.fast, vec![None; handed.len()], |k| {
-            &p.specs[run(k)]
-        });
+        let outs = times.finish(
+            plan,
+            &opts.fast,
+            vec![None; handed.len()],
+            |k| &p.specs[run(k)],
+            stop,
+        )?;
         for (k, o) in outs.iter().enumerate() {
             agg.add(p.gids[run(k)], o);
             s.count(o);

@@ -23,8 +23,8 @@ pub mod sweep;
 
 pub use context::{GpuContext, GpuError};
 pub use run::{
-    integrate, output, pack, read_outputs, run_chunk, ChunkTimes, GpuOptions, GpuRecords,
-    Integrated, PackedChunk,
+    integrate, integrate_until, output, pack, read_outputs, run_chunk, run_chunk_until, ChunkTimes,
+    GpuOptions, GpuRecords, Integrated, PackedChunk, Stop,
 };
 pub use shader::Precision;
 pub use sweep::GpuTimes;

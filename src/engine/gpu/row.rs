@@ -12,8 +12,8 @@
 use super::context::{GpuContext, GpuError};
 use super::layout::{MODE_FREE, STATUS_COLLAPSE, STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK};
 use super::run::{
-    bind_group, read, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions, GpuRecords,
-    WorkLists,
+    bind_group, check_stop, read, stopped, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions,
+    GpuRecords, Stop, WorkLists,
 };
 use super::shader::Precision;
 use super::sweep::GpuTimes;
@@ -1302,16 +1302,18 @@ pub fn run_rows(
     chunk: &PackedRows,
     opts: &GpuOptions,
 ) -> Result<(Vec<Option<RowOutput>>, ChunkTimes), GpuError> {
-    let (ends, times) = integrate_rows(ctx, recs, chunk, opts)?;
+    let (ends, times) = integrate_rows(ctx, recs, chunk, opts, None)?;
     Ok((ends.into_iter().map(Ended::output).collect(), times))
 }
 
-/// [`run_rows`], each run's end as the kernel left it.
+/// [`run_rows`], each run's end as the kernel left it; `stop` watched between dispatches
+/// (`Err(Interrupted)` once raised).
 fn integrate_rows(
     ctx: &GpuContext,
     recs: &GpuRecords,
     chunk: &PackedRows,
     opts: &GpuOptions,
+    stop: Stop<'_>,
 ) -> Result<(Vec<Ended>, ChunkTimes), GpuError> {
     let mut times = ChunkTimes::default();
     let n = chunk.runs;
@@ -1386,7 +1388,7 @@ fn integrate_rows(
         .units_per_dispatch
         .max(1)
         .min(unit_cap(ctx, cap.min(u32::MAX as u64) as u32));
-    lists.run("row", ctx, &kernel, &binds, budget, opts, &mut times)?;
+    lists.run("row", ctx, &kernel, &binds, budget, opts, stop, &mut times)?;
     let t = Instant::now();
     let sbytes = read(ctx, &states)?;
     let cbytes = read(ctx, &counters)?;
@@ -1503,6 +1505,23 @@ pub fn sweep_rows<E: From<GpuError>>(
     runs: std::ops::Range<u64>,
     chunk: usize,
     opts: &GpuOptions,
+    sink: impl FnMut(&[(RowRunSpec, RowOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), E> {
+    sweep_rows_until(ctx, plan, runs, chunk, opts, None, sink, progress)
+}
+
+/// [`sweep_rows`] watching `stop`: looked at before each dispatch, before each run's model is
+/// built for the next chunk and before each run taken again on the CPU; `Err(Interrupted)` once
+/// it is raised (the sink has had whole chunks, in run order).
+#[allow(clippy::too_many_arguments)]
+pub fn sweep_rows_until<E: From<GpuError>>(
+    ctx: &GpuContext,
+    plan: &RowPlan,
+    runs: std::ops::Range<u64>,
+    chunk: usize,
+    opts: &GpuOptions,
+    stop: Stop<'_>,
     mut sink: impl FnMut(&[(RowRunSpec, RowOutput)]) -> Result<(), E>,
     mut progress: impl FnMut(u64),
 ) -> Result<(Summary, GpuTimes), E> {
@@ -1526,32 +1545,38 @@ pub fn sweep_rows<E: From<GpuError>>(
         let t = Instant::now();
         let end = (first + chunk).min(runs.end);
         let specs: Vec<RowRunSpec> = (first..end).into_par_iter().map(|i| plan.run(i)).collect();
-        let (models, blocks): (Vec<RowModel>, Vec<Vec<Vec<f64>>>) = specs
+        // Stopped while the device integrates the chunk before: the rest left unbuilt.
+        let built: Option<Vec<(RowModel, Vec<Vec<f64>>)>> = specs
             .par_iter()
             .map(|s| {
+                if stopped(stop) {
+                    return None;
+                }
                 let m = RowModel::new(&plan.row(s));
                 let b = model_blocks(&m, plan.forcing(s).dt);
-                (m, b)
+                Some((m, b))
             })
-            .unzip();
+            .collect();
+        let (models, blocks): (Vec<RowModel>, Vec<Vec<Vec<f64>>>) =
+            built.ok_or(GpuError::Interrupted)?.into_iter().unzip();
         let mut packed = PackedRows::new(shape.clone());
         for ((s, m), b) in specs.iter().zip(&models).zip(blocks) {
             let forcing = plan.forcing(s);
             packed.push_with_blocks(m, &forcing, s.contact.record, &recs, &opts.fast, b);
         }
-        (specs, models, packed, t.elapsed().as_secs_f64())
+        Ok((specs, models, packed, t.elapsed().as_secs_f64()))
     };
     let mut first = runs.start;
-    let mut next = Some(prep(first));
+    let mut next = Some(prep(first)?);
     while let Some((specs, models, packed, pack_s)) = next.take() {
         let end = first + specs.len() as u64;
         times.pack += pack_s;
         let (done, upcoming) = rayon::join(
-            || integrate_rows(ctx, &recs, &packed, opts),
+            || integrate_rows(ctx, &recs, &packed, opts, stop),
             || (end < runs.end).then(|| prep(end)),
         );
-        next = upcoming;
         let (outs, ct) = done?;
+        next = upcoming.transpose()?;
         times.add_chunk(&ct);
         let t = Instant::now();
         times.handed_off += outs
@@ -1563,7 +1588,7 @@ pub fn sweep_rows<E: From<GpuError>>(
             .into_par_iter()
             .zip(outs)
             .zip(&models)
-            .map(|((s, o), m)| {
+            .map(|((s, o), m)| -> Result<_, GpuError> {
                 // The kernel has no collapse event: it ends a run once a building's peak drift
                 // ratio reaches the limit (`Ended::Collapse`), and the CPU runs it again and
                 // ends it at the collapse. The kernel's test is this one (the limit rounded up
@@ -1573,10 +1598,16 @@ pub fn sweep_rows<E: From<GpuError>>(
                         .iter()
                         .all(|b| b.peak_drift_ratio < plan.collapse_drift_ratio)
                 });
-                let o = o.unwrap_or_else(|| simulate_row(m, &plan.forcing(&s), m.at_rest(), &cpu));
-                (s, o)
+                let o = match o {
+                    Some(o) => o,
+                    None => {
+                        check_stop(stop)?;
+                        simulate_row(m, &plan.forcing(&s), m.at_rest(), &cpu)
+                    }
+                };
+                Ok((s, o))
             })
-            .collect();
+            .collect::<Result<_, GpuError>>()?;
         times.handoff += t.elapsed().as_secs_f64();
         for (_, o) in &rows {
             summary.count_row(o);

@@ -12,7 +12,35 @@ use crate::physics::contact::LawKind;
 use crate::physics::model::{EnergyBalance, Forcing, Oscillator, Pair, RunOutput, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
 use crate::physics::solver::FastOptions;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+
+/// A stop flag a GPU path watches (between dispatches, and between the runs it finishes on the
+/// host), or None: never stopped, dispatches of the whole budget (the command line).
+pub type Stop<'a> = Option<&'a AtomicBool>;
+
+/// Has the watched flag been raised?
+pub(crate) fn stopped(stop: Stop<'_>) -> bool {
+    stop.is_some_and(|s| s.load(Ordering::Relaxed))
+}
+
+/// `Err(Interrupted)` once the watched flag is raised.
+pub(crate) fn check_stop(stop: Stop<'_>) -> Result<(), GpuError> {
+    match stopped(stop) {
+        true => Err(GpuError::Interrupted),
+        false => Ok(()),
+    }
+}
+
+/// While a stop is watched, the time one dispatch is sized to take, s: a software adapter runs
+/// a chunk's dispatch of the whole budget for seconds (lavapipe: about 4 s on
+/// `configs/fragility-sa.toml`), and the flag is looked at between dispatches. The budget only
+/// splits a run's work between dispatches (the kernels save and resume every state: tests
+/// `gpu_chunking_does_not_change_results`, `row_kernel_resumes_between_dispatches`), so the
+/// results do not change.
+const WATCHED_DISPATCH_S: f64 = 0.2;
+/// While a stop is watched, the first dispatch's budget (then sized by the time the last took).
+const WATCHED_FIRST_BUDGET: u32 = 4;
 
 /// Settings of the GPU path.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -415,11 +443,22 @@ pub fn run_chunk(
     chunk: &PackedChunk,
     opts: &GpuOptions,
 ) -> Result<(Vec<Option<RunOutput>>, ChunkTimes), GpuError> {
+    run_chunk_until(ctx, recs, chunk, opts, None)
+}
+
+/// [`run_chunk`] watching `stop` ([`integrate_until`]).
+pub fn run_chunk_until(
+    ctx: &GpuContext,
+    recs: &GpuRecords,
+    chunk: &PackedChunk,
+    opts: &GpuOptions,
+    stop: Stop<'_>,
+) -> Result<(Vec<Option<RunOutput>>, ChunkTimes), GpuError> {
     let runs = &chunk.runs[..];
     if runs.is_empty() {
         return Ok((Vec::new(), ChunkTimes::default()));
     }
-    let (done, mut times) = integrate(ctx, recs, chunk, opts)?;
+    let (done, mut times) = integrate_until(ctx, recs, chunk, opts, stop)?;
     let t = Instant::now();
     let out = read_outputs(ctx, &done, runs, opts, chunk.accel)?;
     times.readback = t.elapsed();
@@ -440,6 +479,18 @@ pub fn integrate(
     recs: &GpuRecords,
     chunk: &PackedChunk,
     opts: &GpuOptions,
+) -> Result<(Integrated, ChunkTimes), GpuError> {
+    integrate_until(ctx, recs, chunk, opts, None)
+}
+
+/// [`integrate`] watching `stop`: looked at before each dispatch, each dispatch then sized to
+/// take about [`WATCHED_DISPATCH_S`]; `Err(Interrupted)` once it is raised.
+pub fn integrate_until(
+    ctx: &GpuContext,
+    recs: &GpuRecords,
+    chunk: &PackedChunk,
+    opts: &GpuOptions,
+    stop: Stop<'_>,
 ) -> Result<(Integrated, ChunkTimes), GpuError> {
     let runs = &chunk.runs[..];
     let mut times = ChunkTimes::default();
@@ -544,7 +595,7 @@ pub fn integrate(
         .units_per_dispatch
         .max(1)
         .min(unit_cap(ctx, CPU_ADAPTER_BUDGET));
-    lists.run("fast", ctx, &kernel, &binds, budget, opts, &mut times)?;
+    lists.run("fast", ctx, &kernel, &binds, budget, opts, stop, &mut times)?;
     Ok((
         Integrated {
             states,
@@ -613,6 +664,8 @@ impl WorkLists {
 
     /// Dispatch `kernel` over the active runs, `budget` units each, until none is left; `binds`
     /// read list a (b) and write list b (a). Adds the kernel time and lane tally to `times`.
+    /// With a `stop` watched, it is looked at before each dispatch (`Err(Interrupted)`), and
+    /// each dispatch's budget (at most `budget`) is sized to take [`WATCHED_DISPATCH_S`].
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
@@ -622,12 +675,17 @@ impl WorkLists {
         binds: &[wgpu::BindGroup; 2],
         budget: u32,
         opts: &GpuOptions,
+        stop: Stop<'_>,
         times: &mut ChunkTimes,
     ) -> Result<(), GpuError> {
         let t = Instant::now();
         let n = (self.ids[0].size() / 4) as u32;
+        let budget = budget.max(1);
         let mut d = Dispatch {
-            budget,
+            budget: match stop {
+                Some(_) => budget.min(WATCHED_FIRST_BUDGET),
+                None => budget,
+            },
             nactive: n,
             max_substeps_per_step: opts.fast.max_substeps_per_step,
             max_substeps: opts.fast.max_substeps,
@@ -641,6 +699,8 @@ impl WorkLists {
             mapped_at_creation: false,
         });
         for parity in (0..2).cycle() {
+            check_stop(stop)?;
+            let td = Instant::now();
             ctx.queue
                 .write_buffer(&self.uniform, 0, bytemuck::bytes_of(&d));
             ctx.queue.write_buffer(&self.tally, 0, &[0; TALLY_BYTES]);
@@ -657,6 +717,13 @@ impl WorkLists {
             times.lane_slots += word(2) as u64;
             if d.nactive == 0 {
                 break;
+            }
+            if stop.is_some() {
+                // The next dispatch's budget in proportion to the time this one's took, grown
+                // at most 4x at a time (its units may cost more: contacts, substeps).
+                let took = td.elapsed().as_secs_f64().max(1e-6);
+                let scale = (WATCHED_DISPATCH_S / took).min(4.0);
+                d.budget = ((d.budget as f64 * scale) as u32).clamp(1, budget);
             }
         }
         times.kernel += t.elapsed();

@@ -111,21 +111,28 @@ impl GpuTimes {
     }
 
     /// A chunk's outputs as read back, with the runs the kernel handed back finished on the CPU
-    /// in f64 (`spec(k)` is the run of `outs[k]`).
+    /// in f64 (`spec(k)` is the run of `outs[k]`); `Err(Interrupted)` if `stop` is raised
+    /// (looked at before each run finished here).
     pub(crate) fn finish<'a>(
         &mut self,
         plan: &dyn PairRuns,
         fast: &crate::physics::solver::FastOptions,
         outs: Vec<Option<RunOutput>>,
         spec: impl Fn(usize) -> &'a RunSpec + Sync,
-    ) -> Vec<RunOutput> {
+        stop: super::Stop<'_>,
+    ) -> Result<Vec<RunOutput>, super::GpuError> {
         let t = Instant::now();
         self.handed_off += outs.iter().filter(|o| o.is_none()).count() as u64;
         let done = outs
             .into_par_iter()
             .enumerate()
-            .map(|(k, o)| o.unwrap_or_else(|| plan.run_on_cpu(spec(k), fast)))
-            .collect();
+            .map(|(k, o)| match o {
+                Some(o) => Some(o),
+                None if super::run::stopped(stop) => None,
+                None => Some(plan.run_on_cpu(spec(k), fast)),
+            })
+            .collect::<Option<Vec<_>>>()
+            .ok_or(super::GpuError::Interrupted);
         self.handoff += t.elapsed().as_secs_f64();
         done
     }
@@ -198,26 +205,47 @@ pub fn run_row_pairs<E: From<super::GpuError>>(
     ctx: &super::GpuContext,
     opts: &super::GpuOptions,
     chunk: usize,
+    sink: impl FnMut(&[(RowSpec, RowOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), E> {
+    run_row_pairs_until(plan, runs, ctx, opts, chunk, None, sink, progress)
+}
+
+/// [`run_row_pairs`] watching `stop` (as [`run_range_until`]; also before each run taken again
+/// on the CPU's row kernel).
+#[allow(clippy::too_many_arguments)]
+pub fn run_row_pairs_until<E: From<super::GpuError>>(
+    plan: &RowPlan,
+    runs: std::ops::Range<u64>,
+    ctx: &super::GpuContext,
+    opts: &super::GpuOptions,
+    chunk: usize,
+    stop: super::Stop<'_>,
     mut sink: impl FnMut(&[(RowSpec, RowOutput)]) -> Result<(), E>,
     progress: impl FnMut(u64),
 ) -> Result<(Summary, GpuTimes), E> {
     let mut summary = Summary::default();
     let pairs = RowPairs(plan);
-    let (s, times) = run_range(
+    let (s, times) = run_range_until(
         &pairs,
         runs,
         ctx,
         opts,
         chunk,
+        stop,
         |done: &[(RunSpec, RunOutput)]| {
             let rows: Vec<(RowSpec, RowOutput)> = done
                 .par_iter()
                 .map(|(p, o)| {
+                    if super::run::stopped(stop) {
+                        return None;
+                    }
                     let spec = plan.run(p.index);
                     let out = crate::engine::cpu::row_of_pair(plan, &spec, o, &opts.fast);
-                    (spec, out)
+                    Some((spec, out))
                 })
-                .collect();
+                .collect::<Option<_>>()
+                .ok_or(super::GpuError::Interrupted)?;
             for (_, o) in &rows {
                 summary.count_row(o);
             }
@@ -240,6 +268,23 @@ pub fn run_range<E: From<super::GpuError>>(
     ctx: &super::GpuContext,
     opts: &super::GpuOptions,
     chunk: usize,
+    sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<(Summary, GpuTimes), E> {
+    run_range_until(plan, runs, ctx, opts, chunk, None, sink, progress)
+}
+
+/// [`run_range`] watching `stop`: looked at before each dispatch ([`super::integrate_until`])
+/// and before each run finished on the CPU; `Err(Interrupted)` once it is raised (the sink
+/// has had whole chunks, in run order).
+#[allow(clippy::too_many_arguments)]
+pub fn run_range_until<E: From<super::GpuError>>(
+    plan: &dyn PairRuns,
+    runs: std::ops::Range<u64>,
+    ctx: &super::GpuContext,
+    opts: &super::GpuOptions,
+    chunk: usize,
+    stop: super::Stop<'_>,
     mut sink: impl FnMut(&[(RunSpec, RunOutput)]) -> Result<(), E>,
     mut progress: impl FnMut(u64),
 ) -> Result<(Summary, GpuTimes), E> {
@@ -255,23 +300,25 @@ pub fn run_range<E: From<super::GpuError>>(
             .into_par_iter()
             .map(|i| plan.run(i))
             .collect();
+        // Stopped while the device integrates the chunk before: left unpacked.
+        super::run::check_stop(stop)?;
         let refs: Vec<&RunSpec> = specs.iter().collect();
         let packed = pack_chunk(plan, &refs, ctx, &recs, opts);
-        (specs, packed, t.elapsed().as_secs_f64())
+        Ok((specs, packed, t.elapsed().as_secs_f64()))
     };
     let mut c0 = runs.start;
-    let mut next = (c0 < n).then(|| prep(c0));
+    let mut next = (c0 < n).then(|| prep(c0)).transpose()?;
     while let Some((specs, packed, pack_s)) = next.take() {
         let c1 = (c0 + chunk).min(n);
         times.pack += pack_s;
         let (done, upcoming) = rayon::join(
-            || super::run_chunk(ctx, &recs, &packed, opts),
+            || super::run_chunk_until(ctx, &recs, &packed, opts, stop),
             || (c1 < n).then(|| prep(c1)),
         );
-        next = upcoming;
         let (outs, ct) = done?;
+        next = upcoming.transpose()?;
         times.add_chunk(&ct);
-        let outs = times.finish(plan, &opts.fast, outs, |k| &specs[k]);
+        let outs = times.finish(plan, &opts.fast, outs, |k| &specs[k], stop)?;
         let rows: Vec<(RunSpec, RunOutput)> = specs.into_iter().zip(outs).collect();
         let t = Instant::now();
         for (_, o) in &rows {
