@@ -451,7 +451,10 @@ def gap(config: Config, *, threads: Optional[int] = None) -> Table:
 def _named_once(table: Any) -> None:
     """A DataFrame naming a column twice is refused naming it, as a CSV or an Arrow table is
     (pandas' own conversion would raise a ValueError naming every column)."""
-    columns = getattr(table, "columns", None)
+    # pyarrow's `columns` are the arrays; its names are `column_names` (pandas, polars: `columns`).
+    columns = getattr(table, "column_names", None)
+    if columns is None:
+        columns = getattr(table, "columns", None)
     if columns is None or isinstance(columns, str) or not isinstance(columns, Iterable):
         return
     names = [str(c) for c in columns]

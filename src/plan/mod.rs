@@ -530,7 +530,7 @@ pub(crate) fn check_axis(
     expected: &str,
 ) -> Result<(), PlanError> {
     if values.is_empty() {
-        return Err(err(key, "is empty: give at least one value"));
+        return Err(err(key, "is missing or empty: give at least one value"));
     }
     for (i, &v) in values.iter().enumerate() {
         if !ok(v) {

@@ -723,6 +723,13 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
             )
         })
         .collect();
+    if ida.curves.len() == 1 {
+        // Fractiles across one curve are that curve: no spread across records to read.
+        t.note(format_args!(
+            "notice: one curve ({}): its 16, 50 and 84 % fractiles are its own demands, with no spread across records; an IDA's fractiles need several curves (records, or the columns --by names)",
+            ida.curves[0].0
+        ));
+    }
     if !short.is_empty() {
         t.note(format_args!(
             "notice: not every curve has a value at each level of {}: {}; the fractiles there are over the runs with a value",

@@ -165,7 +165,7 @@ fn bad_configs_name_the_key() {
         (
             "k_n_per_m = [1e8, 1e9]",
             "k_n_per_m = []",
-            "contact.k_n_per_m: is empty",
+            "contact.k_n_per_m: is missing or empty",
         ),
         (
             "pga_g = [0.2, 0.4]",

@@ -41,3 +41,65 @@ fn spectrum_names_its_damping_in_per_cent_as_typed() {
         "{text}"
     );
 }
+
+/// An IDA over one curve says its fractiles are that curve's demands (all three equal), not a
+/// spread across records.
+#[test]
+fn an_ida_of_one_curve_says_its_fractiles_have_no_spread() {
+    let d = tempdir();
+    let table = d.path().join("one.csv");
+    let mut t = String::from("record,pga_g,status,b1_peak_drift_ratio\n");
+    for (l, pga) in [0.2, 0.4, 0.6].iter().enumerate() {
+        t.push_str(&format!("only,{pga},ok,{}\n", 0.003 * (l + 1) as f64));
+    }
+    std::fs::write(&table, t).unwrap();
+    let out = d.path().join("ida.csv");
+    let r = pound(&[
+        "ida",
+        table.to_str().unwrap(),
+        "--edp",
+        "b1_peak_drift_ratio",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let said = format!(
+        "{}{}",
+        String::from_utf8_lossy(&r.stdout),
+        String::from_utf8_lossy(&r.stderr)
+    );
+    assert!(r.status.success(), "{said}");
+    assert!(said.contains("notice: one curve (only)"), "{said}");
+}
+
+/// A key a law needs that the config leaves out is called missing, not "empty".
+#[test]
+fn a_missing_contact_key_is_called_missing() {
+    let d = tempdir();
+    let cfg = d.path().join("nobeta.toml");
+    std::fs::write(
+        &cfg,
+        r#"
+[building1]
+mass_kg = 1.0e5
+period_s = 0.3
+damping_ratio = 0.05
+[building2]
+mass_kg = 1.0e5
+period_s = 0.6
+damping_ratio = 0.05
+[contact]
+law = "hertz"
+gap_m = 0.01
+[[record]]
+synthetic = { seed = 1, duration_s = 2.0 }
+"#,
+    )
+    .unwrap();
+    let r = pound(&["sweep", cfg.to_str().unwrap(), "-o", "-"]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success(), "{err}");
+    assert!(
+        err.contains("contact.beta_n_per_m1_5: is missing or empty"),
+        "{err}"
+    );
+}
