@@ -16,12 +16,12 @@ from conftest import CONFIGS, REPO
 # (call, config): each runs for longer than the signal's delay, one run or response at a time
 # well under the bound (python/tests measures each: README, "Python").
 LONG_CALLS = [
+    # On one thread these last 1.9 s to 2.5 s on an idle two-core machine; the other shipped
+    # configs end within 0.9 s there (row-of-five 0.8 s, floor-column 0.6 s, gap-study's gap
+    # study 0.6 s), inside the bound whatever Ctrl-C does.
     ("sweep", "collapse-fragility.toml"),
     ("gap", "collapse-fragility.toml"),
     ("sweep", "fragility-sa.toml"),
-    ("sweep", "row-of-five.toml"),
-    ("sweep", "floor-column.toml"),
-    ("gap", "gap-study.toml"),
     # A study of a table takes no stop flag: the call answers Ctrl-C at once, its work dropped.
     ("fragility", "inelastic-fragility.toml"),
     # On the GPU (CI: lavapipe) each of these is one chunk, which took 5.6 s to 8.3 s to stop
@@ -47,6 +47,9 @@ SETUP = {"fragility": 'runs = pounding.sweep(config, backend="cpu", progress=Fal
 
 # SIGINT this long after the call starts; the bound README states.
 DELAY_S = 0.3
+# The GPU's first dispatch waits for its kernel to be built (lavapipe: up to seconds for a row
+# kernel), which no stop cuts short: its calls are signalled once it runs.
+DELAY_GPU_S = 1.0
 BOUND_S = 2.0
 
 
@@ -76,7 +79,7 @@ def test_sigint_stops_a_long_call_within_the_bound(call, config):
     )
     try:
         assert proc.stdout.readline().strip() == "started"
-        time.sleep(DELAY_S)
+        time.sleep(DELAY_GPU_S if call.endswith("-gpu") else DELAY_S)
         assert proc.poll() is None, f"{call} on {config} ended before it could be interrupted"
         sent = time.monotonic()
         proc.send_signal(signal.SIGINT)
