@@ -67,6 +67,58 @@ fn config_err(e: config::ConfigError) -> PyErr {
     }
 }
 
+/// [`config_err`] of a config read from `text` at `path`. A dict's TOML is written here, so a
+/// parse error's line and column point into text the user never saw: the error names the key
+/// instead (`<config dict>: building1.period_s: invalid type: a list, expected a number`).
+fn config_err_in(e: config::ConfigError, text: &str, path: &Path) -> PyErr {
+    let message = e.to_string();
+    if path != Path::new(DICT) {
+        return config_err(e);
+    }
+    let Some(line) = message
+        .split("TOML parse error at line ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .and_then(|n| n.trim().parse::<usize>().ok())
+    else {
+        return config_err(e);
+    };
+    let reason = message
+        .lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| !l.is_empty())
+        .unwrap_or("");
+    ConfigError::new_err(match dict_key_at(text, line) {
+        Some(key) => format!("{DICT}: {key}: {reason}"),
+        None => format!("{DICT}: {reason}"),
+    })
+}
+
+/// The name of a dict config's TOML text.
+const DICT: &str = "<config dict>";
+
+/// The dotted key (`building1.period_s`, `record[1].synthetic`) that line `line` (1-based) of a
+/// dict config's TOML sets, from the table headers above it.
+fn dict_key_at(text: &str, line: usize) -> Option<String> {
+    let lines: Vec<&str> = text.lines().collect();
+    let here = lines.get(line.checked_sub(1)?)?.trim();
+    let key = here.split_once(" = ")?.0.trim().trim_matches('"');
+    let mut table = String::new();
+    for l in lines[..line - 1].iter().rev().map(|l| l.trim()) {
+        if let Some(name) = l.strip_prefix("[[").and_then(|r| r.strip_suffix("]]")) {
+            let index = lines[..line - 1].iter().filter(|x| x.trim() == l).count() - 1;
+            table = format!("{name}[{index}].");
+            break;
+        }
+        if let Some(name) = l.strip_prefix('[').and_then(|r| r.strip_suffix(']')) {
+            table = format!("{name}.");
+            break;
+        }
+    }
+    Some(format!("{table}{key}"))
+}
+
 /// The engine's refusal: of the device (none found, a scene it does not take) or of a setting.
 fn engine_err(e: pounding::engine::EngineError) -> PyErr {
     use pounding::engine::EngineError as E;
@@ -94,7 +146,7 @@ fn config_text(config: &Bound<'_, PyAny>, kind: &str) -> PyResult<(String, PathB
             let table = toml_table(config.cast::<PyDict>()?, "")?;
             let text = toml::to_string(&table)
                 .map_err(|e| ConfigError::new_err(format!("<config dict>: {e}")))?;
-            Ok((text, PathBuf::from("<config dict>")))
+            Ok((text, PathBuf::from(DICT)))
         }
         other => Err(settings_err(format!(
             "config kind `{other}`: expected path, text or dict"
@@ -369,7 +421,7 @@ fn sweep<'py>(
         ));
     }
     let pool = pool(threads)?;
-    let mut plan = config::load_text(&text, &path).map_err(config_err)?;
+    let mut plan = config::load_text(&text, &path).map_err(|e| config_err_in(e, &text, &path))?;
     let settled = SchemeSettings {
         scheme: scheme_of(scheme)?,
         energy,
@@ -521,7 +573,7 @@ fn columns(config: Option<&Bound<'_, PyAny>>, config_kind: &str) -> PyResult<Tab
         Some(c) => {
             let (text, path) = config_text(c, config_kind)?;
             config::load_text(&text, &path)
-                .map_err(config_err)?
+                .map_err(|e| config_err_in(e, &text, &path))?
                 .header()
         }
         None => pounding::plan::columns::header()
@@ -566,7 +618,7 @@ fn trace(
     run: u64,
 ) -> PyResult<(Table, Table)> {
     let (text, path) = config_text(config, config_kind)?;
-    let plan = config::load_text(&text, &path).map_err(config_err)?;
+    let plan = config::load_text(&text, &path).map_err(|e| config_err_in(e, &text, &path))?;
     let t = run_detached(py, move || {
         pounding::studies::trace::trace(&plan, run).map_err(|e| e.to_string())
     })?
@@ -594,7 +646,8 @@ fn gap(
     use pounding::studies::gap::GapStudy;
     let (text, path) = config_text(config, config_kind)?;
     let pool = pool(threads)?;
-    let plan = config::load_text_for_gaps(&text, &path).map_err(config_err)?;
+    let plan =
+        config::load_text_for_gaps(&text, &path).map_err(|e| config_err_in(e, &text, &path))?;
     if let Some(why) = GapStudy::refusal(&plan) {
         return Err(settings_err(format!("{}: {why}", path.display())));
     }

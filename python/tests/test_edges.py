@@ -232,3 +232,24 @@ def test_an_empty_name_is_a_settings_error_naming_the_keyword(name):
         kwargs.pop("thresholds")
     with pytest.raises(pounding.SettingsError, match=rf"^{name}="):
         pounding.fragility(runs, **kwargs)
+
+
+def test_a_dict_configs_error_names_the_key_not_a_line_of_generated_toml():
+    # The dict's TOML is written by the package: its line and column mean nothing to the user.
+    base = {
+        "building1": {"mass_kg": 1e5, "period_s": 0.3, "damping_ratio": 0.05},
+        "building2": {"mass_kg": 1e5, "period_s": 0.6, "damping_ratio": 0.05},
+        "contact": {"law": "linear", "k_n_per_m": 1e9, "gap_m": 0.01},
+        "record": [{"synthetic": {"seed": 1, "duration_s": 2.0}}],
+    }
+    nested = copy.deepcopy(base)
+    nested["building2"]["period_s"] = np.array([[0.3, 0.4], [0.5, 0.6]])
+    unknown = copy.deepcopy(base)
+    unknown["building1"]["x"] = 1
+    for config, key in ((nested, "building2.period_s"), (unknown, "building1.x")):
+        with pytest.raises(pounding.ConfigError) as e:
+            pounding.sweep(config, backend="cpu", progress=False)
+        assert str(e.value).startswith(f"<config dict>: {key}: "), str(e.value)
+        assert "TOML parse error" not in str(e.value) and "line" not in str(e.value), str(e.value)
+    with pytest.raises(pounding.ConfigError, match=r"^<config dict>: missing field `building1`$"):
+        pounding.sweep({}, backend="cpu", progress=False)
