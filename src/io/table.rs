@@ -87,18 +87,23 @@ impl Table {
     /// Arrow table, whose names need not differ) is checked by the studies.
     pub fn check_columns(&self) -> Result<(), TableError> {
         match duplicate_column(&self.header) {
-            Some((column, at)) => Err(TableError::DuplicateColumn {
-                path: self.path.clone(),
-                column,
-                count: at.len(),
-                // Columns numbered from 1, as a person counts them in the header.
-                positions: at
-                    .iter()
-                    .map(|i| (i + 1).to_string())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            }),
+            Some((column, at)) => Err(self.named_twice(column, &at)),
             None => Ok(()),
+        }
+    }
+
+    /// The refusal of `column`, which the header names at each index of `at`.
+    fn named_twice(&self, column: String, at: &[usize]) -> TableError {
+        TableError::DuplicateColumn {
+            path: self.path.clone(),
+            column,
+            count: at.len(),
+            // Columns numbered from 1, as a person counts them in the header.
+            positions: at
+                .iter()
+                .map(|i| (i + 1).to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
         }
     }
 
@@ -114,16 +119,7 @@ impl Table {
                 column: name.into(),
                 available: self.header.join(", "),
             }),
-            _ => Err(TableError::DuplicateColumn {
-                path: self.path.clone(),
-                column: name.into(),
-                count: at.len(),
-                positions: at
-                    .iter()
-                    .map(|i| (i + 1).to_string())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            }),
+            _ => Err(self.named_twice(name.into(), &at)),
         }
     }
 

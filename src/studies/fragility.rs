@@ -482,13 +482,18 @@ impl FragilitySpec {
 /// is `collapsed` (a table written with `--columns` that left the collapse columns out still
 /// says so in its status). False says only that the table does not tell.
 pub fn shows_collapse_limit(table: &Table) -> bool {
-    let column = |c: &String| {
-        crate::plan::row::COLLAPSE_OUTPUTS.contains(&c.as_str()) || collapse_building(c).is_some()
-    };
-    table.header.iter().any(column)
+    has_collapse_column(table)
         || table
             .col("status")
             .is_ok_and(|c| table.rows.iter().any(|r| r[c] == "collapsed"))
+}
+
+/// Whether `table` has a column only a sweep with a collapse limit writes (the run's
+/// [`crate::plan::row::COLLAPSE_OUTPUTS`], or a building's `bK_collapsed`...).
+fn has_collapse_column(table: &Table) -> bool {
+    table.header.iter().any(|c| {
+        crate::plan::row::COLLAPSE_OUTPUTS.contains(&c.as_str()) || collapse_building(c).is_some()
+    })
 }
 
 /// The notice for a table with no `status` column (a sweep written with `--columns` that left
@@ -499,9 +504,7 @@ pub fn no_status_notice(table: &Table) -> Option<String> {
     if table.col("status").is_ok() || table.rows.is_empty() {
         return None;
     }
-    let collapse_columns = table.header.iter().any(|c| {
-        crate::plan::row::COLLAPSE_OUTPUTS.contains(&c.as_str()) || collapse_building(c).is_some()
-    });
+    let collapse_columns = has_collapse_column(table);
     Some(format!(
         "notice: {} has no `status` column (a sweep written with --columns that left it out?): {}; sweep with `--columns ...,status` to count them",
         table.path.display(),

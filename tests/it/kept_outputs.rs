@@ -4,7 +4,7 @@
 //! sweep still resumes to the uninterrupted output; a GPU sweep ends with its output and its
 //! summary line, or with an error and a resumable `.partial`.
 
-use crate::support::{ctx, ok, pound, pound_with_file_limit, tempdir};
+use crate::support::{ctx, ok, pound, pound_with_file_limit, pound_with_file_limit_env, tempdir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -290,34 +290,14 @@ fn journal_commits_by_time_and_a_killed_sweep_resumes_exactly() {
             "4",
         ],
         limit,
+        // Commits by time never due: only the failed write's commit keeps the rows.
+        &[("POUND_COMMIT_S", "3600")],
     );
     assert!(!r.status.success());
     let done = journal_done(&sibling(&cut, ".progress.toml")).unwrap();
     assert!(done > 4, "only {done} runs kept after the failed write");
     ok(&sweep(&cfg, &cut, &["--resume"]));
     assert_eq!(std::fs::read(&cut).unwrap(), std::fs::read(&whole).unwrap());
-}
-
-/// [`pound_with_file_limit`] with `POUND_COMMIT_S=3600` (commits by time never due).
-fn pound_with_file_limit_env(args: &[&str], limit: u64) -> Output {
-    use std::os::unix::process::CommandExt;
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_pound"));
-    cmd.args(args).env("POUND_COMMIT_S", "3600");
-    // SAFETY: only async-signal-safe calls between fork and exec.
-    unsafe {
-        cmd.pre_exec(move || {
-            libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
-            let r = libc::rlimit {
-                rlim_cur: limit,
-                rlim_max: limit,
-            };
-            if libc::setrlimit(libc::RLIMIT_FSIZE, &r) != 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            Ok(())
-        });
-    }
-    cmd.output().unwrap()
 }
 
 /// Item 10: a GPU sweep (the software adapter here) that ends 0 has its output in place, its

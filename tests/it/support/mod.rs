@@ -6,7 +6,10 @@ pub mod gpu;
 pub mod run;
 
 pub use gpu::{ctx, gpu_collect, gpu_run, grazing_contacts, peak_diff};
-pub use run::{ok, pound, pound_with_file_limit, pound_with_outputs, sweep_cpu, table};
+pub use run::{
+    ok, pound, pound_with_file_limit, pound_with_file_limit_env, pound_with_outputs, sweep_cpu,
+    table,
+};
 
 use pounding::physics::contact::{Contact, LawKind};
 use pounding::physics::model::RunOutput;

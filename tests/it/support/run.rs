@@ -35,9 +35,18 @@ pub fn pound_with_outputs(args: &[&str], out: &std::path::Path, plot: &std::path
 /// Run `pound ARGS` under a file-size limit of `limit` bytes (SIGXFSZ ignored), so a write past
 /// it fails as on a full disk: a sweep stops with its finished chunks in `OUT.partial`.
 pub fn pound_with_file_limit(args: &[&str], limit: u64) -> std::process::Output {
+    pound_with_file_limit_env(args, limit, &[])
+}
+
+/// [`pound_with_file_limit`] with `env` set for the run.
+pub fn pound_with_file_limit_env(
+    args: &[&str],
+    limit: u64,
+    env: &[(&str, &str)],
+) -> std::process::Output {
     use std::os::unix::process::CommandExt;
     let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_pound"));
-    cmd.args(args);
+    cmd.args(args).envs(env.iter().copied());
     // SAFETY: only async-signal-safe calls between fork and exec.
     unsafe {
         cmd.pre_exec(move || {
