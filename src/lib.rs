@@ -5,7 +5,7 @@
 //! ```text
 //! TOML config --plan::config--> Plan (a pair or a row) --engine::Engine (cpu | gpu), with the
 //!     kernels the scene takes (engine::Kernel)--> chunks of runs --io--> CSV / Parquet /
-//!     summary with sidecar --studies--> tables and plots
+//!     summary with sidecar (a sweep's stages: sweep) --studies--> tables and plots
 //! ```
 //!
 //! One path for every scene: the config reader is the one place a config's kind is told, and
@@ -18,6 +18,9 @@
 //!   shards and input bounds;
 //! - [`engine`]: the one enum that runs a range of any plan on the CPU or the GPU (`shaders/`);
 //! - [`io`]: outputs that are never destroyed nor called complete when they are not;
+//! - [`sweep`]: one sweep as the command line and the Python package both run it: options
+//!   checked, the config settled into a plan, engine and columns, the runs into a file or a
+//!   table in memory;
 //! - [`studies`]: accuracy, benchmarks, fidelity, fragility (damage states, bootstrap bands), IDA,
 //!   the gap study, sensitivity, the seed paper, plots.
 //!
@@ -30,6 +33,7 @@ pub mod physics;
 pub mod plan;
 pub mod record;
 pub mod studies;
+pub mod sweep;
 
 /// A number as a message or a record command shows it: as typed (shortest round trip) for
 /// ordinary magnitudes, in exponent form beyond (`1e300`, not three hundred digits). At crate

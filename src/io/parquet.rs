@@ -72,7 +72,7 @@ fn err(e: impl std::fmt::Display) -> std::io::Error {
 
 impl ParquetOut {
     /// Columns `columns` (names of `output::header`), and `meta` as key-value metadata
-    /// (`pound.fingerprint.plan`, `.records`, `.engine`, `pound.runs`, `pound.backend`).
+    /// ([`Meta::key_values`]).
     pub fn create(
         target: &Target,
         lock: Option<&PartialLock>,
@@ -100,21 +100,13 @@ impl ParquetOut {
             .with_fields(fields)
             .build()
             .map_err(err)?;
-        let kv = |k: &str, v: String| KeyValue::new(k.to_string(), v);
         let props = WriterProperties::builder()
-            .set_key_value_metadata(Some(vec![
-                kv("pound.fingerprint.plan", meta.fingerprint.plan.clone()),
-                kv(
-                    "pound.fingerprint.records",
-                    meta.fingerprint.records.clone(),
-                ),
-                kv("pound.fingerprint.engine", meta.fingerprint.engine.clone()),
-                kv(
-                    "pound.runs",
-                    format!("{}..{} of {}", meta.first_run, meta.end_run, meta.plan_runs),
-                ),
-                kv("pound.backend", meta.backend.clone()),
-            ]))
+            .set_key_value_metadata(Some(
+                meta.key_values()
+                    .into_iter()
+                    .map(|(k, v)| KeyValue::new(k, v))
+                    .collect(),
+            ))
             .build();
         let (partial, file, sink): (_, _, Box<dyn Write + Send>) = match (target, lock) {
             (Target::File(p), Some(lock)) => {

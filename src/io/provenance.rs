@@ -336,6 +336,22 @@ pub struct Meta {
 }
 
 impl Meta {
+    /// The key-value metadata of a typed output (a Parquet file's, the Python package's Arrow
+    /// tables'): the fingerprint's parts, the runs held and the backend.
+    pub fn key_values(&self) -> Vec<(String, String)> {
+        let f = &self.fingerprint;
+        vec![
+            ("pound.fingerprint.plan".into(), f.plan.clone()),
+            ("pound.fingerprint.records".into(), f.records.clone()),
+            ("pound.fingerprint.engine".into(), f.engine.clone()),
+            (
+                "pound.runs".into(),
+                format!("{}..{} of {}", self.first_run, self.end_run, self.plan_runs),
+            ),
+            ("pound.backend".into(), self.backend.clone()),
+        ]
+    }
+
     /// What differs between the plan of this output and `theirs` (recorded in `there`), or
     /// None where their fingerprints match.
     pub fn differs(&self, theirs: &Meta, there: &str) -> Option<Difference> {
