@@ -6,14 +6,13 @@
 mod arrow;
 
 use arrow::{study_table, table_cells, Columns, Table};
-use pounding::engine::aggregate::Aggregator;
-use pounding::engine::{Backend, Chunk, Engine, Kernel};
+use pounding::engine::Backend;
 use pounding::io::parquet::{kind, Kind};
-use pounding::plan::settings::{
-    check_threads, picked_columns, sweep_warnings, SchemeKind, SchemeSettings,
-};
-use pounding::plan::{config, Plan};
+use pounding::plan::config;
+use pounding::plan::settings::SchemeKind;
 use pounding::studies::report::StudyReport;
+use pounding::sweep::options::{FileFormat, Options, Said, SweepError};
+use pounding::sweep::prepare::Prepared;
 use pyo3::create_exception;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
@@ -261,18 +260,8 @@ fn scheme_of(s: Option<&str>) -> PyResult<Option<SchemeKind>> {
     }
 }
 
-/// The worker threads (`threads`, default all cores), checked as `--threads` is.
-fn pool(threads: Option<usize>) -> PyResult<rayon::ThreadPool> {
-    let mut b = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = threads {
-        b = b.num_threads(check_threads(t).map_err(settings_err)?);
-    }
-    b.build()
-        .map_err(|e| PoundingError::new_err(format!("starting worker threads: {e}")))
-}
-
 /// What the engine's thread tells the waiting Python thread.
-enum Said {
+enum Told {
     Progress(u64),
 }
 
@@ -286,7 +275,7 @@ fn run_watched<T: Send>(
     work: impl FnOnce(&AtomicBool, &dyn Fn(u64)) -> T + Send,
 ) -> PyResult<T> {
     let stop = AtomicBool::new(false);
-    let (tx, rx) = std::sync::mpsc::channel::<Said>();
+    let (tx, rx) = std::sync::mpsc::channel::<Told>();
     // Received with the GIL released, which wants a receiver it may share.
     let rx = std::sync::Mutex::new(rx);
     let mut interrupted: Option<PyErr> = None;
@@ -297,7 +286,7 @@ fn run_watched<T: Send>(
         let stop = &stop;
         let worker = s.spawn(move || {
             let tell = move |n: u64| {
-                let _ = tx.send(Said::Progress(n));
+                let _ = tx.send(Told::Progress(n));
             };
             pool.install(|| work(stop, &tell))
         });
@@ -308,7 +297,7 @@ fn run_watched<T: Send>(
                     .recv_timeout(Duration::from_millis(50))
             });
             match got {
-                Ok(Said::Progress(n)) => {
+                Ok(Told::Progress(n)) => {
                     if let (Some((cb, total)), None) = (progress, &interrupted) {
                         if let Err(e) = cb.call1((n, total)) {
                             stop.store(true, Ordering::Relaxed);
@@ -366,20 +355,18 @@ fn run_detached<T: Send + 'static>(
     }
 }
 
-/// Why a sweep stopped early.
-enum Stopped {
-    Gpu(pounding::engine::gpu::GpuError),
-    Interrupted,
-    Table(String),
-}
-
-impl From<pounding::engine::gpu::GpuError> for Stopped {
-    /// The GPU's answer to the raised stop flag is the interrupt, not a fault of the device.
-    fn from(e: pounding::engine::gpu::GpuError) -> Self {
-        match e {
-            pounding::engine::gpu::GpuError::Interrupted => Stopped::Interrupted,
-            e => Stopped::Gpu(e),
+/// A sweep's refusal or failure as the Python exception of its kind, with the command line's
+/// message (a config's as [`config_err_in`] gives it).
+fn sweep_err(e: SweepError, text: &str, path: &Path) -> PyErr {
+    match e {
+        SweepError::Config(e) => config_err_in(e, text, path),
+        SweepError::Options(_) | SweepError::Settings(_) | SweepError::Aggregate(_) => {
+            settings_err(e)
         }
+        SweepError::Engine(e) => engine_err(e),
+        SweepError::Gpu(e) => GpuError::new_err(e.to_string()),
+        SweepError::Interrupted => pyo3::exceptions::PyKeyboardInterrupt::new_err(e.to_string()),
+        e => PoundingError::new_err(e.to_string()),
     }
 }
 
@@ -409,122 +396,45 @@ fn sweep<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Swept<'py>> {
     let (text, path) = config_text(config, config_kind)?;
-    let (backend, precision) = (backend_of(backend)?, precision_of(precision)?);
-    if aggregate.is_some() && columns.is_some() {
-        return Err(settings_err(
-            "aggregate writes its own summary columns: columns does not apply",
-        ));
-    }
-    if aggregate.is_none() && !exceed.is_empty() {
-        return Err(settings_err(
-            "exceed counts runs per group: it needs aggregate",
-        ));
-    }
-    let pool = pool(threads)?;
-    let mut plan = config::load_text(&text, &path).map_err(|e| config_err_in(e, &text, &path))?;
-    let settled = SchemeSettings {
+    let options = Options {
         scheme: scheme_of(scheme)?,
         energy,
         target_error,
-    }
-    .settle(&mut plan, &text)
-    .map_err(settings_err)?;
-    let mut notices = settled.notices;
-    let mut warnings: Vec<String> = settled
-        .warnings
-        .iter()
-        .map(|w| format!("{}: {w}", path.display()))
-        .collect();
-    plan.ask_storey_columns(columns.as_deref().unwrap_or_default());
-    let gpu = pounding::engine::gpu_for(
-        &plan,
-        backend,
-        precision,
-        settled.chosen.is_some(),
-        &mut |l| notices.push(l),
-    )
-    .map_err(engine_err)?;
-    let engine = Engine::new(plan.scheme(), gpu.as_ref(), precision, chunk).map_err(engine_err)?;
-    let picked = picked_columns(&plan, columns.as_deref()).map_err(settings_err)?;
-    let mut summary = aggregate
-        .as_ref()
-        .map(|by| Aggregator::for_plan(&plan, by, &exceed))
-        .transpose()
-        .map_err(settings_err)?;
-    engine
-        .check(&plan)
-        .map_err(|e| GpuError::new_err(e.to_string()))?;
-    let names = picked.names;
-    let fingerprint = pounding::io::provenance::Fingerprint::of_plan(&plan);
-    let mut meta = vec![
-        ("pound.fingerprint.plan".to_string(), fingerprint.plan),
-        ("pound.fingerprint.records".into(), fingerprint.records),
-        ("pound.fingerprint.engine".into(), fingerprint.engine),
-        ("pound.backend".into(), engine.key()),
-        ("pound.kernel".into(), Kernel::of(&plan).key().into()),
-    ];
-    let runs = plan.len();
-    let (plan, engine, picked) = (&plan, &engine, picked.indices.as_deref());
-    let agg = summary.as_mut();
-    let (outcome, describe) = run_watched(
+        backend: backend_of(backend)?,
+        precision: precision_of(precision)?,
+        chunk,
+        threads,
+        columns,
+        aggregate,
+        exceed,
+        format: FileFormat::Csv,
+        shard: None,
+        resume: false,
+    };
+    let failed = |e| sweep_err(e, &text, &path);
+    options.check().map_err(failed)?;
+    let pool = options.pool().map_err(failed)?;
+    let (mut notices, mut warnings) = (Vec::new(), Vec::new());
+    let prepared = Prepared::new(&options, &path, text.clone(), &mut |said| match said {
+        Said::Notice(n) => notices.push(n),
+        Said::Warning(w) => warnings.push(w),
+    })
+    .map_err(failed)?;
+    let runs = prepared.plan.len();
+    let names = prepared.names.clone();
+    let (swept, rows) = run_watched(
         py,
         &pool,
         progress.as_ref().map(|p| (p, runs)),
         move |stop, tell| {
-            let describe = engine.describe();
-            let mut cols = Columns::new(&names, names.iter().map(|n| kind(n)).collect());
-            let (mut above, mut past) = (0u64, 0u64);
-            let mut agg = agg;
-            let on_device = matches!(engine, Engine::Gpu { .. }) && matches!(plan, Plan::Pair(_));
-            let report = match agg.as_deref_mut() {
-                // A pair's runs fold on the device: only the groups' partials come back.
-                Some(agg) if on_device => engine
-                    .summarise_until(plan, 0..runs, stop, agg, tell)
-                    .map_err(Stopped::from),
-                _ => engine.sweep_until(
-                    plan,
-                    0..runs,
-                    stop,
-                    |c: Chunk<'_>| -> Result<(), Stopped> {
-                        if stop.load(Ordering::Relaxed) {
-                            return Err(Stopped::Interrupted);
-                        }
-                        above += c.above_height();
-                        past += c.past_collapse_drift();
-                        if let Some(agg) = agg.as_deref_mut() {
-                            c.fold_into(agg);
-                            return Ok(());
-                        }
-                        let cells = match c {
-                            Chunk::Pairs(p, rows) => pounding::io::csv::cells(p, rows, picked),
-                            Chunk::Rows(r, rows) => pounding::io::csv::cells(r, rows, picked),
-                        };
-                        cols.append(&cells).map_err(Stopped::Table)
-                    },
-                    tell,
-                ),
-            };
-            // A stopped CPU sweep ends early without an error: its table is not whole.
-            let report = match report {
-                Ok(_) if stop.load(Ordering::Relaxed) => Err(Stopped::Interrupted),
-                r => r,
-            };
-            ((report, cols, above, past), describe)
+            let mut rows = Columns::new(&names, names.iter().map(|n| kind(n)).collect());
+            let swept = prepared.run_to_table(stop, tell, &mut |cells| rows.append(&cells));
+            (swept, rows)
         },
     )?;
-    let (report, cols, above, past) = outcome;
-    let report = match report {
-        Ok(r) => r,
-        Err(Stopped::Gpu(e)) => return Err(GpuError::new_err(e.to_string())),
-        Err(Stopped::Interrupted) => {
-            return Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
-                "the sweep was stopped",
-            ))
-        }
-        Err(Stopped::Table(m)) => return Err(PoundingError::new_err(m)),
-    };
-    warnings.extend(sweep_warnings(plan, above, past));
-    let s = report.summary;
+    let swept = swept.map_err(failed)?;
+    warnings.extend(swept.warnings);
+    let s = swept.totals;
     let totals = PyDict::new(py);
     totals.set_item("runs", s.runs)?;
     totals.set_item("seconds", s.seconds)?;
@@ -533,32 +443,16 @@ fn sweep<'py>(
     totals.set_item("impacts", s.impacts)?;
     totals.set_item("failures", s.failures)?;
     totals.set_item("collapsed", s.collapsed)?;
-    totals.set_item("engine", describe)?;
-    totals.set_item("kernel", Kernel::of(plan).key())?;
-    totals.set_item("scene", plan.scene())?;
-    let table = match summary {
-        Some(agg) => {
-            if agg.runs() != runs {
-                return Err(PoundingError::new_err(format!(
-                    "the summary folded {} runs where the sweep has {runs}",
-                    agg.runs()
-                )));
-            }
-            let t = pounding::io::summary::table(&agg);
+    totals.set_item("engine", swept.describe)?;
+    totals.set_item("kernel", swept.kernel)?;
+    totals.set_item("scene", swept.scene)?;
+    let table = match swept.summary {
+        Some(t) => {
             let mut cols = Columns::new(&t.header, t.kinds);
             cols.append(&t.rows).map_err(PoundingError::new_err)?;
-            cols.finish(&meta)
+            cols.finish(&swept.meta)
         }
-        None => {
-            if cols.rows() as u64 != runs {
-                return Err(PoundingError::new_err(format!(
-                    "{} rows where the sweep has {runs}: the table is incomplete",
-                    cols.rows()
-                )));
-            }
-            meta.push(("pound.runs".into(), format!("0..{runs} of {runs}")));
-            cols.finish(&meta)
-        }
+        None => rows.finish(&swept.meta),
     }
     .map_err(PoundingError::new_err)?;
     Ok((table, totals, notices, warnings))
@@ -645,7 +539,7 @@ fn gap(
 ) -> PyResult<(Table, Vec<String>)> {
     use pounding::studies::gap::GapStudy;
     let (text, path) = config_text(config, config_kind)?;
-    let pool = pool(threads)?;
+    let pool = pounding::sweep::options::pool(threads).map_err(|e| sweep_err(e, &text, &path))?;
     let plan =
         config::load_text_for_gaps(&text, &path).map_err(|e| config_err_in(e, &text, &path))?;
     if let Some(why) = GapStudy::refusal(&plan) {

@@ -64,7 +64,8 @@ impl Options {
         if self.format == FileFormat::Parquet && self.resume {
             return refuse("--resume continues CSV output only: a Parquet file is readable only once its footer is written at the end");
         }
-        if self.aggregate.is_some() && (self.format == FileFormat::Parquet || self.columns.is_some())
+        if self.aggregate.is_some()
+            && (self.format == FileFormat::Parquet || self.columns.is_some())
         {
             return refuse(
                 "--aggregate writes its own summary columns: --format and --columns do not apply",
@@ -84,13 +85,18 @@ impl Options {
 
     /// The worker threads (`--threads`, default all cores).
     pub fn pool(&self) -> Result<rayon::ThreadPool, SweepError> {
-        let mut pool = rayon::ThreadPoolBuilder::new();
-        if let Some(t) = self.threads {
-            pool = pool.num_threads(check_threads(t)?);
-        }
-        pool.build()
-            .map_err(|e| SweepError::Threads(format!("starting worker threads: {e}")))
+        pool(self.threads)
     }
+}
+
+/// `threads` worker threads (default all cores), checked as `--threads` is.
+pub fn pool(threads: Option<usize>) -> Result<rayon::ThreadPool, SweepError> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = threads {
+        pool = pool.num_threads(check_threads(t)?);
+    }
+    pool.build()
+        .map_err(|e| SweepError::Threads(format!("starting worker threads: {e}")))
 }
 
 /// A line a sweep says, for the front end to show its own way (standard error, Python's

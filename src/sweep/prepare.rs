@@ -63,7 +63,12 @@ impl Prepared {
             settled.chosen.is_some(),
             &mut |l| say(Said::Notice(l)),
         )?;
-        let engine = Engine::new(plan.scheme(), gpu.as_ref(), options.precision, options.chunk)?;
+        let engine = Engine::new(
+            plan.scheme(),
+            gpu.as_ref(),
+            options.precision,
+            options.chunk,
+        )?;
         let picked = picked_columns(&plan, options.columns.as_deref())?;
         let summary = options
             .aggregate

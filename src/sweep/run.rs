@@ -142,8 +142,7 @@ impl Prepared {
             match out.aggregator() {
                 Some(agg) => integrate(&engine, plan, todo, None, Into::Summary(agg), progress),
                 None => {
-                    let mut sink =
-                        |c: Chunk<'_>| out.take_chunk(c).map_err(SweepError::from);
+                    let mut sink = |c: Chunk<'_>| out.take_chunk(c).map_err(SweepError::from);
                     integrate(&engine, plan, todo, None, Into::Rows(&mut sink), progress)
                 }
             }
@@ -202,7 +201,14 @@ impl Prepared {
         let describe = engine.describe();
         let mut written = 0u64;
         let (report, above, past) = match summary.as_mut() {
-            Some(agg) => integrate(&engine, plan, 0..runs, Some(stop), Into::Summary(agg), progress)?,
+            Some(agg) => integrate(
+                &engine,
+                plan,
+                0..runs,
+                Some(stop),
+                Into::Summary(agg),
+                progress,
+            )?,
             None => {
                 let mut sink = |c: Chunk<'_>| {
                     if stop.load(Ordering::Relaxed) {
@@ -215,7 +221,14 @@ impl Prepared {
                     written += cells.len() as u64;
                     rows(cells).map_err(SweepError::Table)
                 };
-                integrate(&engine, plan, 0..runs, Some(stop), Into::Rows(&mut sink), progress)?
+                integrate(
+                    &engine,
+                    plan,
+                    0..runs,
+                    Some(stop),
+                    Into::Rows(&mut sink),
+                    progress,
+                )?
             }
         };
         // A stopped CPU sweep ends early without an error: its table is not whole.
