@@ -25,7 +25,6 @@ enum Builder {
 pub struct Columns {
     names: Vec<String>,
     builders: Vec<Builder>,
-    rows: usize,
 }
 
 impl Columns {
@@ -41,12 +40,7 @@ impl Columns {
         Columns {
             names: names.to_vec(),
             builders,
-            rows: 0,
         }
-    }
-
-    pub fn rows(&self) -> usize {
-        self.rows
     }
 
     /// Append rows of cells (in the columns' order). A number that does not parse is an
@@ -68,7 +62,6 @@ impl Columns {
                 }
             }
         }
-        self.rows += rows.len();
         Ok(())
     }
 
