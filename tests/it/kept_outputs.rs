@@ -143,7 +143,7 @@ fn no_output_replaces_an_unfinished_sweeps_rows_or_a_sidecar() {
     ok(&sweep(&a, &whole, &[]));
     let whole_text = std::fs::read(&whole).unwrap();
     let cut = d.path().join("cut.csv");
-    crate::hostile::interrupt(&a, whole_text.len(), &cut, 0.5);
+    crate::support::cli::interrupt(&a, whole_text.len(), &cut, 0.5);
     let (partial, journal) = (sibling(&cut, ".partial"), sibling(&cut, ".progress.toml"));
     let refs = [partial.as_path(), journal.as_path()];
     let before = snapshot(&refs);

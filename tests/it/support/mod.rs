@@ -2,6 +2,7 @@
 //! dir, scene builders and collected sweeps here; running `pound` in [`run`]; the shared GPU
 //! device and GPU comparisons in [`gpu`].
 
+pub mod cli;
 pub mod gpu;
 pub mod run;
 

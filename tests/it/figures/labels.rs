@@ -1,5 +1,5 @@
-//! Hostile pass, round 3 (issue 47), classes 4, 5, 14 and the long title of 9: a figure's labels,
-//! ticks, axes and titles say what it shows, and what it costs is bounded before it is drawn.
+//! A figure's labels, ticks, axes and titles say what it shows, and what it costs is bounded
+//! before it is drawn (issue 47's classes 4, 5, 14 and the long title of 9).
 
 use crate::support::{ok, pound, tempdir};
 use std::path::Path;

@@ -1,4 +1,6 @@
-//! Hostile pass, round 3 (issue 47): see the classes named in `round3.rs`.
+//! `pound fragility` and `pound ida` on tables written by hand: a crossing notice names where the
+//! order is wrong, runs without a value are decided or bound the fit, a fit that cannot be made
+//! says why, and the study flags mean what they say (issue 47's classes 8, 9, 10 and 13).
 
 use crate::support::{ok, pound, table, tempdir};
 use pounding::plan::sample::phi;
