@@ -2,7 +2,7 @@
 //! resume or a merge across a change is refused, naming the key and both values; a storey that
 //! leans hard under gravity is named before any run; every list of statuses names `collapsed`.
 
-use crate::multistorey::ROW_CONFIG;
+use crate::scenes::ROW_CONFIG;
 use crate::support::cli::interrupt;
 use crate::support::run::{ok, pound, sweep_cpu};
 use crate::support::tempdir;

@@ -38,7 +38,7 @@ mod intensity;
 mod kept_outputs;
 mod layers;
 mod messages;
-pub mod multistorey;
+mod multistorey;
 mod oracles;
 mod outputs;
 mod records;

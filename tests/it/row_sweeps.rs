@@ -1,7 +1,7 @@
 //! Sweeps of rows of multi-storey buildings through the output protocol the pair's sweeps use:
 //! `--resume`, `--shard` and `pound merge`, Parquet, `--aggregate`, and `[sample]`.
 
-use crate::multistorey::ROW_CONFIG;
+use crate::scenes::ROW_CONFIG;
 use crate::scenes::STOREYS3;
 use crate::support::cli::interrupt;
 use crate::support::run::{ok, pound};

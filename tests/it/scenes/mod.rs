@@ -1,6 +1,8 @@
 //! Named scenes the tests share: configs (or builders of them) that several features are tested
 //! on, so a scene is written once and a test says only what it changes.
 
+pub mod models;
+
 use crate::support::cli::{interrupt, sweep};
 use crate::support::{ok, tempdir};
 use std::path::{Path, PathBuf};
@@ -63,6 +65,7 @@ synthetic = {{ seed = 1, duration_s = 2.0, dt_s = 0.01, pga_g = 0.35 }}
     )
 }
 
+/// The keys of a 3-storey (and below, a 2-storey) building of 300 t floors, for [`row`].
 pub const STOREYS3: &str =
     "storeys = 3\nstorey_height_m = 3.0\nmass_kg = 3.0e5\nperiod_s = 0.4\ndamping_ratio = 0.05";
 
@@ -103,6 +106,8 @@ pub fn row_config(b0: &str, b1: &str, contact: &str, tail: &str) -> String {
     )
 }
 
+/// [`CHEAP_SWEEP`] written out in a folder of its own beside its record file `rec.txt`, and the
+/// CSV of its uninterrupted sweep.
 pub struct Scene {
     pub dir: tempfile::TempDir,
     pub cfg: PathBuf,
@@ -112,7 +117,8 @@ pub struct Scene {
 }
 
 impl Scene {
-    pub fn new() -> Scene {
+    /// Writes the scene and sweeps it whole (CPU).
+    pub(crate) fn new() -> Scene {
         let dir = tempdir();
         let record = dir.path().join("rec.txt");
         let v: Vec<String> = (0..400)
@@ -132,6 +138,7 @@ impl Scene {
         }
     }
 
+    /// `name` in the scene's folder.
     pub fn path(&self, name: &str) -> PathBuf {
         self.dir.path().join(name)
     }
@@ -141,3 +148,41 @@ impl Scene {
         interrupt(&self.cfg, self.whole.len(), out, fraction);
     }
 }
+
+/// A row of three buildings (2, 4 and 3 storeys: masses, gaps, periods and laws swept; a modal
+/// damping, a soft-storey profile) on one synthetic record.
+pub const ROW_CONFIG: &str = r#"
+[[building]]
+storeys = 2
+storey_height_m = 3.0
+mass_kg = [2e5, 3e5]
+period_s = 0.25
+damping_ratio = 0.05
+gap_right_m = [0.005, 0.01]
+
+[[building]]
+storeys = 4
+storey_height_m = [3.0, 3.0, 3.5, 3.5]
+floor_masses_kg = [3e5, 3e5, 2.5e5, 2e5]
+stiffness_profile = [0.5, 1.0, 1.0, 0.8]
+period_s = [0.5, 0.7]
+damping_ratio = 0.05
+damping = "modal"
+
+[[building]]
+storeys = 3
+storey_height_m = 3.0
+mass_kg = 2e5
+period_s = 0.3
+damping_ratio = 0.03
+
+[contact]
+law = ["hertz", "nonlinear_viscoelastic"]
+formula = "ebrahimi"
+e = 0.6
+beta_n_per_m1_5 = 2.75e9
+gap_m = 0.008
+
+[[record]]
+synthetic = { seed = 4, duration_s = 5.0, dt_s = 0.01, pga_g = 0.4 }
+"#;
