@@ -4,7 +4,7 @@
 pub mod models;
 
 use crate::support::cli::{interrupt, sweep};
-use crate::support::{ok, tempdir};
+use crate::support::{ok, pound, tempdir};
 use std::path::{Path, PathBuf};
 
 /// 96 cheap runs: a synthetic record and a record file (so `-o` can name an input record).
@@ -186,3 +186,64 @@ gap_m = 0.008
 [[record]]
 synthetic = { seed = 4, duration_s = 5.0, dt_s = 0.01, pga_g = 0.4 }
 "#;
+
+/// A small sweep with a sampled gap and period and an intensity ladder, on a synthetic record.
+pub const SAMPLED: &str = r#"
+[run]
+tail_s = 1.0
+
+[building1]
+mass_kg = 1.0e5
+damping_ratio = 0.05
+
+[building2]
+mass_kg = 1.0e5
+period_s = [0.3, 0.9]
+damping_ratio = 0.05
+
+[contact]
+law = ["nonlinear_viscoelastic", "hertz"]
+formula = "exact"
+e = 0.65
+beta_n_per_m1_5 = 2.75e9
+
+[sample]
+n = 12
+seed = 5
+
+[[sample.axis]]
+key = "building1.period_s"
+dist = "lognormal"
+median = 0.5
+beta = 0.3
+min = 0.2
+max = 1.0
+
+[[sample.axis]]
+key = "contact.gap_m"
+dist = "uniform"
+min = 0.0
+max = 0.04
+
+[[record]]
+synthetic = { seed = 2, duration_s = 6.0 }
+
+[intensity]
+pga_g = [0.1, 0.3, 0.6]
+"#;
+
+/// [`SAMPLED`] swept (CPU) into `dir`/runs.csv.
+pub fn sampled_runs(dir: &Path) -> std::path::PathBuf {
+    let cfg = dir.join("sampled.toml");
+    std::fs::write(&cfg, SAMPLED).unwrap();
+    let out = dir.join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        cfg.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--backend",
+        "cpu",
+    ]));
+    out
+}

@@ -124,3 +124,10 @@ pub fn collect(plan: &PairPlan, scheme: &Scheme, chunk: usize) -> Vec<(RunSpec, 
         .unwrap();
     rows
 }
+
+/// The column `name` of CSV text `csv`, as text.
+pub fn csv_column(csv: &str, name: &str) -> Vec<String> {
+    let mut r = csv::Reader::from_reader(csv.as_bytes());
+    let c = r.headers().unwrap().iter().position(|h| h == name).unwrap();
+    r.records().map(|x| x.unwrap()[c].to_string()).collect()
+}
