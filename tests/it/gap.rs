@@ -1,14 +1,11 @@
 //! `pound gap`: the required gap against what `pound sweep` says at gaps around it, for pairs
 //! and for a row of multi-storey buildings; identical buildings; the runs it covers; bad input.
 
+use crate::support::cli::s;
 use crate::support::run::{ok, pound};
 use crate::support::{table, tempdir};
 use std::collections::HashMap;
 use std::path::Path;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// `pound sweep CFG -o OUT` on the CPU, read back.
 fn sweep_table(cfg: &Path, out: &Path) -> Vec<HashMap<String, String>> {

@@ -4,13 +4,10 @@
 use crate::scenes::ROW_CONFIG;
 use crate::scenes::STOREYS3;
 use crate::support::cli::interrupt;
+use crate::support::cli::s;
 use crate::support::run::{ok, pound};
 use crate::support::tempdir;
 use std::path::Path;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// `pound sweep CFG -o OUT --backend cpu EXTRA...`
 fn sweep(cfg: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
