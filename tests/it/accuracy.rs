@@ -1,7 +1,10 @@
 //! The speed-against-error study: errors against the reference fall as the fast scheme takes
 //! more substeps per contact, on every path, and the outputs are written.
 
+use crate::scenes::{row, STOREYS3};
+use crate::support::cli::{fails_with, out, s, stderr as err, write};
 use crate::support::ctx;
+use crate::support::pound;
 use crate::support::tempdir;
 use pounding::studies::accuracy::{csv, panels, study};
 
@@ -59,4 +62,38 @@ fn errors_fall_with_more_substeps_on_every_path() {
         assert!(text.contains(setting), "{setting} in the legend");
     }
     assert_eq!(csv(points).lines().count(), 1 + points.len());
+}
+
+/// Class 2: `--target-error` is met only with evidence: failed runs on either side (here both:
+/// floor masses of 1e-30 and 1e12 kg) and zero compared runs are "NOT met" with exit 1; the
+/// pair table shows failures; `--tol` has `run.tol`'s bound.
+#[test]
+fn no_certificate_without_evidence() {
+    let d = tempdir();
+    let cfg = write(
+        d.path(),
+        "mass.toml",
+        &row(
+            "storeys = 3\nstorey_height_m = 3.0\nfloor_masses_kg = [1e-30, 1e5, 1e12]\nperiod_s = 0.4\ndamping_ratio = 0.05",
+            STOREYS3,
+            "",
+        ),
+    );
+    let acc = d.path().join("acc.csv");
+    let o = pound(&["accuracy", s(&cfg), "--target-error", "1e-2", "-o", s(&acc)]);
+    // Statistics over zero runs are no figure: `-` in the table, and the study is an error
+    // naming why no run could be compared, with nothing written (issue 64).
+    fails_with(&o, "no run could be compared");
+    assert!(err(&o).contains("of 2 runs, 2 failed"), "{}", err(&o));
+    let text = out(&o);
+    assert!(!text.contains("(met)"), "{text}");
+    assert!(text.contains("| - |"), "{text}");
+    assert!(!acc.exists());
+    // --tol: the config key's bound, before any run.
+    fails_with(
+        &pound(&["accuracy", s(&cfg), "--tol", "1e-20", "-o", s(&acc)]),
+        "1e-13 < tol < 1e-2",
+    );
+    // The pair table has a failed column.
+    assert!(pounding::studies::accuracy::MARKDOWN_HEADER.contains("| failed |"));
 }

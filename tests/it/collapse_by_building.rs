@@ -6,12 +6,13 @@
 //! median outside the levels run is flagged as extrapolated. Tables written by hand give the
 //! exact counts.
 
+use crate::support::cli::write;
 use crate::support::{ok, pound, table, tempdir};
 use pounding::io::table::Table;
 use pounding::plan::sample::phi_inv;
 use pounding::studies::fragility::{self, FragilityOptions};
 use pounding::studies::ida::{self, IdaOptions};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
@@ -99,12 +100,6 @@ fn keep_columns(text: &str, keep: &dyn Fn(&str) -> bool) -> String {
 /// An output from before each building's collapse was written: no `bK_collapse...` columns.
 fn older(text: &str) -> String {
     keep_columns(text, &|c| !(c.starts_with('b') && c.contains("_collapse")))
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
 }
 
 /// Building 1 collapses in 1 of 4 runs at 0.5 g, 1 of 2 at 1 g and 3 of 4 at 2 g (the fit of

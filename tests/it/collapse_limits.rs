@@ -2,18 +2,15 @@
 //! resume or a merge across a change is refused, naming the key and both values; a storey that
 //! leans hard under gravity is named before any run; every list of statuses names `collapsed`.
 
-use crate::hostile::interrupt;
-use crate::multistorey::ROW_CONFIG;
+use crate::scenes::ROW_CONFIG;
+use crate::support::cli::interrupt;
+use crate::support::cli::s;
 use crate::support::run::{ok, pound, sweep_cpu};
 use crate::support::tempdir;
 use pounding::io::provenance::{Fingerprint, Settings};
 use pounding::plan::config::load_text;
 use pounding::plan::Plan;
 use std::path::Path;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 fn err(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

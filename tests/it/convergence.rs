@@ -17,7 +17,7 @@
 //! Paths: the CPU scheme (buildings standing still, floor coordinates for tall Rayleigh
 //! buildings), its whole-row twin, and the GPU row kernel in f64 on the test device.
 
-use crate::multistorey::{building, record};
+use crate::scenes::models::{building, record};
 use crate::support::gpu::ctx;
 use crate::support::{records_dir, rel};
 use pounding::engine::gpu::{GpuOptions, Precision};

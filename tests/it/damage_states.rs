@@ -2,6 +2,7 @@
 //! them, FEMA P-58's residual drift states fitted on residual drifts (runs that did not settle
 //! included), each set read only on its own demand, and the error for a name there is not.
 
+use crate::support::cli::yielding_runs;
 use crate::support::{ok, pound, tempdir};
 use pounding::plan::sample::{phi_inv, Rng};
 use pounding::studies::damage_states::DamageStates;
@@ -293,4 +294,53 @@ fn an_unknown_set_is_refused_with_the_names_grouped() {
     let o = pound(&["fragility", "--damage-states", "hazus-c1l-high"]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("give the results CSV"));
+}
+
+/// Class 3, units ignored: damage-state limits in one unit are refused on a column in another,
+/// both named (`--edp peak_force_n --damage-states hazus-c1l-high` read drift-ratio limits as
+/// newtons, rc 0, four identical curves); a file may give its limits' unit, and then reads on
+/// a column in that unit.
+#[test]
+fn limits_and_columns_agree_on_units() {
+    let dir = tempdir();
+    let d = dir.path();
+    let runs = yielding_runs(d);
+    let forces = d.join("forces.toml");
+    std::fs::write(
+        &forces,
+        "unit = \"N\"\n[[state]]\nname = \"light\"\nlimit = 1e6\n[[state]]\nname = \"heavy\"\nlimit = 3e6\n",
+    )
+    .unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let run = |edp: &str, states: &str, out: &str| {
+        pound(&[
+            "fragility",
+            &s(&runs),
+            "--edp",
+            edp,
+            "--damage-states",
+            states,
+            "-o",
+            &s(&d.join(out)),
+        ])
+    };
+    for (o, needles) in [
+        (
+            run("peak_force_n", "hazus-c1l-high", "a.csv"),
+            ["in m/m", "peak_force_n is in N"],
+        ),
+        (
+            run("b1_peak_drift_ratio", &s(&forces), "b.csv"),
+            ["in N", "b1_peak_drift_ratio is in m/m"],
+        ),
+    ] {
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "rc 0: {err}");
+        for n in needles {
+            assert!(err.contains(n), "expected `{n}` in: {err}");
+        }
+    }
+    assert!(!d.join("a.csv").exists() && !d.join("b.csv").exists());
+    ok(&run("peak_force_n", &s(&forces), "c.csv"));
+    ok(&run("b1_peak_drift_ratio", "hazus-c1l-high", "d.csv"));
 }

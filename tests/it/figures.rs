@@ -1,6 +1,7 @@
 //! Figures read back: the legend box covers no plotted point, every legend entry has its own
 //! colour-and-marker (a fitted curve shares its points'), and no series is drawn in yellow.
 
+use crate::support::table;
 use crate::support::{ok, pound, tempdir};
 use std::path::Path;
 
@@ -523,3 +524,180 @@ fn a_failed_fit_is_named_briefly_in_the_legend() {
         n("width")
     );
 }
+
+/// Class 6, silent drops: `pound plot` says how many rows it left out and why, by reason in
+/// the table of meanings' words (a residual drift is empty where the run did not settle), and
+/// names a series of which every row was left out. It left out empty values without a word, so
+/// a whole series vanished.
+#[test]
+fn every_row_left_out_is_counted() {
+    let dir = tempdir();
+    let results = dir.path().join("runs.csv");
+    std::fs::write(
+        &results,
+        "run,record,pga_g,b1_residual_drift_ratio,b1_first_impact_s,status\n\
+         0,quiet,0.2,0.001,,ok\n\
+         1,quiet,0.4,0.002,,ok\n\
+         2,strong,0.2,,1.5,ok\n\
+         3,strong,0.4,,1.2,ok\n\
+         4,quiet,0.6,0.003,,step_limit\n\
+         5,quiet,,0.004,,ok\n\
+         6,quiet,0.8,inf,,ok\n",
+    )
+    .unwrap();
+    let plot = dir.path().join("p.svg");
+    let out = pound(&[
+        "plot",
+        results.to_str().unwrap(),
+        "--x",
+        "pga_g",
+        "--y",
+        "b1_residual_drift_ratio",
+        "--by",
+        "record",
+        "-o",
+        plot.to_str().unwrap(),
+    ]);
+    ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    for said in [
+        "1 rows left out: runs whose status is not ok",
+        "1 rows left out: values that are not finite",
+        "1 rows left out: pga_g is empty",
+        "2 rows left out: b1_residual_drift_ratio is empty (where the run did not settle)",
+        "no series drawn for record = strong: every one of its rows was left out",
+    ] {
+        assert!(err.contains(said), "missing `{said}` in:\n{err}");
+    }
+    // The first impact is empty where the run did not pound.
+    let out = pound(&[
+        "plot",
+        results.to_str().unwrap(),
+        "--x",
+        "pga_g",
+        "--y",
+        "b1_first_impact_s",
+        "-o",
+        plot.to_str().unwrap(),
+    ]);
+    ok(&out);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("3 rows left out: b1_first_impact_s is empty"),
+        "{err}"
+    );
+}
+
+/// Class 6 where it arises in filters and series: a scaled PGA computed per record
+/// (`0.19999999999999998`, `0.20000000000000004`) is one value to `--where` and `--by`, as it
+/// is one level to `pound fragility`. `--where pga_g=0.2` silently dropped a record's rows, and
+/// `--by pga_g` drew twelve series for eight levels.
+#[test]
+fn one_value_computed_per_record_is_one_value() {
+    let dir = tempdir();
+    let runs = dir.path().join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/fragility-example.toml",
+        "-o",
+        runs.to_str().unwrap(),
+    ]));
+    let rows = table(&runs);
+    let pga: Vec<f64> = rows.iter().map(|r| r["pga_g"].parse().unwrap()).collect();
+    let at = |v: f64| pga.iter().filter(|p| (*p / v - 1.0).abs() < 1e-9).count();
+    assert!(
+        pga.iter()
+            .any(|&p| p != 0.2 && (p / 0.2 - 1.0).abs() < 1e-9),
+        "the test needs a PGA of 0.2 g computed inexactly"
+    );
+    let levels = {
+        let mut l: Vec<String> = pga.iter().map(|p| format!("{p:.9}")).collect();
+        l.sort();
+        l.dedup();
+        l.len()
+    };
+    let r = runs.to_str().unwrap();
+    let fit = |filter: &str| {
+        let out = pound(&[
+            "fragility",
+            r,
+            "--im",
+            "pga_g",
+            "--edp",
+            "peak_force_n",
+            "--threshold",
+            "1e6",
+            "--where",
+            filter,
+            "-o",
+            dir.path().join("f.csv").to_str().unwrap(),
+        ]);
+        ok(&out).lines().next().unwrap_or("").to_string()
+    };
+    assert!(fit("pga_g=0.2").starts_with(&format!("{} runs at 1 levels", at(0.2))));
+    let below = pga.iter().filter(|p| **p < 0.2 * (1.0 + 1e-9)).count();
+    assert!(
+        fit("pga_g<=0.2").starts_with(&format!("{below} runs at")),
+        "{}",
+        fit("pga_g<=0.2")
+    );
+    let plot = pound(&[
+        "plot",
+        r,
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--by",
+        "pga_g",
+        "-o",
+        dir.path().join("p.svg").to_str().unwrap(),
+    ]);
+    ok(&plot);
+    let said = String::from_utf8_lossy(&plot.stderr);
+    assert!(
+        said.contains(&format!("{levels} series,")),
+        "{levels} levels: {said}"
+    );
+}
+
+/// Class 14 where a legend stands beside the plot: the title is centred over the whole panel,
+/// so one that fits the panel stays in it (plotters centred it over the plot left of the
+/// legend, and a long default title ran off the panel's left edge).
+#[test]
+fn a_title_stands_over_its_panel() {
+    let dir = tempdir();
+    let runs = dir.path().join("runs.csv");
+    ok(&pound(&[
+        "sweep",
+        "configs/fragility-example.toml",
+        "-o",
+        runs.to_str().unwrap(),
+    ]));
+    let svg = dir.path().join("p.svg");
+    ok(&pound(&[
+        "plot",
+        runs.to_str().unwrap(),
+        "--x",
+        "gap_m",
+        "--y",
+        "peak_force_n",
+        "--by",
+        "record",
+        "--where",
+        "pga_g>=0.5",
+        "-o",
+        svg.to_str().unwrap(),
+    ]));
+    let text = std::fs::read_to_string(&svg).unwrap();
+    // The first text element is the title; the panel is 640 px wide.
+    let title = text.split("<text ").nth(1).expect("a title");
+    assert!(title.contains("peak force against gap"), "{title}");
+    assert!(
+        title.starts_with("x=\"320\""),
+        "the title is not centred on the panel: {title}"
+    );
+}
+
+// What a figure shows: labels, ticks, axes and titles, and what it costs, bounded before it is drawn.
+mod labels;

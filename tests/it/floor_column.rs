@@ -10,7 +10,7 @@
 //! floor height, where two floor/column points become one floor/floor level.
 
 use crate::convergence::{failures, yielding, SETTINGS};
-use crate::multistorey::{building, forcing, record};
+use crate::scenes::models::{building, forcing, record};
 use crate::support::rel;
 use pounding::physics::contact::LawKind;
 use pounding::physics::model::Status;
@@ -308,7 +308,7 @@ fn the_levels_section_sets_the_contact_levels() {
     let dir = crate::support::tempdir();
     let cfg = dir.path().join("levels.toml");
     // Building 2's floors at 3, 6, 9.5, 13 m; building 3's at 3, 6, 9 m.
-    let base = crate::multistorey::ROW_CONFIG;
+    let base = crate::scenes::ROW_CONFIG;
     let load =
         |extra: &str| pounding::plan::config::load_row_text(&format!("{base}\n{extra}"), &cfg);
     let names = |extra: &str| load(extra).unwrap().level_names();
@@ -339,7 +339,7 @@ fn the_levels_section_is_in_the_fingerprint() {
     use pounding::io::provenance::Fingerprint;
     let dir = crate::support::tempdir();
     let cfg = dir.path().join("levels.toml");
-    let base = crate::multistorey::ROW_CONFIG;
+    let base = crate::scenes::ROW_CONFIG;
     let print = |extra: &str| {
         let plan =
             pounding::plan::config::load_row_text(&format!("{base}\n{extra}"), &cfg).unwrap();

@@ -1,14 +1,11 @@
 //! `pound gap`: the required gap against what `pound sweep` says at gaps around it, for pairs
 //! and for a row of multi-storey buildings; identical buildings; the runs it covers; bad input.
 
+use crate::support::cli::s;
 use crate::support::run::{ok, pound};
 use crate::support::{table, tempdir};
 use std::collections::HashMap;
 use std::path::Path;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// `pound sweep CFG -o OUT` on the CPU, read back.
 fn sweep_table(cfg: &Path, out: &Path) -> Vec<HashMap<String, String>> {
@@ -442,4 +439,54 @@ fn gap_refuses_bad_input() {
     assert!(std::fs::read_to_string(&plot)
         .unwrap()
         .contains("Probability of pounding"));
+}
+
+/// Class 12, a fit the grid biases: `pound gap` fits the probability of pounding to the runs'
+/// required gaps themselves, so the gaps it is counted at (the default, a coarse and a fine
+/// grid) do not move the fit, and the median is the maximum-likelihood lognormal's of the
+/// required gaps the CSV holds (the runs whose floors never close counted apart). It fitted
+/// counts at the grid's gaps: the median moved with the grid.
+#[test]
+fn a_gap_fit_does_not_depend_on_the_grid() {
+    let dir = tempdir();
+    let config = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/gap-example.toml");
+    let fitted_line = |grid: Option<&str>| {
+        let out = dir.path().join("gaps.csv");
+        let mut args = vec!["gap", config, "-o", out.to_str().unwrap()];
+        if let Some(g) = grid {
+            args.extend(["--gaps", g]);
+        }
+        let text = ok(&pound(&args));
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("| 1-2 | PGA 0.35 g |"))
+            .unwrap_or_else(|| panic!("no fitted line in:\n{text}"))
+            .to_string();
+        (line, table(&out))
+    };
+    let (default, rows) = fitted_line(None);
+    for grid in ["0:0.5:0.1", "0:0.5:0.001", "0.03,0.2"] {
+        assert_eq!(fitted_line(Some(grid)).0, default, "--gaps {grid}");
+    }
+    // The maximum-likelihood lognormal of the required gaps above 0.
+    let required: Vec<f64> = rows
+        .iter()
+        .map(|r| r["required_gap_m"].parse().unwrap())
+        .collect();
+    let logs: Vec<f64> = required
+        .iter()
+        .filter(|&&r| r > 0.0)
+        .map(|r| r.ln())
+        .collect();
+    let mean = logs.iter().sum::<f64>() / logs.len() as f64;
+    let beta = (logs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / logs.len() as f64).sqrt();
+    assert!(
+        logs.len() > 2 && logs.len() < required.len(),
+        "some runs never close"
+    );
+    let cells: Vec<&str> = default.split('|').map(str::trim).collect();
+    assert_eq!(cells[3], required.len().to_string(), "{default}");
+    assert_eq!(cells[4], logs.len().to_string(), "{default}");
+    assert_eq!(cells[5], format!("{:.2} mm", mean.exp() * 1e3), "{default}");
+    assert_eq!(cells[6], format!("{beta:.3}"), "{default}");
 }

@@ -3,14 +3,10 @@
 //! that ended early for another reason left out with its status; a study whose every run failed
 //! is an error; a study where nothing collapses writes what it wrote before, to the bit.
 
+use crate::support::cli::s;
 use crate::support::{ok, pound, table, tempdir};
 use sha2::{Digest, Sha256};
 use std::collections::HashMap;
-use std::path::Path;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 fn num(row: &HashMap<String, String>, col: &str) -> f64 {
     row[col]

@@ -1,7 +1,7 @@
 //! Rows of multi-storey buildings on the GPU (`shaders/row.wgsl`) against their CPU twin
 //! (`physics::solver::row::fast`) on the test device (lavapipe in CI), in f64 and f32.
 
-use crate::multistorey::{building, forcing, record};
+use crate::scenes::models::{building, forcing, record};
 use crate::support::gpu::ctx;
 use crate::support::rel;
 use pounding::engine::gpu::row::{run_rows, PackedRows, RowShape};
@@ -505,7 +505,7 @@ fn single_storey_rows_on_the_gpu_are_the_pair() {
     if ctx().is_none() {
         return;
     }
-    let scenes = crate::multistorey::single_storey_scenes();
+    let scenes = crate::scenes::models::single_storey_scenes();
     let accel = record(3, 10.0, 0.4);
     let models: Vec<RowModel> = scenes.iter().map(|(_, m)| m.clone()).collect();
     let records = vec![accel.clone(); models.len()];

@@ -230,7 +230,7 @@ fn axes_of_pairs_that_never_touch_are_refused() {
 }
 
 /// A row's `contact.gap_m` list where every pair has its own `gap_right_m` was dropped with a
-/// warning: refused (one value keeps the warning: `hostile::round2`).
+/// warning: refused (one value keeps the warning: `row_sweeps::a_shared_gap_means_one_gap`).
 #[test]
 fn a_shared_gap_list_no_pair_reads_is_refused() {
     refused(

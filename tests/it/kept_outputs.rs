@@ -4,6 +4,7 @@
 //! sweep still resumes to the uninterrupted output; a GPU sweep ends with its output and its
 //! summary line, or with an error and a resumable `.partial`.
 
+use crate::support::cli::{s, sibling, stderr as err, sweep};
 use crate::support::{ctx, ok, pound, pound_with_file_limit, pound_with_file_limit_env, tempdir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -28,24 +29,6 @@ gap_m = [0.0, 0.005, 0.01, 0.02, 0.03, 0.04]
 [[record]]
 synthetic = { seed = 1, duration_s = 3.0 }
 "#;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn sibling(p: &Path, suffix: &str) -> PathBuf {
-    pounding::io::atomic::sibling(p, suffix)
-}
-
-fn err(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn sweep(cfg: &Path, out: &Path, extra: &[&str]) -> Output {
-    let mut args = vec!["sweep", s(cfg), "-o", s(out), "--backend", "cpu"];
-    args.extend_from_slice(extra);
-    pound(&args)
-}
 
 /// Refused with each of `needles` in the message, no panic.
 fn refused(o: &Output, needles: &[&str]) {
@@ -143,7 +126,7 @@ fn no_output_replaces_an_unfinished_sweeps_rows_or_a_sidecar() {
     ok(&sweep(&a, &whole, &[]));
     let whole_text = std::fs::read(&whole).unwrap();
     let cut = d.path().join("cut.csv");
-    crate::hostile::interrupt(&a, whole_text.len(), &cut, 0.5);
+    crate::support::cli::interrupt(&a, whole_text.len(), &cut, 0.5);
     let (partial, journal) = (sibling(&cut, ".partial"), sibling(&cut, ".progress.toml"));
     let refs = [partial.as_path(), journal.as_path()];
     let before = snapshot(&refs);

@@ -1,6 +1,8 @@
 //! Messages say what the file and the numbers say (issue 65, item 5): a derived number is shown
 //! as the value it stands for, not to its last rounding ulp.
 
+use crate::scenes::{row, STOREYS2, STOREYS3};
+use crate::support::cli::{fails_with, s, sweep, warns, write};
 use crate::support::{ok, pound, records_dir, tempdir};
 
 /// A time-value CSV's dt is a difference of two times (0.04 - 0.02 leaves 0.019999999999999997):
@@ -102,4 +104,83 @@ synthetic = { seed = 1, duration_s = 2.0 }
         err.contains("contact.beta_n_per_m1_5: is missing or empty"),
         "{err}"
     );
+}
+
+/// Class 9: messages give the bound or the fact, not a generic complaint.
+#[test]
+fn messages_name_the_bound_and_the_fact() {
+    let d = tempdir();
+    let cfg = write(d.path(), "row.toml", &row(STOREYS3, STOREYS2, ""));
+    fails_with(
+        &pound(&[
+            "gap",
+            s(&cfg),
+            "-o",
+            s(&d.path().join("g.csv")),
+            "--gaps",
+            "0:1e9:1",
+        ]),
+        "expected at most 10000",
+    );
+    let zero = write(
+        d.path(),
+        "zero.AT2",
+        "PEER\nx\nUNITS OF G\nNPTS=   0, DT= .0000 SEC\n0.1 0.2\n",
+    );
+    fails_with(&pound(&["record", "info", s(&zero)]), "NPTS = 0 and DT = 0");
+    let reference = write(
+        d.path(),
+        "ref.toml",
+        &row(STOREYS3, STOREYS2, "")
+            .replace("tail_s = 0.5", "tail_s = 0.5\nscheme = \"reference\""),
+    );
+    fails_with(
+        &pound(&[
+            "sweep",
+            s(&reference),
+            "--target-error",
+            "1e-2",
+            "-o",
+            s(&d.path().join("r.csv")),
+        ]),
+        "(run.tol)",
+    );
+    let spc = write(
+        d.path(),
+        "spc.toml",
+        &row(STOREYS3, STOREYS2, "")
+            .replace("tail_s = 0.5", "tail_s = 0.5\nsubsteps_per_contact = 32"),
+    );
+    warns(
+        &sweep(&spc, &d.path().join("s.csv"), &["--target-error", "1e-2"]),
+        "overrides the config's run.substeps_per_contact = 32",
+    );
+    let results = d.path().join("s.csv");
+    warns(
+        &pound(&[
+            "plot",
+            s(&results),
+            "--x",
+            "gap_1_2_m",
+            "--y",
+            "b1_peak_roof_m",
+            "--log-x",
+            "-o",
+            s(&d.path().join("p.svg")),
+        ]),
+        "points left out: a value <= 0 on a log axis",
+    );
+    let huge = write(
+        d.path(),
+        "huge.toml",
+        &row(STOREYS3, STOREYS2, "").replace("tail_s = 0.5", "tail_s = 1e300"),
+    );
+    let o = pound(&["sweep", s(&huge), "-o", s(&d.path().join("h.csv"))]);
+    fails_with(&o, "1e300 is out of range");
+    // The storey bound is documented.
+    let doc = std::fs::read_to_string("docs/multistorey.md").unwrap();
+    assert!(doc.contains(&format!(
+        "{} storeys",
+        pounding::physics::shear::MAX_STOREYS
+    )));
 }

@@ -2,14 +2,15 @@
 //! independent physical-coordinate integration), then cross-checks between the schemes and
 //! against the pair of oscillators, the energy balance and hard cases.
 
-use crate::support::{pair, rel};
+use crate::scenes::models::{building, forcing, record, single_storey_scenes};
+use crate::scenes::ROW_CONFIG;
+use crate::support::rel;
 use pounding::physics::contact::LawKind;
 use pounding::physics::model::{Forcing, Initial, Status};
 use pounding::physics::row::{Row, RowOutput};
 use pounding::physics::shear::{Damping, ShearBuilding};
 use pounding::physics::solver::row::{simulate_row, RowModel, RowScheme};
 use pounding::physics::solver::{simulate, FastOptions, ReferenceOptions, Scheme};
-use pounding::record::{synthetic, SyntheticSpec};
 use std::f64::consts::PI;
 
 fn schemes() -> [RowScheme; 2] {
@@ -20,32 +21,6 @@ fn schemes() -> [RowScheme; 2] {
         }),
         RowScheme::Reference(ReferenceOptions::default()),
     ]
-}
-
-pub fn record(seed: u64, duration: f64, pga_g: f64) -> Vec<f64> {
-    let r = synthetic(&SyntheticSpec {
-        seed,
-        duration,
-        dt: 0.01,
-        pga_g,
-        ..SyntheticSpec::default()
-    })
-    .unwrap();
-    r.accel.clone()
-}
-
-pub fn forcing(accel: &[f64]) -> Forcing<'_> {
-    Forcing {
-        accel,
-        dt: 0.01,
-        t0: 0.0,
-        scale: 1.0,
-        tail: 0.0,
-    }
-}
-
-pub fn building(n: usize, period: f64, damping: Damping) -> ShearBuilding {
-    ShearBuilding::from_period(vec![3e5; n], &vec![1.0; n], vec![3.0; n], period, damping)
 }
 
 /// A row far apart: no level can touch.
@@ -464,42 +439,6 @@ fn opensees_cross_check() {
     }
 }
 
-pub const ROW_CONFIG: &str = r#"
-[[building]]
-storeys = 2
-storey_height_m = 3.0
-mass_kg = [2e5, 3e5]
-period_s = 0.25
-damping_ratio = 0.05
-gap_right_m = [0.005, 0.01]
-
-[[building]]
-storeys = 4
-storey_height_m = [3.0, 3.0, 3.5, 3.5]
-floor_masses_kg = [3e5, 3e5, 2.5e5, 2e5]
-stiffness_profile = [0.5, 1.0, 1.0, 0.8]
-period_s = [0.5, 0.7]
-damping_ratio = 0.05
-damping = "modal"
-
-[[building]]
-storeys = 3
-storey_height_m = 3.0
-mass_kg = 2e5
-period_s = 0.3
-damping_ratio = 0.03
-
-[contact]
-law = ["hertz", "nonlinear_viscoelastic"]
-formula = "ebrahimi"
-e = 0.6
-beta_n_per_m1_5 = 2.75e9
-gap_m = 0.008
-
-[[record]]
-synthetic = { seed = 4, duration_s = 5.0, dt_s = 0.01, pga_g = 0.4 }
-"#;
-
 /// `pound sweep` of a `[[building]]` config: every run's row is the library's simulation of
 /// the run its number decodes to (parameters and outputs, cell for cell), the header names each
 /// building's and level's columns, and the sidecar vouches for the file.
@@ -843,40 +782,6 @@ fn accuracy_of_a_row_config() {
         .unwrap();
     assert_eq!(o.status.success(), measured <= 1e-3, "{said}");
     assert_eq!(line.ends_with("(met)"), o.status.success(), "{line}");
-}
-
-/// The single-storey scenes of [`single_storey_rows_are_the_pair`]: the pair, and the same pair
-/// as a row of two single-storey shear buildings.
-pub fn single_storey_scenes() -> Vec<(pounding::physics::model::Pair, RowModel)> {
-    [
-        (LawKind::NonlinearViscoelastic, 2.75e9, 0.35),
-        (LawKind::KelvinVoigt, 2e9, 0.2),
-        (LawKind::HuntCrossley, 2.75e9, 0.5),
-        (LawKind::Linear, 1e9, 0.0),
-    ]
-    .into_iter()
-    .map(|(law, stiffness, damping)| {
-        let p = pair(
-            law,
-            stiffness,
-            damping,
-            (2e5, 0.45, 0.05),
-            (3e5, 0.9, 0.03),
-            0.01,
-        );
-        let row = Row::new(
-            vec![
-                ShearBuilding::single(&p.b1, 0.05, 3.0),
-                ShearBuilding::single(&p.b2, 0.03, 3.0),
-            ],
-            vec![p.gap],
-            law,
-            stiffness,
-            damping,
-        );
-        (p, RowModel::new(&row))
-    })
-    .collect()
 }
 
 /// `rows` (single-storey) against the pair's fast scheme on `accel`: the same impacts and

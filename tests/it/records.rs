@@ -1,6 +1,8 @@
 //! Every shared record parses, with the NPTS, dt and PGA that `shared/records/SOURCES.md` lists;
 //! malformed files give errors with file and line; the synthetic generator is deterministic.
 
+use crate::support::cli::{fails_with, pound_in, s};
+use crate::support::ok;
 use crate::support::{records_dir, tempdir};
 use pounding::record::{
     read_record, synthetic, Format, ReadOptions, RecordError, SyntheticSpec, Units, G,
@@ -437,4 +439,47 @@ fn spectrum_of_a_step_is_the_first_overshoot() {
         let e = String::from_utf8_lossy(&o.stderr);
         assert!(e.contains(why), "{bad}: {e}");
     }
+}
+
+/// Class 8: `file =` records of a config in a checkout beside `shared/records` are found
+/// from any working directory; a missing one says where it looked and how to point elsewhere.
+#[test]
+fn records_resolve_from_the_config() {
+    let d = tempdir();
+    let recs = d.path().join("shared/records");
+    std::fs::create_dir_all(&recs).unwrap();
+    let v: Vec<String> = (0..300)
+        .map(|i| format!("{:.5}", 0.2 * (i as f64 * 0.1).sin()))
+        .collect();
+    std::fs::write(recs.join("r.txt"), v.join("\n")).unwrap();
+    let proj = d.path().join("checkout/configs");
+    std::fs::create_dir_all(&proj).unwrap();
+    let body = "[building1]\nmass_kg = 1e5\nperiod_s = 0.5\ndamping_ratio = 0.05\n[building2]\nmass_kg = 1e5\nperiod_s = 0.3\ndamping_ratio = 0.05\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = 0.01\n[[record]]\nfile = \"FILE\"\ndt_s = 0.01\n";
+    let cfg = write(&proj, "c.toml", &body.replace("FILE", "r.txt"));
+    let elsewhere = tempdir();
+    ok(&pound_in(
+        elsewhere.path(),
+        &[
+            "sweep",
+            s(&cfg),
+            "-o",
+            s(&d.path().join("o.csv")),
+            "--backend",
+            "cpu",
+        ],
+    ));
+    let missing = write(&proj, "m.toml", &body.replace("FILE", "nope.txt"));
+    let o = pound_in(
+        elsewhere.path(),
+        &[
+            "sweep",
+            s(&missing),
+            "-o",
+            s(&d.path().join("m.csv")),
+            "--backend",
+            "cpu",
+        ],
+    );
+    fails_with(&o, "no such record in");
+    fails_with(&o, "POUND_RECORDS_DIR");
 }

@@ -1,15 +1,13 @@
 //! Sweeps of rows of multi-storey buildings through the output protocol the pair's sweeps use:
 //! `--resume`, `--shard` and `pound merge`, Parquet, `--aggregate`, and `[sample]`.
 
-use crate::hostile::interrupt;
-use crate::multistorey::ROW_CONFIG;
+use crate::scenes::ROW_CONFIG;
+use crate::scenes::STOREYS3;
+use crate::support::cli::interrupt;
+use crate::support::cli::s;
 use crate::support::run::{ok, pound};
 use crate::support::tempdir;
 use std::path::Path;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// `pound sweep CFG -o OUT --backend cpu EXTRA...`
 fn sweep(cfg: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
@@ -460,4 +458,70 @@ fn outputs_of_another_kernel_are_not_merged_or_resumed() {
     let r = sweep(&cfg, &cut, &["--resume"]);
     let err = String::from_utf8_lossy(&r.stderr);
     assert!(!r.status.success() && err.contains("kernel"), "{err}");
+}
+
+/// Class 6: `contact.gap_m` is one gap shared by the pairs it gives, in the grid as under
+/// `[sample]`; one value is ignored when every pair has its own (a list refused);
+/// `gap_right_m` is a pair's own axis.
+#[test]
+fn a_shared_gap_means_one_gap() {
+    let three = |extra_left: &str| {
+        format!(
+            "[run]\ntail_s = 0.5\n[[building]]\n{STOREYS3}\n{extra_left}\n[[building]]\n{STOREYS3}\n[[building]]\n{STOREYS3}\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = [0.0, 0.01, 0.02]\n[[record]]\nsynthetic = {{ seed = 1, duration_s = 1.0 }}\n"
+        )
+    };
+    let plan = pounding::plan::row::parse_row(
+        &three(""),
+        Path::new("t.toml"),
+        Path::new("."),
+        Path::new("."),
+    )
+    .unwrap();
+    assert_eq!(plan.len(), 3, "one shared axis, not one per pair");
+    for i in 0..plan.len() {
+        let r = plan.run(i);
+        assert_eq!(r.gaps[0], r.gaps[1], "run {i}: {:?}", r.gaps);
+    }
+    // A pair's own gap_right_m is its own axis, crossed with the shared one.
+    let plan = pounding::plan::row::parse_row(
+        &three("gap_right_m = [0.05, 0.06]"),
+        Path::new("t.toml"),
+        Path::new("."),
+        Path::new("."),
+    )
+    .unwrap();
+    assert_eq!(plan.len(), 6);
+    // Ignored when every pair has its own.
+    let all = three("gap_right_m = 0.05")
+        .replace(
+            &format!("[[building]]\n{STOREYS3}\n[contact]"),
+            &format!(
+                "[[building]]\n{STOREYS3}\ngap_right_m = 0.0\n[[building]]\n{STOREYS3}\n[contact]"
+            ),
+        )
+        .replacen(
+            &format!("[[building]]\n{STOREYS3}\n[[building]]"),
+            &format!("[[building]]\n{STOREYS3}\ngap_right_m = 0.01\n[[building]]"),
+            1,
+        );
+    // A list no pair reads would be dropped: refused (`idle_axes`); one value is a leftover.
+    let e =
+        pounding::plan::row::parse_row(&all, Path::new("t.toml"), Path::new("."), Path::new("."))
+            .unwrap_err()
+            .to_string();
+    assert!(
+        e.contains("contact.gap_m: every pair has its own gap_right_m"),
+        "{e}"
+    );
+    let all = all.replace("gap_m = [0.0, 0.01, 0.02]", "gap_m = 0.02");
+    let plan =
+        pounding::plan::row::parse_row(&all, Path::new("t.toml"), Path::new("."), Path::new("."))
+            .unwrap();
+    assert!(
+        plan.warnings()
+            .iter()
+            .any(|w| w.contains("contact.gap_m is ignored")),
+        "{:?}",
+        plan.warnings()
+    );
 }

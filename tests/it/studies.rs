@@ -1,77 +1,9 @@
-//! Studies (issue 5): plots from small sweeps, the lognormal fragility fit against data drawn
-//! from a known curve, sampled sweeps, and the seed paper's cheap numbers.
+//! Studies (issue 5): plots from small sweeps, sampled sweeps, and the seed paper's cheap numbers
+//! (the fragility fit's tests are in `fragility`).
 
-use crate::support::tempdir;
+use crate::scenes::sampled_runs as sweep;
+use crate::support::{csv_column as column, tempdir};
 use crate::support::{ok, pound};
-use pounding::plan::sample::{phi, Rng};
-use pounding::studies::fragility::{fit, Level};
-use std::path::Path;
-
-/// A small sweep with a sampled gap and period and an intensity ladder, on a synthetic record.
-const SAMPLED: &str = r#"
-[run]
-tail_s = 1.0
-
-[building1]
-mass_kg = 1.0e5
-damping_ratio = 0.05
-
-[building2]
-mass_kg = 1.0e5
-period_s = [0.3, 0.9]
-damping_ratio = 0.05
-
-[contact]
-law = ["nonlinear_viscoelastic", "hertz"]
-formula = "exact"
-e = 0.65
-beta_n_per_m1_5 = 2.75e9
-
-[sample]
-n = 12
-seed = 5
-
-[[sample.axis]]
-key = "building1.period_s"
-dist = "lognormal"
-median = 0.5
-beta = 0.3
-min = 0.2
-max = 1.0
-
-[[sample.axis]]
-key = "contact.gap_m"
-dist = "uniform"
-min = 0.0
-max = 0.04
-
-[[record]]
-synthetic = { seed = 2, duration_s = 6.0 }
-
-[intensity]
-pga_g = [0.1, 0.3, 0.6]
-"#;
-
-fn sweep(dir: &Path) -> std::path::PathBuf {
-    let cfg = dir.join("sampled.toml");
-    std::fs::write(&cfg, SAMPLED).unwrap();
-    let out = dir.join("runs.csv");
-    ok(&pound(&[
-        "sweep",
-        cfg.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--backend",
-        "cpu",
-    ]));
-    out
-}
-
-fn column(csv: &str, name: &str) -> Vec<String> {
-    let mut r = csv::Reader::from_reader(csv.as_bytes());
-    let c = r.headers().unwrap().iter().position(|h| h == name).unwrap();
-    r.records().map(|x| x.unwrap()[c].to_string()).collect()
-}
 
 /// Samples cross every grid axis; each of the 12 Latin hypercube strata of the gap appears
 /// once per (law, T2, intensity); sampled periods respect the truncation.
@@ -233,79 +165,6 @@ fn plots_from_a_small_sweep() {
     for f in pounding::physics::restitution::Formula::ALL {
         assert!(text.contains(f.key()), "{} not in the plot", f.key());
     }
-}
-
-/// The fit recovers a known fragility from binomial draws: over 40 synthetic data sets (10
-/// levels, 100 runs each), the true median and dispersion lie within two standard errors in at
-/// least 85 % of them (95 % expected), and the mean estimates are within 3 % of the truth.
-#[test]
-fn fragility_fit_recovers_a_known_curve() {
-    let (median, beta) = (0.35, 0.45);
-    let mut rng = Rng::new(77);
-    let (mut hit_m, mut hit_b, mut sum_m, mut sum_b) = (0, 0, 0.0, 0.0);
-    let sets = 40;
-    for _ in 0..sets {
-        let levels: Vec<Level> = (1..=10)
-            .map(|i| {
-                let im = 0.08 * i as f64;
-                let p = phi((im / median).ln() / beta);
-                let n = 100;
-                let exceed = (0..n).filter(|_| rng.uniform() < p).count() as u64;
-                Level { im, n, exceed }
-            })
-            .collect();
-        let f = fit(&levels).unwrap();
-        hit_m += ((f.median.ln() - median.ln()).abs() < 2.0 * f.se_ln_median) as usize;
-        hit_b += ((f.beta - beta).abs() < 2.0 * f.se_beta) as usize;
-        sum_m += f.median;
-        sum_b += f.beta;
-    }
-    assert!(
-        hit_m * 100 >= 85 * sets && hit_b * 100 >= 85 * sets,
-        "{hit_m} {hit_b}"
-    );
-    let (mm, mb) = (sum_m / sets as f64, sum_b / sets as f64);
-    assert!((mm / median - 1.0).abs() < 0.03, "mean median {mm}");
-    assert!((mb / beta - 1.0).abs() < 0.03, "mean beta {mb}");
-}
-
-/// `pound fragility` on the sampled sweep: counts per level, a fitted curve for pounding at all,
-/// and the plot.
-#[test]
-fn fragility_command_counts_and_fits() {
-    let d = tempdir();
-    let runs = sweep(d.path());
-    let (csv, svg) = (d.path().join("f.csv"), d.path().join("f.svg"));
-    let out = ok(&pound(&[
-        "fragility",
-        runs.to_str().unwrap(),
-        "--im",
-        "pga_g",
-        "--edp",
-        "impacts",
-        "--threshold",
-        "0,5",
-        "--where",
-        "law=hertz",
-        "-o",
-        csv.to_str().unwrap(),
-        "--plot",
-        svg.to_str().unwrap(),
-    ]));
-    assert!(out.contains("72 runs at 3 levels of pga_g"), "{out}");
-    let text = std::fs::read_to_string(&csv).unwrap();
-    assert_eq!(text.lines().count(), 1 + 2 * 3, "{text}");
-    // Exceedance counts never fall with intensity here, and threshold 5 never exceeds 0.
-    let frac: Vec<f64> = column(&text, "fraction")
-        .iter()
-        .map(|x| x.parse().unwrap())
-        .collect();
-    assert!(frac[..3].windows(2).all(|w| w[0] <= w[1]), "{frac:?}");
-    assert!(frac[3..].iter().zip(&frac[..3]).all(|(a, b)| a <= b));
-    // The EDP in the title, each threshold's points named in the legend.
-    let svg = std::fs::read_to_string(&svg).unwrap();
-    assert!(svg.contains("P(impacts &gt; threshold)") || svg.contains("P(impacts > threshold)"));
-    assert!(svg.contains("&gt; 0: observed") || svg.contains("> 0: observed"));
 }
 
 /// The seed's cheap numbers (docs/paper-reproduction.md, `pound paper`): Table 1's velocities

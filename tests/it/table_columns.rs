@@ -14,11 +14,12 @@
 //!   cells, its notice and its figure; a goodness of fit over levels that are all `0/n` or `n/n`
 //!   prints no p.
 
+use crate::support::cli::write;
 use crate::support::{ok, pound, tempdir};
 use pounding::io::table::Table;
 use pounding::studies::fragility::{self, FragilityOptions};
 use pounding::studies::ida::{self, IdaOptions};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
@@ -26,12 +27,6 @@ fn s(p: &Path) -> String {
 
 fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
 }
 
 /// Seven records at four levels of PGA: building 1's drift rises with the level, and a run

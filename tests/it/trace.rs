@@ -131,7 +131,7 @@ fn a_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
 fn a_row_trace_reproduces_its_sweep_row_and_stays_within_its_peaks() {
     let dir = tempdir();
     let cfg = dir.path().join("row.toml");
-    std::fs::write(&cfg, crate::multistorey::ROW_CONFIG).unwrap();
+    std::fs::write(&cfg, crate::scenes::ROW_CONFIG).unwrap();
     let text = sweep(dir.path(), &cfg);
     let lines: Vec<&str> = text.lines().collect();
     let cell = |line: &str, name: &str| -> f64 { cell(lines[0], line, name).parse().unwrap() };

@@ -2,6 +2,7 @@
 //! dir, scene builders and collected sweeps here; running `pound` in [`run`]; the shared GPU
 //! device and GPU comparisons in [`gpu`].
 
+pub mod cli;
 pub mod gpu;
 pub mod run;
 
@@ -122,4 +123,11 @@ pub fn collect(plan: &PairPlan, scheme: &Scheme, chunk: usize) -> Vec<(RunSpec, 
         .run(plan, 0..plan.len(), sink, |_| {})
         .unwrap();
     rows
+}
+
+/// The column `name` of CSV text `csv`, as text.
+pub fn csv_column(csv: &str, name: &str) -> Vec<String> {
+    let mut r = csv::Reader::from_reader(csv.as_bytes());
+    let c = r.headers().unwrap().iter().position(|h| h == name).unwrap();
+    r.records().map(|x| x.unwrap()[c].to_string()).collect()
 }

@@ -1,12 +1,9 @@
-//! Hostile pass, round 3 (issue 47), classes 4, 5, 14 and the long title of 9: a figure's labels,
-//! ticks, axes and titles say what it shows, and what it costs is bounded before it is drawn.
+//! A figure's labels, ticks, axes and titles say what it shows, and what it costs is bounded
+//! before it is drawn (issue 47's classes 4, 5, 14 and the long title of 9).
 
+use crate::support::cli::s;
 use crate::support::{ok, pound, tempdir};
 use std::path::Path;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// An SVG's texts in document order, each with its element's attributes.
 fn texts(svg: &str) -> Vec<(String, String)> {

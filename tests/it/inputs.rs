@@ -1,7 +1,8 @@
-//! Hostile pass, round 3 (issue 47): what a config and a record take. Classes 7 (windows),
-//! 8 (messages: the config's), 11 (names that collide) and the config and record parts of 9.
+//! What a config and a record take (issue 47's classes 7, windows; 8, the config's messages; 11,
+//! names that collide; and the config and record parts of 9): every key names its forms, names do
+//! not collide, a record's window is the one reported, and no input is written in 300 digits.
 
-use super::{row_config, with};
+use crate::scenes::{row_config, with};
 use crate::support::{ok, pound, records_dir, table, tempdir};
 use pounding::plan::config::load_text;
 use std::path::Path;
