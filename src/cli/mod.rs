@@ -461,7 +461,7 @@ pub fn check_study_outputs(
     let mut inputs = vec![("the results", results), ("the results' sidecar", &sidecar)];
     inputs.extend_from_slice(other);
     check_outputs(&inputs, outputs)?;
-    if let Some(w) = pounding::io::journal::provenance_warning(results) {
+    if let Some(w) = pounding::io::provenance::provenance_warning(results) {
         note!("warning: {w}");
     }
     Ok(())

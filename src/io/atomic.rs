@@ -1,10 +1,11 @@
 //! Files that appear whole or not at all: written into a locked `OUT.partial`, fsynced and
 //! renamed; streams (standard output, character devices, FIFOs) written in place.
 
+pub use crate::io::paths::{partial_path, sibling};
 use crate::io::target::{PartialLock, Target};
 use std::fs::File;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Open a stream target for writing in place.
 pub fn open_stream(target: &Target) -> std::io::Result<Box<dyn Write + Send>> {
@@ -24,23 +25,10 @@ pub fn empty(file: &File) -> std::io::Result<()> {
     Ok(())
 }
 
-/// `path` with `suffix` appended to its name (`OUT` -> `OUT.partial`): the unfinished file and
-/// the sidecars of an output.
-pub fn sibling(path: &Path, suffix: &str) -> PathBuf {
-    let mut p = path.as_os_str().to_owned();
-    p.push(suffix);
-    PathBuf::from(p)
-}
-
-/// `OUT.partial` for the output `OUT`: where it is written until it is complete.
-pub fn partial_path(out: &Path) -> PathBuf {
-    sibling(out, ".partial")
-}
-
 /// Refuse to write `path` where its `OUT.partial` holds an unfinished sweep's rows (running:
 /// locked; resumable: its journal exists): every writer of a file output asks first.
 pub fn refuse_unfinished(path: &Path) -> std::io::Result<()> {
-    let journal = crate::io::provenance::progress_path(path);
+    let journal = crate::io::paths::progress_path(path);
     if journal.exists() {
         return Err(std::io::Error::other(format!(
             "{} holds the rows of an unfinished sweep (see {}): finish it with --resume, or delete both",

@@ -368,46 +368,6 @@ fn check_block(
     })
 }
 
-/// Why a results file handed to a study may not be what `pound sweep` wrote (no sidecar, an
-/// unfinished sweep, edited since); None when its sidecar vouches for it. For warnings.
-pub fn provenance_warning(path: &Path) -> Option<String> {
-    let meta = crate::io::provenance::meta_path(path);
-    let progress = crate::io::provenance::progress_path(path);
-    if progress.exists() {
-        return Some(format!(
-            "{} belongs to an unfinished sweep ({} exists)",
-            path.display(),
-            progress.display()
-        ));
-    }
-    let m: crate::io::provenance::Meta = match crate::io::provenance::read_toml(&meta) {
-        Ok(m) => m,
-        Err(_) if !meta.exists() => {
-            return Some(format!(
-                "{} has no sidecar {}: its rows are not vouched for by `pound sweep` (not its output, or the sidecar was removed)",
-                path.display(),
-                meta.display()
-            ))
-        }
-        Err(e) => return Some(format!("{e}")),
-    };
-    let Some(content) = m.content else {
-        return Some(format!(
-            "{} carries no content hash: its rows cannot be checked",
-            meta.display()
-        ));
-    };
-    match file_sha256(path) {
-        Ok(sha) if sha == content.sha256 => None,
-        Ok(_) => Some(format!(
-            "{} differs from what `pound sweep` wrote (content hash in {}): it was edited since",
-            path.display(),
-            meta.display()
-        )),
-        Err(e) => Some(format!("{}: {e}", path.display())),
-    }
-}
-
 /// SHA-256 of a file's bytes.
 pub fn file_sha256(path: &Path) -> std::io::Result<String> {
     let mut f = std::fs::File::open(path)?;

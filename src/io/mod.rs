@@ -12,6 +12,7 @@ pub mod csv;
 pub mod journal;
 pub mod merge;
 pub mod parquet;
+pub mod paths;
 pub mod provenance;
 pub mod summary;
 pub mod sweep_output;

@@ -2,6 +2,7 @@
 //! `OUT.meta.toml` written beside every finished output, and the journal `OUT.progress.toml` of
 //! an unfinished one. `pound merge`, `--resume` and the studies check them.
 
+pub use crate::io::paths::{meta_path, progress_path};
 use crate::plan::shard::Shard;
 use crate::plan::PairPlan;
 use serde::{Deserialize, Serialize};
@@ -386,11 +387,6 @@ impl TargetError {
     }
 }
 
-/// `OUT.meta.toml` for the output `OUT`.
-pub fn meta_path(out: &Path) -> PathBuf {
-    crate::io::atomic::sibling(out, ".meta.toml")
-}
-
 /// Progress of an unfinished output (`OUT.progress.toml`), rewritten atomically after each
 /// chunk's rows are on disk: the first `done` runs of the range are in the first `bytes` bytes of
 /// `OUT.partial`, whose SHA-256 is `sha256`; anything after that is a half-written chunk. A hint,
@@ -402,10 +398,6 @@ pub struct Progress {
     pub bytes: u64,
     #[serde(default)]
     pub sha256: String,
-}
-
-pub fn progress_path(out: &Path) -> PathBuf {
-    crate::io::atomic::sibling(out, ".progress.toml")
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -440,6 +432,46 @@ pub fn write_toml<T: Serialize>(path: &Path, v: &T) -> Result<(), SidecarError> 
         path: path.into(),
         message: e.to_string(),
     })
+}
+
+/// Why a results file handed to a study may not be what `pound sweep` wrote (no sidecar, an
+/// unfinished sweep, edited since); None when its sidecar vouches for it. For warnings.
+pub fn provenance_warning(path: &Path) -> Option<String> {
+    let meta = meta_path(path);
+    let progress = progress_path(path);
+    if progress.exists() {
+        return Some(format!(
+            "{} belongs to an unfinished sweep ({} exists)",
+            path.display(),
+            progress.display()
+        ));
+    }
+    let m: Meta = match read_toml(&meta) {
+        Ok(m) => m,
+        Err(_) if !meta.exists() => {
+            return Some(format!(
+                "{} has no sidecar {}: its rows are not vouched for by `pound sweep` (not its output, or the sidecar was removed)",
+                path.display(),
+                meta.display()
+            ))
+        }
+        Err(e) => return Some(format!("{e}")),
+    };
+    let Some(content) = m.content else {
+        return Some(format!(
+            "{} carries no content hash: its rows cannot be checked",
+            meta.display()
+        ));
+    };
+    match crate::io::journal::file_sha256(path) {
+        Ok(sha) if sha == content.sha256 => None,
+        Ok(_) => Some(format!(
+            "{} differs from what `pound sweep` wrote (content hash in {}): it was edited since",
+            path.display(),
+            meta.display()
+        )),
+        Err(e) => Some(format!("{}: {e}", path.display())),
+    }
 }
 
 #[cfg(test)]

@@ -123,7 +123,7 @@ impl Target {
         let Target::File(p) = self else {
             return Ok(());
         };
-        let probe = crate::io::atomic::sibling(p, &format!(".probe-{}", std::process::id()));
+        let probe = crate::io::paths::sibling(p, &format!(".probe-{}", std::process::id()));
         match OpenOptions::new().write(true).create_new(true).open(&probe) {
             Ok(_) => {
                 let _ = std::fs::remove_file(&probe);
@@ -152,11 +152,11 @@ pub fn check_outputs(
         if t.is_file() {
             for (beside, name) in [
                 (
-                    crate::io::atomic::partial_path as fn(&Path) -> PathBuf,
+                    crate::io::paths::partial_path as fn(&Path) -> PathBuf,
                     "partial file",
                 ),
-                (crate::io::provenance::meta_path, "sidecar"),
-                (crate::io::provenance::progress_path, "journal"),
+                (crate::io::paths::meta_path, "sidecar"),
+                (crate::io::paths::progress_path, "journal"),
             ] {
                 files.push((format!("{what}'s {name}"), beside(t.path())));
             }
@@ -177,7 +177,7 @@ fn refuse_bookkeeping(what: &str, path: &Path) -> Result<(), TargetError> {
     let name = path.as_os_str().to_string_lossy();
     let owner = |suffix: &str| name.strip_suffix(suffix).map(PathBuf::from);
     if let Some(out) = owner(".partial") {
-        let journal = crate::io::provenance::progress_path(&out);
+        let journal = crate::io::paths::progress_path(&out);
         if journal.exists() {
             return Err(refused(
                 what,
@@ -299,7 +299,7 @@ pub fn check_distinct(
         if input.as_os_str() == "-" || is_char_device(input) {
             continue;
         }
-        let partial = crate::io::atomic::partial_path(input);
+        let partial = crate::io::paths::partial_path(input);
         let partial_id = file_id(&partial);
         for (what_out, out, oid) in &outs {
             let same = match (&partial_id, oid) {

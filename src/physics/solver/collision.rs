@@ -3,7 +3,7 @@
 //! hysteresis` report.
 
 use super::reference::{self, ReferenceOptions};
-use super::{Mode, Sample};
+use super::state::{Mode, Sample};
 use crate::physics::contact::Contact;
 use crate::physics::model::{Forcing, Initial, Oscillator, Pair, Status};
 

@@ -1,11 +1,18 @@
 //! Locating the non-smooth instants inside a step: first touch, the turn, separation, and a
 //! touch hidden inside a free step; the mode change each calls for.
 
-use super::fast::LOCATE_BISECTIONS;
 use super::hermite::{cubic_max_bound, hermite_range, CUBIC_SLOPE_WEIGHT};
-use super::tracker::Tracker;
-use super::{ddelta, delta, force, Mode, Segment, State};
+use super::state::{ddelta, delta, Mode, Segment, State};
 use crate::physics::model::{Oscillator, Pair};
+
+/// Event location in the fast schemes: the relative tolerance on the step and the most
+/// iterations (`LOCATE_TOL` and `LOCATE_ITER` in the shaders).
+pub const LOCATE_TOLERANCE: f64 = 1e-9;
+pub const LOCATE_ITERATIONS: u32 = 16;
+
+/// Bisections after event location's regula falsi iterations (in every scheme), enough to
+/// close any bracket to its tolerance (`LOCATE_BISECT` in the shaders).
+pub const LOCATE_BISECTIONS: u32 = 32;
 
 /// Positive once `mode` must end: first touch (Free), the turn `delta' = 0` (Approach),
 /// separation (Restitution).
@@ -273,31 +280,6 @@ pub(crate) fn contact_reach_growth(o: &Oscillator, h: f64) -> f64 {
     (1.0 + slope + margin) * (1.0 + 2.0 * REACH_SLACK)
 }
 
-/// Apply the mode change an event at state `z` (time `t`) calls for; `before` is the state at
-/// the start of the step in which the event was located.
-#[inline]
-pub(crate) fn transition(
-    p: &Pair,
-    mode: Mode,
-    t: f64,
-    z: &State,
-    before: &State,
-    tr: &mut Tracker,
-) -> Mode {
-    match mode {
-        Mode::Free => {
-            let (v0, next) = touch(delta(p, before), ddelta(z), tr.v0);
-            tr.onset(t, v0, force(p, next, v0, z));
-            next
-        }
-        Mode::Approach => Mode::Restitution,
-        Mode::Restitution => {
-            tr.end_impact();
-            Mode::Free
-        }
-    }
-}
-
 /// The impact speed and contact mode of a touch located at penetration rate `v`, where the
 /// step began at penetration `delta_before` and the last impact had speed `last_v0`. A first
 /// touch takes `v0 = delta'` at `delta = 0`; a clamped law that re-engages while still
@@ -331,7 +313,6 @@ pub(crate) fn reapproach(mode: Mode, z: &State) -> Mode {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::solver::fast::LOCATE_ITERATIONS;
 
     /// The search ends on the far side of the root, within its tolerance, for a function regula
     /// falsi models well (a line), one it stalls on (a steep exponential-like rise) and one that

@@ -29,11 +29,12 @@
 //! most free steps with a comparison, and ends early, all with the same output.
 
 use super::events::may_touch;
+pub use super::events::{LOCATE_BISECTIONS, LOCATE_ITERATIONS, LOCATE_TOLERANCE};
 use super::shared::FreeResponse;
-use super::tracker::Integration;
-use super::{
+use super::state::{
     ddelta, delta, finite, impact_step, structural_rel_accel, Mode, Sample, Segment, State,
 };
+use super::tracker::Integration;
 use crate::physics::model::{Forcing, Initial, Pair, RunOutput, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
 
@@ -58,15 +59,6 @@ pub struct FastOptions {
 /// buildings stay pressed together and move with the structures, so the step need only resolve
 /// the contact's local rate (`h_rate`), not a fresh impact.
 pub const SUSTAINED: f64 = 2.0;
-
-/// Event location in the fast schemes: the relative tolerance on the step and the most
-/// iterations (`LOCATE_TOL` and `LOCATE_ITER` in the shaders).
-pub const LOCATE_TOLERANCE: f64 = 1e-9;
-pub const LOCATE_ITERATIONS: u32 = 16;
-
-/// Bisections after event location's regula falsi iterations (in every scheme), enough to
-/// close any bracket to its tolerance (`LOCATE_BISECT` in the shaders).
-pub const LOCATE_BISECTIONS: u32 = 32;
 
 /// Accepted pieces one substep may be cut into by events before the run ends with
 /// `step_limit` (a guard against a stalled event search; the shader has the same cap).
@@ -104,7 +96,7 @@ pub(crate) fn rk4(
         seg.a0 + slope * (tau + h),
     ];
     let inv_m = [1.0 / p.b1.m, 1.0 / p.b2.m];
-    let f = |ag: f64, y: &State| super::rhs(p, mode, v0, ag, inv_m, y);
+    let f = |ag: f64, y: &State| super::state::rhs(p, mode, v0, ag, inv_m, y);
     let add = |y: &State, k: &State, s: f64| -> State { std::array::from_fn(|i| y[i] + s * k[i]) };
     let k1 = f(ag[0], z);
     let k2 = f(ag[1], &add(z, &k1, 0.5 * h));

@@ -7,8 +7,10 @@
 
 use super::events::may_touch;
 use super::fast::SUSTAINED;
+use super::state::{
+    ddelta, finite, impact_step, structural_rel_accel, Mode, Sample, Segment, State,
+};
 use super::tracker::Integration;
-use super::{ddelta, finite, impact_step, structural_rel_accel, Mode, Sample, Segment, State};
 use crate::physics::model::{Forcing, Initial, Pair, RunOutput, Status};
 
 /// Tolerance settings of the reference scheme.
@@ -149,7 +151,7 @@ pub(crate) fn dopri(
 ) -> (State, f64) {
     let inv_m = [1.0 / p.b1.m, 1.0 / p.b2.m];
     let (y, ev) = dopri_stages(z, t, h, |tt, y| {
-        super::rhs(p, mode, v0, seg.at(tt), inv_m, y)
+        super::state::rhs(p, mode, v0, seg.at(tt), inv_m, y)
     });
     let atol = rtol * 1e-6;
     let mut err: f64 = 0.0;

@@ -24,7 +24,7 @@
 
 use super::hermite::{quintic_range, quintic_signed_bounds};
 use super::row::{simulate_uncoupled, RowModel, RowScheme, UNCOUPLED_GAP_M};
-use super::Segment;
+use super::state::Segment;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{CoupledPropagator, Propagator};

@@ -24,8 +24,8 @@
 pub(crate) use super::events::REACH_SLACK;
 use super::events::{contact_reach, contact_reach_growth};
 use super::hermite::{cubic_abs_bound, quintic_max_bound, CUBIC_SLOPE_WEIGHT};
+use super::state::{Segment, State};
 use super::tracker::{free_accel, free_accel_and_jerk, free_accel_peak, free_peak};
-use super::{Segment, State};
 use crate::physics::model::{Forcing, Initial, Oscillator, Pair};
 use crate::physics::propagator::Propagator;
 

@@ -1,12 +1,12 @@
 //! What a run records as it goes (peaks, impacts, the energy balance) and the state of one run
 //! being integrated, shared by both schemes.
 
-use super::events::{event_value, hidden_touch, locate, reapproach, transition};
+use super::events::{event_value, hidden_touch, locate, reapproach, touch};
 use super::hermite::{
     cubic_max_bound, hermite_range, raise_cubic_peak, raise_hump_peak, raise_quintic_peak,
 };
-use super::structural_accel;
-use super::{ddelta, delta, force, force_rate, Mode, Sample, Segment, State};
+use super::state::structural_accel;
+use super::state::{ddelta, delta, force, force_rate, Mode, Sample, Segment, State};
 use crate::physics::model::{EnergyBalance, Initial, Oscillator, Pair, RunOutput, Status};
 
 /// Peaks and impact bookkeeping shared by both schemes.
@@ -215,6 +215,31 @@ impl Tracker {
     pub fn energy(&self, p: &Pair, z: &State) -> EnergyBalance {
         let held = mechanical_energy(p, z);
         EnergyBalance::close(self.e_initial, z[5], z[6], z[4], held, self.e_peak)
+    }
+}
+
+/// Apply the mode change an event at state `z` (time `t`) calls for; `before` is the state at
+/// the start of the step in which the event was located.
+#[inline]
+pub(crate) fn transition(
+    p: &Pair,
+    mode: Mode,
+    t: f64,
+    z: &State,
+    before: &State,
+    tr: &mut Tracker,
+) -> Mode {
+    match mode {
+        Mode::Free => {
+            let (v0, next) = touch(delta(p, before), ddelta(z), tr.v0);
+            tr.onset(t, v0, force(p, next, v0, z));
+            next
+        }
+        Mode::Approach => Mode::Restitution,
+        Mode::Restitution => {
+            tr.end_impact();
+            Mode::Free
+        }
     }
 }
 

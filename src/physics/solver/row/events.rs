@@ -4,7 +4,7 @@
 use super::yielding::{band_edges, may_reach, StoreyMode};
 use super::RowRun;
 use crate::physics::solver::events::{hidden_rise, locate, touch};
-use crate::physics::solver::{Mode, Segment};
+use crate::physics::solver::state::{Mode, Segment};
 
 impl<'m> RowRun<'m> {
     /// Each event's value in state `z`, levels then storeys (positive once that level's contact

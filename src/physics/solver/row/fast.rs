@@ -34,7 +34,7 @@ use crate::physics::solver::fast::{
     SUSTAINED,
 };
 use crate::physics::solver::hermite::{cubic_max_bound, hermite_range};
-use crate::physics::solver::{impact_step, Mode, Segment};
+use crate::physics::solver::state::{impact_step, Mode, Segment};
 
 /// The fast scheme's settings are the pair's.
 pub type RowFastOptions = FastOptions;
@@ -780,7 +780,7 @@ mod tests {
     /// round-trips: the two are one ODE.
     #[test]
     fn floor_rhs_is_the_modal_rhs() {
-        use crate::physics::solver::Mode;
+        use crate::physics::solver::state::Mode;
         // Negative gaps: every level overlaps, so every level's force enters.
         let m = row(vec![-0.0005, -0.0005]);
         let sub = m.substep_model().unwrap();

@@ -6,7 +6,7 @@ use super::{dot, LevelModel, RowModel};
 use crate::physics::row::LevelOutput;
 use crate::physics::solver::events::error_margin;
 use crate::physics::solver::hermite::{cubic_max_bound, hermite_range};
-use crate::physics::solver::{Mode, Segment};
+use crate::physics::solver::state::{Mode, Segment};
 
 impl LevelModel {
     /// Penetration `u_left - u_right - gap`.

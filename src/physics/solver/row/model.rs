@@ -7,7 +7,7 @@ use crate::physics::contact::Contact;
 use crate::physics::row::{struck_side, LevelSide, Row};
 use crate::physics::shear::{storey_drift_row, Modes};
 use crate::physics::solver::events::fourth_derivative_bound;
-use crate::physics::solver::Segment;
+use crate::physics::solver::state::Segment;
 
 /// One building of the row, as the integrators see it.
 #[derive(Debug, Clone)]

@@ -8,8 +8,8 @@ use crate::physics::row::{RowOutput, StoreyOutput};
 use crate::physics::solver::hermite::{
     cubic_max_bound, hermite_range, raise_cubic_peak, raise_hump_peak, raise_quintic_peak,
 };
+use crate::physics::solver::state::{Mode, Segment};
 use crate::physics::solver::tracker::raise_force_peak;
-use crate::physics::solver::{Mode, Segment};
 
 /// A point of a row's time history handed to an observer after every accepted step and
 /// event (as the pair's [`super::Sample`]).

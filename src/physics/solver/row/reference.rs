@@ -12,7 +12,7 @@ use crate::physics::model::{Forcing, Status};
 use crate::physics::row::RowOutput;
 use crate::physics::solver::fast::SUSTAINED;
 use crate::physics::solver::reference::{dopri_stages, retry, ReferenceOptions};
-use crate::physics::solver::{impact_step, Mode, Segment};
+use crate::physics::solver::state::{impact_step, Mode, Segment};
 
 /// One Dormand-Prince step; returns the 5th-order solution and the scaled error norm
 /// (`<= 1` accepts).

@@ -3,7 +3,7 @@
 
 use super::yielding::StoreyMode;
 use super::RowModel;
-use crate::physics::solver::Mode;
+use crate::physics::solver::state::Mode;
 
 /// Each level's contact mode and impact speed: what the right-hand side needs of them.
 pub(crate) type LevelModes = [(Mode, f64)];

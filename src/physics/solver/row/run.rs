@@ -7,7 +7,7 @@ use super::{Floors, LevelModel, LevelState, RowModel, RowObserver, StoreyState};
 use crate::physics::propagator::{CoupledPropagator, GAUSS5};
 use crate::physics::row::{BuildingOutput, Collapse, LevelClosing};
 use crate::physics::solver::hermite::{quintic_max_bound, quintic_range, raise_quintic_peak};
-use crate::physics::solver::{Mode, Segment};
+use crate::physics::solver::state::{Mode, Segment};
 
 /// Building `k` of `modal`, standing still since `seg.t0` (its modes at `z0`, the row's modal
 /// state then), stepped exactly to `t` into `z`: `Propagator` over `t - seg.t0` about the static

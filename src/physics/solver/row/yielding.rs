@@ -25,7 +25,7 @@ use super::{dot, RowModel, RowRun};
 use crate::physics::model::Forcing;
 use crate::physics::solver::events::error_margin;
 use crate::physics::solver::hermite::{cubic_max_bound, hermite_range};
-use crate::physics::solver::Segment;
+use crate::physics::solver::state::Segment;
 
 /// A storey yields once its back drift passes its band by this fraction: the band edge an
 /// unloading storey leaves from is then inside its band, not on it, to rounding.
