@@ -3,6 +3,7 @@
 //! Every path runs with the energy balance on, so each point also carries the distribution of
 //! the runs' energy residuals (the check a user gets on any sweep without a reference).
 
+use crate::engine::quantile::{quantile, Interpolation::Nearest};
 use crate::engine::gpu::{GpuContext, GpuError, GpuOptions, Precision};
 use crate::engine::{Backend, Engine, EngineError};
 use crate::physics::model::{RunOutput, Status};
@@ -59,13 +60,11 @@ fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)
 }
 
-/// The `p` quantile of `v`; NaN for no values (statistics over zero runs are not zeros).
-fn quantile(v: &mut [f64], p: f64) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
+/// The median and the 99th percentile of `v` (sorted here), each a value of the data (nearest
+/// rank); NaN for no values (statistics over zero runs are not zeros).
+fn median_p99(v: &mut [f64]) -> [f64; 2] {
     v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * p).round() as usize]
+    [0.5, 0.99].map(|p| quantile(v, p, Nearest))
 }
 
 /// Errors of `out` against `truth`, run by run.
@@ -94,19 +93,23 @@ pub fn errors(truth: &[RunOutput], out: &[RunOutput]) -> Errors {
             w.push(rel(o.dissipated_energy, t.dissipated_energy));
         }
     }
+    let [force_median, force_p99] = median_p99(&mut f);
+    let [displacement_median, displacement_p99] = median_p99(&mut u);
+    let [energy_median, energy_p99] = median_p99(&mut w);
+    let [residual_median, residual_p99] = median_p99(&mut r);
     Errors {
         compared: f.len() as u64,
-        force_median: quantile(&mut f, 0.5),
-        force_p99: quantile(&mut f, 0.99),
-        displacement_median: quantile(&mut u, 0.5),
-        displacement_p99: quantile(&mut u, 0.99),
-        energy_median: quantile(&mut w, 0.5),
-        energy_p99: quantile(&mut w, 0.99),
+        force_median,
+        force_p99,
+        displacement_median,
+        displacement_p99,
+        energy_median,
+        energy_p99,
         impact_count_differs: differ as f64 / truth.len().max(1) as f64,
         impacts_differ: differ as u64,
         failed,
-        residual_median: quantile(&mut r, 0.5),
-        residual_p99: quantile(&mut r, 0.99),
+        residual_median,
+        residual_p99,
     }
 }
 
@@ -678,7 +681,7 @@ pub fn row_study(
         .unwrap_or_else(|e| match e {});
         (outs, s.runs_per_second())
     };
-    let med_p99 = |mut v: Vec<f64>| [quantile(&mut v, 0.5), quantile(&mut v, 0.99)];
+    let med_p99 = |mut v: Vec<f64>| median_p99(&mut v);
     let yields = plan.yielding.iter().any(Option::is_some);
     let point = |path: &str, setting: f64, rate: f64, truth: &[RowOutput], out: &[RowOutput]| {
         let (mut f, mut u, mut d, mut a, mut r) = (vec![], vec![], vec![], vec![], vec![]);

@@ -13,6 +13,7 @@
 //! collapsed, else 0 (FEMA P-695; Baker 2015). Runs of any other status but `ok` failed, and are
 //! left out.
 
+use crate::engine::quantile::{quantile, Interpolation::Linear};
 use crate::io::table::{caption, label, order_key, Filter, Table, TableError};
 use crate::plan::sample::phi;
 use crate::studies::damage_states::DamageStates;
@@ -993,7 +994,7 @@ pub fn bootstrap(
 ) -> Vec<Option<Band>> {
     let ng = grouped.groups.len();
     let thresholds = grouped.counts.first().map_or(0, |c| c.len());
-    let mut rng = crate::plan::sample::Rng::new(seed);
+    let mut rng = crate::record::rng::SplitMix64::new(seed);
     let mut fits: Vec<Vec<Fit>> = vec![Vec::new(); thresholds];
     let mut unfitted = vec![0usize; thresholds];
     let mut why: Vec<Vec<(NoFit, usize)>> = vec![Vec::new(); thresholds];
@@ -1017,7 +1018,7 @@ pub fn bootstrap(
     }
     let band = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
-        [quantile(&v, 0.05), quantile(&v, 0.95)]
+        [quantile(&v, 0.05, Linear), quantile(&v, 0.95, Linear)]
     };
     fits.into_iter()
         .zip(unfitted)
@@ -1077,20 +1078,6 @@ pub fn crossings(fits: &[Result<Fit, NoFit>], lo: f64, hi: f64) -> Vec<(usize, u
     out
 }
 
-/// Quantile `q` of sorted values, interpolated linearly between order statistics (NaN when
-/// there are none).
-pub fn quantile(sorted: &[f64], q: f64) -> f64 {
-    match sorted.len() {
-        0 => f64::NAN,
-        n => {
-            let x = q * (n - 1) as f64;
-            let (i, f) = (x.floor() as usize, x - x.floor());
-            let next = sorted[(i + 1).min(n - 1)];
-            sorted[i] + f * (next - sorted[i])
-        }
-    }
-}
-
 /// The counts as CSV, a row per threshold and level: the state's name (with `states`), the
 /// threshold, the intensity, the runs decided, those exceeding, the runs among them that
 /// collapsed (counted as exceeding), their fraction, the runs undecided (no value, not decided by
@@ -1147,7 +1134,7 @@ pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -
             }
             s.push_str(&format!(
                 "{},{im},{n},{k},{},{},{u},{},{}\n",
-                number(limit),
+                crate::show(limit),
                 grouped.collapsed.get(l).copied().unwrap_or(0),
                 ratio(k, n),
                 ratio(k, n + u),
@@ -1185,16 +1172,6 @@ pub fn csv_header(spec: &FragilitySpec, states: bool) -> Vec<String> {
         "fraction_if_all_exceed",
     ]));
     h
-}
-
-/// A number as a person reads it: its shortest round-trip text, in exponent form where the
-/// decimal would be long (a threshold of 1e-300 is not 300 digits).
-pub fn number(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs()) {
-        x.to_string()
-    } else {
-        format!("{x:e}")
-    }
 }
 
 /// A threshold's legend entry: `> 1 MN` for `peak_force_n` above 1e6 ([`crate::io::table::quantity`]).
@@ -1453,7 +1430,7 @@ impl FragilityOptions {
         if let Some(t) = crate::plan::config::number_given_twice(&self.thresholds) {
             return refuse(format!(
                 "--threshold: {} is given twice: give each threshold once",
-                number(t)
+                crate::show(t)
             ));
         }
         let (thresholds, names): (Vec<f64>, Vec<String>) = match &states {
@@ -1461,7 +1438,7 @@ impl FragilityOptions {
             None if collapse => (vec![0.0], vec!["collapse".into()]),
             None => (
                 self.thresholds.clone(),
-                self.thresholds.iter().map(|&t| number(t)).collect(),
+                self.thresholds.iter().map(|&t| crate::show(t)).collect(),
             ),
         };
         Ok(Settled {
@@ -1619,7 +1596,7 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
     let mut extrapolated = Vec::new();
     for (i, f) in fits.iter().enumerate() {
         let label = match &states {
-            Some(_) => format!("{} ({})", names[i], number(spec.thresholds[i])),
+            Some(_) => format!("{} ({})", names[i], crate::show(spec.thresholds[i])),
             None => names[i].clone(),
         };
         let band = match (&bands[i], o.bootstrap > 0) {
@@ -1685,7 +1662,7 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
                             "{} ({} > {})",
                             names[i],
                             spec.edp,
-                            number(spec.thresholds[i])
+                            crate::show(spec.thresholds[i])
                         )
                     } else {
                         format!("{} > {}", spec.edp, names[i])
@@ -1763,7 +1740,7 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
         };
         t.note(format_args!(
             "notice: the fitted curves of {} and {} are out of order from {} = {from:.4} to {to:.4}: there the more severe ({}) is the more probable, which no run can be (every run above {} is above {}); the curves are kept as fitted: {outside}, or fit with more runs",
-            names[i], names[j], spec.im, names[j], number(spec.thresholds[j]), number(spec.thresholds[i])
+            names[i], names[j], spec.im, names[j], crate::show(spec.thresholds[j]), crate::show(spec.thresholds[i])
         ));
     }
     if grouped.unknown > 0 {
@@ -1903,8 +1880,8 @@ fn undecided_table(
     };
     for (k, &limit) in spec.thresholds.iter().enumerate() {
         let label = match states {
-            Some(n) => format!("{} ({})", n[k], number(limit)),
-            None => number(limit),
+            Some(n) => format!("{} ({})", n[k], crate::show(limit)),
+            None => crate::show(limit),
         };
         let undecided: u64 = grouped.undecided_at(k).iter().sum();
         t.say(format_args!(
@@ -2030,9 +2007,9 @@ mod tests {
         ] {
             assert_eq!(bounding_column(edp).as_deref(), bound, "{edp}");
         }
-        assert_eq!(number(1e-300), "1e-300");
-        assert_eq!(number(0.005), "0.005");
-        assert_eq!(number(2e6), "2000000");
+        assert_eq!(crate::show(1e-300), "1e-300");
+        assert_eq!(crate::show(0.005), "0.005");
+        assert_eq!(crate::show(2e6), "2000000");
     }
 
     /// Runs with no value: decided where the bound is at or below a threshold, else undecided,

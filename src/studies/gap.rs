@@ -861,9 +861,9 @@ impl<'a> GapStudy<'a> {
                     runs: pairs.len(),
                     censored,
                     closing: ratios.len(),
-                    median: quantile(&ratios, 0.5),
-                    p10: quantile(&ratios, 0.1),
-                    p90: quantile(&ratios, 0.9),
+                    median: quantile(&ratios, 0.5, Linear),
+                    p10: quantile(&ratios, 0.1, Linear),
+                    p90: quantile(&ratios, 0.9, Linear),
                     unconservative,
                 });
             }
@@ -1411,7 +1411,7 @@ fn mills(z: f64) -> f64 {
     }
 }
 
-pub use crate::studies::fragility::quantile;
+use crate::engine::quantile::{quantile, Interpolation::Linear};
 
 /// A round step (1, 2 or 5 times a power of ten) of at least `x`.
 fn round_step(x: f64) -> f64 {
@@ -1585,10 +1585,10 @@ mod tests {
     #[test]
     fn quantiles_and_round_steps() {
         let v = [1.0, 2.0, 3.0, 4.0, 5.0];
-        assert_eq!(quantile(&v, 0.5), 3.0);
-        assert_eq!(quantile(&v, 0.1), 1.4);
-        assert_eq!(quantile(&v, 1.0), 5.0);
-        assert!(quantile(&[], 0.5).is_nan());
+        assert_eq!(quantile(&v, 0.5, Linear), 3.0);
+        assert_eq!(quantile(&v, 0.1, Linear), 1.4);
+        assert_eq!(quantile(&v, 1.0, Linear), 5.0);
+        assert!(quantile(&[], 0.5, Linear).is_nan());
         assert_eq!(round_step(0.0031), 0.005);
         assert_eq!(round_step(0.002), 0.002);
         assert_eq!(round_step(0.011), 0.02);
