@@ -3,8 +3,8 @@
 //! Every path runs with the energy balance on, so each point also carries the distribution of
 //! the runs' energy residuals (the check a user gets on any sweep without a reference).
 
-use crate::engine::quantile::{quantile, Interpolation::Nearest};
 use crate::engine::gpu::{GpuContext, GpuError, GpuOptions, Precision};
+use crate::engine::quantile::{quantile, Interpolation::Nearest};
 use crate::engine::{Backend, Engine, EngineError};
 use crate::physics::model::{RunOutput, Status};
 use crate::physics::row::{Collapse, RowOutput};
