@@ -120,7 +120,7 @@ impl Sketch {
         if self.count == 0 {
             return f64::NAN;
         }
-        let rank = (q * (self.count - 1) as f64).round() as u64;
+        let rank = crate::engine::quantile::nearest_rank(self.count as usize, q) as u64;
         let mut seen = 0;
         for (&b, &n) in &self.buckets {
             seen += n;

@@ -11,6 +11,7 @@
 pub mod aggregate;
 pub mod cpu;
 pub mod gpu;
+pub mod quantile;
 
 use crate::physics::model::{RunOutput, Status};
 use crate::physics::row::RowOutput;

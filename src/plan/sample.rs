@@ -61,33 +61,8 @@ pub enum Method {
     MonteCarlo,
 }
 
-/// SplitMix64: small, fast, and fixed, so a seed gives the same samples everywhere.
-#[derive(Debug, Clone)]
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed)
-    }
-
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in the open interval (0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    /// Uniform integer in `0..n`.
-    pub fn below(&mut self, n: usize) -> usize {
-        (self.uniform() * n as f64) as usize % n.max(1)
-    }
-}
+/// The plans' samples draw from the crate's one seeded generator (the same stream everywhere).
+pub use crate::record::rng::SplitMix64 as Rng;
 
 /// `n` points of the unit cube in `dims` dimensions (row per point).
 pub fn unit_points(method: Method, n: usize, dims: usize, seed: u64) -> Vec<Vec<f64>> {

@@ -5,6 +5,7 @@
 
 pub mod intensity;
 mod read;
+pub mod rng;
 mod synthetic;
 
 pub use read::{read_record, Format, ReadOptions, Units};

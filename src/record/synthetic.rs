@@ -5,6 +5,7 @@
 //! `exp`, whose last bits vary between platforms: the same spec gives the same bits everywhere.
 //! Gaussian noise comes from the Irwin-Hall sum of 12 uniforms (exact mean 0, variance 1).
 
+use super::rng::SplitMix64;
 use super::{Record, RecordError, G};
 use std::path::PathBuf;
 
@@ -38,22 +39,9 @@ impl Default for SyntheticSpec {
     }
 }
 
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-    fn normal(&mut self) -> f64 {
-        (0..12).map(|_| self.uniform()).sum::<f64>() - 6.0
-    }
+/// Gaussian noise: the Irwin-Hall sum of 12 uniforms (exact mean 0, variance 1; no libm).
+fn normal(rng: &mut SplitMix64) -> f64 {
+    (0..12).map(|_| rng.uniform_from_zero()).sum::<f64>() - 6.0
 }
 
 fn envelope(t: f64, d: f64) -> f64 {
@@ -119,13 +107,13 @@ pub fn synthetic(spec: &SyntheticSpec) -> Result<Record, RecordError> {
     let sub = ((spec.dt * wg / 0.2).ceil() as usize).max(1);
     let h = spec.dt / sub as f64;
     let f = |x: f64, v: f64, w: f64| (v, -c * v - k * x - w);
-    let mut rng = SplitMix64(spec.seed ^ 0x005E_ED0F_90D1_u64);
+    let mut rng = SplitMix64::new(spec.seed ^ 0x005E_ED0F_90D1_u64);
     let (mut x, mut v) = (0.0f64, 0.0f64);
     let mut accel = Vec::with_capacity(n);
     for i in 0..n {
         let t = i as f64 * spec.dt;
         accel.push(-(c * v + k * x) * envelope(t, spec.duration));
-        let w = rng.normal();
+        let w = normal(&mut rng);
         for _ in 0..sub {
             let (k1x, k1v) = f(x, v, w);
             let (k2x, k2v) = f(x + 0.5 * h * k1x, v + 0.5 * h * k1v, w);

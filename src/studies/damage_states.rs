@@ -401,7 +401,6 @@ impl DamageStates {
     /// The built-in sets as a table (`--damage-states list`): name, building type and code
     /// level, demand, source and limits.
     pub fn list() -> String {
-        use crate::studies::fragility::number;
         let mut s = String::from(
             "Built-in damage-state sets (pound fragility RESULTS.csv --edp COLUMN --damage-states SET; or a TOML file of [[state]] name and limit). A run is past a state where its EDP exceeds the state's limit; every limit is a drift ratio (m/m).\n\n| set | building type, code level | EDP (K: the building) | source | limits |\n|---|---|---|---|---|\n",
         );
@@ -418,7 +417,7 @@ impl DamageStates {
             let limits: Vec<String> = d
                 .states
                 .iter()
-                .map(|(n, l)| format!("{n} {}", number(*l)))
+                .map(|(n, l)| format!("{n} {}", crate::show(*l)))
                 .collect();
             let edp = d
                 .demand
@@ -949,7 +948,7 @@ mod tests {
             let limits: Vec<String> = d
                 .states
                 .iter()
-                .map(|(s, l)| format!("{s} {}", crate::studies::fragility::number(*l)))
+                .map(|(s, l)| format!("{s} {}", crate::show(*l)))
                 .collect();
             assert_eq!(row[5], limits.join(", "), "{name}");
         }

@@ -20,6 +20,7 @@
 //! the demand (a residual drift where the run did not settle) is left out and counted at its
 //! level, and the fractiles there are over the others, and say so.
 
+use crate::engine::quantile::{quantile, Interpolation::Linear};
 use crate::io::table::{caption, label, name, order_key, Filter, Table, TableError};
 use crate::studies::fragility::{demand_rows, CollapseOf, Demand, LeftOut};
 use crate::studies::plot::{Panel, Series, SMOOTH};
@@ -96,27 +97,6 @@ pub enum IdaError {
     /// message as `pound ida` prints it.
     #[error("{0}")]
     Refused(String),
-}
-
-/// Quantile `q` of sorted values that may end in infinities (collapses), interpolated linearly
-/// between order statistics as [`crate::studies::fragility::quantile`] (type 7): infinite where
-/// either order statistic it interpolates between (with a weight above 0) is.
-pub fn quantile(sorted: &[f64], q: f64) -> f64 {
-    match sorted.len() {
-        0 => f64::NAN,
-        n => {
-            let x = q * (n - 1) as f64;
-            let (i, f) = (x.floor() as usize, x - x.floor());
-            let (here, next) = (sorted[i], sorted[(i + 1).min(n - 1)]);
-            if f == 0.0 || here.is_infinite() {
-                here
-            } else if next.is_infinite() {
-                next
-            } else {
-                here + f * (next - here)
-            }
-        }
-    }
 }
 
 /// Read the curves of `table` under `spec`, and the rows left out (failed, no value, a value not
@@ -246,7 +226,7 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
         v.sort_by(f64::total_cmp);
         counts.push(v.len());
         collapsed.push(v.iter().filter(|x| x.is_infinite()).count());
-        fractiles.push(FRACTILES.map(|f| quantile(&v, f / 100.0)));
+        fractiles.push(FRACTILES.map(|f| quantile(&v, f / 100.0, Linear)));
     }
     let at = |k: &u64| missing.get(k).copied().unwrap_or_default();
     Ok((
@@ -846,27 +826,6 @@ mod tests {
         assert!(ida.csv(&spec(&["record"])).starts_with(
             "target_sa_g,curves,drift_p16,drift_p50,drift_p84,collapsed,collapsed_fraction,rec1,rec2,rec3,rec4,rec5\n0.1,5,"
         ));
-    }
-
-    /// Type-7 quantiles with collapses (infinities) at the end: infinite where the position
-    /// falls on one, or between a finite value and one; the finite ones as before.
-    #[test]
-    fn quantiles_reach_infinity_where_the_collapses_are() {
-        let inf = f64::INFINITY;
-        assert_eq!(quantile(&[1.0, 2.0, 3.0, 4.0, inf], 0.5), 3.0);
-        assert!((quantile(&[1.0, 2.0, 3.0, 4.0, inf], 0.16) - 1.64).abs() < 1e-12);
-        assert_eq!(quantile(&[1.0, 2.0, 3.0, 4.0, inf], 0.84), inf);
-        // Exactly on the last finite value: finite (no weight on the collapse).
-        assert_eq!(quantile(&[1.0, 2.0, inf], 0.5), 2.0);
-        assert_eq!(quantile(&[1.0, inf, inf], 0.5), inf);
-        assert_eq!(quantile(&[inf], 0.16), inf);
-        assert!(quantile(&[], 0.5).is_nan());
-        // Nine finite of ten: the 84 % stays finite (position 7.56, between the 8th and 9th).
-        let mut v: Vec<f64> = (1..=9).map(f64::from).collect();
-        v.push(inf);
-        assert!((quantile(&v, 0.84) - 8.56).abs() < 1e-12);
-        v[8] = inf;
-        assert_eq!(quantile(&v, 0.84), inf);
     }
 
     /// A curve flatlines at its first collapse: infinite at every level above (a run that

@@ -19,4 +19,5 @@ pub mod paper;
 pub mod plot;
 pub mod report;
 pub mod sensitivity;
+pub mod stats;
 pub mod trace;

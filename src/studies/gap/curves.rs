@@ -312,7 +312,7 @@ fn round_step(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::studies::fragility::quantile;
+    use crate::engine::quantile::{quantile, Interpolation::Linear};
 
     /// In the probability-of-pounding panel each intensity's points and its fitted curve share
     /// one style, and intensities differ; a failed fit is named on its points.
@@ -356,10 +356,10 @@ mod tests {
     #[test]
     fn quantiles_and_round_steps() {
         let v = [1.0, 2.0, 3.0, 4.0, 5.0];
-        assert_eq!(quantile(&v, 0.5), 3.0);
-        assert_eq!(quantile(&v, 0.1), 1.4);
-        assert_eq!(quantile(&v, 1.0), 5.0);
-        assert!(quantile(&[], 0.5).is_nan());
+        assert_eq!(quantile(&v, 0.5, Linear), 3.0);
+        assert_eq!(quantile(&v, 0.1, Linear), 1.4);
+        assert_eq!(quantile(&v, 1.0, Linear), 5.0);
+        assert!(quantile(&[], 0.5, Linear).is_nan());
         assert_eq!(round_step(0.0031), 0.005);
         assert_eq!(round_step(0.002), 0.002);
         assert_eq!(round_step(0.011), 0.02);

@@ -20,7 +20,6 @@ mod scenes;
 mod study;
 mod table;
 
-pub use crate::studies::fragility::quantile;
 pub use curves::PoundingCurve;
 pub use fit::{GapFit, NoGapFit};
 pub use scenes::{uncoupled, Outcome, RunEnd};

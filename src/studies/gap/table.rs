@@ -4,7 +4,7 @@
 use super::study::{covering_rule, GapRun, GapStudy, PairGap};
 use crate::physics::separation::Rule;
 use crate::plan::columns::num;
-use crate::studies::fragility::quantile;
+use crate::engine::quantile::{quantile, Interpolation::Linear};
 use rayon::prelude::*;
 
 impl GapStudy<'_> {
@@ -141,9 +141,9 @@ impl GapStudy<'_> {
                     runs: pairs.len(),
                     censored,
                     closing: ratios.len(),
-                    median: quantile(&ratios, 0.5),
-                    p10: quantile(&ratios, 0.1),
-                    p90: quantile(&ratios, 0.9),
+                    median: quantile(&ratios, 0.5, Linear),
+                    p10: quantile(&ratios, 0.1, Linear),
+                    p90: quantile(&ratios, 0.9, Linear),
                     unconservative,
                 });
             }

@@ -1,0 +1,195 @@
+//! A fragility as a CSV table and a plot panel.
+
+use super::demand::{collapse_building, FragilitySpec};
+use super::grouping::Grouped;
+use crate::io::table::{caption, label};
+use crate::studies::plot::{Panel, Series};
+use crate::studies::stats::{Fit, Level, NoFit};
+
+/// The counts as CSV, a row per threshold and level: the state's name (with `states`), the
+/// threshold, the intensity, the runs decided, those exceeding, the runs among them that
+/// collapsed (counted as exceeding), their fraction, the runs undecided (no value, not decided by
+/// the bound: [`Demand::Unknown`]) and the fraction's bounds with those counted as none exceeding
+/// and as all exceeding. The collapse fragility ([`FragilitySpec::is_collapse`]) has a row per
+/// level: the intensity, the runs, those that collapsed and their fraction.
+pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -> String {
+    let quote = |s: &str| {
+        if s.contains([',', '"', '\n', '\r']) {
+            format!("\"{}\"", s.replace('"', "\"\""))
+        } else {
+            s.to_string()
+        }
+    };
+    let ratio = |k: u64, n: u64| {
+        if n > 0 {
+            (k as f64 / n as f64).to_string()
+        } else {
+            String::new()
+        }
+    };
+    let mut s = csv_header(spec, states.is_some())
+        .iter()
+        .map(|h| quote(h))
+        .collect::<Vec<_>>()
+        .join(",");
+    s.push('\n');
+    if spec.is_collapse() {
+        for l in grouped.pooled(&[1]).first().into_iter().flatten() {
+            s.push_str(&format!(
+                "{},{},{},{}\n",
+                l.im,
+                l.n,
+                l.exceed,
+                ratio(l.exceed, l.n)
+            ));
+        }
+        return s;
+    }
+    for (t, &limit) in spec.thresholds.iter().enumerate() {
+        let undecided = grouped.undecided_at(t);
+        for (l, &im) in grouped.ims.iter().enumerate() {
+            let (n, k) = grouped
+                .counts
+                .iter()
+                .fold((0, 0), |(n, k), c| (n + c[t][l].0, k + c[t][l].1));
+            let u = undecided[l];
+            if n + u == 0 {
+                continue;
+            }
+            if let Some(names) = states {
+                s.push_str(&quote(&names[t]));
+                s.push(',');
+            }
+            s.push_str(&format!(
+                "{},{im},{n},{k},{},{},{u},{},{}\n",
+                crate::show(limit),
+                grouped.collapsed.get(l).copied().unwrap_or(0),
+                ratio(k, n),
+                ratio(k, n + u),
+                ratio(k + u, n + u)
+            ));
+        }
+    }
+    s
+}
+
+/// The names of [`csv`]'s columns (`states`: with damage states' names).
+pub fn csv_header(spec: &FragilitySpec, states: bool) -> Vec<String> {
+    let im = spec.im.clone();
+    fn rest<'a>(names: &'a [&'a str]) -> impl Iterator<Item = String> + 'a {
+        names.iter().map(|n| n.to_string())
+    }
+    if spec.is_collapse() {
+        return std::iter::once(im)
+            .chain(rest(&["runs", "collapsed", "fraction"]))
+            .collect();
+    }
+    let mut h: Vec<String> = Vec::new();
+    if states {
+        h.push("state".into());
+    }
+    h.push("threshold".into());
+    h.push(im);
+    h.extend(rest(&[
+        "runs",
+        "exceed",
+        "collapsed",
+        "fraction",
+        "undecided",
+        "fraction_if_none_exceed",
+        "fraction_if_all_exceed",
+    ]));
+    h
+}
+
+/// A threshold's legend entry: `> 1 MN` for `peak_force_n` above 1e6 ([`crate::io::table::quantity`]).
+pub fn threshold_name(edp: &str, t: f64) -> String {
+    format!("> {}", crate::io::table::quantity(edp, t))
+}
+
+/// What a collapse fragility of `edp` gives: `P(collapse)` (the run's), `P(building K
+/// collapses)`.
+pub fn collapse_probability(edp: &str) -> String {
+    match collapse_building(edp) {
+        Some(k) => format!("P(building {k} collapses)"),
+        None => "P(collapse)".into(),
+    }
+}
+
+/// One panel: the observed fractions (points) and the fitted curves (lines), per threshold (the
+/// collapse fragility's one curve is named `collapse`).
+pub fn panel(spec: &FragilitySpec, levels: &[Vec<Level>], fits: &[Result<Fit, NoFit>]) -> Panel {
+    let mut series = Vec::new();
+    let (lo, hi) = levels
+        .iter()
+        .flatten()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), l| {
+            (a.min(l.im), b.max(l.im))
+        });
+    for (k, ((t, lv), f)) in spec.thresholds.iter().zip(levels).zip(fits).enumerate() {
+        // The EDP is in the title; a threshold's points and its curve share one style; a failed
+        // fit says why.
+        let name = if spec.is_collapse() {
+            "collapse".to_string()
+        } else {
+            threshold_name(&spec.edp, *t)
+        };
+        series.push(Series {
+            name: match f {
+                Ok(_) => format!("{name}: observed"),
+                Err(e) if spec.is_collapse() => {
+                    format!("{name}: observed (no fit: {})", e.short_collapse())
+                }
+                Err(e) => format!("{name}: observed (no fit: {})", e.short()),
+            },
+            points: lv
+                .iter()
+                .map(|l| (l.im, l.exceed as f64 / l.n as f64))
+                .collect(),
+            scatter: true,
+            style: Some(k),
+        });
+        if let Ok(f) = f {
+            let n = 100;
+            series.push(Series {
+                name: format!("{name}: fit, median {:.3}, beta {:.3}", f.median, f.beta),
+                points: (0..=n)
+                    .map(|i| {
+                        let im = lo + (hi - lo) * i as f64 / n as f64;
+                        (im, if im > 0.0 { f.probability(im) } else { 0.0 })
+                    })
+                    .collect(),
+                scatter: false,
+                style: Some(k),
+            });
+        }
+    }
+    let (edp, im) = (
+        crate::io::table::name(&spec.edp),
+        crate::io::table::name(&spec.im),
+    );
+    let what = if spec.is_collapse() {
+        collapse_probability(&spec.edp)
+    } else {
+        format!("P({edp} > threshold)")
+    };
+    Panel {
+        title: match caption(&spec.filters) {
+            c if c.is_empty() => format!("{what} against {im}"),
+            c => format!("{what} against {im}; {c}"),
+        },
+        x_label: label(&spec.im),
+        y_label: if let Some(k) = collapse_building(&spec.edp) {
+            format!("probability of building {k}'s collapse")
+        } else if spec.is_collapse() {
+            "probability of collapse".into()
+        } else {
+            "probability of exceedance".into()
+        },
+        log_x: false,
+        log_y: false,
+        series,
+        y_span: Some((0.0, 1.0)),
+        ..Default::default()
+    }
+}
