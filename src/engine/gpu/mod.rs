@@ -21,10 +21,10 @@ pub mod shader;
 pub mod shared;
 pub mod sweep;
 
-pub use context::{GpuContext, GpuError};
+pub use context::{GpuContext, GpuError, Stop};
 pub use run::{
     integrate, integrate_until, output, pack, read_outputs, run_chunk, run_chunk_until, ChunkTimes,
-    GpuOptions, GpuRecords, Integrated, PackedChunk, Stop,
+    GpuOptions, GpuRecords, Integrated, PackedChunk,
 };
 pub use shader::Precision;
 pub use sweep::GpuTimes;

@@ -9,11 +9,11 @@
 //! that persists between dispatches (`S_*` reals, `C_*` u32). Building models (modes, shapes,
 //! masses, heights, propagators) are shared by the runs that use the same one.
 
-use super::context::{GpuContext, GpuError};
+use super::context::{check_stop, stopped, GpuContext, GpuError, Stop};
 use super::layout::{MODE_FREE, STATUS_COLLAPSE, STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK};
 use super::run::{
-    bind_group, check_stop, read, stopped, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions,
-    GpuRecords, Stop, WorkLists,
+    bind_group, read, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions, GpuRecords,
+    WorkLists,
 };
 use super::shader::Precision;
 use super::sweep::GpuTimes;
@@ -1327,7 +1327,7 @@ fn integrate_rows(
     }
     let shape = &chunk.shape;
     let cap = software_cap(ctx, shape)?;
-    let kernel = ctx.row_kernel(opts.precision, shape)?;
+    let kernel = ctx.row_kernel_until(opts.precision, shape, stop)?;
     let t = Instant::now();
     let p = opts.precision;
     let params = storage(
@@ -1567,7 +1567,15 @@ pub fn sweep_rows_until<E: From<GpuError>>(
         Ok((specs, models, packed, t.elapsed().as_secs_f64()))
     };
     let mut first = runs.start;
-    let mut next = Some(prep(first)?);
+    // The kernel is built while the first chunk is prepared (lavapipe builds a tall row's for
+    // seconds), watching the stop; the chunks then find it built.
+    software_cap(ctx, &shape)?;
+    let (kernel, prepared) = rayon::join(
+        || ctx.row_kernel_until(opts.precision, &shape, stop),
+        || prep(first),
+    );
+    kernel?;
+    let mut next = Some(prepared?);
     while let Some((specs, models, packed, pack_s)) = next.take() {
         let end = first + specs.len() as u64;
         times.pack += pack_s;

@@ -1,7 +1,7 @@
 //! Packing runs into buffers, dispatching the kernel in windows of record intervals, reading
 //! back. The work functions take a [`GpuContext`], so tests can pass their own device.
 
-use super::context::{GpuContext, GpuError, Kernel};
+use super::context::{check_stop, GpuContext, GpuError, Kernel, Stop};
 use super::layout::{
     self, Counters, Dispatch, Meta, Params32, Params64, State32, State64, MODE_FREE, NO_RESPONSE,
     STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK,
@@ -12,25 +12,7 @@ use crate::physics::contact::LawKind;
 use crate::physics::model::{EnergyBalance, Forcing, Oscillator, Pair, RunOutput, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
 use crate::physics::solver::FastOptions;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
-
-/// A stop flag a GPU path watches (between dispatches, and between the runs it finishes on the
-/// host), or None: never stopped, dispatches of the whole budget (the command line).
-pub type Stop<'a> = Option<&'a AtomicBool>;
-
-/// Has the watched flag been raised?
-pub(crate) fn stopped(stop: Stop<'_>) -> bool {
-    stop.is_some_and(|s| s.load(Ordering::Relaxed))
-}
-
-/// `Err(Interrupted)` once the watched flag is raised.
-pub(crate) fn check_stop(stop: Stop<'_>) -> Result<(), GpuError> {
-    match stopped(stop) {
-        true => Err(GpuError::Interrupted),
-        false => Ok(()),
-    }
-}
 
 /// While a stop is watched, the time one dispatch is sized to take, s: a software adapter runs
 /// a chunk's dispatch of the whole budget for seconds (lavapipe: about 4 s on
@@ -494,7 +476,7 @@ pub fn integrate_until(
 ) -> Result<(Integrated, ChunkTimes), GpuError> {
     let runs = &chunk.runs[..];
     let mut times = ChunkTimes::default();
-    let kernel = ctx.kernel(opts.precision, opts.fast.energy, chunk.accel)?;
+    let kernel = ctx.kernel_until(opts.precision, opts.fast.energy, chunk.accel, stop)?;
     let n = runs.len();
     let t = Instant::now();
     let params: Vec<u8> = match opts.precision {

@@ -128,7 +128,7 @@ impl GpuTimes {
             .enumerate()
             .map(|(k, o)| match o {
                 Some(o) => Some(o),
-                None if super::run::stopped(stop) => None,
+                None if super::context::stopped(stop) => None,
                 None => Some(plan.run_on_cpu(spec(k), fast)),
             })
             .collect::<Option<Vec<_>>>()
@@ -237,7 +237,7 @@ pub fn run_row_pairs_until<E: From<super::GpuError>>(
             let rows: Vec<(RowSpec, RowOutput)> = done
                 .par_iter()
                 .map(|(p, o)| {
-                    if super::run::stopped(stop) {
+                    if super::context::stopped(stop) {
                         return None;
                     }
                     let spec = plan.run(p.index);
@@ -301,7 +301,7 @@ pub fn run_range_until<E: From<super::GpuError>>(
             .map(|i| plan.run(i))
             .collect();
         // Stopped while the device integrates the chunk before: left unpacked.
-        super::run::check_stop(stop)?;
+        super::context::check_stop(stop)?;
         let refs: Vec<&RunSpec> = specs.iter().collect();
         let packed = pack_chunk(plan, &refs, ctx, &recs, opts);
         Ok((specs, packed, t.elapsed().as_secs_f64()))
