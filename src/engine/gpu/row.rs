@@ -1400,6 +1400,7 @@ fn integrate_rows(
             .collect(),
     };
     let words: &[u32] = bytemuck::cast_slice(&cbytes);
+    unfinished(shape, &chunk.meta, words)?;
     let out = (0..n)
         .map(|r| {
             let s = &reals[r * shape.s_stride()..(r + 1) * shape.s_stride()];
@@ -1410,6 +1411,44 @@ fn integrate_rows(
         .collect();
     times.readback = t.elapsed();
     Ok((out, times))
+}
+
+/// Every run of a chunk read back (`meta` and `counters`: the chunk's blocks) must have ended
+/// as `ended()` in `shaders/row.wgsl` says (its record integrated and, with yielding storeys,
+/// settled or its settling time spent), or with a status that ends it: one still running would
+/// be written as a finished run with part of its record.
+fn unfinished(shape: &RowShape, meta: &[u32], counters: &[u32]) -> Result<(), GpuError> {
+    let nb = shape.storeys.len();
+    // The interval a run runs to, and whether it is there.
+    let ended = |r: usize| {
+        let m = &meta[r * shape.m_stride()..(r + 1) * shape.m_stride()];
+        let c = &counters[r * shape.c_stride()..(r + 1) * shape.c_stride()];
+        let recorded = c[C_I] >= m[M_INTERVALS];
+        let done = if shape.yields() == 0 {
+            recorded
+        } else {
+            recorded && (c[shape.c_settled()] != 0 || c[C_I] >= m[M_MODELS + nb])
+        };
+        let end = match shape.yields() {
+            0 => m[M_INTERVALS],
+            _ => m[M_MODELS + nb],
+        };
+        (c[C_STATUS] != STATUS_OK || done, c[C_I], end)
+    };
+    let runs = meta.len() / shape.m_stride();
+    let left: Vec<usize> = (0..runs).filter(|&r| !ended(r).0).collect();
+    match left.first() {
+        Some(&k) => {
+            let (_, i, end) = ended(k);
+            Err(GpuError::Other {
+                message: format!(
+                    "{} runs of a chunk of {runs} came back from the device unfinished (the first, chunk run {k}, at record interval {i} of {end}); their results cannot be trusted",
+                    left.len()
+                ),
+            })
+        }
+        None => Ok(()),
+    }
 }
 
 /// A run's results from its final state and counters (what `RowRun::finish` does on the CPU,
@@ -1651,5 +1690,60 @@ mod tests {
         }
         let none = collapse_param(f64::INFINITY, Precision::F32);
         assert_eq!(none, f64::INFINITY);
+    }
+
+    /// A row read back with its status OK before its record's end (or, with yielding storeys,
+    /// before it settled or its settling time ran out) is refused, named.
+    #[test]
+    fn a_row_read_back_unfinished_is_an_error() {
+        // Three runs of 10 record intervals; counters (status, interval, settled).
+        let check = |shape: &RowShape, runs: &[(u32, u32, u32)]| {
+            let (ms, cs) = (shape.m_stride(), shape.c_stride());
+            let mut meta = vec![0; ms * runs.len()];
+            let mut counters = vec![0; cs * runs.len()];
+            for (r, &(status, i, settled)) in runs.iter().enumerate() {
+                meta[r * ms + M_INTERVALS] = 10;
+                if shape.yields() > 0 {
+                    meta[r * ms + M_MODELS + shape.storeys.len()] = 15;
+                    counters[r * cs + shape.c_settled()] = settled;
+                }
+                counters[r * cs + C_STATUS] = status;
+                counters[r * cs + C_I] = i;
+            }
+            unfinished(shape, &meta, &counters).map_err(|e| e.to_string())
+        };
+        let elastic = RowShape::elastic(vec![2, 3], vec![[0, 1, 2]]);
+        let ended = [
+            (STATUS_OK, 10, 0),
+            (STATUS_NON_FINITE, 3, 0),
+            (STATUS_HANDOFF, 0, 0),
+            (STATUS_COLLAPSE, 4, 0),
+        ];
+        check(&elastic, &ended).unwrap();
+        let e = check(
+            &elastic,
+            &[(STATUS_OK, 10, 0), (STATUS_OK, 4, 0), (STATUS_OK, 0, 0)],
+        )
+        .unwrap_err();
+        assert!(
+            e.contains("2 runs of a chunk of 3")
+                && e.contains("chunk run 1, at record interval 4 of 10"),
+            "{e}"
+        );
+        // With yielding storeys a run goes on past its record until it settles (or its
+        // settling time, here 15 intervals, runs out).
+        let yielding = RowShape {
+            yielding: vec![true, false],
+            ..elastic
+        };
+        check(&yielding, &[(STATUS_OK, 12, 1), (STATUS_OK, 15, 0)]).unwrap();
+        let e = check(&yielding, &[(STATUS_OK, 12, 1), (STATUS_OK, 12, 0)]).unwrap_err();
+        assert!(
+            e.contains("1 runs of a chunk of 2")
+                && e.contains("chunk run 1, at record interval 12 of 15"),
+            "{e}"
+        );
+        let e = check(&yielding, &[(STATUS_OK, 9, 1)]).unwrap_err();
+        assert!(e.contains("at record interval 9 of 15"), "{e}");
     }
 }
