@@ -300,6 +300,19 @@ impl RowShape {
         self.c_settled() + self.yields() * (1 + SC_STRIDE * self.yielding_storeys())
     }
 
+    /// The last record interval any run of a chunk with meta blocks `meta` may reach: its
+    /// record's end, or with yielding storeys its settling time's.
+    fn last_interval(&self, meta: &[u32]) -> u64 {
+        let end = M_MODELS + self.storeys.len();
+        (meta.chunks(self.m_stride()))
+            .map(|m| match self.yields() {
+                0 => m[M_INTERVALS],
+                _ => m[M_INTERVALS].max(m[end]),
+            })
+            .max()
+            .unwrap_or(0) as u64
+    }
+
     /// Bytes of a run's largest per-run block in `precision` (the chunk's cap follows from it).
     pub fn largest_block_bytes(&self, precision: Precision) -> usize {
         let reals = self.s_stride().max(self.p_stride()) * precision.bytes();
@@ -1388,7 +1401,10 @@ fn integrate_rows(
         .units_per_dispatch
         .max(1)
         .min(unit_cap(ctx, cap.min(u32::MAX as u64) as u32));
-    lists.run("row", ctx, &kernel, &binds, budget, opts, stop, &mut times)?;
+    let max_units = row_units(shape.last_interval(&chunk.meta), &opts.fast);
+    lists.run(
+        "row", ctx, &kernel, &binds, budget, max_units, opts, stop, &mut times,
+    )?;
     let t = Instant::now();
     let sbytes = read(ctx, &states)?;
     let cbytes = read(ctx, &counters)?;
@@ -1411,6 +1427,22 @@ fn integrate_rows(
         .collect();
     times.readback = t.elapsed();
     Ok((out, times))
+}
+
+/// The most units of work a row run of at most `end` record intervals (its settling tail
+/// included) can take with `fast`'s caps (`shaders/row.wgsl`, `integrate_run`), doubled for
+/// what a count by hand may miss: each interval is begun once; a piece takes one RK4 substep in
+/// its trial (the run ends at `max_substeps + 1`), then at most a probe of a hidden touch and
+/// its retake, or the event search (its estimates each with a guard probe, its bisections, the
+/// step to its end); a unit that only moves to the next substep comes at most
+/// `max_substeps_per_step` times per interval.
+fn row_units(end: u64, fast: &FastOptions) -> u64 {
+    use crate::physics::solver::fast::{LOCATE_BISECTIONS, LOCATE_ITERATIONS};
+    let search = 2 * LOCATE_ITERATIONS as u64 + LOCATE_BISECTIONS as u64 + 1;
+    let pieces = (fast.max_substeps as u64 + 1).saturating_mul(2 + search);
+    let moves = end.saturating_mul(fast.max_substeps_per_step as u64);
+    let count = end.saturating_add(moves).saturating_add(pieces);
+    count.saturating_mul(2)
 }
 
 /// Every run of a chunk read back (`meta` and `counters`: the chunk's blocks) must have ended

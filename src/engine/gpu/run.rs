@@ -577,7 +577,11 @@ pub fn integrate_until(
         .units_per_dispatch
         .max(1)
         .min(unit_cap(ctx, CPU_ADAPTER_BUDGET));
-    lists.run("fast", ctx, &kernel, &binds, budget, opts, stop, &mut times)?;
+    let intervals = runs.iter().map(|r| r.meta.intervals as u64).max();
+    let max_units = pair_units(intervals.unwrap_or(0), &opts.fast);
+    lists.run(
+        "fast", ctx, &kernel, &binds, budget, max_units, opts, stop, &mut times,
+    )?;
     Ok((
         Integrated {
             states,
@@ -648,6 +652,9 @@ impl WorkLists {
     /// read list a (b) and write list b (a). Adds the kernel time and lane tally to `times`.
     /// With a `stop` watched, it is looked at before each dispatch (`Err(Interrupted)`), and
     /// each dispatch's budget (at most `budget`) is sized to take [`WATCHED_DISPATCH_S`].
+    /// `max_units`: the most units any run of the chunk can take ([`pair_units`],
+    /// `RowShape::max_units`); a device that reports runs active past it is refused
+    /// ([`endless`]).
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
@@ -656,6 +663,7 @@ impl WorkLists {
         kernel: &Kernel,
         binds: &[wgpu::BindGroup; 2],
         budget: u32,
+        max_units: u64,
         opts: &GpuOptions,
         stop: Stop<'_>,
         times: &mut ChunkTimes,
@@ -680,6 +688,8 @@ impl WorkLists {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        // The budgets of the dispatches that left runs active.
+        let mut spent = 0u64;
         for parity in (0..2).cycle() {
             check_stop(stop)?;
             let td = Instant::now();
@@ -700,6 +710,8 @@ impl WorkLists {
             if d.nactive == 0 {
                 break;
             }
+            spent += d.budget as u64;
+            endless(label, spent, max_units)?;
             if stop.is_some() {
                 // The next dispatch's budget in proportion to the time this one's took, grown
                 // at most 4x at a time (its units may cost more: contacts, substeps).
@@ -734,6 +746,34 @@ pub(super) fn ran(label: &str, given: u32, units: u32, active: u32) -> Result<()
         });
     }
     Ok(())
+}
+
+/// Check that runs still active have not done more work than any run can: a lane leaves its
+/// run early only where the run ends, so a run active after a dispatch did that dispatch's
+/// whole budget, and one active after all of them did `spent` units in all. A device that
+/// reports runs active forever would otherwise be dispatched forever.
+pub(super) fn endless(label: &str, spent: u64, max_units: u64) -> Result<(), GpuError> {
+    match spent > max_units {
+        true => Err(GpuError::Other {
+            message: format!(
+                "the {label} kernel reported runs still active after {spent} units of work each, more than any run of the chunk can take ({max_units}); its results cannot be trusted"
+            ),
+        }),
+        false => Ok(()),
+    }
+}
+
+/// The most units of work a pair run of at most `intervals` record intervals can take with
+/// `fast`'s caps (`shaders/fast.wgsl`, `integrate_run`), doubled for what a count by hand may
+/// miss: each interval is begun once (one unit: a free step, its substeps set up, or the end);
+/// a piece's unit either takes an RK4 substep (the run ends at `max_substeps + 1`) or only
+/// moves to the next substep (at most `max_substeps_per_step` per interval).
+pub(super) fn pair_units(intervals: u64, fast: &FastOptions) -> u64 {
+    let moves = intervals.saturating_mul(fast.max_substeps_per_step as u64);
+    let count = intervals
+        .saturating_add(moves)
+        .saturating_add(fast.max_substeps as u64 + 1);
+    count.saturating_mul(2)
 }
 
 /// Each run's state and counters before the first dispatch, the state in `precision`'s bytes:
@@ -847,6 +887,22 @@ mod tests {
         );
         let e = ran("row", 5, 9, 6).unwrap_err().to_string();
         assert!(e.contains("6 runs still active of the 5"), "{e}");
+    }
+
+    /// Runs still active after more units than any run can take are an error, not a dispatch
+    /// more; the bound holds a pair run's units.
+    #[test]
+    fn runs_active_past_every_runs_units_are_an_error() {
+        endless("fast", 100, 100).unwrap();
+        let e = endless("row", 101, 100).unwrap_err().to_string();
+        assert!(
+            e.contains("still active after 101 units") && e.contains("(100)"),
+            "{e}"
+        );
+        let fast = FastOptions::default();
+        let (i, m) = (1000, fast.max_substeps_per_step as u64);
+        assert!(pair_units(i, &fast) >= i + i * m + fast.max_substeps as u64 + 1);
+        assert_eq!(pair_units(u64::MAX, &fast), u64::MAX);
     }
 
     /// A run read back with its status OK before its record's end is refused, named.
