@@ -2,7 +2,8 @@
 //! the work functions so tests can bring their own device.
 
 use super::layout::{Counters, Dispatch, Meta};
-use super::shader::{aggregate_source, fast_source, row_source, Precision};
+use super::precision::Precision;
+use super::shader::{aggregate_source, fast_source};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::Duration;
@@ -93,7 +94,7 @@ pub struct Kernel {
 
 /// A compiled stage and variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stage {
+pub(super) enum Stage {
     /// `fast.wgsl`, with or without the energy balance and the peak accelerations.
     Fast { energy: bool, accel: bool },
     /// `aggregate.wgsl`.
@@ -269,33 +270,6 @@ impl GpuContext {
         )
     }
 
-    /// The row kernel for `shape` in `precision`, compiled on first use.
-    pub fn row_kernel(
-        &self,
-        precision: Precision,
-        shape: &super::row::RowShape,
-    ) -> Result<Arc<Kernel>, GpuError> {
-        self.row_kernel_until(precision, shape, None)
-    }
-
-    /// [`GpuContext::row_kernel`] watching `stop` while it is built ([`GpuContext::stage`]).
-    pub fn row_kernel_until(
-        &self,
-        precision: Precision,
-        shape: &super::row::RowShape,
-        stop: Stop<'_>,
-    ) -> Result<Arc<Kernel>, GpuError> {
-        use std::hash::{Hash, Hasher};
-        let constants = shape.wgsl_constants();
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        constants.hash(&mut h);
-        let stage = Stage::Row {
-            hash: h.finish(),
-            loops: !shape.unrolled(),
-        };
-        self.stage(stage, precision, || row_source(precision, &constants), stop)
-    }
-
     /// Kernels built so far and kept for reuse.
     pub fn kernels_built(&self) -> usize {
         self.kernels.lock().unwrap().len()
@@ -308,7 +282,7 @@ impl GpuContext {
     /// row of five's kernel for about 3 s), so once the flag is raised this returns
     /// `Err(Interrupted)` and the build goes on alone; it adds its kernel to the cache whole
     /// when it is done (a later call finds it) and nothing if it fails.
-    fn stage(
+    pub(super) fn stage(
         &self,
         stage: Stage,
         precision: Precision,

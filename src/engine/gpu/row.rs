@@ -9,13 +9,13 @@
 //! that persists between dispatches (`S_*` reals, `C_*` u32). Building models (modes, shapes,
 //! masses, heights, propagators) are shared by the runs that use the same one.
 
-use super::context::{check_stop, stopped, GpuContext, GpuError, Stop};
+use super::context::{check_stop, stopped, GpuContext, GpuError, Kernel, Stage, Stop};
 use super::layout::{MODE_FREE, STATUS_COLLAPSE, STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK};
+use super::precision::Precision;
 use super::run::{
     bind_group, read, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions, GpuRecords,
     WorkLists,
 };
-use super::shader::Precision;
 use super::sweep::GpuTimes;
 use crate::engine::Summary;
 use crate::physics::contact::LawKind;
@@ -28,6 +28,7 @@ use crate::physics::solver::FastOptions;
 use crate::plan::row::{RowPlan, RowRunSpec};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 // A run's parameter block (reals).
@@ -108,12 +109,6 @@ pub const MW: usize = 11;
 /// Reals per yielding storey after its building's model block: `k`, `d_y`, `b`, then its
 /// modal row (the drift in the building's modes).
 pub const STOREY_HEAD: usize = 4;
-
-/// The band's slack in f32 (`row::yielding::YIELD_SLACK` is f64's): a storey leaves its band edge
-/// inside the band once f32 has rounded its back drift `d - p / (1 - b)`, whose terms are up
-/// to the ductility times `d_y` (a few 1e-7 each): 1e-4 of `d_y` keeps an unloading storey
-/// from re-yielding on rounding at ductilities up to a few hundred.
-pub const F32_YIELD_SLACK: f64 = 1e-4;
 
 /// lavapipe ends a shader's loops after about 65,535 back edges per invocation, counted over
 /// all its loops (see [`super::run::CPU_ADAPTER_BUDGET`]): a dispatch's units on a software
@@ -1260,6 +1255,42 @@ fn may_couple(b: &BuildingModel) -> bool {
     b.n() > 1 && b.floor_form.as_ref().is_some_and(|f| f.geometric.is_some())
 }
 
+/// The row kernels, kept by the context as every other (it knows no row shape: the shape
+/// gives the stage its key and its source).
+impl GpuContext {
+    /// The row kernel for `shape` in `precision`, compiled on first use.
+    pub fn row_kernel(
+        &self,
+        precision: Precision,
+        shape: &RowShape,
+    ) -> Result<Arc<Kernel>, GpuError> {
+        self.row_kernel_until(precision, shape, None)
+    }
+
+    /// [`GpuContext::row_kernel`] watching `stop` while it is built ([`GpuContext::stage`]).
+    pub fn row_kernel_until(
+        &self,
+        precision: Precision,
+        shape: &RowShape,
+        stop: Stop<'_>,
+    ) -> Result<Arc<Kernel>, GpuError> {
+        use std::hash::{Hash, Hasher};
+        let constants = shape.wgsl_constants();
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        constants.hash(&mut h);
+        let stage = Stage::Row {
+            hash: h.finish(),
+            loops: !shape.unrolled(),
+        };
+        self.stage(
+            stage,
+            precision,
+            || super::shader::row_source(precision, &constants),
+            stop,
+        )
+    }
+}
+
 /// Units of work per dispatch on a software adapter (unbounded on hardware), or an error when
 /// a row of `shape` cannot run there at all.
 fn software_cap(ctx: &GpuContext, shape: &RowShape) -> Result<u64, GpuError> {
@@ -1777,5 +1808,56 @@ mod tests {
         );
         let e = check(&yielding, &[(STATUS_OK, 9, 1)]).unwrap_err();
         assert!(e.contains("at record interval 9 of 15"), "{e}");
+    }
+
+    /// Every loop in the shaders ends after a count, as building them without naga's loop
+    /// bounding requires (context.rs): no `while`, every `for` has a step, every `loop` leaves
+    /// once its budget is spent and spends it each pass; the per-shape code the host writes
+    /// has no loop at all.
+    #[test]
+    fn every_loop_counts() {
+        use crate::engine::gpu::shader::{
+            AGGREGATE_WGSL, CONTACT_WGSL, FAST_WGSL, HERMITE_WGSL, LANES_WGSL, ROW_LOOPS_WGSL,
+            ROW_WGSL, TYPES_WGSL, YIELDING_WGSL,
+        };
+        let shape = RowShape::elastic(vec![3, 6], vec![[0, 0, 0], [0, 1, 1]]);
+        let written = shape.wgsl_constants();
+        let sources = [
+            ("types", TYPES_WGSL),
+            ("contact", CONTACT_WGSL),
+            ("hermite", HERMITE_WGSL),
+            ("fast", FAST_WGSL),
+            ("row", ROW_WGSL),
+            ("row_loops", ROW_LOOPS_WGSL),
+            ("yielding", YIELDING_WGSL),
+            ("lanes", LANES_WGSL),
+            ("aggregate", AGGREGATE_WGSL),
+            ("written out for 3 + 6 storeys", written.as_str()),
+        ];
+        let (mut fors, mut loops) = (0, 0);
+        for (name, src) in sources {
+            let code: Vec<&str> = src.lines().map(|l| l.split("//").next().unwrap()).collect();
+            for (i, line) in code.iter().enumerate() {
+                let at = format!("{name}.wgsl line {}: {line}", i + 1);
+                assert!(!line.contains("while"), "{at}");
+                if let Some(h) = line.find("for (") {
+                    let header = line[h..].split(") {").next().unwrap();
+                    let clauses: Vec<&str> = header.split(';').collect();
+                    assert_eq!(clauses.len(), 3, "{at}");
+                    assert!(!clauses[2].trim().is_empty(), "{at}");
+                    fors += 1;
+                }
+                if line.contains("loop {") {
+                    let body = code[i..(i + 12).min(code.len())].join("\n");
+                    assert!(body.contains("budget == 0u"), "{at}");
+                    assert!(body.contains("budget = budget - 1u"), "{at}");
+                    loops += 1;
+                }
+            }
+            if name.starts_with("written") {
+                assert!(!src.contains("for (") && !src.contains("loop {"));
+            }
+        }
+        assert!(fors > 20 && loops == 2, "{fors} for, {loops} loop");
     }
 }

@@ -6,7 +6,7 @@ use super::layout::{
     self, Counters, Dispatch, Meta, Params32, Params64, State32, State64, MODE_FREE, NO_RESPONSE,
     STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK,
 };
-use super::shader::Precision;
+use super::precision::Precision;
 use super::shared::Start;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{EnergyBalance, Forcing, Oscillator, Pair, RunOutput, Status};
@@ -154,7 +154,7 @@ pub struct Packed {
 }
 
 /// A chunk's packed runs, and the tables of the free responses some of them share
-/// ([`super::shared::share`]).
+/// (`share` in `sweep.rs`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PackedChunk {
     pub runs: Vec<Packed>,
