@@ -105,6 +105,8 @@ pub(super) enum Stage {
 }
 
 type KernelKey = (Stage, Precision);
+/// The kernels built, each with its key.
+type Kernels = Vec<(KernelKey, Arc<Kernel>)>;
 
 /// Device, queue and compiled kernels, created once per process (or per test).
 pub struct GpuContext {
@@ -114,7 +116,7 @@ pub struct GpuContext {
     /// Errors reported outside an explicit check (validation, out of memory, device loss).
     errors: Arc<Mutex<Option<GpuError>>>,
     /// Shared with the threads that build kernels for a watched call ([`GpuContext::stage`]).
-    kernels: Arc<Mutex<Vec<(KernelKey, Arc<Kernel>)>>>,
+    kernels: Arc<Mutex<Kernels>>,
 }
 
 impl GpuContext {
