@@ -1,7 +1,8 @@
 //! GPU path: shader layout against the Rust structs, GPU against the CPU twin.
 
 use pounding::engine::gpu::layout::{self, Layout};
-use pounding::engine::gpu::shader::{aggregate_source, fast_source, Precision};
+use pounding::engine::gpu::shader::{aggregate_source, fast_source};
+use pounding::engine::gpu::Precision;
 
 fn parse(precision: Precision) -> naga::Module {
     parse_source(&fast_source(precision, true, true))

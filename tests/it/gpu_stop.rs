@@ -4,11 +4,12 @@
 
 use crate::support::gpu::ctx;
 use pounding::engine::aggregate::Aggregator;
-use pounding::engine::gpu::{GpuError, Precision};
+use pounding::engine::gpu::{GpuContext, GpuError, Precision};
 use pounding::engine::{Chunk, Engine};
 use pounding::plan::{config, Plan};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 /// A shipped config, or (`pair-row`) a row of two one-storey buildings.
 fn plan(name: &str) -> Plan {
@@ -143,4 +144,71 @@ fn a_watched_stop_never_raised_changes_no_gpu_result() {
         assert_eq!(plain.len(), runs.end as usize, "{name}");
         crate::support::assert_same_text(name, &watched.join("\n"), &plain.join("\n"));
     }
+}
+
+/// A kernel's build is one driver call no flag cuts short (lavapipe builds a row of five's for
+/// seconds), so a watched sweep builds it on a thread of its own and looks at the flag
+/// meanwhile: raised during the build, the call returns `Interrupted` before the kernel is
+/// built (none is kept yet), and the build, left to finish alone, keeps its kernel whole for
+/// the next call.
+#[test]
+fn a_raised_stop_leaves_a_row_kernel_build() {
+    let Some(shared) = ctx() else { return };
+    if !shared.is_software() {
+        // A hardware driver builds the kernel well within the flag's delay: nothing to leave.
+        return;
+    }
+    // A device of its own: no kernel kept from another test.
+    let ctx = GpuContext::new().unwrap();
+    let plan = plan("row-of-five.toml");
+    let engine = Engine::new(plan.scheme(), Some(&ctx), Precision::F32, Some(64)).unwrap();
+    let runs = 0..plan.len();
+    let stop = AtomicBool::new(false);
+    let mut sunk = 0;
+    let r = std::thread::scope(|s| {
+        s.spawn(|| {
+            std::thread::sleep(Duration::from_millis(500));
+            stop.store(true, Ordering::Relaxed);
+        });
+        engine.sweep_until(
+            &plan,
+            runs.clone(),
+            &stop,
+            |_: Chunk<'_>| -> Result<(), GpuError> {
+                sunk += 1;
+                Ok(())
+            },
+            |_| {},
+        )
+    });
+    assert!(matches!(r, Err(GpuError::Interrupted)), "{r:?}");
+    assert_eq!(sunk, 0);
+    assert_eq!(
+        ctx.kernels_built(),
+        0,
+        "the call waited for the kernel's build"
+    );
+    // The build was under way: it ends alone and keeps its kernel.
+    let t = Instant::now();
+    while ctx.kernels_built() == 0 {
+        assert!(
+            t.elapsed().as_secs() < 600,
+            "the build left behind never ended"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let mut rows = 0;
+    let report = engine
+        .sweep(
+            &plan,
+            runs.clone(),
+            |c: Chunk<'_>| -> Result<(), GpuError> {
+                rows += cells(c).len();
+                Ok(())
+            },
+            |_| {},
+        )
+        .unwrap();
+    assert_eq!((rows as u64, report.summary.runs), (runs.end, runs.end));
+    assert_eq!(ctx.kernels_built(), 1, "the next call builds it again");
 }

@@ -2,8 +2,11 @@
 //! the work functions so tests can bring their own device.
 
 use super::layout::{Counters, Dispatch, Meta};
-use super::shader::{aggregate_source, fast_source, row_source, Precision};
-use std::sync::{Arc, Mutex};
+use super::precision::Precision;
+use super::shader::{aggregate_source, fast_source};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+use std::time::Duration;
 
 /// What went wrong on the GPU path; each message says what to do next.
 #[derive(Debug, thiserror::Error)]
@@ -34,6 +37,27 @@ pub enum GpuError {
     #[error("stopped: the sweep's stop flag was raised")]
     Interrupted,
 }
+
+/// A stop flag a GPU path watches (between dispatches, while a kernel is built, and between the
+/// runs it finishes on the host), or None: never stopped, dispatches of the whole budget (the
+/// command line).
+pub type Stop<'a> = Option<&'a AtomicBool>;
+
+/// Has the watched flag been raised?
+pub(crate) fn stopped(stop: Stop<'_>) -> bool {
+    stop.is_some_and(|s| s.load(Ordering::Relaxed))
+}
+
+/// `Err(Interrupted)` once the watched flag is raised.
+pub(crate) fn check_stop(stop: Stop<'_>) -> Result<(), GpuError> {
+    match stopped(stop) {
+        true => Err(GpuError::Interrupted),
+        false => Ok(()),
+    }
+}
+
+/// How often a watched kernel build looks at the stop flag.
+const BUILD_POLL: Duration = Duration::from_millis(15);
 
 /// One adapter as `pound gpu info` lists it.
 #[derive(Debug, Clone)]
@@ -70,7 +94,7 @@ pub struct Kernel {
 
 /// A compiled stage and variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stage {
+pub(super) enum Stage {
     /// `fast.wgsl`, with or without the energy balance and the peak accelerations.
     Fast { energy: bool, accel: bool },
     /// `aggregate.wgsl`.
@@ -81,6 +105,8 @@ enum Stage {
 }
 
 type KernelKey = (Stage, Precision);
+/// The kernels built, each with its key.
+type Kernels = Vec<(KernelKey, Arc<Kernel>)>;
 
 /// Device, queue and compiled kernels, created once per process (or per test).
 pub struct GpuContext {
@@ -89,7 +115,8 @@ pub struct GpuContext {
     pub info: wgpu::AdapterInfo,
     /// Errors reported outside an explicit check (validation, out of memory, device loss).
     errors: Arc<Mutex<Option<GpuError>>>,
-    kernels: Mutex<Vec<(KernelKey, Arc<Kernel>)>>,
+    /// Shared with the threads that build kernels for a watched call ([`GpuContext::stage`]).
+    kernels: Arc<Mutex<Kernels>>,
 }
 
 impl GpuContext {
@@ -153,7 +180,7 @@ impl GpuContext {
             queue,
             info,
             errors,
-            kernels: Mutex::new(Vec::new()),
+            kernels: Arc::default(),
         }
     }
 
@@ -215,155 +242,110 @@ impl GpuContext {
         energy: bool,
         accel: bool,
     ) -> Result<Arc<Kernel>, GpuError> {
-        self.stage(Stage::Fast { energy, accel }, precision, || {
-            fast_source(precision, energy, accel)
-        })
+        self.kernel_until(precision, energy, accel, None)
+    }
+
+    /// [`GpuContext::kernel`] watching `stop` while it is built ([`GpuContext::stage`]).
+    pub fn kernel_until(
+        &self,
+        precision: Precision,
+        energy: bool,
+        accel: bool,
+        stop: Stop<'_>,
+    ) -> Result<Arc<Kernel>, GpuError> {
+        let stage = Stage::Fast { energy, accel };
+        self.stage(
+            stage,
+            precision,
+            || fast_source(precision, energy, accel),
+            stop,
+        )
     }
 
     /// The aggregation stage in `precision`, compiled on first use.
     pub fn aggregator(&self, precision: Precision) -> Result<Arc<Kernel>, GpuError> {
-        self.stage(Stage::Aggregate, precision, || aggregate_source(precision))
+        self.stage(
+            Stage::Aggregate,
+            precision,
+            || aggregate_source(precision),
+            None,
+        )
     }
 
-    /// The row kernel for `shape` in `precision`, compiled on first use.
-    pub fn row_kernel(
-        &self,
-        precision: Precision,
-        shape: &super::row::RowShape,
-    ) -> Result<Arc<Kernel>, GpuError> {
-        use std::hash::{Hash, Hasher};
-        let constants = shape.wgsl_constants();
-        let mut h = std::collections::hash_map::DefaultHasher::new();
-        constants.hash(&mut h);
-        let stage = Stage::Row {
-            hash: h.finish(),
-            loops: !shape.unrolled(),
-        };
-        self.stage(stage, precision, || row_source(precision, &constants))
+    /// Kernels built so far and kept for reuse.
+    pub fn kernels_built(&self) -> usize {
+        self.kernels.lock().unwrap().len()
     }
 
-    fn stage(
+    /// The kernel of `stage` in `precision`: kept from an earlier call, or built from
+    /// `source()`. Unwatched, it is built here, holding the cache, so that calls at once build
+    /// it once. Watched, it is built on a thread of its own while this one looks at `stop`
+    /// every [`BUILD_POLL`]: a build is one driver call no flag can cut short (lavapipe builds a
+    /// row of five's kernel for about 3 s), so once the flag is raised this returns
+    /// `Err(Interrupted)` and the build goes on alone; it adds its kernel to the cache whole
+    /// when it is done (a later call finds it) and nothing if it fails.
+    pub(super) fn stage(
         &self,
         stage: Stage,
         precision: Precision,
         source: impl FnOnce() -> String,
+        stop: Stop<'_>,
     ) -> Result<Arc<Kernel>, GpuError> {
+        let key = (stage, precision);
         let mut ks = self.kernels.lock().unwrap();
-        if let Some((_, k)) = ks.iter().find(|(p, _)| *p == (stage, precision)) {
-            return Ok(k.clone());
+        if let Some(k) = cached(&ks, key) {
+            return Ok(k);
         }
         if precision == Precision::F64 && !self.supports_f64() {
             return Err(GpuError::NoF64 {
                 adapter: self.info.name.clone(),
             });
         }
-        let k = Arc::new(self.compile(stage, precision, source())?);
-        ks.push(((stage, precision), k.clone()));
-        Ok(k)
-    }
-
-    fn compile(
-        &self,
-        stage: Stage,
-        precision: Precision,
-        source: String,
-    ) -> Result<Kernel, GpuError> {
-        let d = &self.device;
-        let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-        let name = match stage {
-            Stage::Fast { .. } => "fast",
-            Stage::Aggregate => "aggregate",
-            Stage::Row { .. } => "row",
-        };
-        let label = format!("{name}.wgsl {}", precision.key());
-        let desc = wgpu::ShaderModuleDescriptor {
-            label: Some(&label),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        };
-        // Every loop in these shaders counts (a `for` that steps its counter, or a `loop` that
-        // spends a budget each pass: `shader::tests::every_loop_counts`), so naga's forced loop
-        // bounding (a second counter and exit test in every loop) is left out: on lavapipe it
-        // kept loops from unrolling and cost a third of a row sweep's time (BENCHMARKS.md,
-        // "Rows on lavapipe: the shape written out"). Except for a row kernel whose shape runs
-        // as loops: without the bounding, a 6-storey pair did not finish one run in 50 s on an
-        // H200 where it had run with it (BENCHMARKS.md, "Rows on an H200"); on lavapipe the
-        // bounding leaves those rows' runs/s as they were, so every adapter builds it alike.
-        // Bounds and division checks stay.
-        let checks = wgpu::ShaderRuntimeChecks {
-            force_loop_bounding: matches!(stage, Stage::Row { loops: true, .. }),
-            ..wgpu::ShaderRuntimeChecks::checked()
-        };
-        // SAFETY: wgpu asks that a shader built without loop bounding never loops forever;
-        // every loop of ours ends after a count (above).
-        let module = unsafe { d.create_shader_module_trusted(desc, checks) };
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
-            count: None,
-        };
-        let storage = |read_only| wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        };
-        // Binding order as declared in each shader.
-        let entries: Vec<wgpu::BindGroupLayoutEntry> = match stage {
-            // row.wgsl binds as fast.wgsl, its building models (read only) at 9, no 10.
-            Stage::Fast { .. } | Stage::Row { .. } => vec![
-                entry(
-                    0,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: wgpu::BufferSize::new(size_of::<Dispatch>() as u64),
-                    },
-                ),
-                entry(1, storage(true)),
-                entry(2, storage(true)),
-                entry(3, storage(true)),
-                entry(4, storage(false)),
-                entry(5, storage(false)),
-                entry(6, storage(false)),
-                entry(7, storage(true)),
-                entry(8, storage(false)),
-                entry(9, storage(true)),
-                entry(10, storage(true)),
-            ]
-            .into_iter()
-            .take(if matches!(stage, Stage::Row { .. }) {
-                10
-            } else {
-                11
-            })
-            .collect(),
-            Stage::Aggregate => (0..9).map(|b| entry(b, storage(b < 5))).collect(),
-        };
-        let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some(&format!("{name} bind group layout")),
-            entries: &entries,
-        });
-        let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some(&format!("{name} pipeline layout")),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(&format!("{name} pipeline")),
-            layout: Some(&pl),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Shader {
-                adapter: self.info.name.clone(),
-                precision: precision.key(),
-                message: e.to_string(),
-            });
+        if stop.is_none() {
+            let k = Arc::new(compile(
+                &self.device,
+                &self.info.name,
+                stage,
+                precision,
+                source(),
+            )?);
+            ks.push((key, k.clone()));
+            return Ok(k);
         }
-        Ok(Kernel { pipeline, layout })
+        drop(ks);
+        check_stop(stop)?;
+        let (tx, rx) = mpsc::channel();
+        let (device, adapter) = (self.device.clone(), self.info.name.clone());
+        let (kernels, source) = (self.kernels.clone(), source());
+        std::thread::Builder::new()
+            .name("pound kernel build".into())
+            .spawn(move || {
+                let built = compile(&device, &adapter, stage, precision, source).map(|k| {
+                    let mut ks = kernels.lock().unwrap();
+                    // Another call may have built it meanwhile: one kernel per key.
+                    cached(&ks, key).unwrap_or_else(|| {
+                        let k = Arc::new(k);
+                        ks.push((key, k.clone()));
+                        k
+                    })
+                });
+                // The caller may have left (stopped): then no one reads it.
+                let _ = tx.send(built);
+            })
+            .map_err(|e| GpuError::Other {
+                message: format!("starting a thread to build a kernel: {e}"),
+            })?;
+        loop {
+            match rx.recv_timeout(BUILD_POLL) {
+                Ok(built) => return built,
+                Err(mpsc::RecvTimeoutError::Timeout) => check_stop(stop)?,
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(GpuError::Other {
+                        message: "the thread building a kernel ended without one".into(),
+                    })
+                }
+            }
+        }
     }
 
     /// Most reals of `precision` one storage buffer may hold on this device (the shared free
@@ -394,4 +376,118 @@ impl GpuContext {
             l.max_compute_workgroups_per_dimension as u64 * super::layout::WORKGROUP_SIZE as u64;
         by_binding.min(by_groups)
     }
+}
+
+/// The kernel `cached` keeps for `key`.
+fn cached(kernels: &[(KernelKey, Arc<Kernel>)], key: KernelKey) -> Option<Arc<Kernel>> {
+    kernels
+        .iter()
+        .find(|(k, _)| *k == key)
+        .map(|(_, k)| k.clone())
+}
+
+/// Build `stage` in `precision` from `source` on `device` (of `adapter`, named in errors).
+fn compile(
+    device: &wgpu::Device,
+    adapter: &str,
+    stage: Stage,
+    precision: Precision,
+    source: String,
+) -> Result<Kernel, GpuError> {
+    let d = device;
+    let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+    let name = match stage {
+        Stage::Fast { .. } => "fast",
+        Stage::Aggregate => "aggregate",
+        Stage::Row { .. } => "row",
+    };
+    let label = format!("{name}.wgsl {}", precision.key());
+    let desc = wgpu::ShaderModuleDescriptor {
+        label: Some(&label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    };
+    // Every loop in these shaders counts (a `for` that steps its counter, or a `loop` that
+    // spends a budget each pass: `shader::tests::every_loop_counts`), so naga's forced loop
+    // bounding (a second counter and exit test in every loop) is left out: on lavapipe it
+    // kept loops from unrolling and cost a third of a row sweep's time (BENCHMARKS.md,
+    // "Rows on lavapipe: the shape written out"). Except for a row kernel whose shape runs
+    // as loops: without the bounding, a 6-storey pair did not finish one run in 50 s on an
+    // H200 where it had run with it (BENCHMARKS.md, "Rows on an H200"); on lavapipe the
+    // bounding leaves those rows' runs/s as they were, so every adapter builds it alike.
+    // Bounds and division checks stay.
+    let checks = wgpu::ShaderRuntimeChecks {
+        force_loop_bounding: matches!(stage, Stage::Row { loops: true, .. }),
+        ..wgpu::ShaderRuntimeChecks::checked()
+    };
+    // SAFETY: wgpu asks that a shader built without loop bounding never loops forever;
+    // every loop of ours ends after a count (above).
+    let module = unsafe { d.create_shader_module_trusted(desc, checks) };
+    let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty,
+        count: None,
+    };
+    let storage = |read_only| wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only },
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    };
+    // Binding order as declared in each shader.
+    let entries: Vec<wgpu::BindGroupLayoutEntry> = match stage {
+        // row.wgsl binds as fast.wgsl, its building models (read only) at 9, no 10.
+        Stage::Fast { .. } | Stage::Row { .. } => vec![
+            entry(
+                0,
+                wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: wgpu::BufferSize::new(size_of::<Dispatch>() as u64),
+                },
+            ),
+            entry(1, storage(true)),
+            entry(2, storage(true)),
+            entry(3, storage(true)),
+            entry(4, storage(false)),
+            entry(5, storage(false)),
+            entry(6, storage(false)),
+            entry(7, storage(true)),
+            entry(8, storage(false)),
+            entry(9, storage(true)),
+            entry(10, storage(true)),
+        ]
+        .into_iter()
+        .take(if matches!(stage, Stage::Row { .. }) {
+            10
+        } else {
+            11
+        })
+        .collect(),
+        Stage::Aggregate => (0..9).map(|b| entry(b, storage(b < 5))).collect(),
+    };
+    let layout = d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(&format!("{name} bind group layout")),
+        entries: &entries,
+    });
+    let pl = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(&format!("{name} pipeline layout")),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(&format!("{name} pipeline")),
+        layout: Some(&pl),
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(GpuError::Shader {
+            adapter: adapter.to_string(),
+            precision: precision.key(),
+            message: e.to_string(),
+        });
+    }
+    Ok(Kernel { pipeline, layout })
 }

@@ -121,7 +121,7 @@ pub struct Meta {
     /// Record intervals to simulate (record plus tail).
     pub intervals: u32,
     /// First real of the run's shared free response in the `responses` buffer
-    /// ([`super::shared`]), or [`NO_RESPONSE`].
+    /// (`shared.rs`), or [`NO_RESPONSE`].
     pub response: u32,
 }
 
@@ -270,12 +270,12 @@ pub fn workgroups(n: u32) -> u32 {
 }
 
 /// Bytes of one `Params` at `precision`.
-pub fn params_bytes(precision: super::Precision) -> usize {
+pub fn params_bytes(precision: super::precision::Precision) -> usize {
     core::mem::size_of::<Params64>() / 8 * precision.bytes()
 }
 
 /// Bytes of one `State` at `precision`.
-pub fn state_bytes(precision: super::Precision) -> usize {
+pub fn state_bytes(precision: super::precision::Precision) -> usize {
     core::mem::size_of::<State64>() / 8 * precision.bytes()
 }
 

@@ -3,6 +3,7 @@
 //!
 //! - [`context`]: adapter, device, queue and compiled pipelines, acquired apart from the work;
 //! - [`layout`]: the `#[repr(C)]` buffer types both sides share (checked against the WGSL by naga);
+//! - [`precision`]: f32 or f64 on the device;
 //! - [`shader`]: the WGSL text with its constants filled in from Rust;
 //! - [`run`]: packing runs, dispatching, reading back one chunk;
 //! - [`row`]: rows of multi-storey buildings (`shaders/row.wgsl`), packed, dispatched, read back;
@@ -14,6 +15,7 @@
 pub mod context;
 pub mod fold;
 pub mod layout;
+pub mod precision;
 pub mod reduce;
 pub mod row;
 pub mod run;
@@ -21,10 +23,10 @@ pub mod shader;
 pub mod shared;
 pub mod sweep;
 
-pub use context::{GpuContext, GpuError};
+pub use context::{GpuContext, GpuError, Stop};
+pub use precision::Precision;
 pub use run::{
     integrate, integrate_until, output, pack, read_outputs, run_chunk, run_chunk_until, ChunkTimes,
-    GpuOptions, GpuRecords, Integrated, PackedChunk, Stop,
+    GpuOptions, GpuRecords, Integrated, PackedChunk,
 };
-pub use shader::Precision;
 pub use sweep::GpuTimes;

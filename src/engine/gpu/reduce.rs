@@ -4,8 +4,8 @@
 
 use super::context::{GpuContext, GpuError};
 use super::layout::{self, AggConfig, Segment, PART_R, PART_U, SLOT_WORDS};
+use super::precision::Precision;
 use super::run::{bind_group, read, read_prefix, storage, zeroed, Integrated};
-use super::shader::Precision;
 use crate::engine::aggregate::{Aggregator, Partial, MAX_EXCEED};
 use std::collections::HashMap;
 

@@ -9,13 +9,13 @@
 //! that persists between dispatches (`S_*` reals, `C_*` u32). Building models (modes, shapes,
 //! masses, heights, propagators) are shared by the runs that use the same one.
 
-use super::context::{GpuContext, GpuError};
+use super::context::{check_stop, stopped, GpuContext, GpuError, Kernel, Stage, Stop};
 use super::layout::{MODE_FREE, STATUS_COLLAPSE, STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK};
+use super::precision::Precision;
 use super::run::{
-    bind_group, check_stop, read, stopped, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions,
-    GpuRecords, Stop, WorkLists,
+    bind_group, read, storage, unit_cap, wait, zeroed, ChunkTimes, GpuOptions, GpuRecords,
+    WorkLists,
 };
-use super::shader::Precision;
 use super::sweep::GpuTimes;
 use crate::engine::Summary;
 use crate::physics::contact::LawKind;
@@ -28,6 +28,7 @@ use crate::physics::solver::FastOptions;
 use crate::plan::row::{RowPlan, RowRunSpec};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 // A run's parameter block (reals).
@@ -108,12 +109,6 @@ pub const MW: usize = 11;
 /// Reals per yielding storey after its building's model block: `k`, `d_y`, `b`, then its
 /// modal row (the drift in the building's modes).
 pub const STOREY_HEAD: usize = 4;
-
-/// The band's slack in f32 (`row::yielding::YIELD_SLACK` is f64's): a storey leaves its band edge
-/// inside the band once f32 has rounded its back drift `d - p / (1 - b)`, whose terms are up
-/// to the ductility times `d_y` (a few 1e-7 each): 1e-4 of `d_y` keeps an unloading storey
-/// from re-yielding on rounding at ductilities up to a few hundred.
-pub const F32_YIELD_SLACK: f64 = 1e-4;
 
 /// lavapipe ends a shader's loops after about 65,535 back edges per invocation, counted over
 /// all its loops (see [`super::run::CPU_ADAPTER_BUDGET`]): a dispatch's units on a software
@@ -298,6 +293,19 @@ impl RowShape {
 
     fn c_stride(&self) -> usize {
         self.c_settled() + self.yields() * (1 + SC_STRIDE * self.yielding_storeys())
+    }
+
+    /// The last record interval any run of a chunk with meta blocks `meta` may reach: its
+    /// record's end, or with yielding storeys its settling time's.
+    fn last_interval(&self, meta: &[u32]) -> u64 {
+        let end = M_MODELS + self.storeys.len();
+        (meta.chunks(self.m_stride()))
+            .map(|m| match self.yields() {
+                0 => m[M_INTERVALS],
+                _ => m[M_INTERVALS].max(m[end]),
+            })
+            .max()
+            .unwrap_or(0) as u64
     }
 
     /// Bytes of a run's largest per-run block in `precision` (the chunk's cap follows from it).
@@ -1247,6 +1255,42 @@ fn may_couple(b: &BuildingModel) -> bool {
     b.n() > 1 && b.floor_form.as_ref().is_some_and(|f| f.geometric.is_some())
 }
 
+/// The row kernels, kept by the context as every other (it knows no row shape: the shape
+/// gives the stage its key and its source).
+impl GpuContext {
+    /// The row kernel for `shape` in `precision`, compiled on first use.
+    pub fn row_kernel(
+        &self,
+        precision: Precision,
+        shape: &RowShape,
+    ) -> Result<Arc<Kernel>, GpuError> {
+        self.row_kernel_until(precision, shape, None)
+    }
+
+    /// [`GpuContext::row_kernel`] watching `stop` while it is built ([`GpuContext::stage`]).
+    pub fn row_kernel_until(
+        &self,
+        precision: Precision,
+        shape: &RowShape,
+        stop: Stop<'_>,
+    ) -> Result<Arc<Kernel>, GpuError> {
+        use std::hash::{Hash, Hasher};
+        let constants = shape.wgsl_constants();
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        constants.hash(&mut h);
+        let stage = Stage::Row {
+            hash: h.finish(),
+            loops: !shape.unrolled(),
+        };
+        self.stage(
+            stage,
+            precision,
+            || super::shader::row_source(precision, &constants),
+            stop,
+        )
+    }
+}
+
 /// Units of work per dispatch on a software adapter (unbounded on hardware), or an error when
 /// a row of `shape` cannot run there at all.
 fn software_cap(ctx: &GpuContext, shape: &RowShape) -> Result<u64, GpuError> {
@@ -1327,7 +1371,7 @@ fn integrate_rows(
     }
     let shape = &chunk.shape;
     let cap = software_cap(ctx, shape)?;
-    let kernel = ctx.row_kernel(opts.precision, shape)?;
+    let kernel = ctx.row_kernel_until(opts.precision, shape, stop)?;
     let t = Instant::now();
     let p = opts.precision;
     let params = storage(
@@ -1388,7 +1432,10 @@ fn integrate_rows(
         .units_per_dispatch
         .max(1)
         .min(unit_cap(ctx, cap.min(u32::MAX as u64) as u32));
-    lists.run("row", ctx, &kernel, &binds, budget, opts, stop, &mut times)?;
+    let max_units = row_units(shape.last_interval(&chunk.meta), &opts.fast);
+    lists.run(
+        "row", ctx, &kernel, &binds, budget, max_units, opts, stop, &mut times,
+    )?;
     let t = Instant::now();
     let sbytes = read(ctx, &states)?;
     let cbytes = read(ctx, &counters)?;
@@ -1400,6 +1447,7 @@ fn integrate_rows(
             .collect(),
     };
     let words: &[u32] = bytemuck::cast_slice(&cbytes);
+    unfinished(shape, &chunk.meta, words)?;
     let out = (0..n)
         .map(|r| {
             let s = &reals[r * shape.s_stride()..(r + 1) * shape.s_stride()];
@@ -1410,6 +1458,60 @@ fn integrate_rows(
         .collect();
     times.readback = t.elapsed();
     Ok((out, times))
+}
+
+/// The most units of work a row run of at most `end` record intervals (its settling tail
+/// included) can take with `fast`'s caps (`shaders/row.wgsl`, `integrate_run`), doubled for
+/// what a count by hand may miss: each interval is begun once; a piece takes one RK4 substep in
+/// its trial (the run ends at `max_substeps + 1`), then at most a probe of a hidden touch and
+/// its retake, or the event search (its estimates each with a guard probe, its bisections, the
+/// step to its end); a unit that only moves to the next substep comes at most
+/// `max_substeps_per_step` times per interval.
+fn row_units(end: u64, fast: &FastOptions) -> u64 {
+    use crate::physics::solver::fast::{LOCATE_BISECTIONS, LOCATE_ITERATIONS};
+    let search = 2 * LOCATE_ITERATIONS as u64 + LOCATE_BISECTIONS as u64 + 1;
+    let pieces = (fast.max_substeps as u64 + 1).saturating_mul(2 + search);
+    let moves = end.saturating_mul(fast.max_substeps_per_step as u64);
+    let count = end.saturating_add(moves).saturating_add(pieces);
+    count.saturating_mul(2)
+}
+
+/// Every run of a chunk read back (`meta` and `counters`: the chunk's blocks) must have ended
+/// as `ended()` in `shaders/row.wgsl` says (its record integrated and, with yielding storeys,
+/// settled or its settling time spent), or with a status that ends it: one still running would
+/// be written as a finished run with part of its record.
+fn unfinished(shape: &RowShape, meta: &[u32], counters: &[u32]) -> Result<(), GpuError> {
+    let nb = shape.storeys.len();
+    // The interval a run runs to, and whether it is there.
+    let ended = |r: usize| {
+        let m = &meta[r * shape.m_stride()..(r + 1) * shape.m_stride()];
+        let c = &counters[r * shape.c_stride()..(r + 1) * shape.c_stride()];
+        let recorded = c[C_I] >= m[M_INTERVALS];
+        let done = if shape.yields() == 0 {
+            recorded
+        } else {
+            recorded && (c[shape.c_settled()] != 0 || c[C_I] >= m[M_MODELS + nb])
+        };
+        let end = match shape.yields() {
+            0 => m[M_INTERVALS],
+            _ => m[M_MODELS + nb],
+        };
+        (c[C_STATUS] != STATUS_OK || done, c[C_I], end)
+    };
+    let runs = meta.len() / shape.m_stride();
+    let left: Vec<usize> = (0..runs).filter(|&r| !ended(r).0).collect();
+    match left.first() {
+        Some(&k) => {
+            let (_, i, end) = ended(k);
+            Err(GpuError::Other {
+                message: format!(
+                    "{} runs of a chunk of {runs} came back from the device unfinished (the first, chunk run {k}, at record interval {i} of {end}); their results cannot be trusted",
+                    left.len()
+                ),
+            })
+        }
+        None => Ok(()),
+    }
 }
 
 /// A run's results from its final state and counters (what `RowRun::finish` does on the CPU,
@@ -1567,7 +1669,15 @@ pub fn sweep_rows_until<E: From<GpuError>>(
         Ok((specs, models, packed, t.elapsed().as_secs_f64()))
     };
     let mut first = runs.start;
-    let mut next = Some(prep(first)?);
+    // The kernel is built while the first chunk is prepared (lavapipe builds a tall row's for
+    // seconds), watching the stop; the chunks then find it built.
+    software_cap(ctx, &shape)?;
+    let (kernel, prepared) = rayon::join(
+        || ctx.row_kernel_until(opts.precision, &shape, stop),
+        || prep(first),
+    );
+    kernel?;
+    let mut next = Some(prepared?);
     while let Some((specs, models, packed, pack_s)) = next.take() {
         let end = first + specs.len() as u64;
         times.pack += pack_s;
@@ -1643,5 +1753,111 @@ mod tests {
         }
         let none = collapse_param(f64::INFINITY, Precision::F32);
         assert_eq!(none, f64::INFINITY);
+    }
+
+    /// A row read back with its status OK before its record's end (or, with yielding storeys,
+    /// before it settled or its settling time ran out) is refused, named.
+    #[test]
+    fn a_row_read_back_unfinished_is_an_error() {
+        // Three runs of 10 record intervals; counters (status, interval, settled).
+        let check = |shape: &RowShape, runs: &[(u32, u32, u32)]| {
+            let (ms, cs) = (shape.m_stride(), shape.c_stride());
+            let mut meta = vec![0; ms * runs.len()];
+            let mut counters = vec![0; cs * runs.len()];
+            for (r, &(status, i, settled)) in runs.iter().enumerate() {
+                meta[r * ms + M_INTERVALS] = 10;
+                if shape.yields() > 0 {
+                    meta[r * ms + M_MODELS + shape.storeys.len()] = 15;
+                    counters[r * cs + shape.c_settled()] = settled;
+                }
+                counters[r * cs + C_STATUS] = status;
+                counters[r * cs + C_I] = i;
+            }
+            unfinished(shape, &meta, &counters).map_err(|e| e.to_string())
+        };
+        let elastic = RowShape::elastic(vec![2, 3], vec![[0, 1, 2]]);
+        let ended = [
+            (STATUS_OK, 10, 0),
+            (STATUS_NON_FINITE, 3, 0),
+            (STATUS_HANDOFF, 0, 0),
+            (STATUS_COLLAPSE, 4, 0),
+        ];
+        check(&elastic, &ended).unwrap();
+        let e = check(
+            &elastic,
+            &[(STATUS_OK, 10, 0), (STATUS_OK, 4, 0), (STATUS_OK, 0, 0)],
+        )
+        .unwrap_err();
+        assert!(
+            e.contains("2 runs of a chunk of 3")
+                && e.contains("chunk run 1, at record interval 4 of 10"),
+            "{e}"
+        );
+        // With yielding storeys a run goes on past its record until it settles (or its
+        // settling time, here 15 intervals, runs out).
+        let yielding = RowShape {
+            yielding: vec![true, false],
+            ..elastic
+        };
+        check(&yielding, &[(STATUS_OK, 12, 1), (STATUS_OK, 15, 0)]).unwrap();
+        let e = check(&yielding, &[(STATUS_OK, 12, 1), (STATUS_OK, 12, 0)]).unwrap_err();
+        assert!(
+            e.contains("1 runs of a chunk of 2")
+                && e.contains("chunk run 1, at record interval 12 of 15"),
+            "{e}"
+        );
+        let e = check(&yielding, &[(STATUS_OK, 9, 1)]).unwrap_err();
+        assert!(e.contains("at record interval 9 of 15"), "{e}");
+    }
+
+    /// Every loop in the shaders ends after a count, as building them without naga's loop
+    /// bounding requires (context.rs): no `while`, every `for` has a step, every `loop` leaves
+    /// once its budget is spent and spends it each pass; the per-shape code the host writes
+    /// has no loop at all.
+    #[test]
+    fn every_loop_counts() {
+        use crate::engine::gpu::shader::{
+            AGGREGATE_WGSL, CONTACT_WGSL, FAST_WGSL, HERMITE_WGSL, LANES_WGSL, ROW_LOOPS_WGSL,
+            ROW_WGSL, TYPES_WGSL, YIELDING_WGSL,
+        };
+        let shape = RowShape::elastic(vec![3, 6], vec![[0, 0, 0], [0, 1, 1]]);
+        let written = shape.wgsl_constants();
+        let sources = [
+            ("types", TYPES_WGSL),
+            ("contact", CONTACT_WGSL),
+            ("hermite", HERMITE_WGSL),
+            ("fast", FAST_WGSL),
+            ("row", ROW_WGSL),
+            ("row_loops", ROW_LOOPS_WGSL),
+            ("yielding", YIELDING_WGSL),
+            ("lanes", LANES_WGSL),
+            ("aggregate", AGGREGATE_WGSL),
+            ("written out for 3 + 6 storeys", written.as_str()),
+        ];
+        let (mut fors, mut loops) = (0, 0);
+        for (name, src) in sources {
+            let code: Vec<&str> = src.lines().map(|l| l.split("//").next().unwrap()).collect();
+            for (i, line) in code.iter().enumerate() {
+                let at = format!("{name}.wgsl line {}: {line}", i + 1);
+                assert!(!line.contains("while"), "{at}");
+                if let Some(h) = line.find("for (") {
+                    let header = line[h..].split(") {").next().unwrap();
+                    let clauses: Vec<&str> = header.split(';').collect();
+                    assert_eq!(clauses.len(), 3, "{at}");
+                    assert!(!clauses[2].trim().is_empty(), "{at}");
+                    fors += 1;
+                }
+                if line.contains("loop {") {
+                    let body = code[i..(i + 12).min(code.len())].join("\n");
+                    assert!(body.contains("budget == 0u"), "{at}");
+                    assert!(body.contains("budget = budget - 1u"), "{at}");
+                    loops += 1;
+                }
+            }
+            if name.starts_with("written") {
+                assert!(!src.contains("for (") && !src.contains("loop {"));
+            }
+        }
+        assert!(fors > 20 && loops == 2, "{fors} for, {loops} loop");
     }
 }

@@ -1,36 +1,18 @@
 //! Packing runs into buffers, dispatching the kernel in windows of record intervals, reading
 //! back. The work functions take a [`GpuContext`], so tests can pass their own device.
 
-use super::context::{GpuContext, GpuError, Kernel};
+use super::context::{check_stop, GpuContext, GpuError, Kernel, Stop};
 use super::layout::{
     self, Counters, Dispatch, Meta, Params32, Params64, State32, State64, MODE_FREE, NO_RESPONSE,
     STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK,
 };
-use super::shader::Precision;
+use super::precision::Precision;
 use super::shared::Start;
 use crate::physics::contact::LawKind;
 use crate::physics::model::{EnergyBalance, Forcing, Oscillator, Pair, RunOutput, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
 use crate::physics::solver::FastOptions;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
-
-/// A stop flag a GPU path watches (between dispatches, and between the runs it finishes on the
-/// host), or None: never stopped, dispatches of the whole budget (the command line).
-pub type Stop<'a> = Option<&'a AtomicBool>;
-
-/// Has the watched flag been raised?
-pub(crate) fn stopped(stop: Stop<'_>) -> bool {
-    stop.is_some_and(|s| s.load(Ordering::Relaxed))
-}
-
-/// `Err(Interrupted)` once the watched flag is raised.
-pub(crate) fn check_stop(stop: Stop<'_>) -> Result<(), GpuError> {
-    match stopped(stop) {
-        true => Err(GpuError::Interrupted),
-        false => Ok(()),
-    }
-}
 
 /// While a stop is watched, the time one dispatch is sized to take, s: a software adapter runs
 /// a chunk's dispatch of the whole budget for seconds (lavapipe: about 4 s on
@@ -172,7 +154,7 @@ pub struct Packed {
 }
 
 /// A chunk's packed runs, and the tables of the free responses some of them share
-/// ([`super::shared::share`]).
+/// (`share` in `sweep.rs`).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PackedChunk {
     pub runs: Vec<Packed>,
@@ -494,7 +476,7 @@ pub fn integrate_until(
 ) -> Result<(Integrated, ChunkTimes), GpuError> {
     let runs = &chunk.runs[..];
     let mut times = ChunkTimes::default();
-    let kernel = ctx.kernel(opts.precision, opts.fast.energy, chunk.accel)?;
+    let kernel = ctx.kernel_until(opts.precision, opts.fast.energy, chunk.accel, stop)?;
     let n = runs.len();
     let t = Instant::now();
     let params: Vec<u8> = match opts.precision {
@@ -595,7 +577,11 @@ pub fn integrate_until(
         .units_per_dispatch
         .max(1)
         .min(unit_cap(ctx, CPU_ADAPTER_BUDGET));
-    lists.run("fast", ctx, &kernel, &binds, budget, opts, stop, &mut times)?;
+    let intervals = runs.iter().map(|r| r.meta.intervals as u64).max();
+    let max_units = pair_units(intervals.unwrap_or(0), &opts.fast);
+    lists.run(
+        "fast", ctx, &kernel, &binds, budget, max_units, opts, stop, &mut times,
+    )?;
     Ok((
         Integrated {
             states,
@@ -666,6 +652,9 @@ impl WorkLists {
     /// read list a (b) and write list b (a). Adds the kernel time and lane tally to `times`.
     /// With a `stop` watched, it is looked at before each dispatch (`Err(Interrupted)`), and
     /// each dispatch's budget (at most `budget`) is sized to take [`WATCHED_DISPATCH_S`].
+    /// `max_units`: the most units any run of the chunk can take ([`pair_units`],
+    /// `RowShape::max_units`); a device that reports runs active past it is refused
+    /// ([`endless`]).
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
@@ -674,6 +663,7 @@ impl WorkLists {
         kernel: &Kernel,
         binds: &[wgpu::BindGroup; 2],
         budget: u32,
+        max_units: u64,
         opts: &GpuOptions,
         stop: Stop<'_>,
         times: &mut ChunkTimes,
@@ -698,6 +688,8 @@ impl WorkLists {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        // The budgets of the dispatches that left runs active.
+        let mut spent = 0u64;
         for parity in (0..2).cycle() {
             check_stop(stop)?;
             let td = Instant::now();
@@ -718,6 +710,8 @@ impl WorkLists {
             if d.nactive == 0 {
                 break;
             }
+            spent += d.budget as u64;
+            endless(label, spent, max_units)?;
             if stop.is_some() {
                 // The next dispatch's budget in proportion to the time this one's took, grown
                 // at most 4x at a time (its units may cost more: contacts, substeps).
@@ -752,6 +746,34 @@ pub(super) fn ran(label: &str, given: u32, units: u32, active: u32) -> Result<()
         });
     }
     Ok(())
+}
+
+/// Check that runs still active have not done more work than any run can: a lane leaves its
+/// run early only where the run ends, so a run active after a dispatch did that dispatch's
+/// whole budget, and one active after all of them did `spent` units in all. A device that
+/// reports runs active forever would otherwise be dispatched forever.
+pub(super) fn endless(label: &str, spent: u64, max_units: u64) -> Result<(), GpuError> {
+    match spent > max_units {
+        true => Err(GpuError::Other {
+            message: format!(
+                "the {label} kernel reported runs still active after {spent} units of work each, more than any run of the chunk can take ({max_units}); its results cannot be trusted"
+            ),
+        }),
+        false => Ok(()),
+    }
+}
+
+/// The most units of work a pair run of at most `intervals` record intervals can take with
+/// `fast`'s caps (`shaders/fast.wgsl`, `integrate_run`), doubled for what a count by hand may
+/// miss: each interval is begun once (one unit: a free step, its substeps set up, or the end);
+/// a piece's unit either takes an RK4 substep (the run ends at `max_substeps + 1`) or only
+/// moves to the next substep (at most `max_substeps_per_step` per interval).
+pub(super) fn pair_units(intervals: u64, fast: &FastOptions) -> u64 {
+    let moves = intervals.saturating_mul(fast.max_substeps_per_step as u64);
+    let count = intervals
+        .saturating_add(moves)
+        .saturating_add(fast.max_substeps as u64 + 1);
+    count.saturating_mul(2)
 }
 
 /// Each run's state and counters before the first dispatch, the state in `precision`'s bytes:
@@ -865,6 +887,22 @@ mod tests {
         );
         let e = ran("row", 5, 9, 6).unwrap_err().to_string();
         assert!(e.contains("6 runs still active of the 5"), "{e}");
+    }
+
+    /// Runs still active after more units than any run can take are an error, not a dispatch
+    /// more; the bound holds a pair run's units.
+    #[test]
+    fn runs_active_past_every_runs_units_are_an_error() {
+        endless("fast", 100, 100).unwrap();
+        let e = endless("row", 101, 100).unwrap_err().to_string();
+        assert!(
+            e.contains("still active after 101 units") && e.contains("(100)"),
+            "{e}"
+        );
+        let fast = FastOptions::default();
+        let (i, m) = (1000, fast.max_substeps_per_step as u64);
+        assert!(pair_units(i, &fast) > i + i * m + fast.max_substeps as u64);
+        assert_eq!(pair_units(u64::MAX, &fast), u64::MAX);
     }
 
     /// A run read back with its status OK before its record's end is refused, named.

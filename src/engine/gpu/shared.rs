@@ -21,13 +21,7 @@
 //! A run takes its distance `R` from the shared motion only at checkpoints, where it checks for
 //! an early end, so one state per `CHECK_EVERY` steps is all the kernel reads.
 
-use super::layout::NO_RESPONSE;
-use super::run::Packed;
-use super::sweep::PairRuns;
-use crate::engine::cpu::{free_motion_stretches, same_free_motion, MIN_SHARED_RUNS};
 use crate::physics::solver::FreeResponse;
-use crate::plan::RunSpec;
-use rayon::prelude::*;
 
 /// Reals of a table's header, and per checkpoint (see the module's notes).
 pub const fn header_reals(accel: bool) -> usize {
@@ -78,101 +72,4 @@ pub struct Start {
     pub state: [f64; 4],
     /// `[u1, u2, a1, a2]` (the accelerations' 0 where the runs do not track them).
     pub peaks: [f64; 4],
-}
-
-/// Does `spec` lie in a stretch of at least [`MIN_SHARED_RUNS`] consecutive runs of `plan` with
-/// its free motion? Decided on the plan, not the chunk, so that whether a run shares (which
-/// moves an f32 result by rounding: the response is stepped in f64) does not depend on where
-/// chunks end or how a chunk is ordered.
-fn in_long_stretch(plan: &dyn PairRuns, spec: &RunSpec) -> bool {
-    let same = |j: u64| same_free_motion(spec, &plan.run(j));
-    let (mut lo, mut hi) = (spec.index, spec.index);
-    while ((hi - lo + 1) as usize) < MIN_SHARED_RUNS && lo > 0 && same(lo - 1) {
-        lo -= 1;
-    }
-    while ((hi - lo + 1) as usize) < MIN_SHARED_RUNS && hi + 1 < plan.runs() && same(hi + 1) {
-        hi += 1;
-    }
-    (hi - lo + 1) as usize >= MIN_SHARED_RUNS
-}
-
-/// Give the runs of `packed` (`specs[k]` is the run of `packed[k]`) that lie in a stretch of at
-/// least [`MIN_SHARED_RUNS`] consecutive runs of the plan with the same free motion a shared
-/// response, one per stretch of such runs that are consecutive in `packed`: sets
-/// `meta.response` and `start` of those runs, and returns the responses' tables, one after
-/// another. Stretches past `max_reals` in all step their whole records.
-pub fn share(
-    plan: &dyn PairRuns,
-    specs: &[&RunSpec],
-    packed: &mut [Packed],
-    max_reals: usize,
-) -> Vec<f64> {
-    let mut stretches: Vec<Vec<usize>> = Vec::new();
-    for ks in free_motion_stretches(specs) {
-        let len = ks.len();
-        let contiguous = specs[ks.end - 1].index - specs[ks.start].index == len as u64 - 1;
-        let members: Vec<usize> = if len >= MIN_SHARED_RUNS && contiguous {
-            ks.collect()
-        } else {
-            ks.filter(|&j| in_long_stretch(plan, specs[j])).collect()
-        };
-        if !members.is_empty() {
-            stretches.push(members);
-        }
-    }
-    // Each table's place, as long as they fit; the tables are then built in parallel in place.
-    let max_reals = max_reals.min(u32::MAX as usize);
-    let mut total = 0;
-    let mut placed = Vec::new();
-    for ks in stretches {
-        let len = table_reals(plan.forcing(specs[ks[0]]).intervals(), plan.accel());
-        if total + len > max_reals {
-            break;
-        }
-        placed.push((ks, total, len));
-        total += len;
-    }
-    let mut tables = vec![0.0; total];
-    let mut slots = Vec::with_capacity(placed.len());
-    let mut rest = &mut tables[..];
-    for (_, _, len) in &placed {
-        let (slot, tail) = rest.split_at_mut(*len);
-        slots.push(slot);
-        rest = tail;
-    }
-    let starts: Vec<Vec<Start>> = placed
-        .par_iter()
-        .zip(slots)
-        .map(|((ks, _, _), slot)| {
-            let forcing = plan.forcing(specs[ks[0]]);
-            let pair = specs[ks[0]].pair();
-            let r = if plan.accel() {
-                FreeResponse::with_accel(&pair.b1, &pair.b2, &forcing)
-            } else {
-                FreeResponse::new(&pair.b1, &pair.b2, &forcing)
-            };
-            fill_table(&r, slot);
-            ks.iter()
-                .map(|&k| {
-                    let first = r.first_possible_contact(specs[k].gap);
-                    let (z, peaks) = r.at(first);
-                    Start {
-                        i: first as u32,
-                        state: [z[0], z[1], z[2], z[3]],
-                        peaks,
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    for ((ks, offset, _), starts) in placed.into_iter().zip(starts) {
-        for (k, start) in ks.into_iter().zip(starts) {
-            packed[k].meta.response = offset as u32;
-            packed[k].start = Some(start);
-        }
-    }
-    debug_assert!(packed
-        .iter()
-        .all(|p| (p.meta.response == NO_RESPONSE) == p.start.is_none()));
-    tables
 }

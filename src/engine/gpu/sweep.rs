@@ -1,10 +1,14 @@
 //! A range of runs on the GPU, chunk after chunk: packed on the host while the device integrates
 //! the previous chunk, read back, the runs the kernel hands back finished on the CPU in f64.
 
+use super::layout::NO_RESPONSE;
+use super::run::Packed;
+use super::shared::{fill_table, table_reals, Start};
+use crate::engine::cpu::{free_motion_stretches, same_free_motion, MIN_SHARED_RUNS};
 use crate::engine::Summary;
 use crate::physics::model::{Forcing, RunOutput};
 use crate::physics::row::RowOutput;
-use crate::physics::solver::{simulate_tracking_accel, FastOptions, Scheme};
+use crate::physics::solver::{simulate_tracking_accel, FastOptions, FreeResponse, Scheme};
 use crate::plan::contact::ContactPlan;
 use crate::plan::row::{RowPlan, RowRunSpec as RowSpec};
 use crate::plan::{PairPlan, RunSpec};
@@ -128,7 +132,7 @@ impl GpuTimes {
             .enumerate()
             .map(|(k, o)| match o {
                 Some(o) => Some(o),
-                None if super::run::stopped(stop) => None,
+                None if super::context::stopped(stop) => None,
                 None => Some(plan.run_on_cpu(spec(k), fast)),
             })
             .collect::<Option<Vec<_>>>()
@@ -169,7 +173,7 @@ pub(crate) fn pack_run(
 }
 
 /// Pack the runs `specs` of `plan`, in this order, as one chunk: the runs that can share a free
-/// response ([`super::shared::share`]) get one, unless `opts` says not to or asks for the energy
+/// response ([`share`]) get one, unless `opts` says not to or asks for the energy
 /// balance (the shortcuts skip its integrals).
 pub(crate) fn pack_chunk(
     plan: &dyn PairRuns,
@@ -184,7 +188,7 @@ pub(crate) fn pack_chunk(
         .collect();
     let shared = if opts.share_free_response && !opts.fast.energy {
         let max = ctx.max_buffer_reals(opts.precision);
-        super::shared::share(plan, specs, &mut runs, max)
+        share(plan, specs, &mut runs, max)
     } else {
         Vec::new()
     };
@@ -237,7 +241,7 @@ pub fn run_row_pairs_until<E: From<super::GpuError>>(
             let rows: Vec<(RowSpec, RowOutput)> = done
                 .par_iter()
                 .map(|(p, o)| {
-                    if super::run::stopped(stop) {
+                    if super::context::stopped(stop) {
                         return None;
                     }
                     let spec = plan.run(p.index);
@@ -301,7 +305,7 @@ pub fn run_range_until<E: From<super::GpuError>>(
             .map(|i| plan.run(i))
             .collect();
         // Stopped while the device integrates the chunk before: left unpacked.
-        super::run::check_stop(stop)?;
+        super::context::check_stop(stop)?;
         let refs: Vec<&RunSpec> = specs.iter().collect();
         let packed = pack_chunk(plan, &refs, ctx, &recs, opts);
         Ok((specs, packed, t.elapsed().as_secs_f64()))
@@ -331,4 +335,101 @@ pub fn run_range_until<E: From<super::GpuError>>(
     }
     s.seconds = start.elapsed().as_secs_f64();
     Ok((s, times))
+}
+
+/// Does `spec` lie in a stretch of at least [`MIN_SHARED_RUNS`] consecutive runs of `plan` with
+/// its free motion? Decided on the plan, not the chunk, so that whether a run shares (which
+/// moves an f32 result by rounding: the response is stepped in f64) does not depend on where
+/// chunks end or how a chunk is ordered.
+fn in_long_stretch(plan: &dyn PairRuns, spec: &RunSpec) -> bool {
+    let same = |j: u64| same_free_motion(spec, &plan.run(j));
+    let (mut lo, mut hi) = (spec.index, spec.index);
+    while ((hi - lo + 1) as usize) < MIN_SHARED_RUNS && lo > 0 && same(lo - 1) {
+        lo -= 1;
+    }
+    while ((hi - lo + 1) as usize) < MIN_SHARED_RUNS && hi + 1 < plan.runs() && same(hi + 1) {
+        hi += 1;
+    }
+    (hi - lo + 1) as usize >= MIN_SHARED_RUNS
+}
+
+/// Give the runs of `packed` (`specs[k]` is the run of `packed[k]`) that lie in a stretch of at
+/// least [`MIN_SHARED_RUNS`] consecutive runs of the plan with the same free motion a shared
+/// response, one per stretch of such runs that are consecutive in `packed`: sets
+/// `meta.response` and `start` of those runs, and returns the responses' tables, one after
+/// another. Stretches past `max_reals` in all step their whole records.
+pub fn share(
+    plan: &dyn PairRuns,
+    specs: &[&RunSpec],
+    packed: &mut [Packed],
+    max_reals: usize,
+) -> Vec<f64> {
+    let mut stretches: Vec<Vec<usize>> = Vec::new();
+    for ks in free_motion_stretches(specs) {
+        let len = ks.len();
+        let contiguous = specs[ks.end - 1].index - specs[ks.start].index == len as u64 - 1;
+        let members: Vec<usize> = if len >= MIN_SHARED_RUNS && contiguous {
+            ks.collect()
+        } else {
+            ks.filter(|&j| in_long_stretch(plan, specs[j])).collect()
+        };
+        if !members.is_empty() {
+            stretches.push(members);
+        }
+    }
+    // Each table's place, as long as they fit; the tables are then built in parallel in place.
+    let max_reals = max_reals.min(u32::MAX as usize);
+    let mut total = 0;
+    let mut placed = Vec::new();
+    for ks in stretches {
+        let len = table_reals(plan.forcing(specs[ks[0]]).intervals(), plan.accel());
+        if total + len > max_reals {
+            break;
+        }
+        placed.push((ks, total, len));
+        total += len;
+    }
+    let mut tables = vec![0.0; total];
+    let mut slots = Vec::with_capacity(placed.len());
+    let mut rest = &mut tables[..];
+    for (_, _, len) in &placed {
+        let (slot, tail) = rest.split_at_mut(*len);
+        slots.push(slot);
+        rest = tail;
+    }
+    let starts: Vec<Vec<Start>> = placed
+        .par_iter()
+        .zip(slots)
+        .map(|((ks, _, _), slot)| {
+            let forcing = plan.forcing(specs[ks[0]]);
+            let pair = specs[ks[0]].pair();
+            let r = if plan.accel() {
+                FreeResponse::with_accel(&pair.b1, &pair.b2, &forcing)
+            } else {
+                FreeResponse::new(&pair.b1, &pair.b2, &forcing)
+            };
+            fill_table(&r, slot);
+            ks.iter()
+                .map(|&k| {
+                    let first = r.first_possible_contact(specs[k].gap);
+                    let (z, peaks) = r.at(first);
+                    Start {
+                        i: first as u32,
+                        state: [z[0], z[1], z[2], z[3]],
+                        peaks,
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    for ((ks, offset, _), starts) in placed.into_iter().zip(starts) {
+        for (k, start) in ks.into_iter().zip(starts) {
+            packed[k].meta.response = offset as u32;
+            packed[k].start = Some(start);
+        }
+    }
+    debug_assert!(packed
+        .iter()
+        .all(|p| (p.meta.response == NO_RESPONSE) == p.start.is_none()));
+    tables
 }
