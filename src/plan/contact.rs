@@ -1,6 +1,6 @@
 //! The axes every scene shares, below which each scene adds its buildings' and gaps' axes: the
 //! contact (law, formula, `e`, stiffness), the record and the intensity, with the scheme and the
-//! tail. A pair's plan ([`crate::plan::PairPlan`]) and a row's ([`crate::plan::row::RowPlan`])
+//! tail. A pair's plan ([`crate::plan::pair::PairPlan`]) and a row's ([`crate::plan::row::RowPlan`])
 //! each hold one [`ContactPlan`]; run `i` of either is contact run `i / per_scene` with scene
 //! values `i % per_scene`, so both number runs in the same order.
 //!
@@ -13,8 +13,8 @@ use crate::physics::contact::LawKind;
 use crate::physics::model::Forcing;
 use crate::physics::restitution::{damping_for, Formula};
 use crate::physics::solver::Scheme;
+use crate::plan::axes::{check_axis, err, PlanError, POSITIVE};
 use crate::plan::intensity::{self, Intensity};
-use crate::plan::{check_axis, err, PlanError, POSITIVE};
 use crate::record::{Record, G};
 use std::collections::HashMap;
 use std::sync::Arc;

@@ -23,7 +23,7 @@ use crate::physics::solver::separation::{
 };
 use crate::plan::columns::{at, contact_and_motion, num, RECORD_IMS};
 use crate::plan::intensity::TARGET_COLUMNS;
-use crate::plan::row::level_name;
+use crate::plan::columns::row::level_name;
 use crate::plan::sample::phi;
 use crate::plan::{Motions, Plan};
 use crate::studies::plot::{Panel, Series};

@@ -4,7 +4,9 @@
 use std::path::Path;
 
 /// Bottom up, as in `src/lib.rs`.
-const LAYERS: [&str; 6] = ["physics", "record", "plan", "engine", "io", "studies"];
+const LAYERS: [&str; 7] = [
+    "physics", "record", "config", "plan", "engine", "io", "studies",
+];
 
 fn layer(name: &str) -> Option<usize> {
     LAYERS.iter().position(|l| *l == name)
