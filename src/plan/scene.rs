@@ -1,12 +1,12 @@
 //! The one plan every command holds: a pair or a row.
 
+use crate::physics::solver::Scheme;
 use crate::plan::axes::Motions;
 use crate::plan::columns;
 use crate::plan::contact::ContactPlan;
 use crate::plan::limits;
 use crate::plan::pair::PairPlan;
 use crate::plan::row::RowPlan;
-use crate::physics::solver::Scheme;
 
 /// A validated sweep of one scene, the one plan every command holds: the config reader
 /// ([`crate::plan::config::load_text`]) decides the scene's kind once, and the layers below ask the plan,
@@ -72,9 +72,7 @@ impl Plan {
     /// of them (`b1_s2_peak_ductility`); a pair has none.
     pub fn ask_storey_columns(&mut self, columns: &[String]) {
         if let Plan::Row(r) = self {
-            r.storey_columns |= columns
-                .iter()
-                .any(|c| RowPlan::asks_storey_columns(c));
+            r.storey_columns |= columns.iter().any(|c| RowPlan::asks_storey_columns(c));
         }
     }
 

@@ -492,7 +492,8 @@ pub fn shows_collapse_limit(table: &Table) -> bool {
 /// [`crate::plan::columns::row::COLLAPSE_OUTPUTS`], or a building's `bK_collapsed`...).
 fn has_collapse_column(table: &Table) -> bool {
     table.header.iter().any(|c| {
-        crate::plan::columns::row::COLLAPSE_OUTPUTS.contains(&c.as_str()) || collapse_building(c).is_some()
+        crate::plan::columns::row::COLLAPSE_OUTPUTS.contains(&c.as_str())
+            || collapse_building(c).is_some()
     })
 }
 

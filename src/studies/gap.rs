@@ -21,9 +21,9 @@ use crate::physics::shear::ShearBuilding;
 use crate::physics::solver::separation::{
     sampled_peak_drift_ratios, separation_with, LevelSeparation, Separation,
 };
+use crate::plan::columns::row::level_name;
 use crate::plan::columns::{at, contact_and_motion, num, RECORD_IMS};
 use crate::plan::intensity::TARGET_COLUMNS;
-use crate::plan::columns::row::level_name;
 use crate::plan::sample::phi;
 use crate::plan::{Motions, Plan};
 use crate::studies::plot::{Panel, Series};

@@ -264,7 +264,10 @@ fn ranges_expand() {
         pounding::config::parse_colon_range("0.1:1:0.3").unwrap(),
         vec![0.1, 0.4, 0.7, 1.0]
     );
-    assert_eq!(pounding::config::parse_colon_range("0.5").unwrap(), vec![0.5]);
+    assert_eq!(
+        pounding::config::parse_colon_range("0.5").unwrap(),
+        vec![0.5]
+    );
     assert!(pounding::config::parse_colon_range("1:0:0.1").is_none());
     let p = parse(&BASE.replacen(
         "pga_g = [0.2, 0.4]",

@@ -570,18 +570,26 @@ fn a_shared_gap_means_one_gap() {
             1,
         );
     // A list no pair reads would be dropped: refused (`idle_axes`); one value is a leftover.
-    let e =
-        pounding::plan::config::parse_row(&all, Path::new("t.toml"), Path::new("."), Path::new("."))
-            .unwrap_err()
-            .to_string();
+    let e = pounding::plan::config::parse_row(
+        &all,
+        Path::new("t.toml"),
+        Path::new("."),
+        Path::new("."),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(
         e.contains("contact.gap_m: every pair has its own gap_right_m"),
         "{e}"
     );
     let all = all.replace("gap_m = [0.0, 0.01, 0.02]", "gap_m = 0.02");
-    let plan =
-        pounding::plan::config::parse_row(&all, Path::new("t.toml"), Path::new("."), Path::new("."))
-            .unwrap();
+    let plan = pounding::plan::config::parse_row(
+        &all,
+        Path::new("t.toml"),
+        Path::new("."),
+        Path::new("."),
+    )
+    .unwrap();
     assert!(
         plan.warnings()
             .iter()
