@@ -3,8 +3,9 @@
 //! The data path, in the order of the folders:
 //!
 //! ```text
-//! TOML config --config--> raw sections --plan::config--> Plan (a pair or a row) --engine::Engine (cpu | gpu), with the
-//!     kernels the scene takes (engine::Kernel)--> chunks of runs --io--> CSV / Parquet /
+//! TOML config --config--> raw sections --plan::config--> Plan (a pair or a row)
+//!     --engine::Engine (cpu | gpu), with the kernels the scene takes (engine::Kernel)-->
+//!     chunks of runs --io--> CSV / Parquet /
 //!     summary with sidecar --studies--> tables and plots
 //! ```
 //!
@@ -16,8 +17,8 @@
 //! - [`record`]: ground motions, read from files or synthesised, and their intensity measures;
 //! - [`config`]: a TOML config as written (plain data: its sections, their parsing, errors in
 //!   the config's words: file, key, what was expected), knowing nothing of plans;
-//! - [`plan`]: a validated sweep of a pair or a row ([`plan::Plan`]), decoded from a config, its intensity axis, its columns and their meanings, samples,
-//!   shards and input bounds;
+//! - [`plan`]: a validated sweep of a pair or a row ([`plan::Plan`]), decoded from a config,
+//!   its intensity axis, its columns and their meanings, samples, shards and input bounds;
 //! - [`engine`]: the one enum that runs a range of any plan on the CPU or the GPU (`shaders/`);
 //! - [`io`]: outputs that are never destroyed nor called complete when they are not;
 //! - [`studies`]: accuracy, benchmarks, fidelity, fragility (damage states, bootstrap bands), IDA,

@@ -122,9 +122,9 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
 #[derive(Debug, Clone)]
 pub enum Config {
     /// `[building1]` and `[building2]`.
-    Pair(RawConfig),
+    Pair(Box<RawConfig>),
     /// `[[building]]` entries.
-    Row(RawRowConfig),
+    Row(Box<RawRowConfig>),
 }
 
 /// Config `text` read from `path` (named in errors) into its raw sections, its kind told by
@@ -132,10 +132,10 @@ pub enum Config {
 /// write it as a row.
 pub fn from_text(text: &str, path: &Path) -> Result<Config, ConfigError> {
     Ok(if is_row_config(text) {
-        Config::Row(row_from_text(text, path)?)
+        Config::Row(Box::new(row_from_text(text, path)?))
     } else {
         refuse_yielding_pair(text, path)?;
-        Config::Pair(pair_from_text(text, path)?)
+        Config::Pair(Box::new(pair_from_text(text, path)?))
     })
 }
 

@@ -1,6 +1,6 @@
 //! The axes every scene shares, below which each scene adds its buildings' and gaps' axes: the
 //! contact (law, formula, `e`, stiffness), the record and the intensity, with the scheme and the
-//! tail. A pair's plan ([`crate::plan::pair::PairPlan`]) and a row's ([`crate::plan::row::RowPlan`])
+//! tail. A pair's plan ([`crate::plan::PairPlan`]) and a row's ([`crate::plan::row::RowPlan`])
 //! each hold one [`ContactPlan`]; run `i` of either is contact run `i / per_scene` with scene
 //! values `i % per_scene`, so both number runs in the same order.
 //!

@@ -9,8 +9,8 @@ use crate::plan::pair::PairPlan;
 use crate::plan::row::RowPlan;
 
 /// A validated sweep of one scene, the one plan every command holds: the config reader
-/// ([`crate::plan::config::load_text`]) decides the scene's kind once, and the layers below ask the plan,
-/// never the config. A `[building1]`/`[building2]` config is a pair of one-storey buildings,
+/// ([`crate::plan::config::load_text`]) decides the scene's kind once, and the layers below ask
+/// the plan, never the config. A `[building1]`/`[building2]` config is a pair of one-storey buildings,
 /// planned by [`PairPlan`] (whose runs the engine's pair kernels take); a `[[building]]` config
 /// is a row of 2..n shear buildings of 1..N storeys, planned by [`RowPlan`] (the row
 /// kernels). Both number their runs in the same axis order (contact, record, intensity,

@@ -21,14 +21,14 @@ use crate::plan::sample::refused_draw;
 use std::path::Path;
 
 /// What decodes each building of a row: the file (named in errors) and the samples drawn.
-pub(crate) struct RowReader<'a> {
-    pub path: &'a Path,
-    pub samples: Option<&'a RowSamples>,
+struct RowReader<'a> {
+    path: &'a Path,
+    samples: Option<&'a RowSamples>,
 }
 
 impl RowReader<'_> {
     /// The error at `key`.
-    pub fn invalid(&self, key: &str, message: String) -> ConfigError {
+    fn invalid(&self, key: &str, message: String) -> ConfigError {
         ConfigError::Invalid {
             path: self.path.into(),
             key: key.into(),
@@ -37,7 +37,7 @@ impl RowReader<'_> {
     }
 
     /// Does `[sample]` set `a`?
-    pub fn sampled(&self, a: RowSampled) -> bool {
+    fn sampled(&self, a: RowSampled) -> bool {
         self.samples.is_some_and(|s| s.axes.contains(&a))
     }
 
@@ -58,12 +58,7 @@ impl RowReader<'_> {
     }
 
     /// The values of axis `a` at `key`, each within `check`.
-    pub fn axis(
-        &self,
-        key: &str,
-        a: &Axis,
-        (ok, expected): Check,
-    ) -> Result<Vec<f64>, ConfigError> {
+    fn axis(&self, key: &str, a: &Axis, (ok, expected): Check) -> Result<Vec<f64>, ConfigError> {
         let v = a.values().map_err(|m| self.invalid(key, m))?;
         check_axis(key, &v, ok, expected).map_err(|e| self.invalid(&e.key, e.message))?;
         Ok(v)
