@@ -3,9 +3,10 @@
 //! The data path, in the order of the folders:
 //!
 //! ```text
-//! TOML config --plan::config--> Plan (a pair or a row) --engine::Engine (cpu | gpu), with the
-//!     kernels the scene takes (engine::Kernel)--> chunks of runs --io--> CSV / Parquet /
-//!     summary with sidecar (a sweep's stages: sweep) --studies--> tables and plots
+//! TOML config --config--> raw sections --plan::config--> Plan (a pair or a row)
+//!     --engine::Engine (cpu | gpu), with the kernels the scene takes (engine::Kernel)-->
+//!     chunks of runs --io--> CSV / Parquet / summary with sidecar (a sweep's stages: sweep)
+//!     --studies--> tables and plots
 //! ```
 //!
 //! One path for every scene: the config reader is the one place a config's kind is told, and
@@ -14,8 +15,10 @@
 //!
 //! - [`physics`]: one run in f64: buildings, contact laws, restitution, free stepping, solvers;
 //! - [`record`]: ground motions, read from files or synthesised, and their intensity measures;
-//! - [`plan`]: a validated sweep of a pair or a row ([`plan::Plan`]), its intensity axis, its columns and their meanings, samples,
-//!   shards and input bounds;
+//! - [`config`]: a TOML config as written (plain data: its sections, their parsing, errors in
+//!   the config's words: file, key, what was expected), knowing nothing of plans;
+//! - [`plan`]: a validated sweep of a pair or a row ([`plan::Plan`]), decoded from a config,
+//!   its intensity axis, its columns and their meanings, samples, shards and input bounds;
 //! - [`engine`]: the one enum that runs a range of any plan on the CPU or the GPU (`shaders/`);
 //! - [`io`]: outputs that are never destroyed nor called complete when they are not;
 //! - [`sweep`]: one sweep as the command line and the Python package both run it: options
@@ -27,6 +30,7 @@
 //! Each layer imports only those above it in this list (the command line, `src/cli/`, sits on
 //! top of them all, in the binary).
 
+pub mod config;
 pub mod engine;
 pub mod io;
 pub mod physics;

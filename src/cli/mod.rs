@@ -502,7 +502,7 @@ pub fn values_arg(flag: &str, text: &str, unit: &str, max: usize, why: &str) -> 
             .map(|x| x.trim().parse::<f64>().ok())
             .collect()
     } else {
-        pounding::plan::config::parse_colon_range(text)
+        pounding::config::parse_colon_range(text)
     }
     .with_context(|| {
         format!("{flag} `{text}`: expected start:stop:step, a list a,b,c or one value{unit}")
@@ -513,7 +513,7 @@ pub fn values_arg(flag: &str, text: &str, unit: &str, max: usize, why: &str) -> 
             values.len()
         );
     }
-    if let Some(v) = pounding::plan::config::number_given_twice(&values) {
+    if let Some(v) = pounding::config::number_given_twice(&values) {
         bail!(
             "{flag} `{text}`: {} is given twice: give each value once",
             pounding::plan::limits::show(v)

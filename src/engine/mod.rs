@@ -285,7 +285,7 @@ impl Chunk<'_> {
     /// storey heights.
     pub fn above_height(&self) -> u64 {
         match self {
-            Chunk::Pairs(_, rows) => crate::plan::limits::above_height(rows),
+            Chunk::Pairs(_, rows) => crate::plan::pair::above_height(rows),
             Chunk::Rows(plan, rows) => plan.above_height(rows),
         }
     }

@@ -2,7 +2,7 @@
 //! section 9). A target PGA or a plain factor scales a record the same way in every run; a
 //! spectral target (`sa_g`, `sa_avg_g`) at a period that follows a building's fundamental
 //! period scales it per run, so its factor is resolved where the run's periods are known
-//! ([`crate::plan::PairPlan::run`], [`crate::plan::row::RowPlan::run`]).
+//! ([`crate::plan::pair::PairPlan::run`], [`crate::plan::row::RowPlan::run`]).
 
 use crate::record::intensity::{arias_cav, log_periods, pgv_pgd, sa, sa_avg, DEFAULT_DAMPING};
 use crate::record::{Record, G};

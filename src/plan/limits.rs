@@ -96,17 +96,9 @@ pub const WARN_DRIFT_RATIO: f64 = 0.10;
 /// about 3 m). A peak displacement above it is physically absurd, and a sweep warns.
 pub const HEIGHT_PER_PERIOD_M: f64 = 30.0;
 
-/// Runs whose peak displacement exceeds a building's height estimated from its period
-/// ([`HEIGHT_PER_PERIOD_M`]).
-pub fn above_height(rows: &[(crate::plan::RunSpec, crate::physics::model::RunOutput)]) -> u64 {
-    let h = HEIGHT_PER_PERIOD_M;
-    rows.iter()
-        .filter(|(s, o)| o.peak_u1 > h * s.t1 || o.peak_u2 > h * s.t2)
-        .count() as u64
-}
-
-/// The runs of a grid axis or range (`{ from, to, n }`).
-pub const MAX_AXIS_POINTS: usize = 10_000_000;
+/// The runs of a grid axis or range (`{ from, to, n }`): the config's own bound, listed here
+/// with the others.
+pub use crate::config::axis::MAX_AXIS_POINTS;
 
 /// A number as a message shows it ([`crate::show`], beside the records that show numbers too).
 pub use crate::show;
@@ -135,7 +127,7 @@ pub fn check_periods(periods: &[f64]) -> Result<(), String> {
             periods.len()
         ));
     }
-    if let Some(t) = crate::plan::config::number_given_twice(periods) {
+    if let Some(t) = crate::config::number_given_twice(periods) {
         return Err(format!(
             "{} s is given twice: give each period once",
             show(t)

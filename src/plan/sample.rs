@@ -103,7 +103,7 @@ pub fn draw(method: Method, n: usize, dists: &[Dist], seed: u64) -> Vec<Vec<f64>
 pub(crate) fn refused_draw(
     points: &[Vec<f64>],
     j: usize,
-    check: crate::plan::Check,
+    check: crate::plan::axes::Check,
 ) -> Option<String> {
     let (ok, expected) = check;
     points

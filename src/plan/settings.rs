@@ -5,7 +5,7 @@
 
 use crate::physics::solver::calibration::{for_target_in, Choice, Suite};
 use crate::physics::solver::{FastOptions, ReferenceOptions, Scheme};
-use crate::plan::Plan;
+use crate::plan::scene::Plan;
 
 /// A scheme asked for over the config's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -144,7 +144,7 @@ pub fn picked_columns(plan: &Plan, asked: Option<&[String]>) -> Result<Picked, S
             names: header,
         });
     };
-    if let Some(twice) = crate::plan::config::name_given_twice(asked) {
+    if let Some(twice) = crate::config::name_given_twice(asked) {
         return Err(SettingsError(format!(
             "--columns: `{twice}` is given twice: give each column once"
         )));

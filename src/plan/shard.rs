@@ -1,7 +1,8 @@
 //! Deterministic cost-balanced shards of a plan (`--shard I/N`, for Slurm job arrays or
 //! Kubernetes Indexed Jobs): contiguous run ranges that tile the plan.
 
-use crate::plan::{ContactPlan, Plan};
+use crate::plan::contact::ContactPlan;
+use crate::plan::scene::Plan;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
@@ -73,7 +74,7 @@ mod tests {
     use super::*;
 
     /// Two records of different lengths, so runs differ in cost: 3 x 2 x 2 = 12 runs.
-    fn plan() -> crate::plan::PairPlan {
+    fn plan() -> crate::plan::pair::PairPlan {
         crate::plan::config::parse_builtin(
             r#"
 [building1]

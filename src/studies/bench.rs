@@ -306,7 +306,7 @@ pub fn row_plan(storeys: usize, n: u64, yielding: bool) -> RowPlan {
     } else {
         row_config(storeys, n)
     };
-    crate::plan::row::parse_row(
+    crate::plan::config::parse_row(
         &text,
         std::path::Path::new("bench-rows.toml"),
         std::path::Path::new("."),

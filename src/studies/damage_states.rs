@@ -513,7 +513,7 @@ impl DamageStates {
         let text =
             std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read: {e}", given))?;
         let raw: RawStates = toml::from_str(&text).map_err(|e| {
-            let m = crate::plan::config::in_toml_words(e.to_string());
+            let m = crate::config::in_toml_words(e.to_string());
             // `unit` is the set's, written before the first [[state]] (after it, TOML puts it
             // in that state).
             let hint = if m.contains("unknown field `unit`") {

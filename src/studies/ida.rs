@@ -556,7 +556,7 @@ impl IdaOptions {
     /// The checks of the settings alone, made before any table is read (as `pound ida` makes
     /// them): [`study`] makes them again first.
     pub fn check(&self) -> Result<(), IdaError> {
-        if let Some(twice) = crate::plan::config::name_given_twice(&self.by) {
+        if let Some(twice) = crate::config::name_given_twice(&self.by) {
             return Err(IdaError::Refused(format!(
                 "--by: `{twice}` is given twice: give each column once"
             )));

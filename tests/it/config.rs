@@ -261,11 +261,14 @@ fn path_records_resolve_against_the_config() {
 #[test]
 fn ranges_expand() {
     assert_eq!(
-        config::parse_colon_range("0.1:1:0.3").unwrap(),
+        pounding::config::parse_colon_range("0.1:1:0.3").unwrap(),
         vec![0.1, 0.4, 0.7, 1.0]
     );
-    assert_eq!(config::parse_colon_range("0.5").unwrap(), vec![0.5]);
-    assert!(config::parse_colon_range("1:0:0.1").is_none());
+    assert_eq!(
+        pounding::config::parse_colon_range("0.5").unwrap(),
+        vec![0.5]
+    );
+    assert!(pounding::config::parse_colon_range("1:0:0.1").is_none());
     let p = parse(&BASE.replacen(
         "pga_g = [0.2, 0.4]",
         "pga_g = { from = 0.1, to = 1.0, n = 3, log = true }",

@@ -4,8 +4,8 @@
 use std::path::Path;
 
 /// Bottom up, as in `src/lib.rs`.
-const LAYERS: [&str; 7] = [
-    "physics", "record", "plan", "engine", "io", "sweep", "studies",
+const LAYERS: [&str; 8] = [
+    "physics", "record", "config", "plan", "engine", "io", "sweep", "studies",
 ];
 
 fn layer(name: &str) -> Option<usize> {

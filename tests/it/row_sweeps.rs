@@ -470,7 +470,7 @@ fn a_shared_gap_means_one_gap() {
             "[run]\ntail_s = 0.5\n[[building]]\n{STOREYS3}\n{extra_left}\n[[building]]\n{STOREYS3}\n[[building]]\n{STOREYS3}\n[contact]\nlaw = \"linear\"\nk_n_per_m = 1e9\ngap_m = [0.0, 0.01, 0.02]\n[[record]]\nsynthetic = {{ seed = 1, duration_s = 1.0 }}\n"
         )
     };
-    let plan = pounding::plan::row::parse_row(
+    let plan = pounding::plan::config::parse_row(
         &three(""),
         Path::new("t.toml"),
         Path::new("."),
@@ -483,7 +483,7 @@ fn a_shared_gap_means_one_gap() {
         assert_eq!(r.gaps[0], r.gaps[1], "run {i}: {:?}", r.gaps);
     }
     // A pair's own gap_right_m is its own axis, crossed with the shared one.
-    let plan = pounding::plan::row::parse_row(
+    let plan = pounding::plan::config::parse_row(
         &three("gap_right_m = [0.05, 0.06]"),
         Path::new("t.toml"),
         Path::new("."),
@@ -505,18 +505,26 @@ fn a_shared_gap_means_one_gap() {
             1,
         );
     // A list no pair reads would be dropped: refused (`idle_axes`); one value is a leftover.
-    let e =
-        pounding::plan::row::parse_row(&all, Path::new("t.toml"), Path::new("."), Path::new("."))
-            .unwrap_err()
-            .to_string();
+    let e = pounding::plan::config::parse_row(
+        &all,
+        Path::new("t.toml"),
+        Path::new("."),
+        Path::new("."),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(
         e.contains("contact.gap_m: every pair has its own gap_right_m"),
         "{e}"
     );
     let all = all.replace("gap_m = [0.0, 0.01, 0.02]", "gap_m = 0.02");
-    let plan =
-        pounding::plan::row::parse_row(&all, Path::new("t.toml"), Path::new("."), Path::new("."))
-            .unwrap();
+    let plan = pounding::plan::config::parse_row(
+        &all,
+        Path::new("t.toml"),
+        Path::new("."),
+        Path::new("."),
+    )
+    .unwrap();
     assert!(
         plan.warnings()
             .iter()

@@ -152,7 +152,7 @@ impl FragilitySpec {
 }
 
 /// Whether `table` shows that its sweep had a collapse limit: a collapse column
-/// ([`crate::plan::row::COLLAPSE_OUTPUTS`], a building's `bK_collapsed`), or a row whose status
+/// ([`crate::plan::columns::row::COLLAPSE_OUTPUTS`], a building's `bK_collapsed`), or a row whose status
 /// is `collapsed` (a table written with `--columns` that left the collapse columns out still
 /// says so in its status). False says only that the table does not tell.
 pub fn shows_collapse_limit(table: &Table) -> bool {
@@ -163,10 +163,11 @@ pub fn shows_collapse_limit(table: &Table) -> bool {
 }
 
 /// Whether `table` has a column only a sweep with a collapse limit writes (the run's
-/// [`crate::plan::row::COLLAPSE_OUTPUTS`], or a building's `bK_collapsed`...).
+/// [`crate::plan::columns::row::COLLAPSE_OUTPUTS`], or a building's `bK_collapsed`...).
 fn has_collapse_column(table: &Table) -> bool {
     table.header.iter().any(|c| {
-        crate::plan::row::COLLAPSE_OUTPUTS.contains(&c.as_str()) || collapse_building(c).is_some()
+        crate::plan::columns::row::COLLAPSE_OUTPUTS.contains(&c.as_str())
+            || collapse_building(c).is_some()
     })
 }
 
@@ -193,7 +194,7 @@ pub fn no_status_notice(table: &Table) -> Option<String> {
 /// Whether `table` can give the collapse fragility of `edp` ([`is_collapse_edp`]), or why not
 /// (named). The run's (`collapsed`) needs a status column (whose `collapsed` runs it counts) and
 /// a sign that the sweep had a collapse limit: a run whose status is `collapsed`, or some
-/// collapse column such a sweep writes ([`crate::plan::row::COLLAPSE_OUTPUTS`], or a building's
+/// collapse column such a sweep writes ([`crate::plan::columns::row::COLLAPSE_OUTPUTS`], or a building's
 /// `bK_collapsed`); with neither, the table cannot tell a sweep whose runs could not collapse (a
 /// curve of none would be no result) from one written with `--columns` that left them out, and
 /// says both. Building K's needs its `bK_collapsed`: a missing one is named as missing, never
@@ -206,7 +207,7 @@ pub fn check_collapse_table(table: &Table, edp: &str) -> Result<(), TableError> 
             message,
         })
     };
-    let run_columns = crate::plan::row::COLLAPSE_OUTPUTS;
+    let run_columns = crate::plan::columns::row::COLLAPSE_OUTPUTS;
     let has = |c: &str| table.col(c).is_ok();
     let buildings: Vec<&str> = table
         .header

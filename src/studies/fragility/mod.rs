@@ -190,7 +190,7 @@ impl FragilityOptions {
         }) {
             return refuse(why);
         }
-        if let Some(t) = crate::plan::config::number_given_twice(&self.thresholds) {
+        if let Some(t) = crate::config::number_given_twice(&self.thresholds) {
             return refuse(format!(
                 "--threshold: {} is given twice: give each threshold once",
                 crate::show(t)

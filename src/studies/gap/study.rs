@@ -4,7 +4,7 @@ use super::scenes::{Outcome, RunEnd, Scenes};
 use crate::physics::row::Collapse;
 use crate::physics::separation::{cqc_rho, Rule};
 use crate::physics::solver::separation::{LevelSeparation, Separation};
-use crate::plan::row::level_name;
+use crate::plan::columns::row::level_name;
 use crate::plan::{Motions, Plan};
 use rayon::prelude::*;
 

@@ -2,9 +2,9 @@
 //! gaps), and each rule's record against the time histories.
 
 use super::study::{covering_rule, GapRun, GapStudy, PairGap};
+use crate::engine::quantile::{quantile, Interpolation::Linear};
 use crate::physics::separation::Rule;
 use crate::plan::columns::num;
-use crate::engine::quantile::{quantile, Interpolation::Linear};
 use rayon::prelude::*;
 
 impl GapStudy<'_> {

@@ -446,7 +446,7 @@ mod tests {
 
     #[test]
     fn every_pair_column_and_row_pattern_has_a_meaning() {
-        for c in crate::plan::columns::HEADER {
+        for c in crate::plan::columns::pair::HEADER {
             assert!(meaning(c).is_some(), "{c}");
         }
         let m = meaning("level_b1f3_b2f2_peak_force_n").unwrap();
@@ -459,14 +459,14 @@ mod tests {
             .text
             .contains("floor 1 of building 2 strikes the columns of storey 2 of building 1"));
         assert_eq!(meaning("b12_peak_drift_ratio").unwrap().unit, "m/m");
-        for c in crate::plan::row::BUILDING_OUTPUTS
+        for c in crate::plan::columns::row::BUILDING_OUTPUTS
             .iter()
-            .chain(&crate::plan::row::INELASTIC_OUTPUTS)
+            .chain(&crate::plan::columns::row::INELASTIC_OUTPUTS)
         {
             assert!(meaning(&format!("b3_{c}")).is_some(), "{c}");
         }
         assert_eq!(meaning("b2_hysteretic_energy_j").unwrap().unit, "J");
-        for c in crate::plan::row::STOREY_OUTPUTS {
+        for c in crate::plan::columns::row::STOREY_OUTPUTS {
             assert!(meaning(&format!("b2_s14_{c}")).is_some(), "{c}");
             assert!(crate::plan::row::RowPlan::asks_storey_columns(&format!(
                 "b2_s14_{c}"

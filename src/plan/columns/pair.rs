@@ -3,8 +3,9 @@
 //! device fold all name columns from here.
 
 use crate::physics::model::RunOutput;
+use crate::plan::contact::{ContactPlan, ContactRun};
 use crate::plan::intensity::{target_values, IM_COLUMNS};
-use crate::plan::{ContactPlan, ContactRun, PairPlan, RunSpec};
+use crate::plan::pair::{PairPlan, RunSpec};
 
 /// Every column, in file order: the swept parameters (with the intensity measures of the scaled
 /// record, which every run writes whatever it was scaled to), then the status and the outputs.

@@ -1,0 +1,352 @@
+//! A row's columns: their names (which follow its buildings, storeys and contact levels) and
+//! the cells of a run's row.
+
+use crate::physics::row::{struck_side, LevelSide, RowOutput, StoreyOutput};
+use crate::plan::columns::pair::{self as columns, num};
+use crate::plan::row::{RowPlan, RowRunSpec};
+
+/// The column prefix of a contact level: `level_b1f3_b2f3` for floor 3 of building 1 (`left`
+/// = 0, buildings from 0 here) against floor 3 of building 2 (floors from 1);
+/// `level_b1f3_b2c4` where floor 3 of building 1 strikes the columns of building 2's storey 4.
+pub fn level_name(left: usize, sides: &[LevelSide; 2]) -> String {
+    format!(
+        "level_b{}{}_b{}{}",
+        left + 1,
+        sides[0].name(),
+        left + 2,
+        sides[1].name()
+    )
+}
+
+/// Each building's output columns (after its `b1_` prefix).
+pub const BUILDING_OUTPUTS: [&str; 5] = [
+    "peak_roof_m",
+    "peak_drift_ratio",
+    "drift_storey",
+    "peak_accel_m_s2",
+    "accel_floor",
+];
+
+/// Where a run collapsed (empty where it did not): the time, the building and its storey (from
+/// 1). Rows with a collapse limit have them.
+pub const COLLAPSE_OUTPUTS: [&str; 3] = ["collapse_time_s", "collapse_building", "collapse_storey"];
+
+/// Each building's collapse columns (after its `b1_` prefix), in rows with a collapse limit:
+/// whether it collapsed (0 or 1), when and in which storey (empty where it did not).
+pub const BUILDING_COLLAPSE_OUTPUTS: [&str; 3] =
+    ["collapsed", "collapse_time_s", "collapse_storey"];
+
+/// A yielding building's further output columns (after its `b1_` prefix).
+pub const INELASTIC_OUTPUTS: [&str; 6] = [
+    "residual_drift_ratio",
+    "residual_storey",
+    "peak_ductility",
+    "ductility_storey",
+    "hysteretic_energy_j",
+    "yielded_storeys",
+];
+
+/// A yielding storey's output columns with `--columns` (after its `b1_s2_` prefix: building 1,
+/// storey 2 from the ground).
+pub const STOREY_OUTPUTS: [&str; 3] = [
+    "residual_drift_ratio",
+    "peak_ductility",
+    "hysteretic_energy_j",
+];
+
+impl RowPlan {
+    /// Does `column` name a yielding storey's own column (`b1_s2_peak_ductility`)?
+    pub fn asks_storey_columns(column: &str) -> bool {
+        column
+            .strip_prefix('b')
+            .and_then(|r| r.split_once("_s"))
+            .and_then(|(k, rest)| {
+                let (j, suffix) = rest.split_once('_')?;
+                let digits = |x: &str| !x.is_empty() && x.bytes().all(|c| c.is_ascii_digit());
+                (digits(k) && digits(j) && STOREY_OUTPUTS.contains(&suffix)).then_some(())
+            })
+            .is_some()
+    }
+}
+
+/// Each contact level's output columns (after its `level_b1f3_b2f3_` prefix).
+pub const LEVEL_OUTPUTS: [&str; 4] = [
+    "impacts",
+    "peak_force_n",
+    "peak_penetration_m",
+    "impact_velocity_m_s",
+];
+impl RowPlan {
+    /// The contact levels' column prefixes ([`level_name`]).
+    pub fn level_names(&self) -> Vec<String> {
+        (self.levels().iter())
+            .map(|l| level_name(l.left, &l.sides))
+            .collect()
+    }
+
+    /// The contact levels as a Markdown table: each one's column prefix, kind (floor/floor or
+    /// floor/column), elevation and, on a column, the struck storey's height fraction `xi` and
+    /// the share `s` of the force on its top floor (`pound columns CONFIG`).
+    pub fn level_table(&self) -> String {
+        let mut t = String::from(
+            "| level | kind | elevation m | struck storey: xi | share on its top floor s |\n|---|---|---:|---:|---:|\n",
+        );
+        let row = self.row(&self.run(0));
+        for (l, name) in row.levels.iter().zip(self.level_names()) {
+            let (kind, xi, s) = match struck_side(&l.sides) {
+                None => ("floor/floor", String::new(), String::new()),
+                Some(k) => {
+                    let b = &row.buildings[l.left + k];
+                    let j = l.sides[k].floor;
+                    let below: f64 = b.heights[..j - 1].iter().sum();
+                    let xi = (l.elevation - below) / b.heights[j - 1];
+                    let s = l.sides[k].weight;
+                    ("floor/column", format!("{xi:.3}"), format!("{s:.3}"))
+                }
+            };
+            t.push_str(&format!(
+                "| `{name}` | {kind} | {} | {xi} | {s} |\n",
+                crate::show(l.elevation)
+            ));
+        }
+        t
+    }
+
+    /// Every column, in file order: the contact and motion columns of the pair, each
+    /// building's `Sa(T1)` of the scaled record (`b1_sa_t1_g`, ...), each building's
+    /// parameters (`b1_...`), each gap, the status and totals, each building's
+    /// peaks, each level's, and the energy balance (empty unless asked for).
+    pub fn header(&self) -> Vec<String> {
+        let mut h: Vec<String> = columns::HEADER[..columns::CONTACT_AND_MOTION]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let nb = self.buildings.len();
+        for b in 1..=nb {
+            h.push(format!("b{b}_{}", crate::plan::intensity::SA_T1_COLUMN));
+        }
+        for b in 1..=nb {
+            for c in ["storeys", "mass_kg", "t1_s", "xi"] {
+                h.push(format!("b{b}_{c}"));
+            }
+            if let Some(y) = self.swept_yield(b - 1) {
+                h.push(format!("b{b}_{}", y.value_name()));
+            }
+        }
+        for a in 1..nb {
+            h.push(format!("gap_{a}_{}_m", a + 1));
+        }
+        h.push("sample".into());
+        for c in [
+            "status",
+            "impacts",
+            "peak_force_n",
+            "peak_penetration_m",
+            "impact_velocity_m_s",
+            "first_impact_s",
+            "contact_time_s",
+            "dissipated_energy_j",
+            "substeps",
+        ] {
+            h.push(c.into());
+        }
+        if self.collapse_drift_ratio.is_finite() {
+            for c in COLLAPSE_OUTPUTS {
+                h.push(c.into());
+            }
+        }
+        for (b, y) in self.yielding.iter().enumerate() {
+            for c in BUILDING_OUTPUTS {
+                h.push(format!("b{}_{c}", b + 1));
+            }
+            if self.buildings[b].p_delta.is_some() {
+                h.push(format!("b{}_stability_coefficient", b + 1));
+            }
+            if self.collapse_drift_ratio.is_finite() {
+                for c in BUILDING_COLLAPSE_OUTPUTS {
+                    h.push(format!("b{}_{c}", b + 1));
+                }
+            }
+            if y.is_some() {
+                for c in INELASTIC_OUTPUTS {
+                    h.push(format!("b{}_{c}", b + 1));
+                }
+                if self.storey_columns {
+                    for j in 1..=self.buildings[b].storeys() {
+                        for c in STOREY_OUTPUTS {
+                            h.push(format!("b{}_s{j}_{c}", b + 1));
+                        }
+                    }
+                }
+            }
+        }
+        for (l, struck) in self.level_names().iter().zip(&self.struck) {
+            for c in LEVEL_OUTPUTS {
+                h.push(format!("{l}_{c}"));
+            }
+            if let Some(yields) = struck {
+                h.push(format!("{l}_column_shear_n"));
+                if *yields {
+                    h.push(format!("{l}_column_shear_ratio"));
+                }
+            }
+        }
+        for c in ["input_energy_j", "damping_energy_j", "energy_residual"] {
+            h.push(c.into());
+        }
+        h
+    }
+
+    /// The number of parameter columns, which lead the header: the status column's index.
+    pub fn parameter_columns(&self) -> usize {
+        let swept = (0..self.buildings.len())
+            .filter(|&b| self.swept_yield(b).is_some())
+            .count();
+        columns::CONTACT_AND_MOTION + 5 * self.buildings.len() + swept + self.gaps.len() + 1
+    }
+
+    /// The outputs an `--aggregate` summary folds per group (as magnitudes): the row's totals,
+    /// each building's peaks and each contact level's; not the storey and floor numbers, the
+    /// first impact's time, the step count or the energy balance.
+    pub fn summarised(&self) -> Vec<String> {
+        let skip = [
+            "first_impact_s",
+            "substeps",
+            "input_energy_j",
+            "damping_energy_j",
+            "energy_residual",
+        ];
+        self.header()
+            .into_iter()
+            .skip(self.parameter_columns() + 1)
+            .filter(|c| {
+                !skip.contains(&c.as_str())
+                    && !COLLAPSE_OUTPUTS.contains(&c.as_str())
+                    && !c.ends_with("_collapsed")
+                    && !c.ends_with("_collapse_time_s")
+                    && !c.ends_with("_collapse_storey")
+                    && !c.ends_with("_stability_coefficient")
+                    && !c.ends_with("_drift_storey")
+                    && !c.ends_with("_accel_floor")
+                    && !c.ends_with("_residual_storey")
+                    && !c.ends_with("_ductility_storey")
+            })
+            .collect()
+    }
+
+    /// The fields of one run, in [`RowPlan::header`] order.
+    pub fn cells(&self, run: &RowRunSpec, out: &RowOutput) -> Vec<String> {
+        let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+        let mut c = columns::contact_and_motion(&self.contact, &run.contact);
+        c.extend(
+            run.period
+                .iter()
+                .map(|&t| num(self.contact.sa_g(&run.contact, t))),
+        );
+        for (b, a) in self.buildings.iter().enumerate() {
+            c.push(a.storeys().to_string());
+            c.push(opt(run.mass[b]));
+            c.push(num(run.period[b]));
+            c.push(num(run.damping[b]));
+            if self.swept_yield(b).is_some() {
+                c.push(opt(run.yield_value[b]));
+            }
+        }
+        c.extend(run.gaps.iter().map(|&g| num(g)));
+        c.push(run.sample.map(|s| s.to_string()).unwrap_or_default());
+        let penetration = out
+            .levels
+            .iter()
+            .map(|l| l.peak_penetration)
+            .fold(0.0, f64::max);
+        c.extend([
+            out.status.key().to_string(),
+            out.impacts.to_string(),
+            num(out.peak_force),
+            num(penetration),
+            num(out.impact_velocity),
+            opt(out.first_impact),
+            num(out.contact_time),
+            num(out.dissipated_energy),
+            out.substeps.to_string(),
+        ]);
+        if self.collapse_drift_ratio.is_finite() {
+            let cl = out.collapse;
+            c.extend([
+                opt(cl.map(|x| x.time)),
+                cl.map(|x| x.building.to_string()).unwrap_or_default(),
+                cl.map(|x| x.storey.to_string()).unwrap_or_default(),
+            ]);
+        }
+        let mut storeys = out.storeys.iter();
+        for (k, (b, y)) in out.buildings.iter().zip(&self.yielding).enumerate() {
+            c.extend([
+                num(b.peak_roof),
+                num(b.peak_drift_ratio),
+                b.drift_storey.to_string(),
+                num(b.peak_accel),
+                b.accel_floor.to_string(),
+            ]);
+            let a = &self.buildings[k];
+            if a.p_delta.is_some() {
+                c.push(num(a.stability_at_1s * run.period[k] * run.period[k]));
+            }
+            if self.collapse_drift_ratio.is_finite() {
+                let cl = b.collapse;
+                c.extend([
+                    (cl.is_some() as u8).to_string(),
+                    opt(cl.map(|x| x.time)),
+                    cl.map(|x| x.storey.to_string()).unwrap_or_default(),
+                ]);
+            }
+            if y.is_some() {
+                // A run that failed, or did not settle, has no residual drift: empty.
+                let ie = b.inelastic.unwrap_or_default();
+                let known = |x: f64| if x.is_finite() { num(x) } else { String::new() };
+                c.extend([
+                    known(ie.residual_drift_ratio),
+                    ie.residual_storey.to_string(),
+                    num(ie.peak_ductility),
+                    ie.ductility_storey.to_string(),
+                    num(ie.hysteretic_energy),
+                    ie.yielded_storeys.to_string(),
+                ]);
+                for _ in 0..self.buildings[k].storeys() {
+                    let st = storeys.next().copied().unwrap_or(StoreyOutput {
+                        residual_drift_ratio: f64::NAN,
+                        peak_ductility: f64::NAN,
+                        hysteretic_energy: f64::NAN,
+                        yielded: false,
+                    });
+                    if self.storey_columns {
+                        c.extend([
+                            known(st.residual_drift_ratio),
+                            known(st.peak_ductility),
+                            known(st.hysteretic_energy),
+                        ]);
+                    }
+                }
+            }
+        }
+        for (l, struck) in out.levels.iter().zip(&self.struck) {
+            c.extend([
+                l.impacts.to_string(),
+                num(l.peak_force),
+                num(l.peak_penetration),
+                num(l.impact_velocity),
+            ]);
+            if let Some(yields) = struck {
+                c.push(num(l.column_shear));
+                if *yields {
+                    c.push(num(l.column_shear_ratio));
+                }
+            }
+        }
+        c.extend([
+            opt(out.energy.map(|e| e.input)),
+            opt(out.energy.map(|e| e.damping)),
+            opt(out.energy.map(|e| e.residual)),
+        ]);
+        c
+    }
+}
