@@ -215,7 +215,7 @@ fn costly_scenes_say_so_and_report_progress() {
         "tall.toml",
         &row(tall, STOREYS3, "").replace("gap_m = [0.0, 0.01]", "gap_m = 0.0"),
     );
-    let plan = pounding::plan::row::parse_row(
+    let plan = pounding::plan::config::parse_row(
         &std::fs::read_to_string(&cfg).unwrap(),
         &cfg,
         d.path(),
