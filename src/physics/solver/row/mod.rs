@@ -24,7 +24,9 @@
 //! transitions, a step accepted), `outputs` (samples to an observer, peaks, the run's output),
 //! and [`yielding`] (the storeys' springs).
 
+mod algebra;
 mod events;
+mod exact_step;
 pub mod fast;
 mod floors;
 mod levels;
@@ -33,20 +35,16 @@ mod outputs;
 pub mod reference;
 mod rhs;
 mod run;
+mod sample;
+mod storey;
 pub mod yielding;
 
 use crate::physics::model::Forcing;
 use crate::physics::row::RowOutput;
 pub use fast::RowFastOptions;
-use floors::Floors;
-pub(crate) use levels::{LevelState, StoreyState};
+pub(crate) use model::BuildingModel;
 pub use model::RowModel;
-use model::{dot, FLOOR_SUBSTEPS_FROM};
-pub(crate) use model::{BuildingModel, LevelModel};
-pub use outputs::{RowObserver, RowSample, StoreySample};
-pub(crate) use rhs::{rhs, LevelModes, Motion};
-use run::step_still;
-pub(crate) use run::RowRun;
+pub use sample::{RowObserver, RowSample, StoreySample};
 
 impl RowScheme {
     pub fn key(&self) -> &'static str {
@@ -123,3 +121,6 @@ fn simulate<'a>(
         RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false, observer),
     }
 }
+
+#[cfg(test)]
+mod tests;
