@@ -1,8 +1,8 @@
 //! A row run's events: each level's contact mode and each yielding storey's spring state
 //! ending, located within a step, and the transitions they call for; the acceptance of a step.
 
-use super::yielding::{band_edges, may_reach, StoreyMode};
-use super::RowRun;
+use super::run::RowRun;
+use super::storey::{band_edges, may_reach, StoreyMode};
 use crate::physics::solver::events::{hidden_rise, locate, touch};
 use crate::physics::solver::state::{Mode, Segment};
 

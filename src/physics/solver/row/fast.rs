@@ -23,8 +23,12 @@
 //!    touch), is taken in substeps by its building, yield onset and unloading located as
 //!    events; after the record the run goes on at rest until no storey can yield again.
 
-use super::run::CoupledStep;
-use super::{rhs, Motion, RowModel, RowObserver, RowRun, FLOOR_SUBSTEPS_FROM};
+use super::exact_step::CoupledStep;
+use super::model::{RowModel, FLOOR_SUBSTEPS_FROM};
+use super::rhs::{rhs, Motion};
+use super::run::RowRun;
+use super::sample::RowObserver;
+use super::yielding::next_segment;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
 use crate::physics::row::RowOutput;
@@ -318,7 +322,7 @@ fn run_with<'a>(
     let mode_building: Vec<usize> = (m.buildings.iter().enumerate())
         .flat_map(|(k, b)| std::iter::repeat_n(k, b.n()))
         .collect();
-    while let Some(seg) = super::yielding::next_segment(m, forcing, i, &mut run) {
+    while let Some(seg) = next_segment(m, forcing, i, &mut run) {
         i += 1;
         // A building near collapse moves in substeps, where its storeys' collapse is an event.
         let mut watched = !m.drifts.is_empty() && run.refresh_watch();
@@ -704,7 +708,7 @@ mod tests {
     use crate::physics::contact::LawKind;
     use crate::physics::row::Row;
     use crate::physics::shear::{Damping, ShearBuilding};
-    use crate::physics::solver::row::RowSample;
+    use crate::physics::solver::row::sample::RowSample;
 
     /// Two tall buildings (one with a soft first storey) and a low one, `gaps` apart.
     fn row(gaps: Vec<f64>) -> RowModel {
@@ -802,14 +806,14 @@ mod tests {
             assert!((lm.delta(&z) - ls.delta(&y)).abs() < 1e-15);
         }
         let (mut fz, mut fy) = (vec![0.0; len], vec![0.0; len]);
-        let motion = super::super::Motion {
+        let motion = super::super::rhs::Motion {
             levels: &levels,
             active: &[true; 3],
             energy: true,
             storeys: &[],
         };
-        super::super::rhs(&m, &motion, 0.7, &z, &mut fz);
-        super::super::rhs(&sub, &motion, 0.7, &y, &mut fy);
+        super::super::rhs::rhs(&m, &motion, 0.7, &z, &mut fz);
+        super::super::rhs::rhs(&sub, &motion, 0.7, &y, &mut fy);
         sub.modes_to_substeps(&mut fz);
         let scale = fy.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         for (i, (a, b)) in fz.iter().zip(&fy).enumerate() {

@@ -1,8 +1,9 @@
 //! A building's floor kinematics at an instant (displacements, velocities, relative and absolute
 //! accelerations, jerks and contact forces), from its modal or floor state.
 
-use super::yielding::StoreyMode;
-use super::{dot, BuildingModel, RowModel, FLOOR_SUBSTEPS_FROM};
+use super::algebra::dot;
+use super::model::{BuildingModel, RowModel, FLOOR_SUBSTEPS_FROM};
+use super::storey::StoreyMode;
 
 /// Floor kinematics of one building at one instant: displacements, velocities, relative
 /// accelerations and absolute accelerations (with contact forces), and, in free flight, the

@@ -2,7 +2,8 @@
 //! bounds that say whether a free step may touch; and each level's and yielding storey's record
 //! in a run.
 
-use super::{dot, LevelModel, RowModel};
+use super::algebra::dot;
+use super::model::{LevelModel, RowModel};
 use crate::physics::row::LevelOutput;
 use crate::physics::solver::events::error_margin;
 use crate::physics::solver::hermite::{cubic_max_bound, hermite_range};

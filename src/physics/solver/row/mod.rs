@@ -17,14 +17,19 @@
 //! substeps sized to the contact only in record steps where some level may touch, in floor
 //! coordinates for the buildings whose damping allows it: `RowModel::substep_model`).
 //!
-//! By concern: `model` (the row as the integrators see it), `levels` (a contact level's
-//! kinematics, force and bounds, and each level's and storey's record), `rhs` (the right-hand
-//! side), `floors` (a building's floor kinematics at an instant), `run` (one run's state, the
-//! buildings that move or stand still, free steps), `events` (events located and their
-//! transitions, a step accepted), `outputs` (samples to an observer, peaks, the run's output),
-//! and [`yielding`] (the storeys' springs).
+//! By concern, bottom up (each file imports only those before it): `algebra` (the dot
+//! product), `storey` (a yielding storey's model and spring state, its band's edges), `model`
+//! (the row as the integrators see it), `levels` (a contact level's kinematics, force and
+//! bounds, and each level's and storey's record), `rhs` (the right-hand side), `floors` (a
+//! building's floor kinematics at an instant), `exact_step` (a building stepped exactly over a
+//! free step), `sample` (what an observer hears), `run` (one run's state, the buildings that
+//! move or stand still, free steps), `events` (events located and their transitions, a step
+//! accepted), `outputs` (samples to an observer, peaks, the run's output), [`yielding`] (the
+//! storeys' springs over a run, its settling tail), then the schemes; `tests` runs whole rows.
 
+mod algebra;
 mod events;
+mod exact_step;
 pub mod fast;
 mod floors;
 mod levels;
@@ -33,20 +38,16 @@ mod outputs;
 pub mod reference;
 mod rhs;
 mod run;
+mod sample;
+mod storey;
 pub mod yielding;
 
 use crate::physics::model::Forcing;
 use crate::physics::row::RowOutput;
 pub use fast::RowFastOptions;
-use floors::Floors;
-pub(crate) use levels::{LevelState, StoreyState};
+pub(crate) use model::BuildingModel;
 pub use model::RowModel;
-use model::{dot, FLOOR_SUBSTEPS_FROM};
-pub(crate) use model::{BuildingModel, LevelModel};
-pub use outputs::{RowObserver, RowSample, StoreySample};
-pub(crate) use rhs::{rhs, LevelModes, Motion};
-use run::step_still;
-pub(crate) use run::RowRun;
+pub use sample::{RowObserver, RowSample, StoreySample};
 
 impl RowScheme {
     pub fn key(&self) -> &'static str {
@@ -123,3 +124,6 @@ fn simulate<'a>(
         RowScheme::Reference(o) => reference::run_tracked(m, forcing, z0, o, false, observer),
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -2,7 +2,8 @@
 //! in modal terms, the yielding storeys, and what the schemes ask of the whole model (the state
 //! at rest, floors from modes, free-step bounds).
 
-use super::yielding::StoreyModel;
+use super::algebra::dot;
+use super::storey::StoreyModel;
 use crate::physics::contact::Contact;
 use crate::physics::row::{struck_side, LevelSide, Row};
 use crate::physics::shear::{storey_drift_row, Modes};
@@ -468,11 +469,6 @@ impl RowModel {
             modal + self.plastic_strain_correction(z)
         }
     }
-}
-
-#[inline]
-pub(super) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 impl RowModel {

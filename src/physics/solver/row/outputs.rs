@@ -1,8 +1,11 @@
 //! What a row run reports: its time history to an observer ([`RowSample`]), the peaks tracked
 //! between samples (floors, levels, closings), and the run's output at its end.
 
-use super::yielding::StoreyMode;
-use super::{step_still, BuildingModel, RowRun};
+use super::exact_step::step_still;
+use super::model::BuildingModel;
+use super::run::RowRun;
+use super::sample::{RowSample, StoreySample};
+use super::storey::StoreyMode;
 use crate::physics::model::{EnergyBalance, Status};
 use crate::physics::row::{RowOutput, StoreyOutput};
 use crate::physics::solver::hermite::{
@@ -10,38 +13,6 @@ use crate::physics::solver::hermite::{
 };
 use crate::physics::solver::state::{Mode, Segment};
 use crate::physics::solver::tracker::raise_force_peak;
-
-/// A point of a row's time history handed to an observer after every accepted step and
-/// event (as the pair's [`super::Sample`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct RowSample {
-    pub t: f64,
-    /// Each building's floor displacements relative to the ground, m (lowest floor first).
-    pub floors: Vec<Vec<f64>>,
-    /// Each level's penetration (0 where apart), m, contact force, N, and contact mode.
-    pub penetrations: Vec<f64>,
-    pub forces: Vec<f64>,
-    pub modes: Vec<Mode>,
-    /// Each yielding storey, building by building (none in an elastic row).
-    pub storeys: Vec<StoreySample>,
-}
-
-/// A yielding storey at a sample.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StoreySample {
-    /// Its building and storey, from 0 (storey 0 joins the ground and the lowest floor).
-    pub building: usize,
-    pub storey: usize,
-    /// Drift and plastic drift over the storey's height; its shear `k (d - p)`, N; the work
-    /// its plastic drift has absorbed, `int f dp`, J (its hysteretic energy so far).
-    pub drift_ratio: f64,
-    pub plastic_drift_ratio: f64,
-    pub shear_n: f64,
-    pub hysteretic_energy_j: f64,
-}
-
-/// What observes a row's run.
-pub type RowObserver<'o> = &'o mut dyn FnMut(&RowSample);
 
 impl<'m> RowRun<'m> {
     /// Set the contact forces on each building's floors in state `z` into `floors[.][end]`.
@@ -426,10 +397,10 @@ impl<'m> RowRun<'m> {
             m.static_offsets(&self.z, &mut qs);
             qs
         });
-        let residual = |s: usize, sm: &super::yielding::StoreyModel| match &leaning {
+        let residual = |s: usize, sm: &super::storey::StoreyModel| match &leaning {
             Some(qs) if sm.geometric != 0.0 => {
                 let o = m.buildings[sm.building].off;
-                super::dot(&sm.modal_row, &qs[o..]) / sm.height
+                super::algebra::dot(&sm.modal_row, &qs[o..]) / sm.height
             }
             _ => self.z[m.plastic_slot(s)] / sm.height,
         };

@@ -6,8 +6,12 @@
 //! amplitude would ask for needless accuracy), and of each level in contact against the
 //! impact's scales.
 
-use super::yielding::StoreyMode;
-use super::{rhs, LevelModes, Motion, RowModel, RowObserver, RowRun};
+use super::model::RowModel;
+use super::rhs::{rhs, LevelModes, Motion};
+use super::run::RowRun;
+use super::sample::RowObserver;
+use super::storey::StoreyMode;
+use super::yielding::next_segment;
 use crate::physics::model::{Forcing, Status};
 use crate::physics::row::RowOutput;
 use crate::physics::solver::fast::SUSTAINED;
@@ -105,7 +109,7 @@ pub(crate) fn run_tracked<'a>(
     let mut storeys = Vec::with_capacity(m.storeys.len());
     let mut active = run.active.clone();
     let mut i = 0;
-    while let Some(seg) = super::yielding::next_segment(m, forcing, i, &mut run) {
+    while let Some(seg) = next_segment(m, forcing, i, &mut run) {
         i += 1;
         let mut t = seg.t0;
         let t1 = seg.t1();

@@ -1,8 +1,8 @@
 //! The right-hand side of a row's state: modal (or floor) accelerations under the ground motion,
 //! the levels' contact forces and the yielding storeys' plastic loads, and the work rates.
 
-use super::yielding::StoreyMode;
-use super::RowModel;
+use super::model::RowModel;
+use super::storey::StoreyMode;
 use crate::physics::solver::state::Mode;
 
 /// Each level's contact mode and impact speed: what the right-hand side needs of them.
@@ -72,7 +72,7 @@ pub(crate) fn rhs(m: &RowModel, motion: &Motion, ag: f64, z: &[f64], out: &mut [
                 if let Some(e) = &b.modes.coupling {
                     let v = &z[n + o..n + o + nb];
                     for (i, row) in e.iter().enumerate() {
-                        let ev = super::dot(row, v);
+                        let ev = super::algebra::dot(row, v);
                         out[n + o + i] -= ev;
                         if energy {
                             e_damp += v[i] * ev;
