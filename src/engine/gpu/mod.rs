@@ -1,6 +1,7 @@
 //! The GPU engine, host side: the `fast` scheme as a WGSL compute shader (`shaders/fast.wgsl`),
 //! one invocation per run, and the `--aggregate` fold on the device (`shaders/aggregate.wgsl`).
 //!
+//! - [`buffers`]: storage buffers, bind groups, waiting and reading back;
 //! - [`context`]: adapter, device, queue and compiled pipelines, acquired apart from the work;
 //! - [`layout`]: the `#[repr(C)]` buffer types both sides share (checked against the WGSL by naga);
 //! - [`precision`]: f32 or f64 on the device;
@@ -12,6 +13,7 @@
 //!
 //! May import the physics, the plan and [`crate::engine::aggregate`]; never io or studies.
 
+pub mod buffers;
 pub mod context;
 pub mod fold;
 pub mod layout;

@@ -2,10 +2,11 @@
 //! into per-group partials and histograms where they were computed, so a sweep reads back
 //! kilobytes per chunk instead of a state per run.
 
+use super::buffers::{bind_group, read, read_prefix, storage, zeroed};
 use super::context::{GpuContext, GpuError};
 use super::layout::{self, AggConfig, Segment, PART_R, PART_U, SLOT_WORDS};
 use super::precision::Precision;
-use super::run::{bind_group, read, read_prefix, storage, zeroed, Integrated};
+use super::run::Integrated;
 use crate::engine::aggregate::{Aggregator, Partial, MAX_EXCEED};
 use std::collections::HashMap;
 
