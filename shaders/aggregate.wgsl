@@ -10,27 +10,12 @@
 // of `gpu::output`. Runs the fast stage handed back (STATUS_HANDOFF) are listed, not folded:
 // the host finishes them on the CPU and folds them there.
 //
-// The host prepends the prelude (src/engine/gpu/shader.rs): `real`, WG, types.wgsl, and the sketch
-// and partial layout constants (NOUT, BUCKETS, KMIN, KMAX, SKETCH_MIN, SKETCH_MAX, INV_LN_G,
-// MAX_EXCEED, PART_U, PART_R, P_*). The bucket's log is taken in f32 (lavapipe's f64 log is
-// wrong): a value within f32 rounding of a bucket boundary may land one bucket over, which
-// moves a quantile by at most one bucket's 2 %.
-
-// Keep in sync with src/engine/gpu/layout.rs (the layout test checks sizes and offsets).
-struct AggConfig {
-    nseg: u32,
-    nexceed: u32,
-    _pad0: u32,
-    _pad1: u32,
-    exceed_output: array<u32, 8>,
-}
-
-struct Segment {
-    start: u32,
-    len: u32,
-    slot: u32,
-    _pad: u32,
-}
+// The host prepends the prelude (src/engine/gpu/shader.rs): `real`, WG, the structs and codes
+// shared with the host, types.wgsl, the sketch and partial layout constants (NOUT, BUCKETS, KMIN, KMAX,
+// SKETCH_MIN, SKETCH_MAX, INV_LN_G, MAX_EXCEED, PART_U, PART_R, P_*), and this stage's buffer
+// structs AggConfig and Segment, all written from src/engine/gpu/layout.rs. The bucket's log is
+// taken in f32 (lavapipe's f64 log is wrong): a value within f32 rounding of a bucket boundary
+// may land one bucket over, which moves a quantile by at most one bucket's 2 %.
 
 @group(0) @binding(0) var<storage, read> cfg: AggConfig;
 @group(0) @binding(1) var<storage, read> thresholds: array<real>;

@@ -12,9 +12,10 @@
 // lavapipe's f64 pow/exp/sin are wrong, so every transcendental coefficient comes precomputed in
 // `Params`, and the one fifth root is an f32 seed refined by Newton steps in `real`.
 
-// Params, State, Meta, Counters, Dispatch, Tally, Seg and the MODE_/STATUS_ codes are in
-// types.wgsl; the contact laws in contact.wgsl; Hermite interpolation in hermite.wgsl.
-// Keep in sync with src/engine/gpu/layout.rs (the layout test checks sizes and offsets).
+// Params, State, Meta, Counters, Dispatch and the MODE_/STATUS_ codes are written by the host
+// from their Rust definitions (src/engine/gpu/layout.rs, put in the prelude by shader.rs); Tally
+// and Seg are in types.wgsl; the contact laws in contact.wgsl; Hermite interpolation in
+// hermite.wgsl.
 
 @group(0) @binding(0) var<uniform> disp: Dispatch;
 @group(0) @binding(1) var<storage, read> params: array<Params>;

@@ -1,7 +1,8 @@
 //! Every struct shared with the WGSL shaders, one `#[repr(C)]` Pod type each, and the
-//! workgroup/buffer-size arithmetic. Keep in sync with `shaders/fast.wgsl` (the struct and field
-//! names there are the same; `tests/it/gpu.rs` parses the shader with naga and checks every size
-//! and offset against these types).
+//! workgroup/buffer-size arithmetic. The shaders' declarations of these structs are written from
+//! the same field lists ([`Layout::wgsl`], put before the stages by `shader.rs`), so there is no
+//! copy to keep in sync; `tests/it/gpu.rs` parses the assembled shaders with naga and checks
+//! every size and offset against these types (WGSL's alignment rules against `repr(C)`'s).
 //!
 //! Structs of reals come in two precisions with the same fields (`...64` for f64, `...32` for
 //! f32): the shader is compiled with `alias real = f64;` or `f32;` prepended. Each is all-real so
@@ -12,10 +13,52 @@ use bytemuck::{Pod, Zeroable};
 /// Invocations per workgroup (`@workgroup_size` in the shader is substituted from this).
 pub const WORKGROUP_SIZE: u32 = 64;
 
-/// Field names and byte offsets of a shared struct, for the layout test.
+/// A struct shared with the shaders: its WGSL declaration, and its field names and byte offsets
+/// for the layout test.
 pub trait Layout {
     const NAME: &'static str;
     fn fields() -> Vec<(&'static str, usize)>;
+    /// `struct NAME { field: type, ... }` as the shaders declare it, from the Rust field list.
+    fn wgsl() -> String;
+}
+
+/// A field's type in WGSL: `real` (the prelude's alias for the kernel's precision) for the
+/// reals of a `real_structs!` pair, `u32` and arrays of it for the integer structs.
+pub trait WgslType {
+    fn wgsl() -> String;
+}
+
+impl WgslType for u32 {
+    fn wgsl() -> String {
+        "u32".into()
+    }
+}
+
+impl WgslType for f64 {
+    fn wgsl() -> String {
+        "real".into()
+    }
+}
+
+impl WgslType for f32 {
+    fn wgsl() -> String {
+        "real".into()
+    }
+}
+
+impl<const N: usize> WgslType for [u32; N] {
+    fn wgsl() -> String {
+        format!("array<u32, {N}>")
+    }
+}
+
+/// The WGSL declaration of struct `name` with `fields` (name, WGSL type), one field a line.
+fn wgsl_struct(name: &str, fields: &[(&str, String)]) -> String {
+    let body: String = fields
+        .iter()
+        .map(|(f, ty)| format!("    {f}: {ty},\n"))
+        .collect();
+    format!("struct {name} {{\n{body}}}\n")
 }
 
 macro_rules! real_structs {
@@ -44,12 +87,39 @@ macro_rules! real_structs {
             fn fields() -> Vec<(&'static str, usize)> {
                 vec![$((stringify!($f), core::mem::offset_of!($n64, $f))),*]
             }
+            fn wgsl() -> String {
+                wgsl_struct($name, &[$((stringify!($f), <f64 as WgslType>::wgsl())),*])
+            }
         }
 
         impl Layout for $n32 {
             const NAME: &'static str = $name;
             fn fields() -> Vec<(&'static str, usize)> {
                 vec![$((stringify!($f), core::mem::offset_of!($n32, $f))),*]
+            }
+            fn wgsl() -> String {
+                wgsl_struct($name, &[$((stringify!($f), <f32 as WgslType>::wgsl())),*])
+            }
+        }
+    };
+}
+
+/// An all-`u32` struct shared with the shaders (so no padding the two sides could disagree on):
+/// the `#[repr(C)]` Pod type and its [`Layout`], from one field list.
+macro_rules! u32_struct {
+    ($(#[$doc:meta])* $name:ident { $($(#[$fdoc:meta])* $f:ident: $ty:ty),* $(,)? }) => {
+        $(#[$doc])*
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
+        pub struct $name { $($(#[$fdoc])* pub $f: $ty),* }
+
+        impl Layout for $name {
+            const NAME: &'static str = stringify!($name);
+            fn fields() -> Vec<(&'static str, usize)> {
+                vec![$((stringify!($f), core::mem::offset_of!($name, $f))),*]
+            }
+            fn wgsl() -> String {
+                wgsl_struct(Self::NAME, &[$((stringify!($f), <$ty as WgslType>::wgsl())),*])
             }
         }
     };
@@ -108,130 +178,74 @@ real_structs! {
     }
 }
 
-/// Per-run integers fixed for the sweep.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
-pub struct Meta {
-    /// `LAW_*` code.
-    pub law: u32,
-    /// First sample of the run's record in the records buffer.
-    pub rec_offset: u32,
-    /// Samples in the record.
-    pub rec_len: u32,
-    /// Record intervals to simulate (record plus tail).
-    pub intervals: u32,
-    /// First real of the run's shared free response in the `responses` buffer
-    /// (`shared.rs`), or [`NO_RESPONSE`].
-    pub response: u32,
+u32_struct! {
+    /// Per-run integers fixed for the sweep.
+    Meta {
+        /// `LAW_*` code.
+        law: u32,
+        /// First sample of the run's record in the records buffer.
+        rec_offset: u32,
+        /// Samples in the record.
+        rec_len: u32,
+        /// Record intervals to simulate (record plus tail).
+        intervals: u32,
+        /// First real of the run's shared free response in the `responses` buffer
+        /// (`shared.rs`), or [`NO_RESPONSE`].
+        response: u32,
+    }
 }
 
 /// `Meta::response` of a run that steps its whole record.
 pub const NO_RESPONSE: u32 = u32::MAX;
 
-/// Per-run integer state, carried between dispatches.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
-pub struct Counters {
-    /// `MODE_*`
-    pub mode: u32,
-    pub impacts: u32,
-    /// `STATUS_*`; a run that is not `STATUS_OK` is not stepped again.
-    pub status: u32,
-    /// RK4 substeps taken so far.
-    pub substeps: u32,
-    /// Record interval of the current impact's onset.
-    pub i_onset: u32,
-    /// Current record interval.
-    pub i: u32,
-    /// Current RK4 substep of interval `i` (1..=m), 0 before the interval is started.
-    pub j: u32,
-    /// RK4 substeps of interval `i`.
-    pub m: u32,
-    /// Pieces (event cuts) taken in substep `j`.
-    pub pieces: u32,
-    /// Record intervals taken by the exact free step.
-    pub free_steps: u32,
-    /// Record intervals settled by the shared free response (skipped at the start, or at an
-    /// early end).
-    pub shared_steps: u32,
-}
-
-/// Uniforms of one dispatch: at most `budget` units of work (a free interval, or one piece of a
-/// substep) for each of the `nactive` runs listed in the dispatch's run-id buffer.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
-pub struct Dispatch {
-    pub budget: u32,
-    pub nactive: u32,
-    /// A record step needing more substeps ends the run with `STATUS_STEP_LIMIT`.
-    pub max_substeps_per_step: u32,
-    /// Substep budget of one run.
-    pub max_substeps: u32,
-    /// A record step needing more substeps ends the run with `STATUS_HANDOFF`.
-    pub handoff_substeps_per_step: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
-    pub _pad3: u32,
-}
-
-impl Layout for Meta {
-    const NAME: &'static str = "Meta";
-    fn fields() -> Vec<(&'static str, usize)> {
-        use core::mem::offset_of;
-        vec![
-            ("law", offset_of!(Meta, law)),
-            ("rec_offset", offset_of!(Meta, rec_offset)),
-            ("rec_len", offset_of!(Meta, rec_len)),
-            ("intervals", offset_of!(Meta, intervals)),
-            ("response", offset_of!(Meta, response)),
-        ]
+u32_struct! {
+    /// Per-run integer state, carried between dispatches.
+    Counters {
+        /// `MODE_*`
+        mode: u32,
+        impacts: u32,
+        /// `STATUS_*`; a run that is not `STATUS_OK` is not stepped again.
+        status: u32,
+        /// RK4 substeps taken so far.
+        substeps: u32,
+        /// Record interval of the current impact's onset.
+        i_onset: u32,
+        /// Current record interval.
+        i: u32,
+        /// Current RK4 substep of interval `i` (1..=m), 0 before the interval is started.
+        j: u32,
+        /// RK4 substeps of interval `i`.
+        m: u32,
+        /// Pieces (event cuts) taken in substep `j`.
+        pieces: u32,
+        /// Record intervals taken by the exact free step.
+        free_steps: u32,
+        /// Record intervals settled by the shared free response (skipped at the start, or at an
+        /// early end).
+        shared_steps: u32,
     }
 }
 
-impl Layout for Counters {
-    const NAME: &'static str = "Counters";
-    fn fields() -> Vec<(&'static str, usize)> {
-        use core::mem::offset_of;
-        vec![
-            ("mode", offset_of!(Counters, mode)),
-            ("impacts", offset_of!(Counters, impacts)),
-            ("status", offset_of!(Counters, status)),
-            ("substeps", offset_of!(Counters, substeps)),
-            ("i_onset", offset_of!(Counters, i_onset)),
-            ("i", offset_of!(Counters, i)),
-            ("j", offset_of!(Counters, j)),
-            ("m", offset_of!(Counters, m)),
-            ("pieces", offset_of!(Counters, pieces)),
-            ("free_steps", offset_of!(Counters, free_steps)),
-            ("shared_steps", offset_of!(Counters, shared_steps)),
-        ]
+u32_struct! {
+    /// Uniforms of one dispatch: at most `budget` units of work (a free interval, or one piece of a
+    /// substep) for each of the `nactive` runs listed in the dispatch's run-id buffer.
+    Dispatch {
+        budget: u32,
+        nactive: u32,
+        /// A record step needing more substeps ends the run with `STATUS_STEP_LIMIT`.
+        max_substeps_per_step: u32,
+        /// Substep budget of one run.
+        max_substeps: u32,
+        /// A record step needing more substeps ends the run with `STATUS_HANDOFF`.
+        handoff_substeps_per_step: u32,
+        _pad1: u32,
+        _pad2: u32,
+        _pad3: u32,
     }
 }
 
-impl Layout for Dispatch {
-    const NAME: &'static str = "Dispatch";
-    fn fields() -> Vec<(&'static str, usize)> {
-        use core::mem::offset_of;
-        vec![
-            ("budget", offset_of!(Dispatch, budget)),
-            ("nactive", offset_of!(Dispatch, nactive)),
-            (
-                "max_substeps_per_step",
-                offset_of!(Dispatch, max_substeps_per_step),
-            ),
-            ("max_substeps", offset_of!(Dispatch, max_substeps)),
-            (
-                "handoff_substeps_per_step",
-                offset_of!(Dispatch, handoff_substeps_per_step),
-            ),
-            ("_pad1", offset_of!(Dispatch, _pad1)),
-            ("_pad2", offset_of!(Dispatch, _pad2)),
-            ("_pad3", offset_of!(Dispatch, _pad3)),
-        ]
-    }
-}
-
-// Codes shared with the shader (keep in sync with the `const`s in `shaders/fast.wgsl`).
+// Codes shared with the shaders (`shader::shared_with_host` writes their WGSL `const`s; the row
+// kernel gets `STATUS_COLLAPSE` with its shape constants).
 pub const MODE_FREE: u32 = 0;
 pub const MODE_APPROACH: u32 = 1;
 pub const MODE_RESTITUTION: u32 = 2;
@@ -279,58 +293,31 @@ pub fn state_bytes(precision: super::precision::Precision) -> usize {
     core::mem::size_of::<State64>() / 8 * precision.bytes()
 }
 
-/// Settings of the aggregation stage (`shaders/aggregate.wgsl`), in a read-only storage buffer
-/// (a uniform array would need 16-byte strides).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
-pub struct AggConfig {
-    /// Segments in this dispatch.
-    pub nseg: u32,
-    /// `--exceed` thresholds in use (their values are in the `thresholds` buffer).
-    pub nexceed: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
-    /// Output index (`aggregate::OUTPUTS`) of each threshold.
-    pub exceed_output: [u32; crate::engine::aggregate::MAX_EXCEED],
-}
-
-/// Consecutive runs of a chunk (in the order they were packed) that belong to one group; the
-/// stage folds each segment in one workgroup.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Pod, Zeroable)]
-pub struct Segment {
-    /// First run (index into the chunk's buffers) and run count.
-    pub start: u32,
-    pub len: u32,
-    /// The group's histogram slot in the `hist` buffer.
-    pub slot: u32,
-    pub _pad: u32,
-}
-
-impl Layout for AggConfig {
-    const NAME: &'static str = "AggConfig";
-    fn fields() -> Vec<(&'static str, usize)> {
-        use core::mem::offset_of;
-        vec![
-            ("nseg", offset_of!(AggConfig, nseg)),
-            ("nexceed", offset_of!(AggConfig, nexceed)),
-            ("_pad0", offset_of!(AggConfig, _pad0)),
-            ("_pad1", offset_of!(AggConfig, _pad1)),
-            ("exceed_output", offset_of!(AggConfig, exceed_output)),
-        ]
+u32_struct! {
+    /// Settings of the aggregation stage (`shaders/aggregate.wgsl`), in a read-only storage buffer
+    /// (a uniform array would need 16-byte strides).
+    AggConfig {
+        /// Segments in this dispatch.
+        nseg: u32,
+        /// `--exceed` thresholds in use (their values are in the `thresholds` buffer).
+        nexceed: u32,
+        _pad0: u32,
+        _pad1: u32,
+        /// Output index (`aggregate::OUTPUTS`) of each threshold.
+        exceed_output: [u32; crate::engine::aggregate::MAX_EXCEED],
     }
 }
 
-impl Layout for Segment {
-    const NAME: &'static str = "Segment";
-    fn fields() -> Vec<(&'static str, usize)> {
-        use core::mem::offset_of;
-        vec![
-            ("start", offset_of!(Segment, start)),
-            ("len", offset_of!(Segment, len)),
-            ("slot", offset_of!(Segment, slot)),
-            ("_pad", offset_of!(Segment, _pad)),
-        ]
+u32_struct! {
+    /// Consecutive runs of a chunk (in the order they were packed) that belong to one group; the
+    /// stage folds each segment in one workgroup.
+    Segment {
+        /// First run (index into the chunk's buffers) and run count.
+        start: u32,
+        len: u32,
+        /// The group's histogram slot in the `hist` buffer.
+        slot: u32,
+        _pad: u32,
     }
 }
 

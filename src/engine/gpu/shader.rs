@@ -1,9 +1,11 @@
 //! WGSL sources and their per-precision prelude.
 
-use super::layout::{FORMS_PER_RUN, WORKGROUP_SIZE};
+use super::layout::{Layout, FORMS_PER_RUN, WORKGROUP_SIZE};
 use super::precision::Precision;
 
-/// Structs and codes every stage shares, then one file per stage, as in `shaders/`.
+/// Codes, settings and shader-only structs every stage shares, then one file per stage, as in
+/// `shaders/` (the structs and codes shared with the host are written from `layout`:
+/// [`shared_with_host`]).
 pub const TYPES_WGSL: &str = include_str!("../../../shaders/types.wgsl");
 pub const CONTACT_WGSL: &str = include_str!("../../../shaders/contact.wgsl");
 pub const HERMITE_WGSL: &str = include_str!("../../../shaders/hermite.wgsl");
@@ -15,14 +17,42 @@ pub const YIELDING_WGSL: &str = include_str!("../../../shaders/yielding.wgsl");
 pub const LANES_WGSL: &str = include_str!("../../../shaders/lanes.wgsl");
 pub const AGGREGATE_WGSL: &str = include_str!("../../../shaders/aggregate.wgsl");
 
+/// The WGSL declarations of the buffer structs every stage shares with the host, and the run
+/// modes and statuses it reads from `Counters`, written from their Rust definitions in `layout`
+/// (one source for both sides; `real` is the prelude's alias, so one text serves both
+/// precisions). `STATUS_COLLAPSE` is the row kernel's alone: its shape constants carry it.
+pub fn shared_with_host() -> String {
+    use super::layout::{
+        Counters, Dispatch, Meta, Params64, State64, MODE_APPROACH, MODE_FREE, MODE_RESTITUTION,
+        STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK, STATUS_STEP_LIMIT,
+    };
+    format!(
+        "// Structs and codes shared with the host, written from src/engine/gpu/layout.rs.\n{}{}{}{}\
+         const MODE_FREE: u32 = {MODE_FREE}u;\nconst MODE_APPROACH: u32 = {MODE_APPROACH}u;\n\
+         const MODE_RESTITUTION: u32 = {MODE_RESTITUTION}u;\nconst STATUS_OK: u32 = {STATUS_OK}u;\n\
+         const STATUS_NON_FINITE: u32 = {STATUS_NON_FINITE}u;\n\
+         const STATUS_STEP_LIMIT: u32 = {STATUS_STEP_LIMIT}u;\n\
+         const STATUS_HANDOFF: u32 = {STATUS_HANDOFF}u;\n{}",
+        Params64::wgsl(),
+        State64::wgsl(),
+        Meta::wgsl(),
+        Counters::wgsl(),
+        Dispatch::wgsl(),
+    )
+}
+
 /// What every stage starts with: the `real` alias, its epsilon, a tiny and a huge number (for
-/// degenerate-cubic and finiteness tests), the workgroup size, then `types.wgsl`.
+/// degenerate-cubic and finiteness tests), the workgroup size, the structs and codes shared with
+/// the host ([`shared_with_host`]), then `types.wgsl`.
 fn prelude(precision: Precision) -> String {
     let real = match precision {
         Precision::F32 => "alias real = f32;\nconst EPS: real = 1.1920929e-7;\nconst TINY: real = 1e-30;\nconst BIG: real = 1e37;\n",
         Precision::F64 => "alias real = f64;\nconst EPS: real = 2.220446049250313e-16;\nconst TINY: real = 1e-300;\nconst BIG: real = 1e300;\n",
     };
-    format!("{real}const WG: u32 = {WORKGROUP_SIZE}u;\n{TYPES_WGSL}")
+    format!(
+        "{real}const WG: u32 = {WORKGROUP_SIZE}u;\n{}{TYPES_WGSL}",
+        shared_with_host()
+    )
 }
 
 /// `shaders/fast.wgsl` for `precision`, after the prelude: with the reals per run of the
@@ -67,10 +97,13 @@ pub fn row_source(precision: Precision, constants: &str) -> String {
     )
 }
 
-/// `shaders/aggregate.wgsl` for `precision`, after the prelude: with the sketch's bucket range
-/// and the partials' layout, all from `aggregate` and `layout` (one source of truth).
+/// `shaders/aggregate.wgsl` for `precision`, after the prelude: with the sketch's bucket range,
+/// the partials' layout and the stage's own buffer structs, all from `aggregate` and `layout`
+/// (one source of truth).
 pub fn aggregate_source(precision: Precision) -> String {
-    use super::layout::{PART_R, PART_U, P_EXCEED, P_FAILURES, P_IMPACTS, P_POUNDED, P_RUNS};
+    use super::layout::{
+        AggConfig, Segment, PART_R, PART_U, P_EXCEED, P_FAILURES, P_IMPACTS, P_POUNDED, P_RUNS,
+    };
     use crate::engine::aggregate::{
         BUCKETS, GAMMA, KMAX, KMIN, MAX_EXCEED, NOUT, SKETCH_MAX, SKETCH_MIN,
     };
@@ -80,7 +113,9 @@ pub fn aggregate_source(precision: Precision) -> String {
          const SKETCH_MIN: real = {SKETCH_MIN:e};\nconst SKETCH_MAX: real = {SKETCH_MAX:e};\nconst INV_LN_G: f32 = {inv_ln_g:?};\n\
          const MAX_EXCEED: u32 = {MAX_EXCEED}u;\nconst PART_U: u32 = {PART_U}u;\nconst PART_R: u32 = {PART_R}u;\n\
          const P_RUNS: u32 = {P_RUNS}u;\nconst P_FAILURES: u32 = {P_FAILURES}u;\n\
-         const P_POUNDED: u32 = {P_POUNDED}u;\nconst P_IMPACTS: u32 = {P_IMPACTS}u;\nconst P_EXCEED: u32 = {P_EXCEED}u;\n{AGGREGATE_WGSL}",
-        prelude(precision)
+         const P_POUNDED: u32 = {P_POUNDED}u;\nconst P_IMPACTS: u32 = {P_IMPACTS}u;\nconst P_EXCEED: u32 = {P_EXCEED}u;\n{}{}{AGGREGATE_WGSL}",
+        prelude(precision),
+        AggConfig::wgsl(),
+        Segment::wgsl(),
     )
 }
