@@ -349,7 +349,6 @@ fn circles(
 /// `crate::folder::file` and `use super::{a, b}` groups counted; a folder's mod.rs is the folder
 /// itself, a subfolder one node of its parent), so each folder's files read bottom up too.
 #[test]
-#[ignore = "issue 66: circles removed on other branches"]
 fn no_folder_has_a_circle_of_imports() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let edges = folder_edges(&src);
@@ -378,7 +377,6 @@ fn lines_outside_tests(text: &str) -> usize {
 /// Issue 66: no source file is over about 800 lines outside its `#[cfg(test)]` module, so each
 /// can be read at once.
 #[test]
-#[ignore = "issue 66: large files split on other branches"]
 fn no_source_file_is_over_800_lines_outside_its_tests() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut files = Vec::new();
