@@ -11,8 +11,8 @@
 // the units that end a free step or a piece then tracking it in code they all share, so that a
 // unit's loop trips stay those of about one RK4 step and one tracking, however long the search).
 //
-// The host prepends the prelude, then the row's shape (src/engine/gpu/row.rs, `RowShape`): NB
-// buildings, NM modes in all, NL contact levels (NLA = max(NL, 1) sizes their arrays), ZLEN
+// The host prepends the prelude, then the row's shape (src/engine/gpu/row/shape.rs, `RowShape`,
+// written out by row/wgsl.rs): NB buildings, NM modes in all, NL contact levels (NLA = max(NL, 1) sizes their arrays), ZLEN
 // reals of state, MAXN the most storeys; each building's storeys and first mode (B_N, B_OFF);
 // each level's left building and floors (L_A, L_FA, L_FB); the offsets and strides of the
 // per-run blocks (P_*, M_*, S_*, C_*, LS_*, LC_*, BS_*, BC_*, MW); then the functions that run

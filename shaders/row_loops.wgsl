@@ -1,5 +1,5 @@
 // The row kernel's per-shape functions as loops over the shape's tables, for rows too tall to
-// write out (src/engine/gpu/row.rs, `RowShape::unrolled`): appended to row.wgsl in place of
+// write out (src/engine/gpu/row/shape.rs, `RowShape::unrolled`): appended to row.wgsl in place of
 // the code `RowShape::wgsl_unrolled` writes for smaller rows, with the same names, operations
 // and order (so either gives the same values). Twins: row/mod.rs (LevelModel, Floors::fill),
 // row::rhs, yielding.rs (StoreyModel::drift, row::plastic_rhs).

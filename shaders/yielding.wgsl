@@ -1,4 +1,4 @@
-// Rust twin: src/physics/solver/row/yielding.rs (StoreyModel, the RowModel and RowRun parts
+// Rust twin: src/physics/solver/row/{storey,yielding}.rs (StoreyModel, the RowModel and RowRun parts
 // of yielding storeys, and their steps in fast.rs), function for function, in modes only (as
 // row.wgsl). Yielding storeys in the row kernel (physics.md section 8): storey s is a bilinear
 // spring with kinematic hardening, force k (d - p), band |d - p / (1 - b)| <= d_y; while

@@ -537,14 +537,13 @@ fn gap(
     config_kind: &str,
     threads: Option<usize>,
 ) -> PyResult<(Table, Vec<String>)> {
-    use pounding::studies::gap::GapStudy;
+    use pounding::studies::gap::{GapPlanError, GapStudy};
     let (text, path) = config_text(config, config_kind)?;
     let pool = pounding::sweep::options::pool(threads).map_err(|e| sweep_err(e, &text, &path))?;
-    let plan =
-        config::load_text_for_gaps(&text, &path).map_err(|e| config_err_in(e, &text, &path))?;
-    if let Some(why) = GapStudy::refusal(&plan) {
-        return Err(settings_err(format!("{}: {why}", path.display())));
-    }
+    let plan = GapStudy::plan_of(&text, &path).map_err(|e| match e {
+        GapPlanError::Config(e) => config_err_in(e, &text, &path),
+        GapPlanError::Refused(why) => settings_err(why),
+    })?;
     let warnings: Vec<String> = plan
         .input_warnings()
         .into_iter()

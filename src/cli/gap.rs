@@ -4,7 +4,6 @@
 use super::{write_file, Holds};
 use anyhow::{bail, Context, Result};
 use pounding::physics::separation::Rule;
-use pounding::plan::config;
 use pounding::studies::gap::{GapStudy, PoundingCurve};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -57,10 +56,7 @@ pub fn run(a: Args) -> Result<()> {
         .map(pounding::plan::settings::check_threads)
         .transpose()?;
     // The study runs no contact and computes the gaps: the config may leave both out.
-    let plan = config::load_text_for_gaps(&text, &a.config)?;
-    if let Some(why) = GapStudy::refusal(&plan) {
-        bail!("{}: {why}", a.config.display());
-    }
+    let plan = GapStudy::plan_of(&text, &a.config)?;
     super::warn_all(&a.config, plan.input_warnings());
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = threads {

@@ -23,5 +23,5 @@ mod table;
 pub use curves::PoundingCurve;
 pub use fit::{GapFit, NoGapFit};
 pub use scenes::{uncoupled, Outcome, RunEnd};
-pub use study::{covering_rule, GapRun, GapStudy, PairGap, STOPPED};
+pub use study::{covering_rule, GapPlanError, GapRun, GapStudy, PairGap, STOPPED};
 pub use table::RuleSummary;

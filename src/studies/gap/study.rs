@@ -8,6 +8,15 @@ use crate::plan::columns::row::level_name;
 use crate::plan::{Motions, Plan};
 use rayon::prelude::*;
 
+/// Why a config gives no gap study: its text is not a config, or it has no gap to give.
+#[derive(Debug, thiserror::Error)]
+pub enum GapPlanError {
+    #[error(transparent)]
+    Config(#[from] crate::config::ConfigError),
+    #[error("{0}")]
+    Refused(String),
+}
+
 /// What one adjacent pair needs in one run: the exact gap at its governing level (the level
 /// that needs the most) and, per rule, the largest over its levels of the rule's gap.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -109,6 +118,18 @@ impl<'a> GapStudy<'a> {
     /// whose response could not be computed, and why (only where storeys yield).
     pub fn run(plan: &'a Plan) -> Result<GapStudy<'a>, String> {
         Self::run_until(plan, &std::sync::atomic::AtomicBool::new(false))
+    }
+
+    /// The plan a gap study runs, from a config's text at `path`, as `pound gap` and
+    /// `pounding.gap` both take it: read without its contact and gap axes
+    /// ([`crate::plan::config::load_text_for_gaps`]), then refused where it has no gap to give
+    /// ([`GapStudy::refusal`], the message led by the path).
+    pub fn plan_of(text: &str, path: &std::path::Path) -> Result<Plan, GapPlanError> {
+        let plan = crate::plan::config::load_text_for_gaps(text, path)?;
+        match Self::refusal(&plan) {
+            Some(why) => Err(GapPlanError::Refused(format!("{}: {why}", path.display()))),
+            None => Ok(plan),
+        }
     }
 
     /// [`GapStudy::run`] until `stop` is raised: each response and each run looks at it first,
