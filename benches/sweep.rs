@@ -27,7 +27,7 @@ fn sweeps(c: &mut Criterion) {
                     ..Default::default()
                 };
                 let gpu = Engine::gpu(&ctx, opts, None).expect("default chunk");
-                ctx.kernel(precision, false, false)
+                ctx.kernel(precision, false, false, None)
                     .expect("kernel compiles");
                 g.bench_function(format!("gpu_{}", precision.key()), |b| {
                     b.iter(|| bench::run(&plan, &gpu).expect("gpu sweep"))

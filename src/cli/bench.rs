@@ -101,7 +101,7 @@ pub fn run(a: Args) -> Result<()> {
         let plan = bench::plan(n);
         if let (Some(ctx), Some(gpu)) = (&ctx, &gpu) {
             // The first call compiles the kernel; keep that out of the figures.
-            ctx.kernel(precision, false, false)?;
+            ctx.kernel(precision, false, false, None)?;
             let r = bench::run(&plan, gpu)?;
             note!("{} runs on GPU: {:.0} runs/s", r.runs, r.runs_per_second());
             rows.push(r);

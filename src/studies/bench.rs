@@ -389,10 +389,10 @@ pub fn run_storeys_gpu(
     // The kernels a sweep of this plan takes (`engine::Kernel::of`): a row of two one-storey
     // buildings runs on the pair's.
     let (summary, times) = if plan.runs_as_pair() {
-        ctx.kernel(opts.precision, opts.fast.energy, true)?;
+        ctx.kernel(opts.precision, opts.fast.energy, true, None)?;
         run_row_pairs(plan, runs, ctx, opts, chunk, sink, |_| {})?
     } else {
-        ctx.row_kernel(opts.precision, &RowShape::of_plan(plan))?;
+        ctx.row_kernel(opts.precision, &RowShape::of_plan(plan), None)?;
         sweep_rows(ctx, plan, runs, chunk, opts, sink, |_| {})?
     };
     Ok(StoreyRow {

@@ -235,18 +235,9 @@ impl GpuContext {
     }
 
     /// The fast-scheme kernel in `precision`, with or without the energy balance and the
-    /// buildings' peak accelerations, compiled on first use.
+    /// buildings' peak accelerations, compiled on first use; `stop` watched while it is built
+    /// ([`GpuContext::stage`]).
     pub fn kernel(
-        &self,
-        precision: Precision,
-        energy: bool,
-        accel: bool,
-    ) -> Result<Arc<Kernel>, GpuError> {
-        self.kernel_until(precision, energy, accel, None)
-    }
-
-    /// [`GpuContext::kernel`] watching `stop` while it is built ([`GpuContext::stage`]).
-    pub fn kernel_until(
         &self,
         precision: Precision,
         energy: bool,

@@ -350,7 +350,7 @@ pub fn integrate_until(
 ) -> Result<(Integrated, ChunkTimes), GpuError> {
     let runs = &chunk.runs[..];
     let mut times = ChunkTimes::default();
-    let kernel = ctx.kernel_until(opts.precision, opts.fast.energy, chunk.accel, stop)?;
+    let kernel = ctx.kernel(opts.precision, opts.fast.energy, chunk.accel, stop)?;
     let n = runs.len();
     let t = Instant::now();
     let params: Vec<u8> = match opts.precision {
@@ -690,22 +690,29 @@ fn initial_states(runs: &[Packed], precision: Precision) -> (Vec<u8>, Vec<Counte
 /// Every run of a chunk read back must have ended (its record integrated, or a status that
 /// ends it): one still running would be written as a finished run with part of its record.
 pub(super) fn unfinished(cs: &[Counters], runs: &[Packed]) -> Result<(), GpuError> {
-    let left = cs
-        .iter()
-        .zip(runs)
-        .filter(|(c, r)| c.status == STATUS_OK && c.i < r.meta.intervals)
-        .count();
-    match cs.iter().zip(runs).position(|(c, r)| c.status == STATUS_OK && c.i < r.meta.intervals) {
-        Some(k) => Err(GpuError::Other {
-            message: format!(
-                "{left} runs of a chunk of {} came back from the device unfinished (the first, chunk run {k}, at record interval {} of {}); their results cannot be trusted",
-                runs.len(),
-                cs[k].i,
-                runs[k].meta.intervals
-            ),
-        }),
-        None => Ok(()),
-    }
+    came_back_ended(runs.len(), |k| {
+        let (c, end) = (&cs[k], runs[k].meta.intervals);
+        (c.status == STATUS_OK && c.i < end).then_some((c.i, end))
+    })
+}
+
+/// `Err` naming the runs of a chunk of `runs` that came back unfinished (the pair's and the
+/// row's checks): `left(k)` is run `k`'s record interval and the one it runs to where it has
+/// not ended, `None` where it has.
+pub(super) fn came_back_ended(
+    runs: usize,
+    left: impl Fn(usize) -> Option<(u32, u32)>,
+) -> Result<(), GpuError> {
+    let mut unended = (0..runs).filter_map(|k| left(k).map(|at| (k, at)));
+    let Some((k, (i, end))) = unended.next() else {
+        return Ok(());
+    };
+    Err(GpuError::Other {
+        message: format!(
+            "{} runs of a chunk of {runs} came back from the device unfinished (the first, chunk run {k}, at record interval {i} of {end}); their results cannot be trusted",
+            1 + unended.count()
+        ),
+    })
 }
 
 /// Each run's results from its final state, in input order (None: handed back); `accel`: the

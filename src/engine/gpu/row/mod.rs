@@ -28,7 +28,7 @@ use super::buffers::{bind_group, read, storage, wait, zeroed};
 use super::context::{check_stop, stopped, GpuContext, GpuError, Kernel, Stage, Stop};
 use super::layout::{MODE_FREE, STATUS_COLLAPSE, STATUS_HANDOFF, STATUS_NON_FINITE, STATUS_OK};
 use super::precision::Precision;
-use super::run::{unit_cap, ChunkTimes, GpuOptions, GpuRecords, WorkLists};
+use super::run::{came_back_ended, unit_cap, ChunkTimes, GpuOptions, GpuRecords, WorkLists};
 use super::sweep::GpuTimes;
 use crate::engine::Summary;
 use crate::physics::model::Status;
@@ -48,17 +48,9 @@ const SOFTWARE_LOOP_TRIPS: u64 = 60_000;
 /// The row kernels, kept by the context as every other (it knows no row shape: the shape
 /// gives the stage its key and its source).
 impl GpuContext {
-    /// The row kernel for `shape` in `precision`, compiled on first use.
+    /// The row kernel for `shape` in `precision`, compiled on first use; `stop` watched while
+    /// it is built ([`GpuContext::stage`]).
     pub fn row_kernel(
-        &self,
-        precision: Precision,
-        shape: &RowShape,
-    ) -> Result<Arc<Kernel>, GpuError> {
-        self.row_kernel_until(precision, shape, None)
-    }
-
-    /// [`GpuContext::row_kernel`] watching `stop` while it is built ([`GpuContext::stage`]).
-    pub fn row_kernel_until(
         &self,
         precision: Precision,
         shape: &RowShape,
@@ -161,7 +153,7 @@ fn integrate_rows(
     }
     let shape = &chunk.shape;
     let cap = software_cap(ctx, shape)?;
-    let kernel = ctx.row_kernel_until(opts.precision, shape, stop)?;
+    let kernel = ctx.row_kernel(opts.precision, shape, stop)?;
     let t = Instant::now();
     let p = opts.precision;
     let params = storage(
@@ -272,36 +264,18 @@ fn row_units(end: u64, fast: &FastOptions) -> u64 {
 /// be written as a finished run with part of its record.
 fn unfinished(shape: &RowShape, meta: &[u32], counters: &[u32]) -> Result<(), GpuError> {
     let nb = shape.storeys.len();
-    // The interval a run runs to, and whether it is there.
-    let ended = |r: usize| {
+    came_back_ended(meta.len() / shape.m_stride(), |r| {
         let m = &meta[r * shape.m_stride()..(r + 1) * shape.m_stride()];
         let c = &counters[r * shape.c_stride()..(r + 1) * shape.c_stride()];
-        let recorded = c[C_I] >= m[M_INTERVALS];
-        let done = if shape.yields() == 0 {
-            recorded
-        } else {
-            recorded && (c[shape.c_settled()] != 0 || c[C_I] >= m[M_MODELS + nb])
+        // The interval a run runs to: its record's end, or with yielding storeys its settling
+        // time's, unless it settled first.
+        let (end, settled) = match shape.yields() {
+            0 => (m[M_INTERVALS], false),
+            _ => (m[M_MODELS + nb], c[shape.c_settled()] != 0),
         };
-        let end = match shape.yields() {
-            0 => m[M_INTERVALS],
-            _ => m[M_MODELS + nb],
-        };
-        (c[C_STATUS] != STATUS_OK || done, c[C_I], end)
-    };
-    let runs = meta.len() / shape.m_stride();
-    let left: Vec<usize> = (0..runs).filter(|&r| !ended(r).0).collect();
-    match left.first() {
-        Some(&k) => {
-            let (_, i, end) = ended(k);
-            Err(GpuError::Other {
-                message: format!(
-                    "{} runs of a chunk of {runs} came back from the device unfinished (the first, chunk run {k}, at record interval {i} of {end}); their results cannot be trusted",
-                    left.len()
-                ),
-            })
-        }
-        None => Ok(()),
-    }
+        let done = c[C_I] >= m[M_INTERVALS] && (settled || c[C_I] >= end);
+        (c[C_STATUS] == STATUS_OK && !done).then_some((c[C_I], end))
+    })
 }
 
 /// A run's results from its final state and counters (what `RowRun::finish` does on the CPU,
@@ -463,7 +437,7 @@ pub fn sweep_rows_until<E: From<GpuError>>(
     // seconds), watching the stop; the chunks then find it built.
     software_cap(ctx, &shape)?;
     let (kernel, prepared) = rayon::join(
-        || ctx.row_kernel_until(opts.precision, &shape, stop),
+        || ctx.row_kernel(opts.precision, &shape, stop),
         || prep(first),
     );
     kernel?;
