@@ -2,6 +2,7 @@
 //! keys checked by name, P-Delta off (or without gravity) the sweep without it, collapsed runs
 //! ended, reported and counted apart, and the GPU's rows agreeing with the CPU's.
 
+use crate::support::cli::stderr;
 use crate::support::{ok, pound, table, tempdir};
 
 /// A yielding 3-storey frame with P-Delta (a leaning column: twice its floors' weight) beside
@@ -47,10 +48,6 @@ fn sweep(dir: &std::path::Path, name: &str, config: &str, extra: &[&str]) -> std
     let mut args = vec!["sweep", cfg.to_str().unwrap(), "-o", out.to_str().unwrap()];
     args.extend(extra);
     pound(&args)
-}
-
-fn stderr(o: &std::process::Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 /// Each key's error names it and what it expects; a building unstable under gravity alone is

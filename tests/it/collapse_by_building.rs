@@ -6,7 +6,7 @@
 //! median outside the levels run is flagged as extrapolated. Tables written by hand give the
 //! exact counts.
 
-use crate::support::cli::write;
+use crate::support::cli::{stderr, write};
 use crate::support::{ok, pound, table, tempdir};
 use pounding::io::table::Table;
 use pounding::plan::sample::phi_inv;
@@ -16,10 +16,6 @@ use std::path::Path;
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
-}
-
-fn stderr(o: &std::process::Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 /// A row sweep's columns with a collapse limit, cut to what the studies read: the run's collapse

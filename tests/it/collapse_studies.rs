@@ -4,6 +4,7 @@
 //! as an infinite demand (the flatline), in its fractiles and its table. Hand-written tables
 //! give the exact counts; one small P-Delta sweep runs them end to end.
 
+use crate::support::cli::stderr;
 use crate::support::{ok, pound, table, tempdir};
 use pounding::io::table::Table;
 use pounding::plan::sample::phi_inv;
@@ -12,10 +13,6 @@ use std::path::{Path, PathBuf};
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
-}
-
-fn stderr(o: &std::process::Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 /// The header of a row sweep that can collapse, cut to what the studies read.

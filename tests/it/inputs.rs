@@ -3,6 +3,7 @@
 //! not collide, a record's window is the one reported, and no input is written in 300 digits.
 
 use crate::scenes::{row_config, with};
+use crate::support::cli::stderr;
 use crate::support::{ok, pound, records_dir, table, tempdir};
 use pounding::plan::config::load_text;
 use std::path::Path;
@@ -24,10 +25,6 @@ fn error_of(text: &str) -> Option<String> {
     load_text(text, Path::new("t.toml"))
         .err()
         .map(|e| e.to_string())
-}
-
-fn stderr(o: &std::process::Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 /// Class 7, windows: with `window_s`, a target is met on the window, and `pound record

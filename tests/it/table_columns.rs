@@ -14,7 +14,7 @@
 //!   cells, its notice and its figure; a goodness of fit over levels that are all `0/n` or `n/n`
 //!   prints no p.
 
-use crate::support::cli::write;
+use crate::support::cli::{stderr, write};
 use crate::support::{ok, pound, tempdir};
 use pounding::io::table::Table;
 use pounding::studies::fragility::{self, FragilityOptions};
@@ -23,10 +23,6 @@ use std::path::Path;
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
-}
-
-fn stderr(o: &std::process::Output) -> String {
-    String::from_utf8_lossy(&o.stderr).to_string()
 }
 
 /// Seven records at four levels of PGA: building 1's drift rises with the level, and a run
