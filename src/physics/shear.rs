@@ -54,7 +54,7 @@ pub struct ShearBuilding {
     /// Storey heights, m.
     pub heights: Vec<f64>,
     pub damping: Damping,
-    /// Bilinear storey springs (None: every storey linear elastic).
+    /// Yielding storey springs, bilinear or deteriorating (None: every storey linear elastic).
     pub yielding: Option<Yielding>,
     /// P-Delta: each storey's geometric stiffness `P_j / h_j`, N/m, `P_j` the gravity load it
     /// carries (None: no P-Delta; [`ShearBuilding::with_p_delta`]).
@@ -70,6 +70,45 @@ pub struct Yielding {
     pub force: Vec<f64>,
     /// Post-yield stiffness ratio `b` per storey, `0 <= b < 1` (0: elastic-perfectly-plastic).
     pub post_yield: Vec<f64>,
+    /// Capped, deteriorating storeys (IMK, physics.md section 13); None: bilinear.
+    pub deterioration: Option<Deterioration>,
+}
+
+/// Which IMK hysteresis rule a deteriorating storey follows (OpenSees' material of that name).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ImkRule {
+    /// `IMKBilin`: unloading and reloading along the deteriorated bounding lines.
+    Bilinear,
+    /// `IMKPeakOriented`: reloading aims at the largest earlier excursion on that side.
+    PeakOriented,
+}
+
+impl ImkRule {
+    /// The config's word for the rule (`hysteresis = "..."`).
+    pub fn key(self) -> &'static str {
+        match self {
+            ImkRule::Bilinear => "imk_bilinear",
+            ImkRule::PeakOriented => "imk_peak_oriented",
+        }
+    }
+}
+
+/// The IMK backbone beyond yield and its cyclic deterioration, per storey, in drift ratios
+/// (physics.md section 13): the yield drift and hardening ratio are [`Yielding`]'s.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Deterioration {
+    pub rule: ImkRule,
+    /// `theta_p`: yield to capping (> 0).
+    pub plastic: Vec<f64>,
+    /// `theta_pc`: capping to zero strength (> 0).
+    pub post_capping: Vec<f64>,
+    /// `kappa`: residual strength over the initial yield strength, in `[0, 1)`.
+    pub residual: Vec<f64>,
+    /// `theta_u`: no strength beyond this drift ratio, from the origin (infinite: none).
+    pub ultimate: Vec<f64>,
+    /// `gamma`: the energy capacity `E_t = gamma F_y theta_y h` (None: no cyclic
+    /// deterioration).
+    pub energy: Option<Vec<f64>>,
 }
 
 impl Yielding {
@@ -88,6 +127,7 @@ impl Yielding {
                 .map(|((k, h), t)| k * t * h)
                 .collect(),
             post_yield,
+            deterioration: None,
         }
     }
 }

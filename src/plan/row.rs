@@ -107,6 +107,7 @@ impl YieldSpec {
         Yielding {
             force,
             post_yield: self.post_yield.clone(),
+            deterioration: None,
         }
     }
 }

@@ -319,6 +319,7 @@ fn opensees_cross_check() {
                 yielding: b.get("yield_force_n").map(|f| Yielding {
                     force: floats(f),
                     post_yield: floats(&b["post_yield_ratio"]),
+                    deterioration: None,
                 }),
                 geometric: None,
             })
