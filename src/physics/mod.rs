@@ -10,6 +10,7 @@
 //! studies), so every layer above can use it and its tests need no files.
 
 pub mod contact;
+pub mod imk;
 pub mod model;
 pub mod propagator;
 pub mod restitution;

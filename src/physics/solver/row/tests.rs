@@ -26,6 +26,7 @@ fn sdof(m: f64, t: f64, xi: f64, d_y: f64, b: f64) -> ShearBuilding {
         yielding: Some(Yielding {
             force: vec![k * d_y],
             post_yield: vec![b],
+            deterioration: None,
         }),
         geometric: None,
     }

@@ -1,0 +1,162 @@
+use super::*;
+
+/// The storey of the research notes' OpenSees runs: k = 2e7 N/m, h = 3 m, theta_y = 0.005,
+/// b = 0.03, theta_p = 0.02, theta_pc = 0.08, kappa = 0.2, theta_u = 0.15, gamma = 50.
+fn spring(rule: ImkRule, gamma: Option<f64>) -> ImkSpring {
+    ImkSpring::from_ratios(rule, 2.0e7, 3.0, 0.005, 0.03, (0.02, 0.08, 0.2, 0.15), gamma)
+}
+
+/// The undeteriorated backbone in closed form (physics.md section 13).
+fn backbone(sp: &ImkSpring, u: f64) -> f64 {
+    let uy = sp.fy / sp.k;
+    let ucap = uy + sp.up;
+    let fcap = sp.fcap0();
+    if u <= uy {
+        sp.k * u
+    } else if u <= ucap {
+        sp.fy + sp.kp * (u - uy)
+    } else if u > sp.uu {
+        0.0
+    } else {
+        (fcap - fcap / sp.upc * (u - ucap)).max(sp.fres)
+    }
+}
+
+/// The force at each drift of a quasi-static protocol (drifts visited in turn from 0).
+fn drive(sp: &ImkSpring, path: &[f64]) -> Vec<f64> {
+    let mut st = ImkState::new(sp);
+    let mut at = 0.0;
+    path.iter()
+        .map(|&d| {
+            let f = st.follow(sp, at, d, &mut |_, _, _| {});
+            at = d;
+            f
+        })
+        .collect()
+}
+
+#[test]
+fn a_monotonic_push_follows_the_backbone_in_closed_form() {
+    for rule in [ImkRule::Bilinear, ImkRule::PeakOriented] {
+        let sp = spring(rule, Some(50.0));
+        let path: Vec<f64> = (1..=500).map(|i| i as f64 * 1e-3).collect();
+        for (d, f) in path.iter().zip(drive(&sp, &path)) {
+            let want = backbone(&sp, *d);
+            assert!((f - want).abs() <= 1e-6 * sp.fy, "{rule:?} at {d}: {f} vs {want}");
+            // And the mirror image.
+        }
+        let neg: Vec<f64> = path.iter().map(|d| -d).collect();
+        for (d, f) in neg.iter().zip(drive(&sp, &neg)) {
+            let want = -backbone(&sp, -d);
+            assert!((f - want).abs() <= 1e-6 * sp.fy, "{rule:?} at {d}: {f} vs {want}");
+        }
+    }
+}
+
+#[test]
+fn points_of_the_backbone_as_opensees_gives_them() {
+    // openseespy 3.7.1.2 (IMK sources identical to 3.8.0), 0.1 mm steps, both materials.
+    for rule in [ImkRule::Bilinear, ImkRule::PeakOriented] {
+        let sp = spring(rule, Some(50.0));
+        let f = drive(&sp, &[0.03, 0.075, 0.2, 0.44, 0.46]);
+        for (got, want) in f.iter().zip([309000.0, 336000.0, 161000.0, 60000.0, 0.0]) {
+            assert!((got - want).abs() < 1e-6 * sp.fy, "{rule:?}: {f:?}");
+        }
+    }
+}
+
+/// Peak forces of +-0.06 m cycles (4 yield drifts, before capping) by OpenSees (the research
+/// notes' script): each is the backbone's after the energy rule's deterioration.
+#[test]
+fn constant_amplitude_cycles_deteriorate_as_opensees() {
+    let cases = [
+        (
+            ImkRule::Bilinear,
+            [327000.0, -306667.0, 286362.0, -267543.0, 248908.0, -231948.0, 215334.0, -200582.0],
+        ),
+        (
+            ImkRule::PeakOriented,
+            [327000.0, -306667.0, 296367.0, -286298.0, 276371.0, -266699.0, 257193.0, -247967.0],
+        ),
+    ];
+    for (rule, want) in cases {
+        let sp = spring(rule, Some(50.0));
+        let path: Vec<f64> = (0..8).map(|i| if i % 2 == 0 { 0.06 } else { -0.06 }).collect();
+        let got = drive(&sp, &path);
+        for (g, w) in got.iter().zip(want) {
+            // OpenSees' steps keep a step's stored energy in each excursion's: ~1e-3.
+            assert!((g - w).abs() < 2e-3 * w.abs(), "{rule:?}: {got:?}");
+        }
+    }
+}
+
+#[test]
+fn the_first_bilinear_cycle_is_the_energy_rule_by_hand() {
+    // The research notes' hand check: K rule at the first reversal, then S and C at the zero
+    // crossing, the backbone at -0.06 m.
+    let sp = spring(ImkRule::Bilinear, Some(50.0));
+    let e_t = 50.0 * sp.fy * 0.015;
+    let (k, fy, kp) = (sp.k, sp.fy, sp.kp);
+    let f1 = fy + kp * (0.06 - 0.015);
+    let w1 = 0.5 * fy * 0.015 + 0.5 * (fy + f1) * 0.045;
+    let stored = 0.5 * f1 * f1 / k;
+    let bk = (w1 - stored) / (e_t - (w1 - stored));
+    let ku = k * (1.0 - bk);
+    let e1 = w1 - 0.5 * f1 * f1 / ku;
+    let bs = e1 / (e_t - e1);
+    let (fy2, kp2) = (fy * (1.0 - bs), kp * (1.0 - bs));
+    let want = -(fy2 + kp2 * (0.06 - fy2 / k));
+    let got = drive(&sp, &[0.06, -0.06])[1];
+    assert!((got - want).abs() < 1e-6 * fy, "{got} vs {want}");
+    assert!((want + 306667.0).abs() < 1.0);
+}
+
+#[test]
+fn without_an_energy_capacity_cycles_repeat() {
+    for rule in [ImkRule::Bilinear, ImkRule::PeakOriented] {
+        let sp = spring(rule, None);
+        let path: Vec<f64> = (0..8).map(|i| if i % 2 == 0 { 0.06 } else { -0.06 }).collect();
+        let f = drive(&sp, &path);
+        for w in f.windows(2) {
+            assert!((w[0] + w[1]).abs() < 1e-6 * sp.fy, "{rule:?}: {f:?}");
+        }
+    }
+}
+
+#[test]
+fn once_the_energy_is_spent_no_strength_is_left() {
+    for rule in [ImkRule::Bilinear, ImkRule::PeakOriented] {
+        let sp = spring(rule, Some(5.0));
+        let path: Vec<f64> = (0..40).map(|i| if i % 2 == 0 { 0.06 } else { -0.06 }).collect();
+        let mut st = ImkState::new(&sp);
+        let mut at = 0.0;
+        for &d in &path {
+            st.follow(&sp, at, d, &mut |_, _, _| {});
+            at = d;
+        }
+        assert_eq!(st.branch, Branch::Collapsed, "{rule:?}");
+        assert_eq!(st.strength_ratio(&sp), 0.0);
+    }
+}
+
+#[test]
+fn past_the_ultimate_drift_bilinear_keeps_the_residual_the_other_way() {
+    let sp = spring(ImkRule::Bilinear, None);
+    let f = drive(&sp, &[0.46, 0.3, -0.1]);
+    assert_eq!(f[0], 0.0);
+    assert!((f[2] + sp.fres).abs() < 1e-6 * sp.fy, "{f:?}");
+    let sp = spring(ImkRule::PeakOriented, None);
+    let f = drive(&sp, &[0.46, 0.3, -0.1]);
+    assert_eq!(f, vec![0.0, 0.0, 0.0]);
+}
+
+#[test]
+fn the_work_on_a_closed_elastic_path_is_zero() {
+    let sp = spring(ImkRule::Bilinear, Some(50.0));
+    let mut st = ImkState::new(&sp);
+    st.follow(&sp, 0.0, 0.01, &mut |_, _, _| {});
+    st.follow(&sp, 0.01, -0.01, &mut |_, _, _| {});
+    st.follow(&sp, -0.01, 0.0, &mut |_, _, _| {});
+    assert!(st.work_at(0.0).abs() < 1e-9 * sp.fy);
+    assert!(!st.yielded);
+}
