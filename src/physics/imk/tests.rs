@@ -40,13 +40,14 @@ fn a_monotonic_push_follows_the_backbone_in_closed_form() {
     for rule in [ImkRule::Bilinear, ImkRule::PeakOriented] {
         let sp = spring(rule, Some(50.0));
         let path: Vec<f64> = (1..=500).map(|i| i as f64 * 1e-3).collect();
-        for (d, f) in path.iter().zip(drive(&sp, &path)) {
+        // (The ultimate drift itself is an edge either way.)
+        let near_uu = |d: f64| (d.abs() - sp.uu).abs() < 1e-6;
+        for (d, f) in path.iter().zip(drive(&sp, &path)).filter(|(d, _)| !near_uu(**d)) {
             let want = backbone(&sp, *d);
             assert!((f - want).abs() <= 1e-6 * sp.fy, "{rule:?} at {d}: {f} vs {want}");
-            // And the mirror image.
         }
         let neg: Vec<f64> = path.iter().map(|d| -d).collect();
-        for (d, f) in neg.iter().zip(drive(&sp, &neg)) {
+        for (d, f) in neg.iter().zip(drive(&sp, &neg)).filter(|(d, _)| !near_uu(**d)) {
             let want = -backbone(&sp, -d);
             assert!((f - want).abs() <= 1e-6 * sp.fy, "{rule:?} at {d}: {f} vs {want}");
         }
