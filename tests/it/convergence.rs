@@ -42,19 +42,19 @@ const AT_128: f64 = 1e-5;
 /// The default setting, from which impact counts must equal the reference's.
 const DEFAULT: f64 = 16.0;
 
-struct Scene {
-    name: &'static str,
-    model: RowModel,
-    accel: Vec<f64>,
-    dt: f64,
+pub(crate) struct Scene {
+    pub name: &'static str,
+    pub model: RowModel,
+    pub accel: Vec<f64>,
+    pub dt: f64,
     /// Whether the buildings may pound (else they must never touch).
-    pounds: bool,
+    pub pounds: bool,
     /// Whether the run collapses (a storey reaches the collapse drift ratio).
-    collapses: bool,
+    pub collapses: bool,
 }
 
 impl Scene {
-    fn forcing(&self) -> Forcing<'_> {
+    pub(crate) fn forcing(&self) -> Forcing<'_> {
         Forcing {
             accel: &self.accel,
             dt: self.dt,
@@ -79,7 +79,7 @@ pub(crate) fn yielding(mut s: ShearBuilding, theta: f64, b: f64) -> ShearBuildin
 
 /// A 6-storey frame with a soft first storey (Rayleigh damping: its substeps run in floor
 /// coordinates on the CPU).
-fn soft_frame() -> ShearBuilding {
+pub(crate) fn soft_frame() -> ShearBuilding {
     ShearBuilding::from_period(
         vec![3e5; 6],
         &[0.5, 1.0, 1.0, 0.9, 0.8, 0.7],
@@ -90,7 +90,7 @@ fn soft_frame() -> ShearBuilding {
 }
 
 /// A 3-storey frame whose floors are at the soft frame's lowest three (4, 7 and 10 m).
-fn low_frame() -> ShearBuilding {
+pub(crate) fn low_frame() -> ShearBuilding {
     ShearBuilding::from_period(
         vec![2.5e5; 3],
         &[1.0; 3],
@@ -100,7 +100,7 @@ fn low_frame() -> ShearBuilding {
     )
 }
 
-fn row(buildings: Vec<ShearBuilding>, gaps: Vec<f64>, law: LawKind) -> RowModel {
+pub(crate) fn row(buildings: Vec<ShearBuilding>, gaps: Vec<f64>, law: LawKind) -> RowModel {
     let stiffness = if law.is_hertzian() { 2.75e9 } else { 1e9 };
     RowModel::new(&Row::new(buildings, gaps, law, stiffness, 0.65))
 }
@@ -358,7 +358,7 @@ fn run_error(o: &RowOutput, t: &RowOutput) -> Result<f64, String> {
 }
 
 /// The failures of one path: `outs[k][r]` is run `r` at `SETTINGS[k]`.
-fn judge(
+pub(crate) fn judge(
     path: &str,
     scenes: &[&Scene],
     truth: &[RowOutput],
@@ -419,14 +419,14 @@ pub(crate) fn failures(name: &str, errs: &[(f64, f64)]) -> Vec<String> {
     bad
 }
 
-fn fast(s: f64) -> FastOptions {
+pub(crate) fn fast(s: f64) -> FastOptions {
     FastOptions {
         substeps_per_contact: s,
         ..FastOptions::default()
     }
 }
 
-fn truths(scenes: &[&Scene]) -> Vec<RowOutput> {
+pub(crate) fn truths(scenes: &[&Scene]) -> Vec<RowOutput> {
     scenes
         .iter()
         .map(|sc| {

@@ -31,6 +31,7 @@ mod gpu_rows;
 mod gpu_stop;
 mod hard;
 mod idle_axes;
+mod imk;
 mod im_columns;
 mod inelastic;
 mod inputs;

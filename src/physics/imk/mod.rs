@@ -67,8 +67,21 @@ impl ImkSpring {
     }
 
     /// The drift a located event may pass its threshold by (as a bilinear storey's band).
-    fn slack(&self) -> f64 {
+    pub fn slack(&self) -> f64 {
         1e-9 * self.fy / self.k
+    }
+
+    /// How close to rest a storey must be before its residual drift is taken, m: the reach of
+    /// its motion (from the energy left) about where its force is zero. `IMKBilin` returns to
+    /// the same line at each zero crossing (exact at any reach within its piece's rest
+    /// thresholds); a peak-oriented storey reloads towards its peaks through the crossing, a
+    /// softer line, so its rest point still moves by up to the reach: taken once that is below
+    /// 1e-6 of the yield drift.
+    pub fn rest_reach(&self) -> f64 {
+        match self.rule {
+            ImkRule::Bilinear => f64::INFINITY,
+            ImkRule::PeakOriented => 1e-6 * self.fy / self.k,
+        }
     }
 
     /// The capping strength before any deterioration, N.
@@ -87,6 +100,11 @@ pub struct Piece {
     pub lo: f64,
     pub hi: f64,
     pub heading: f64,
+    /// The thresholds other than the force's zero crossing: a new excursion there moves no
+    /// `IMKBilin` line and only starts a peak-oriented reloading line through the same point,
+    /// so a storey at rest (its force zero) settles within these ([`ImkSpring::rest_reach`]).
+    pub rest_lo: f64,
+    pub rest_hi: f64,
 }
 
 impl Piece {
@@ -160,7 +178,7 @@ enum Mark {
 }
 
 /// One storey spring's state: its deteriorated backbones, energies and current piece.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImkState {
     /// The backbones of the positive and negative sides, in magnitudes.
     sides: [Side; 2],
@@ -203,6 +221,8 @@ impl ImkState {
                 lo: f64::NEG_INFINITY,
                 hi: f64::INFINITY,
                 heading: 0.0,
+                rest_lo: f64::NEG_INFINITY,
+                rest_hi: f64::INFINITY,
             },
             marks: [Mark::None; 2],
             yielded: false,
@@ -311,16 +331,18 @@ impl ImkState {
             lo: f64::NEG_INFINITY,
             hi: f64::INFINITY,
             heading: 0.0,
+            rest_lo: f64::NEG_INFINITY,
+            rest_hi: f64::INFINITY,
         };
         let mut marks = [Mark::None; 2];
         // Each side's threshold in its own magnitudes, found from the piece in them.
         for sign in [1.0, -1.0] {
             let (x0, g0) = (sign * d0, sign * f0);
-            let (x, mark) = self.threshold(sp, sign, x0, g0, slope);
+            let ((x, mark), rest) = self.threshold(sp, sign, x0, g0, slope);
             if sign > 0.0 {
-                (piece.hi, marks[0]) = (x, mark);
+                (piece.hi, marks[0], piece.rest_hi) = (x, mark, rest);
             } else {
-                (piece.lo, marks[1]) = (-x, mark);
+                (piece.lo, marks[1], piece.rest_lo) = (-x, mark, -rest);
             }
         }
         piece.heading = match branch {
@@ -332,14 +354,26 @@ impl ImkState {
     }
 
     /// The first threshold a piece through `(x0, g0)` with `slope` meets moving outwards on side
-    /// `sign` (in that side's magnitudes), and where it leads.
-    fn threshold(&self, sp: &ImkSpring, sign: f64, x0: f64, g0: f64, slope: f64) -> (f64, Mark) {
+    /// `sign` (in that side's magnitudes), and where it leads; and the first other than a zero
+    /// crossing.
+    fn threshold(
+        &self,
+        sp: &ImkSpring,
+        sign: f64,
+        x0: f64,
+        g0: f64,
+        slope: f64,
+    ) -> ((f64, Mark), f64) {
         let side = &self.sides[idx(sign)];
         let other_failed = self.sides[idx(-sign)].failed;
         let mut best = (f64::INFINITY, Mark::None);
+        let mut rest = f64::INFINITY;
         let mut take = |x: f64, m: Mark| {
             if x < best.0 {
                 best = (x, m);
+            }
+            if m != Mark::Zero {
+                rest = rest.min(x);
             }
         };
         if !side.failed && self.branch != Branch::Collapsed {
@@ -390,7 +424,7 @@ impl ImkState {
             }
             _ => {}
         }
-        best
+        (best, rest)
     }
 
     /// The drift rate turned against a piece that flows one way, at drift `d`.
@@ -535,6 +569,8 @@ impl ImkState {
             lo: f64::NEG_INFINITY,
             hi: f64::INFINITY,
             heading: 0.0,
+            rest_lo: f64::NEG_INFINITY,
+            rest_hi: f64::INFINITY,
         };
         self.marks = [Mark::None; 2];
     }

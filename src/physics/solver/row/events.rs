@@ -138,17 +138,20 @@ impl<'m> RowRun<'m> {
     }
 
     /// The earliest fraction of a step `z0 -> z1` (length `h`) at which an elastic storey's
-    /// back drift could rise past its band between the ends (both inside it).
+    /// back drift could rise past its band between the ends (both inside it), or an IMK
+    /// storey's drift past a threshold of its piece.
     pub(super) fn hidden_yield(&self, z0: &[f64], z1: &[f64], h: f64) -> Option<f64> {
         let n = self.m.n;
         let mut first: Option<f64> = None;
         for (s, (sm, &mode)) in self.m.storeys.iter().zip(&self.storey_modes).enumerate() {
-            if mode != StoreyMode::Elastic || !self.active[sm.building] {
+            if !self.active[sm.building] {
                 continue;
             }
             let p = self.m.plastic_slot(s);
-            let e0 = sm.edges(sm.drift(z0, 0), sm.drift(z0, n), z0[p]);
-            let e1 = sm.edges(sm.drift(z1, 0), sm.drift(z1, n), z1[p]);
+            let edges = |z: &[f64]| sm.mode_edges(mode, sm.drift(z, 0), sm.drift(z, n), z[p]);
+            let (Some(e0), Some(e1)) = (edges(z0), edges(z1)) else {
+                continue;
+            };
             for (a, b) in e0.iter().zip(&e1) {
                 if let Some(x) = hidden_rise(a.0, a.1, b.0, b.1, h) {
                     first = Some(first.map_or(x, |f| f.min(x)));
@@ -216,6 +219,21 @@ impl<'m> RowRun<'m> {
                     }
                 }
                 StoreyMode::Yielding(_) => StoreyMode::Elastic,
+                StoreyMode::Imk(_) => {
+                    // The spring takes its pieces' changes at this drift and rate; the plastic
+                    // drift moves to the new piece's force (by rounding, or by the whole force
+                    // where a side has just lost its strength), with the work of that move.
+                    let record = &mut self.storeys[s];
+                    let sp = sm.imk.as_ref().expect("an IMK mode has its spring");
+                    let st = record.imk.as_mut().expect("and its state");
+                    let f = st.advance(sp, d, r);
+                    record.yielded |= st.yielded;
+                    let p_new = d - f / sm.k;
+                    let f_mid = sm.k * (d - 0.5 * (p + p_new));
+                    z[slot + ns] += f_mid * (p_new - p);
+                    z[slot] = p_new;
+                    StoreyMode::Imk(*st.piece())
+                }
             };
         }
     }

@@ -165,13 +165,16 @@ impl LevelModel {
     }
 }
 
-/// One yielding storey's record (its spring state is in [`RowRun::storey_modes`]).
+/// One yielding storey's record (its spring state is in [`RowRun::storey_modes`], and an IMK
+/// storey's history here).
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct StoreyState {
     /// It has yielded at least once.
     pub yielded: bool,
     /// Its largest `|d| / h`.
     pub peak_drift_ratio: f64,
+    /// An IMK storey's spring state (None: bilinear).
+    pub imk: Option<crate::physics::imk::ImkState>,
 }
 
 /// The contact state of one level and its impact bookkeeping.

@@ -4,6 +4,7 @@
 
 use super::algebra::dot;
 use super::storey::StoreyModel;
+use crate::physics::imk::ImkSpring;
 use crate::physics::contact::Contact;
 use crate::physics::row::{struck_side, LevelSide, Row};
 use crate::physics::shear::{storey_drift_row, Modes};
@@ -227,6 +228,24 @@ impl RowModel {
                 let first = storeys.len();
                 for j in 0..n {
                     let modal_row = storey_drift_row(&modes.shape, j);
+                    let imk = y.deterioration.as_ref().map(|det| {
+                        let k = b.stiffness[j];
+                        let h = b.heights[j];
+                        ImkSpring::from_ratios(
+                            det.rule,
+                            k,
+                            h,
+                            y.force[j] / (k * h),
+                            y.post_yield[j],
+                            (
+                                det.plastic[j],
+                                det.post_capping[j],
+                                det.residual[j],
+                                det.ultimate[j],
+                            ),
+                            det.energy.as_ref().map(|e| e[j]),
+                        )
+                    });
                     storeys.push(StoreyModel {
                         building: k,
                         storey: j,
@@ -239,6 +258,7 @@ impl RowModel {
                         row: modal_row.clone(),
                         psi: modal_row.clone(),
                         modal_row,
+                        imk,
                     });
                 }
                 first

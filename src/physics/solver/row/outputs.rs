@@ -252,8 +252,8 @@ impl<'m> RowRun<'m> {
                             let sm = &m.storeys[s];
                             let p = z[m.plastic_slot(s)];
                             let pv = match self.storey_modes[s] {
-                                StoreyMode::Yielding(_) => (1.0 - sm.b) * dv,
                                 StoreyMode::Elastic => 0.0,
+                                mode => sm.flow(mode) * dv,
                             };
                             (c.k * (d - p), c.k * (dv - pv))
                         }

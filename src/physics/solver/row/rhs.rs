@@ -119,8 +119,9 @@ fn plastic_rhs(m: &RowModel, motion: &Motion, z: &[f64], out: &mut [f64]) {
         for (i, psi) in sm.psi.iter().enumerate() {
             out[n + sm.off + i] += psi * kp;
         }
-        if let StoreyMode::Yielding(_) = motion.storeys[s] {
-            let dp = (1.0 - sm.b) * sm.drift(z, n);
+        let mode = motion.storeys[s];
+        if mode != StoreyMode::Elastic {
+            let dp = sm.flow(mode) * sm.drift(z, n);
             out[ps] = dp;
             out[ps + ns] = sm.k * (sm.drift(z, 0) - p) * dp;
         }

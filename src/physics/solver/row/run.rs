@@ -8,6 +8,7 @@ use super::levels::{LevelState, StoreyState};
 use super::model::{LevelModel, RowModel};
 use super::sample::RowObserver;
 use super::storey::StoreyMode;
+use crate::physics::imk::ImkState;
 use crate::physics::row::{BuildingOutput, Collapse, LevelClosing};
 use crate::physics::solver::hermite::{quintic_max_bound, quintic_range, raise_quintic_peak};
 use crate::physics::solver::state::{Mode, Segment};
@@ -94,8 +95,18 @@ impl<'m> RowRun<'m> {
             touched: vec![false; m.buildings.len()],
             active: vec![true; m.buildings.len()],
             level_on: vec![true; m.levels.len()],
-            storey_modes: vec![StoreyMode::Elastic; m.storeys.len()],
-            storeys: vec![StoreyState::default(); m.storeys.len()],
+            storey_modes: (m.storeys.iter())
+                .map(|sm| match &sm.imk {
+                    Some(sp) => StoreyMode::Imk(*ImkState::new(sp).piece()),
+                    None => StoreyMode::Elastic,
+                })
+                .collect(),
+            storeys: (m.storeys.iter())
+                .map(|sm| StoreyState {
+                    imk: sm.imk.as_ref().map(ImkState::new),
+                    ..StoreyState::default()
+                })
+                .collect(),
             settled: false,
             firing: Vec::with_capacity(m.levels.len() + m.storeys.len()),
             closings: None,
@@ -418,10 +429,17 @@ impl<'m> RowRun<'m> {
         self.levels.iter().any(|l| l.mode != Mode::Free)
     }
 
-    /// Is some storey of a building still standing on a bounding line?
+    /// Is some storey of a building still standing on a bounding line (or an IMK piece that
+    /// flows one way)?
     pub fn any_yielding(&self) -> bool {
-        (self.storey_modes.iter().zip(&self.m.storeys))
-            .any(|(m, sm)| matches!(m, StoreyMode::Yielding(_)) && !self.gone[sm.building])
+        (self.storey_modes.iter().zip(&self.m.storeys)).any(|(m, sm)| {
+            let one_way = match m {
+                StoreyMode::Elastic => false,
+                StoreyMode::Yielding(_) => true,
+                StoreyMode::Imk(piece) => piece.heading != 0.0,
+            };
+            one_way && !self.gone[sm.building]
+        })
     }
 
     /// `z` with the buildings that left the scene at rest: what the settling check reads (a

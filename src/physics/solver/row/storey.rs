@@ -3,6 +3,7 @@
 //! storeys' model ([`super::yielding`]) that the row's model and its integration read.
 
 use super::algebra::dot;
+use crate::physics::imk::{ImkSpring, Piece};
 use crate::physics::solver::events::error_margin;
 use crate::physics::solver::hermite::{cubic_max_bound, hermite_range};
 
@@ -18,6 +19,9 @@ pub(crate) enum StoreyMode {
     Elastic,
     /// On its upper (`+1`) or lower (`-1`) bounding line: force slope `b k`.
     Yielding(f64),
+    /// A deteriorating (IMK) storey on this piece of its force-drift law
+    /// ([`crate::physics::imk`]): force slope `piece.slope`.
+    Imk(Piece),
 }
 
 /// One yielding storey, as the integrators see it.
@@ -42,6 +46,8 @@ pub(crate) struct StoreyModel {
     /// How the storey's plastic load `k p` enters the accelerations `z'[n + off + i]`: the
     /// modal row again (`Phi^T D^T`), or `+-1 / m` of the two floors.
     pub psi: Vec<f64>,
+    /// Its IMK spring where it deteriorates (None: bilinear).
+    pub imk: Option<ImkSpring>,
 }
 
 impl StoreyModel {
@@ -58,12 +64,57 @@ impl StoreyModel {
     }
 
     /// Positive once `mode` must end: the back drift past the band (elastic), the drift
-    /// velocity reversed (yielding).
+    /// velocity reversed (yielding), an IMK piece's threshold passed or its heading reversed.
     #[inline]
     pub fn event_value(&self, mode: StoreyMode, d: f64, rate: f64, p: f64) -> f64 {
         match mode {
             StoreyMode::Elastic => self.back_drift(d, p).abs() - self.d_y * (1.0 + YIELD_SLACK),
             StoreyMode::Yielding(sign) => -sign * rate,
+            StoreyMode::Imk(piece) => piece.event_value(d, rate, self.imk_slack()),
+        }
+    }
+
+    /// The drift an IMK piece's threshold may be passed by before its event fires.
+    #[inline]
+    fn imk_slack(&self) -> f64 {
+        self.imk.as_ref().map_or(0.0, ImkSpring::slack)
+    }
+
+    /// The plastic drift's rate over the drift's in `mode`: `p' = flow d'` (0 where the force
+    /// moves with the initial stiffness, so the plastic drift stands still).
+    #[inline]
+    pub fn flow(&self, mode: StoreyMode) -> f64 {
+        match mode {
+            StoreyMode::Elastic => 0.0,
+            StoreyMode::Yielding(_) => 1.0 - self.b,
+            StoreyMode::Imk(piece) => 1.0 - piece.slope / self.k,
+        }
+    }
+
+    /// Can the storey in `mode` take an exact free step (its plastic drift standing still, and
+    /// no reversal to watch)? An elastic storey, an IMK one on a piece of the initial stiffness
+    /// that does not flow one way.
+    #[inline]
+    pub fn free(&self, mode: StoreyMode) -> bool {
+        match mode {
+            StoreyMode::Elastic => true,
+            StoreyMode::Yielding(_) => false,
+            StoreyMode::Imk(piece) => piece.slope == self.k && piece.heading == 0.0,
+        }
+    }
+
+    /// The edges of what `mode` may not pass without an event, as functions that reach 0 on
+    /// them, with their rates (for the checks of a step that no event hides inside it): the
+    /// band of an elastic storey, the thresholds of an IMK piece; none while it yields.
+    #[inline]
+    pub fn mode_edges(&self, mode: StoreyMode, d: f64, rate: f64, p: f64) -> Option<[(f64, f64); 2]> {
+        match mode {
+            StoreyMode::Elastic => Some(self.edges(d, rate, p)),
+            StoreyMode::Yielding(_) => None,
+            StoreyMode::Imk(piece) => {
+                let slack = self.imk_slack();
+                Some([(d - piece.hi - slack, rate), (piece.lo - d - slack, -rate)])
+            }
         }
     }
 
@@ -71,8 +122,18 @@ impl StoreyModel {
     /// drift and rate `[d0, d0', d1, d1']` at its ends and plastic drift `p`, when `bound`
     /// bounds `|d''''|` over it? As a level's `may_touch`: the Hermite cubic of each edge
     /// function within twice its error bound of 0.
-    pub fn may_yield(&self, [d0, r0, d1, r1]: [f64; 4], p: f64, bound: f64, h: f64) -> bool {
-        may_reach(self.edges(d0, r0, p), self.edges(d1, r1, p), bound, h)
+    pub fn may_yield(
+        &self,
+        mode: StoreyMode,
+        [d0, r0, d1, r1]: [f64; 4],
+        p: f64,
+        bound: f64,
+        h: f64,
+    ) -> bool {
+        match (self.mode_edges(mode, d0, r0, p), self.mode_edges(mode, d1, r1, p)) {
+            (Some(e0), Some(e1)) => may_reach(e0, e1, bound, h),
+            _ => true,
+        }
     }
 
     /// The band's two edges as functions that reach 0 on them: `[s - d_y, -s - d_y]` with

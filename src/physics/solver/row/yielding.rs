@@ -118,8 +118,8 @@ impl RowModel {
             }
             let kp = sm.k * z[self.plastic_slot(s)];
             let kdp = match modes[s] {
-                StoreyMode::Yielding(_) => sm.k * (1.0 - sm.b) * sm.drift(z, self.n),
                 StoreyMode::Elastic => 0.0,
+                mode => sm.k * sm.flow(mode) * sm.drift(z, self.n),
             };
             for (i, p) in sm.psi.iter().enumerate() {
                 acc[sm.off - o + i] += p * kp;
@@ -143,8 +143,11 @@ impl RowModel {
     }
 
     /// Can no storey yield again in the free motion from modal state `z` (no level in contact,
-    /// every storey in its band)? See the module's text.
-    pub(crate) fn settled(&self, z: &[f64]) -> bool {
+    /// every storey in its band, `modes` the storeys' states)? See the module's text.
+    pub(crate) fn settled(&self, z: &[f64], modes: &[StoreyMode]) -> bool {
+        if self.storeys.iter().any(|sm| sm.imk.is_some()) {
+            return self.settled_imk(z, modes);
+        }
         if self.storeys.iter().any(|sm| sm.geometric != 0.0) {
             return self.settled_p_delta(z);
         }
@@ -180,6 +183,72 @@ impl RowModel {
         })
     }
 
+    /// [`RowModel::settled`] with IMK storeys: each on a piece that does not flow one way, a
+    /// linear spring of its slope `K` (the unloading stiffness may have deteriorated below `k`),
+    /// so the motion's energy `E' = E + sum f^2 (1/2K - 1/2k)` (`E` counts each spring as `k`'s)
+    /// can only fall, and bounds the storey's drift within `sqrt(2 E' / K)` of where its force
+    /// is zero. It stays on its piece while that reach is inside the piece's thresholds; a
+    /// bilinear storey beside it stays in its band as in [`RowModel::settled`] with `E'`. With
+    /// P-Delta the plastic drifts' static response is the one of free pieces only (slope `k`):
+    /// a storey on another piece keeps the run going.
+    fn settled_imk(&self, z: &[f64], modes: &[StoreyMode]) -> bool {
+        let p_delta = self.storeys.iter().any(|sm| sm.geometric != 0.0);
+        let n = self.n;
+        let mut qs = vec![0.0; n];
+        let mut e = if p_delta {
+            self.static_offsets(z, &mut qs);
+            (0..n)
+                .map(|i| {
+                    let x = z[i] - qs[i];
+                    0.5 * (z[n + i] * z[n + i] + self.w2[i] * x * x)
+                })
+                .sum()
+        } else {
+            self.mechanical_energy(z).max(0.0)
+        };
+        let drift = |sm: &super::storey::StoreyModel| {
+            let o = self.buildings[sm.building].off;
+            dot(&sm.modal_row, &z[o..])
+        };
+        for (s, (sm, mode)) in self.storeys.iter().zip(modes).enumerate() {
+            if let StoreyMode::Imk(piece) = mode {
+                if piece.heading != 0.0 || piece.slope <= 0.0 || (p_delta && piece.slope != sm.k) {
+                    return false;
+                }
+                let f = sm.k * (drift(sm) - z[self.plastic_slot(s)]);
+                e += f * f * (0.5 / piece.slope - 0.5 / sm.k);
+            }
+        }
+        self.storeys.iter().zip(modes).enumerate().all(|(s, (sm, mode))| {
+            let p = z[self.plastic_slot(s)];
+            // Where the storey's force is zero at rest, and its stiffness about there.
+            let (rest, stiffness) = match mode {
+                StoreyMode::Imk(piece) => (piece.d0 - piece.f0 / piece.slope, piece.slope),
+                _ => (p, sm.k),
+            };
+            let (center, stiffness) = if p_delta {
+                let o = self.buildings[sm.building].off;
+                (dot(&sm.modal_row, &qs[o..]), stiffness - sm.geometric)
+            } else {
+                (rest, stiffness)
+            };
+            if stiffness <= 0.0 {
+                return false;
+            }
+            let reach = (2.0 * e / stiffness).sqrt();
+            match mode {
+                StoreyMode::Imk(piece) => {
+                    let sp = sm.imk.as_ref().expect("an IMK mode has its spring");
+                    let slack = sp.slack();
+                    reach <= sp.rest_reach()
+                        && center - reach >= piece.rest_lo - slack
+                        && center + reach <= piece.rest_hi + slack
+                }
+                _ => sm.back_drift(center, p).abs() + reach <= sm.d_y * (1.0 + YIELD_SLACK),
+            }
+        })
+    }
+
     /// Each building with a storey that yields now or may reach a bounding line over the
     /// exact free step `z -> z1` of length `h` (modal states, each mode's `|q''''|` bound in
     /// `bounds`), into `out`; whether any.
@@ -197,8 +266,8 @@ impl RowModel {
                 continue;
             }
             let (ends, bound) = self.drift_over_step(sm.building, &sm.modal_row, (z, z1), bounds);
-            out[sm.building] = *mode != StoreyMode::Elastic
-                || sm.may_yield(ends, z[self.plastic_slot(s)], bound, h);
+            out[sm.building] =
+                !sm.free(*mode) || sm.may_yield(*mode, ends, z[self.plastic_slot(s)], bound, h);
         }
         out.iter().any(|&x| x)
     }
@@ -251,8 +320,8 @@ pub(crate) fn next_segment(
         return None;
     }
     let settled = || match run.standing_state(&run.z) {
-        Some(standing) => m.settled(&standing),
-        None => m.settled(&run.z),
+        Some(standing) => m.settled(&standing, &run.storey_modes),
+        None => m.settled(&run.z, &run.storey_modes),
     };
     if !run.any_contact() && !run.any_yielding() && settled() {
         run.settled = true;
