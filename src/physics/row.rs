@@ -404,6 +404,11 @@ pub struct StoreyOutput {
     pub hysteretic_energy: f64,
     /// It yielded at least once.
     pub yielded: bool,
+    /// An IMK storey's capping strength left over its initial one, the weaker side's (0: no
+    /// strength left); NaN for a bilinear storey.
+    pub strength_ratio: f64,
+    /// An IMK storey passed its capping point.
+    pub capped: bool,
 }
 
 impl InelasticOutput {

@@ -212,6 +212,14 @@ fn every_imk_run_converges_on_the_cpu_paths() {
     let all = scenes();
     let scenes: Vec<&Scene> = all.iter().collect();
     let truth = truths(&scenes);
+    // What each scene is for: every IMK scene passes a capping point; those with the energy
+    // rule lose strength.
+    for (sc, t) in scenes.iter().zip(&truth) {
+        assert!(t.storeys.iter().any(|s| s.capped), "{}: capped", sc.name);
+        let energy_rule = !sc.name.contains("no energy rule");
+        let lost = t.storeys.iter().any(|s| s.strength_ratio < 1.0);
+        assert_eq!(lost, energy_rule, "{}: strength lost", sc.name);
+    }
     let mut bad = Vec::new();
     type Path = fn(&Scene, f64) -> RowOutput;
     let paths: [(&str, Path); 2] = [

@@ -317,6 +317,8 @@ impl RowPlan {
                         peak_ductility: f64::NAN,
                         hysteretic_energy: f64::NAN,
                         yielded: false,
+                        strength_ratio: f64::NAN,
+                        capped: false,
                     });
                     if self.storey_columns {
                         c.extend([

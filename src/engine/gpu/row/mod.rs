@@ -347,6 +347,8 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> 
                 peak_ductility: s[shape.s_storeys() + k] * st.height / st.d_y,
                 hysteretic_energy: s[ps + ns + k],
                 yielded: c[shape.c_storeys() + SC_STRIDE * k + SC_YIELDED] != 0,
+                strength_ratio: f64::NAN,
+                capped: false,
             })
             .collect();
         let spans: Vec<_> = (shape.first_storeys().into_iter())

@@ -415,6 +415,11 @@ impl<'m> RowRun<'m> {
                 peak_ductility: st.peak_drift_ratio * sm.height / sm.d_y,
                 hysteretic_energy: self.z[m.plastic_slot(s) + ns],
                 yielded: st.yielded,
+                strength_ratio: match (&sm.imk, &st.imk) {
+                    (Some(sp), Some(state)) => state.strength_ratio(sp),
+                    _ => f64::NAN,
+                },
+                capped: st.imk.is_some_and(|state| state.capped),
             })
             .collect();
         let mut out = RowOutput {
