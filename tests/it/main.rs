@@ -32,6 +32,7 @@ mod gpu_stop;
 mod hard;
 mod idle_axes;
 mod im_columns;
+mod imk_config;
 mod inelastic;
 mod inputs;
 mod intensity;

@@ -319,7 +319,8 @@ fn check_ultimate(
                 ),
             ),
         };
-        if u <= capping {
+        // "At" as written: 0.005 + 0.03 rounds below 0.035.
+        if u <= capping * (1.0 + 1e-12) {
             let name = (storeys.key)(ImkKey::Ultimate.key());
             let at = match r.ultimate_drift_ratio {
                 Some(StoreyValues::Each(_)) => format!("{name}[{i}]"),
