@@ -217,6 +217,10 @@ fn imk_given(r: &RawShearBuilding, k: ImkKey) -> Option<&StoreyValues> {
     }
 }
 
+/// An IMK key as given: its values per storey, and per storey the smallest and largest value
+/// a run takes.
+type Given = (Vec<f64>, Vec<(f64, f64)>);
+
 /// A building's IMK storeys (`hysteresis` names `rule`): `theta_p` and `theta_pc` required,
 /// `kappa` 0, `theta_u` infinite and `gamma` none where absent. `theta_y`: the yield drift
 /// ratio per storey at its largest where the config tells it (a yield drift); the ultimate
@@ -229,8 +233,7 @@ fn imk_storeys(
     storeys: &Storeys,
 ) -> Result<ImkSpec, ConfigError> {
     let mut axes = Vec::new();
-    // Per key: its values per storey, and per storey the smallest and largest a run takes.
-    let mut read = |k: ImkKey| -> Result<Option<(Vec<f64>, Vec<(f64, f64)>)>, ConfigError> {
+    let mut read = |k: ImkKey| -> Result<Option<Given>, ConfigError> {
         let Some(v) = imk_given(r, k) else {
             return Ok(None);
         };
