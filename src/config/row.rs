@@ -58,6 +58,18 @@ pub struct RawShearBuilding {
     /// `inverted_triangular` (lateral forces `~ m_i z_i`, the default) or `uniform` (`~ m_i`).
     pub yield_shear_distribution: Option<String>,
     pub post_yield_ratio: Option<PerStorey>,
+    /// The storeys' hysteresis (physics.md section 13): `bilinear` (the default),
+    /// `imk_bilinear` or `imk_peak_oriented` (capped, deteriorating: the keys below).
+    pub hysteresis: Option<String>,
+    /// IMK storeys, per storey in drift ratios: `theta_p` (yield to capping) and `theta_pc`
+    /// (capping to zero strength), both required; `kappa` (residual strength over the yield
+    /// strength, default 0); `theta_u` (no strength beyond it; absent: none); `gamma` (energy
+    /// capacity `E_t = gamma F_y theta_y h`; absent: no cyclic deterioration).
+    pub plastic_drift_ratio: Option<StoreyValues>,
+    pub post_capping_drift_ratio: Option<StoreyValues>,
+    pub residual_strength_ratio: Option<StoreyValues>,
+    pub ultimate_drift_ratio: Option<StoreyValues>,
+    pub energy_capacity_ratio: Option<StoreyValues>,
     /// Which stiffness the Rayleigh or modal damping is built on: `initial` (the only choice;
     /// tangent-stiffness damping can create spurious damping forces after yielding).
     pub damping_stiffness: Option<String>,
@@ -84,6 +96,25 @@ forms!(YieldDrift, "a drift ratio (every storey), a list of them (one per storey
     table: Some(|m| {
         RangeSpec::deserialize(serde::de::value::MapAccessDeserializer::new(m))
             .map(YieldDrift::Axis)
+    }),
+});
+
+/// A storey value as written: one value for every storey, one per storey, or a range table
+/// (`{ from, to, n }`): an axis of values each for every storey.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StoreyValues {
+    One(f64),
+    Each(Vec<f64>),
+    Axis(RangeSpec),
+}
+
+forms!(StoreyValues, "a number (every storey), a list of numbers (one per storey, bottom to top), or a range table { from, to, n } / { from, to, step } (an axis of values each for every storey)", {
+    number: Some(StoreyValues::One),
+    text: None,
+    list: Some(|s| elements(s).map(StoreyValues::Each)),
+    table: Some(|m| {
+        RangeSpec::deserialize(serde::de::value::MapAccessDeserializer::new(m))
+            .map(StoreyValues::Axis)
     }),
 });
 

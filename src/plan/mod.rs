@@ -37,6 +37,7 @@ pub mod columns;
 pub mod config;
 pub mod contact;
 pub mod decode;
+pub mod deterioration;
 pub mod intensity;
 pub mod limits;
 pub mod pair;

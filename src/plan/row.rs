@@ -14,6 +14,7 @@ use crate::physics::solver::row::RowScheme;
 use crate::physics::solver::Scheme;
 use crate::plan::axes::{Check, Motions, DAMPING, GAP, PERIOD, POSITIVE};
 use crate::plan::contact::{ContactPlan, ContactRun};
+use crate::plan::deterioration::ImkSpec;
 use crate::plan::pair::RunSpec;
 
 /// A yield drift ratio: > 0 and at most 0.2.
@@ -47,7 +48,7 @@ pub enum YieldStrength {
 }
 
 /// A yielding building's storeys, as the config gives them.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct YieldSpec {
     pub strength: YieldStrength,
     /// Post-yield stiffness ratio per storey.
@@ -56,6 +57,23 @@ pub struct YieldSpec {
     /// coefficient) is an axis: its values (one placeholder where it is sampled). A run's
     /// value ([`RowRunSpec::yield_value`]) replaces the strength's.
     pub axis: Option<Vec<f64>>,
+    /// Capped, deteriorating (IMK) storeys; None: bilinear.
+    pub deterioration: Option<ImkSpec>,
+}
+
+// The plan's fingerprint hashes this text: a bilinear building's reads as it did before IMK
+// storeys, so its sidecars still match.
+impl std::fmt::Debug for YieldSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = f.debug_struct("YieldSpec");
+        d.field("strength", &self.strength)
+            .field("post_yield", &self.post_yield)
+            .field("axis", &self.axis);
+        if let Some(imk) = &self.deterioration {
+            d.field("deterioration", imk);
+        }
+        d.finish()
+    }
 }
 
 impl YieldSpec {
@@ -68,21 +86,34 @@ impl YieldSpec {
         }
     }
 
+    /// The names of building `b`'s swept or sampled values, in column order (each a column
+    /// `bk_<name>`): its strength's, then each IMK key given as an axis.
+    pub fn swept_names(&self) -> Vec<&'static str> {
+        let strength = self.axis.is_some().then(|| self.value_name());
+        let imk = self.deterioration.iter().flat_map(|d| &d.axes);
+        strength
+            .into_iter()
+            .chain(imk.map(|(k, _)| k.key()))
+            .collect()
+    }
+
     /// The storeys of `b` (its stiffnesses, masses and heights final), with the run's `value`
-    /// of the swept strength where it has one.
-    pub fn of(&self, b: &ShearBuilding, value: Option<f64>) -> Yielding {
+    /// of the swept strength where it has one and its `imk` values of the IMK axes.
+    pub fn of(&self, b: &ShearBuilding, value: Option<f64>, imk: &[f64]) -> Yielding {
+        let deterioration = self.deterioration.as_ref().map(|d| d.of(imk));
         let force = match &self.strength {
             YieldStrength::DriftRatio(theta) => {
                 let theta = match value {
                     Some(v) => vec![v; theta.len()],
                     None => theta.clone(),
                 };
-                return Yielding::from_drift_ratio(
+                let y = Yielding::from_drift_ratio(
                     &b.stiffness,
                     &b.heights,
                     &theta,
                     self.post_yield.clone(),
                 );
+                return Yielding { deterioration, ..y };
             }
             YieldStrength::Force(f) => f.clone(),
             YieldStrength::BaseShear {
@@ -107,7 +138,7 @@ impl YieldSpec {
         Yielding {
             force,
             post_yield: self.post_yield.clone(),
-            deterioration: None,
+            deterioration,
         }
     }
 }
@@ -257,6 +288,8 @@ pub struct RowPlan {
     pub yielding: Vec<Option<YieldSpec>>,
     /// Per building, the index in `dims` of its swept or sampled strength (after the gaps).
     pub(crate) yield_dim: Vec<Option<usize>>,
+    /// Per building, the index in `dims` of each of its IMK axes (after its strength's).
+    pub(crate) imk_dim: Vec<Vec<usize>>,
     /// Write each yielding storey's columns too (`bk_sj_...`, [`STOREY_OUTPUTS`]): set where
     /// `--columns` asks for one ([`RowPlan::asks_storey_columns`]).
     pub storey_columns: bool,
@@ -277,6 +310,9 @@ pub struct RowRunSpec {
     pub sample: Option<usize>,
     /// Per building, the value of its swept or sampled strength (None where fixed or elastic).
     pub yield_value: Vec<Option<f64>>,
+    /// Per building, the value of each of its IMK axes ([`ImkSpec::axes`]; none where it has
+    /// none).
+    pub imk_value: Vec<Vec<f64>>,
 }
 
 impl RowPlan {
@@ -321,6 +357,15 @@ impl RowPlan {
                 .map(|b| {
                     let axis = self.yielding[b].as_ref()?.axis.as_ref()?;
                     Some(axis[at[self.yield_dim[b]?]])
+                })
+                .collect(),
+            imk_value: (0..nb)
+                .map(|b| {
+                    let axes = self.yielding[b].iter().flat_map(|y| &y.deterioration);
+                    let axes = axes.flat_map(|d| &d.axes);
+                    (axes.zip(&self.imk_dim[b]))
+                        .map(|((_, v), &k)| v[at[k]])
+                        .collect()
                 })
                 .collect(),
         };
@@ -377,6 +422,7 @@ impl RowPlan {
         std::iter::once((0, samples))
             .chain((1..1 + 3 * nb).map(|k| (k, self.dims[k])))
             .chain(self.yield_dim.iter().flatten().map(|&k| (k, self.dims[k])))
+            .chain(self.imk_dim.iter().flatten().map(|&k| (k, self.dims[k])))
             .collect()
     }
 
@@ -595,7 +641,7 @@ impl RowPlan {
                 );
                 s.yielding = self.yielding[b]
                     .as_ref()
-                    .map(|y| y.of(&s, run.yield_value[b]));
+                    .map(|y| y.of(&s, run.yield_value[b], &run.imk_value[b]));
                 match a.p_delta {
                     Some(ratio) => s.with_p_delta(ratio),
                     None => s,
@@ -640,10 +686,22 @@ impl RowPlan {
             .collect()
     }
 
-    /// Building `b`'s yielding storeys where their strength is swept or sampled (it then has
-    /// a parameter column, `bk_yield_drift_ratio` or `bk_yield_base_shear_coefficient`).
-    pub fn swept_yield(&self, b: usize) -> Option<&YieldSpec> {
-        self.yielding[b].as_ref().filter(|y| y.axis.is_some())
+    /// Building `b`'s swept or sampled values' names, each a parameter column `bk_<name>`
+    /// after `bk_xi` ([`YieldSpec::swept_names`]; none for an elastic building).
+    pub fn swept_names(&self, b: usize) -> Vec<&'static str> {
+        self.yielding[b]
+            .as_ref()
+            .map_or_else(Vec::new, YieldSpec::swept_names)
+    }
+
+    /// `run`'s values of building `b`'s [`RowPlan::swept_names`], in their order.
+    pub fn swept_values(&self, b: usize, run: &RowRunSpec) -> Vec<Option<f64>> {
+        let strength = self.yielding[b]
+            .as_ref()
+            .filter(|y| y.axis.is_some())
+            .map(|_| run.yield_value[b]);
+        let imk = run.imk_value[b].iter().map(|&v| Some(v));
+        strength.into_iter().chain(imk).collect()
     }
     /// Is every run of this plan two elastic one-storey buildings whose floors meet (one contact
     /// level), without P-Delta, run by the fast scheme? Then the pair's kernels run it

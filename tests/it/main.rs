@@ -33,6 +33,7 @@ mod hard;
 mod idle_axes;
 mod imk;
 mod im_columns;
+mod imk_config;
 mod inelastic;
 mod inputs;
 mod intensity;

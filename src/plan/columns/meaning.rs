@@ -248,7 +248,7 @@ const ENERGY: [(&str, &str, &str, &str); 2] = [
 ];
 
 /// Per building `k`: suffix, unit, short name, meaning.
-const PER_BUILDING: [(&str, &str, &str, &str); 22] = [
+const PER_BUILDING: [(&str, &str, &str, &str); 27] = [
     ("sa_t1_g", "g", "Sa(T1), building {k}", "Sa(T1, 5 %) of the scaled record at building {k}'s fundamental period b{k}_t1_s, whatever it was scaled to: pseudo-spectral acceleration (w^2 times the peak displacement) of a linear oscillator from rest, exact for the acceleration linear between samples, over the record as simulated (its window if any, not the free tail)"),
     ("storeys", "-", "storeys, building {k}", "storeys of building {k}"),
     ("mass_kg", "kg", "floor mass, building {k}", "floor mass of building {k} (empty where floor masses are given)"),
@@ -256,6 +256,11 @@ const PER_BUILDING: [(&str, &str, &str, &str); 22] = [
     ("xi", "-", "damping ratio, building {k}", "damping ratio of building {k}"),
     ("yield_drift_ratio", "m/m", "yield drift ratio, building {k}", "yield drift ratio of every storey of building {k} (swept or sampled)"),
     ("yield_base_shear_coefficient", "-", "base shear strength, building {k}", "base shear strength of building {k} over its weight (swept or sampled)"),
+    ("plastic_drift_ratio", "m/m", "plastic drift ratio, building {k}", "IMK theta_p, yield to capping, of every storey of building {k} (swept)"),
+    ("post_capping_drift_ratio", "m/m", "post-capping drift ratio, building {k}", "IMK theta_pc, capping to zero strength, of every storey of building {k} (swept)"),
+    ("residual_strength_ratio", "-", "residual strength ratio, building {k}", "IMK kappa, residual strength over the yield strength, of every storey of building {k} (swept)"),
+    ("ultimate_drift_ratio", "m/m", "ultimate drift ratio, building {k}", "IMK theta_u, no strength beyond it, of every storey of building {k} (swept)"),
+    ("energy_capacity_ratio", "-", "energy capacity ratio, building {k}", "IMK gamma, energy capacity E_t = gamma F_y theta_y h, of every storey of building {k} (swept)"),
     ("peak_roof_m", "m", "peak roof displacement, building {k}", "largest roof displacement of building {k} relative to the ground"),
     ("peak_drift_ratio", "m/m", "peak drift ratio, building {k}", "largest interstorey drift ratio of building {k}"),
     ("drift_storey", "-", "storey of peak drift, building {k}", "the storey of that drift (from 1)"),

@@ -129,8 +129,8 @@ impl RowPlan {
             for c in ["storeys", "mass_kg", "t1_s", "xi"] {
                 h.push(format!("b{b}_{c}"));
             }
-            if let Some(y) = self.swept_yield(b - 1) {
-                h.push(format!("b{b}_{}", y.value_name()));
+            for name in self.swept_names(b - 1) {
+                h.push(format!("b{b}_{name}"));
             }
         }
         for a in 1..nb {
@@ -199,9 +199,9 @@ impl RowPlan {
 
     /// The number of parameter columns, which lead the header: the status column's index.
     pub fn parameter_columns(&self) -> usize {
-        let swept = (0..self.buildings.len())
-            .filter(|&b| self.swept_yield(b).is_some())
-            .count();
+        let swept: usize = (0..self.buildings.len())
+            .map(|b| self.swept_names(b).len())
+            .sum();
         columns::CONTACT_AND_MOTION + 5 * self.buildings.len() + swept + self.gaps.len() + 1
     }
 
@@ -248,9 +248,7 @@ impl RowPlan {
             c.push(opt(run.mass[b]));
             c.push(num(run.period[b]));
             c.push(num(run.damping[b]));
-            if self.swept_yield(b).is_some() {
-                c.push(opt(run.yield_value[b]));
-            }
+            c.extend(self.swept_values(b, run).into_iter().map(opt));
         }
         c.extend(run.gaps.iter().map(|&g| num(g)));
         c.push(run.sample.map(|s| s.to_string()).unwrap_or_default());

@@ -183,6 +183,7 @@ pub(crate) fn parse_row_as(
         per_scene,
         yielding,
         yield_dim: layout.yield_dim,
+        imk_dim: layout.imk_dim,
         storey_columns: false,
         struck: Vec::new(),
     };
@@ -274,10 +275,15 @@ impl RowReader<'_> {
                 ))
             }
         };
-        let sampled_yield = (
-            self.sampled(RowSampled::YieldDrift(b)),
-            self.sampled(RowSampled::YieldShear(b)),
-        );
+        // A sampled yield drift ratio at its largest (an IMK storey's capping point).
+        let sampled_drift = self.samples.and_then(|s| {
+            let j = s
+                .axes
+                .iter()
+                .position(|a| *a == RowSampled::YieldDrift(b))?;
+            Some(s.points.iter().map(|p| p[j]).fold(0.0, f64::max))
+        });
+        let sampled_yield = (sampled_drift, self.sampled(RowSampled::YieldShear(b)));
         let invalid = |k: &str, m: String| self.invalid(k, m);
         let yielding = parse_yielding(r, n, sampled_yield, &key, &invalid)?;
         let period_s = self.required(RowSampled::Period(b), r.period_s.as_ref())?;
@@ -470,6 +476,8 @@ struct Layout {
     gap_axis: Vec<usize>,
     /// Per building, the index in `dims` of its swept or sampled strength.
     yield_dim: Vec<Option<usize>>,
+    /// Per building, the index in `dims` of each of its IMK axes.
+    imk_dim: Vec<Vec<usize>>,
 }
 
 impl Layout {
@@ -499,19 +507,32 @@ impl Layout {
                 .enumerate()
                 .map(|(a, g)| if gap_axis[a] == a { g.len() } else { 1 }),
         );
-        // Each swept or sampled strength: an axis after the gaps (none in an elastic row).
-        let yield_dim: Vec<Option<usize>> = yielding
-            .iter()
-            .map(|y| {
-                let axis = y.as_ref()?.axis.as_ref()?;
-                dims.push(axis.len());
-                Some(dims.len() - 1)
-            })
-            .collect();
+        // Each swept or sampled strength, then that building's IMK axes: axes after the gaps
+        // (none in an elastic row).
+        let mut yield_dim = Vec::new();
+        let mut imk_dim = Vec::new();
+        for y in yielding {
+            let mut push = |n: usize| {
+                dims.push(n);
+                dims.len() - 1
+            };
+            yield_dim.push(
+                y.as_ref()
+                    .and_then(|y| y.axis.as_ref())
+                    .map(|a| push(a.len())),
+            );
+            let imk = y.iter().flat_map(|y| &y.deterioration);
+            imk_dim.push(
+                imk.flat_map(|d| &d.axes)
+                    .map(|(_, v)| push(v.len()))
+                    .collect(),
+            );
+        }
         Layout {
             dims,
             gap_axis,
             yield_dim,
+            imk_dim,
         }
     }
 

@@ -1,9 +1,12 @@
-//! A building's yielding storeys decoded from its `[[building]]` keys.
+//! A building's yielding storeys decoded from its `[[building]]` keys: their strength, their
+//! hardening, and where `hysteresis` names an IMK rule, their capping and deterioration.
 
 use crate::config::axis::Axis;
 use crate::config::error::ConfigError;
-use crate::config::row::{PerStorey, RawShearBuilding, YieldDrift};
+use crate::config::row::{PerStorey, RawShearBuilding, StoreyValues, YieldDrift};
+use crate::physics::shear::{Deterioration, ImkRule};
 use crate::plan::axes::{check_axis, Check};
+use crate::plan::deterioration::{hysteresis, ImkKey, ImkSpec, HYSTERESIS_WORDS};
 use crate::plan::row::{YieldSpec, YieldStrength, YIELD_DRIFT, YIELD_SHEAR};
 
 /// The keys of one building's storeys: `n` of them; `key` names a key, `invalid` makes its
@@ -56,20 +59,41 @@ impl Storeys<'_> {
         check_axis(&key, &v, ok, expected).map_err(|e| (self.invalid)(&e.key, e.message))?;
         Ok(v)
     }
+
+    /// A value for every storey, one per storey, or an axis, each within `check`: the values
+    /// per storey (an axis's first for every storey), and the axis's values where it is one.
+    fn storey_values(
+        &self,
+        name: &str,
+        v: &StoreyValues,
+        (ok, expected): Check,
+    ) -> Result<(Vec<f64>, Option<Vec<f64>>), ConfigError> {
+        let one = match v {
+            StoreyValues::One(x) => PerStorey::One(*x),
+            StoreyValues::Each(v) => PerStorey::Each(v.clone()),
+            StoreyValues::Axis(range) => {
+                let v = self.values(name, &Axis::Range(range.clone()), (ok, expected))?;
+                return Ok((vec![v[0]; self.n], Some(v)));
+            }
+        };
+        Ok((self.per_storey(name, &one, &ok, expected)?, None))
+    }
 }
 
 /// A building's yielding storeys as its `[[building]]` gives them (`key` names its keys), or
 /// None where it gives none (elastic).
+///
+/// `sampled_drift`: the largest yield drift ratio `[sample]` draws, where it samples it.
 pub(crate) fn parse_yielding(
     r: &RawShearBuilding,
     n: usize,
-    (sampled_drift, sampled_shear): (bool, bool),
+    (sampled_drift, sampled_shear): (Option<f64>, bool),
     key: &dyn Fn(&str) -> String,
     invalid: &dyn Fn(&str, String) -> ConfigError,
 ) -> Result<Option<YieldSpec>, ConfigError> {
     for (sampled, given, name) in [
         (
-            sampled_drift,
+            sampled_drift.is_some(),
             r.yield_drift_ratio.is_some(),
             "yield_drift_ratio",
         ),
@@ -87,21 +111,36 @@ pub(crate) fn parse_yielding(
         }
     }
     check_damping_stiffness(r, key, invalid)?;
+    let rule = match r.hysteresis.as_deref().map(|w| (w, hysteresis(w))) {
+        None => None,
+        Some((_, Some(rule))) => rule,
+        Some((other, None)) => {
+            return Err(invalid(
+                &key("hysteresis"),
+                format!("`{other}`: expected {HYSTERESIS_WORDS}"),
+            ))
+        }
+    };
     let storeys = Storeys { n, key, invalid };
     let strengths = [
-        r.yield_drift_ratio.is_some() || sampled_drift,
+        r.yield_drift_ratio.is_some() || sampled_drift.is_some(),
         r.yield_force_n.is_some(),
         r.yield_base_shear_coefficient.is_some() || sampled_shear,
     ];
     let (strength, axis) = match strengths.iter().filter(|&&x| x).count() {
         0 => {
+            let imk = ImkKey::ALL.map(|k| (imk_given(r, k).is_some(), k.key()));
             for (given, name) in [
                 (r.post_yield_ratio.is_some(), "post_yield_ratio"),
                 (
                     r.yield_shear_distribution.is_some(),
                     "yield_shear_distribution",
                 ),
-            ] {
+                (r.hysteresis.is_some(), "hysteresis"),
+            ]
+            .into_iter()
+            .chain(imk)
+            {
                 if given {
                     return Err(invalid(
                         &key(name),
@@ -111,7 +150,7 @@ pub(crate) fn parse_yielding(
             }
             return Ok(None);
         }
-        1 => strength(r, sampled_drift, &storeys)?,
+        1 => strength(r, sampled_drift.is_some(), &storeys)?,
         _ => {
             return Err(invalid(
                 &key("yield_drift_ratio"),
@@ -135,11 +174,172 @@ pub(crate) fn parse_yielding(
         )?,
         None => vec![0.0; n],
     };
+    // The yield drift ratio per storey at its largest, where the config tells it.
+    let theta_y = match (&strength, sampled_drift) {
+        (_, Some(max)) => Some(vec![max; n]),
+        (YieldStrength::DriftRatio(theta), None) => Some(match &axis {
+            Some(a) => vec![a.iter().cloned().fold(0.0, f64::max); n],
+            None => theta.clone(),
+        }),
+        _ => None,
+    };
+    let deterioration = match rule {
+        Some(rule) => Some(imk_storeys(r, rule, theta_y.as_deref(), &storeys)?),
+        None => {
+            if let Some(k) = ImkKey::ALL.into_iter().find(|k| imk_given(r, *k).is_some()) {
+                return Err(invalid(
+                    &key(k.key()),
+                    format!(
+                        "applies to IMK storeys only: add hysteresis = \"imk_bilinear\" or \"imk_peak_oriented\", or remove {}",
+                        k.key()
+                    ),
+                ));
+            }
+            None
+        }
+    };
     Ok(Some(YieldSpec {
         strength,
         post_yield,
         axis,
+        deterioration,
     }))
+}
+
+/// IMK key `k` as `r` gives it.
+fn imk_given(r: &RawShearBuilding, k: ImkKey) -> Option<&StoreyValues> {
+    match k {
+        ImkKey::Plastic => r.plastic_drift_ratio.as_ref(),
+        ImkKey::PostCapping => r.post_capping_drift_ratio.as_ref(),
+        ImkKey::Residual => r.residual_strength_ratio.as_ref(),
+        ImkKey::Ultimate => r.ultimate_drift_ratio.as_ref(),
+        ImkKey::Energy => r.energy_capacity_ratio.as_ref(),
+    }
+}
+
+/// An IMK key as given: its values per storey, and per storey the smallest and largest value
+/// a run takes.
+type Given = (Vec<f64>, Vec<(f64, f64)>);
+
+/// A building's IMK storeys (`hysteresis` names `rule`): `theta_p` and `theta_pc` required,
+/// `kappa` 0, `theta_u` infinite and `gamma` none where absent. `theta_y`: the yield drift
+/// ratio per storey at its largest where the config tells it (a yield drift); the ultimate
+/// drift must lie beyond the capping point `theta_y + theta_p` at its largest, or beyond
+/// `theta_p` where `theta_y` follows each run's stiffness (a force or base-shear strength).
+fn imk_storeys(
+    r: &RawShearBuilding,
+    rule: ImkRule,
+    theta_y: Option<&[f64]>,
+    storeys: &Storeys,
+) -> Result<ImkSpec, ConfigError> {
+    let mut axes = Vec::new();
+    let mut read = |k: ImkKey| -> Result<Option<Given>, ConfigError> {
+        let Some(v) = imk_given(r, k) else {
+            return Ok(None);
+        };
+        let (values, axis) = storeys.storey_values(k.key(), v, k.check())?;
+        let range = match &axis {
+            Some(a) => {
+                let lo = a.iter().cloned().fold(f64::INFINITY, f64::min);
+                let hi = a.iter().cloned().fold(0.0, f64::max);
+                vec![(lo, hi); storeys.n]
+            }
+            None => values.iter().map(|&x| (x, x)).collect(),
+        };
+        if let Some(a) = axis {
+            axes.push((k, a));
+        }
+        Ok(Some((values, range)))
+    };
+    let required = |k: ImkKey, what: &str| {
+        (storeys.invalid)(
+            &(storeys.key)(k.key()),
+            format!(
+                "missing: IMK storeys (hysteresis = \"{}\") need {} ({what})",
+                rule.key(),
+                k.key()
+            ),
+        )
+    };
+    let (plastic, plastic_range) = read(ImkKey::Plastic)?.ok_or_else(|| {
+        required(
+            ImkKey::Plastic,
+            "theta_p, the drift ratio from yield to capping",
+        )
+    })?;
+    let (post_capping, _) = read(ImkKey::PostCapping)?.ok_or_else(|| {
+        required(
+            ImkKey::PostCapping,
+            "theta_pc, the drift ratio from capping to zero strength",
+        )
+    })?;
+    let residual = read(ImkKey::Residual)?.map_or(vec![0.0; storeys.n], |(v, _)| v);
+    let ultimate = read(ImkKey::Ultimate)?;
+    let energy = read(ImkKey::Energy)?.map(|(v, _)| v);
+    if let Some((_, range)) = &ultimate {
+        check_ultimate(r, range, &plastic_range, theta_y, storeys)?;
+    }
+    Ok(ImkSpec {
+        deterioration: Deterioration {
+            rule,
+            plastic,
+            post_capping,
+            residual,
+            ultimate: ultimate.map_or(vec![f64::INFINITY; storeys.n], |(v, _)| v),
+            energy,
+        },
+        axes,
+    })
+}
+
+/// Each storey's ultimate drift ratio (its smallest, per storey in `ultimate`) beyond its
+/// capping point: `theta_y + theta_p` at their largest, or `theta_p` where `theta_y` is not
+/// known before a run.
+fn check_ultimate(
+    r: &RawShearBuilding,
+    ultimate: &[(f64, f64)],
+    plastic: &[(f64, f64)],
+    theta_y: Option<&[f64]>,
+    storeys: &Storeys,
+) -> Result<(), ConfigError> {
+    let show = crate::plan::limits::show;
+    for (i, (&(u, _), &(_, p))) in ultimate.iter().zip(plastic).enumerate() {
+        let (capping, what) = match theta_y {
+            Some(y) => (
+                y[i] + p,
+                format!(
+                    "capping point theta_y + theta_p = {} + {} = {}",
+                    show(y[i]),
+                    show(p),
+                    show(y[i] + p)
+                ),
+            ),
+            None => (
+                p,
+                format!(
+                    "plastic_drift_ratio theta_p = {} (theta_y follows each run's storey stiffness under yield_force_n or yield_base_shear_coefficient, so only theta_p is checked here)",
+                    show(p)
+                ),
+            ),
+        };
+        // "At" as written: 0.005 + 0.03 rounds below 0.035.
+        if u <= capping * (1.0 + 1e-12) {
+            let name = (storeys.key)(ImkKey::Ultimate.key());
+            let at = match r.ultimate_drift_ratio {
+                Some(StoreyValues::Each(_)) => format!("{name}[{i}]"),
+                _ => name,
+            };
+            return Err((storeys.invalid)(
+                &at,
+                format!(
+                    "{} is at or before storey {}'s {what}: expected an ultimate drift ratio beyond it",
+                    show(u),
+                    i + 1
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `damping_stiffness`: `initial`, the only choice.

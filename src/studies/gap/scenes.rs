@@ -79,8 +79,8 @@ impl Scenes<'_> {
                     for c in ["storeys", "mass_kg", "t1_s", "xi"] {
                         h.push(format!("b{b}_{c}"));
                     }
-                    if let Some(y) = r.swept_yield(b - 1) {
-                        h.push(format!("b{b}_{}", y.value_name()));
+                    for name in r.swept_names(b - 1) {
+                        h.push(format!("b{b}_{name}"));
                     }
                 }
             }
@@ -114,8 +114,8 @@ impl Scenes<'_> {
                     cells.push(r.mass[b].map(num).unwrap_or_default());
                     cells.push(num(r.period[b]));
                     cells.push(num(r.damping[b]));
-                    if plan.swept_yield(b).is_some() {
-                        cells.push(r.yield_value[b].map(num).unwrap_or_default());
+                    for v in plan.swept_values(b, &r) {
+                        cells.push(v.map(num).unwrap_or_default());
                     }
                 }
                 cells.push(sample(r.sample));
