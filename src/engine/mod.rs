@@ -199,6 +199,10 @@ impl Kernel {
             Kernel::Row if fast.energy => Some(EngineError::GpuUnfit(
                 "the energy balance of rows is integrated on the CPU only",
             )),
+            // The row kernel's storeys are bilinear: IMK storeys would run as bilinear there.
+            Kernel::Row if plan_has_imk(plan) => Some(EngineError::GpuUnfit(
+                "IMK storeys (hysteresis = \"imk_bilinear\" or \"imk_peak_oriented\") run on the CPU only",
+            )),
             Kernel::Row if calibrated && precision == Precision::F32 => {
                 Some(EngineError::GpuUnfit(
                     "--target-error on rows is calibrated in f64 (add --precision f64)",
@@ -206,6 +210,14 @@ impl Kernel {
             }
             Kernel::Row => None,
         }
+    }
+}
+
+/// Does a row plan have a building of IMK (deteriorating) storeys?
+fn plan_has_imk(plan: &Plan) -> bool {
+    match plan {
+        Plan::Row(r) => (r.yielding.iter().flatten()).any(|y| y.deterioration.is_some()),
+        Plan::Pair(_) => false,
     }
 }
 

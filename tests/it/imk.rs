@@ -24,7 +24,13 @@ pub(crate) struct Imk {
 }
 
 /// `s` with every storey an IMK spring of `rule`: yield drift ratio `theta`, hardening `b`.
-pub(crate) fn imk(mut s: ShearBuilding, rule: ImkRule, theta: f64, b: f64, r: Imk) -> ShearBuilding {
+pub(crate) fn imk(
+    mut s: ShearBuilding,
+    rule: ImkRule,
+    theta: f64,
+    b: f64,
+    r: Imk,
+) -> ShearBuilding {
     let n = s.storeys();
     let mut y = Yielding::from_drift_ratio(&s.stiffness, &s.heights, &vec![theta; n], vec![b; n]);
     y.deterioration = Some(Deterioration {
@@ -123,7 +129,13 @@ fn scenes() -> Vec<Scene> {
         "IMK bilinear storey past capping in free flight (gap 2 m)",
         row(
             vec![
-                imk(building(1, 0.6, Damping::Modal(0.05)), bilin, 0.004, 0.03, RC),
+                imk(
+                    building(1, 0.6, Damping::Modal(0.05)),
+                    bilin,
+                    0.004,
+                    0.03,
+                    RC,
+                ),
                 building(1, 0.3, Damping::Modal(0.05)),
             ],
             vec![2.0],
@@ -137,8 +149,20 @@ fn scenes() -> Vec<Scene> {
         "IMK peak-oriented storeys pounding (gap 1 cm)",
         row(
             vec![
-                imk(building(2, 0.5, Damping::Modal(0.05)), peak, 0.004, 0.03, RC),
-                imk(building(1, 0.3, Damping::Modal(0.05)), bilin, 0.003, 0.0, RC),
+                imk(
+                    building(2, 0.5, Damping::Modal(0.05)),
+                    peak,
+                    0.004,
+                    0.03,
+                    RC,
+                ),
+                imk(
+                    building(1, 0.3, Damping::Modal(0.05)),
+                    bilin,
+                    0.003,
+                    0.0,
+                    RC,
+                ),
             ],
             vec![0.01],
             LawKind::NonlinearViscoelastic,
@@ -170,7 +194,11 @@ fn scenes() -> Vec<Scene> {
                     bilin,
                     0.004,
                     0.02,
-                    Imk { theta_pc: 0.015, kappa: 0.3, ..RC },
+                    Imk {
+                        theta_pc: 0.015,
+                        kappa: 0.3,
+                        ..RC
+                    },
                 ),
                 building(1, 0.3, Damping::Modal(0.05)),
             ],
@@ -186,8 +214,14 @@ fn scenes() -> Vec<Scene> {
         model: RowModel::new(
             &Row::new(
                 vec![
-                    imk(building(3, 0.9, Damping::Rayleigh(0.05)), peak, 0.004, 0.01, RC)
-                        .with_p_delta(3.0),
+                    imk(
+                        building(3, 0.9, Damping::Rayleigh(0.05)),
+                        peak,
+                        0.004,
+                        0.01,
+                        RC,
+                    )
+                    .with_p_delta(3.0),
                     building(2, 0.3, Damping::Modal(0.05)),
                 ],
                 vec![0.02],

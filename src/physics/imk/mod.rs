@@ -398,7 +398,10 @@ impl ImkState {
                 }
                 match sp.rule {
                     ImkRule::Bilinear => {
-                        take(side.bilin_meet(sp, x0, g0, slope, other_failed), Mark::Backbone);
+                        take(
+                            side.bilin_meet(sp, x0, g0, slope, other_failed),
+                            Mark::Backbone,
+                        );
                         if !self.residual_reached {
                             if let Some(x) = side.bilin_residual_drift(sp, other_failed) {
                                 if x > x0 {
@@ -543,14 +546,12 @@ impl ImkState {
                 let u0 = sign * d;
                 let k_global = side.g_global / (side.x_global - u0);
                 let k_local = side.g_local / (side.x_local - u0);
-                let (k, branch) = if u0 < side.x_local
-                    && side.g_local < side.g_global
-                    && k_local > k_global
-                {
-                    (k_local, Branch::TowardsLocal(sign))
-                } else {
-                    (k_global, Branch::TowardsGlobal(sign))
-                };
+                let (k, branch) =
+                    if u0 < side.x_local && side.g_local < side.g_global && k_local > k_global {
+                        (k_local, Branch::TowardsLocal(sign))
+                    } else {
+                        (k_global, Branch::TowardsGlobal(sign))
+                    };
                 self.set_piece(sp, d, f, k, branch);
             }
         }

@@ -94,7 +94,12 @@ impl Side {
             }
             ImkRule::PeakOriented => {
                 if x < self.ucap {
-                    (self.fcap + self.kp * (x - self.ucap), self.kp, self.ucap, Mark::Break)
+                    (
+                        self.fcap + self.kp * (x - self.ucap),
+                        self.kp,
+                        self.ucap,
+                        Mark::Break,
+                    )
                 } else if x < ures {
                     let g = self.fcap + self.kpc * (x - self.ucap);
                     (g, self.kpc, ures, at_residual)
@@ -156,7 +161,12 @@ impl Side {
     /// the capping point their new intersection (OpenSees' rule, both materials; `IMKBilin`
     /// also flattens the post-capping slope with the strength and keeps the hardening line
     /// above the residual strength).
-    pub fn deteriorate(&mut self, sp: &ImkSpring, beta: f64, (x_from, g_from, kunload): (f64, f64, f64)) {
+    pub fn deteriorate(
+        &mut self,
+        sp: &ImkSpring,
+        beta: f64,
+        (x_from, g_from, kunload): (f64, f64, f64),
+    ) {
         let keep = 1.0 - beta;
         let fcap_proj = (self.fcap - self.kpc * self.ucap) * keep;
         self.fy *= keep;

@@ -3,7 +3,15 @@ use super::*;
 /// The storey of the research notes' OpenSees runs: k = 2e7 N/m, h = 3 m, theta_y = 0.005,
 /// b = 0.03, theta_p = 0.02, theta_pc = 0.08, kappa = 0.2, theta_u = 0.15, gamma = 50.
 fn spring(rule: ImkRule, gamma: Option<f64>) -> ImkSpring {
-    ImkSpring::from_ratios(rule, 2.0e7, 3.0, 0.005, 0.03, (0.02, 0.08, 0.2, 0.15), gamma)
+    ImkSpring::from_ratios(
+        rule,
+        2.0e7,
+        3.0,
+        0.005,
+        0.03,
+        (0.02, 0.08, 0.2, 0.15),
+        gamma,
+    )
 }
 
 /// The undeteriorated backbone in closed form (physics.md section 13).
@@ -42,14 +50,28 @@ fn a_monotonic_push_follows_the_backbone_in_closed_form() {
         let path: Vec<f64> = (1..=500).map(|i| i as f64 * 1e-3).collect();
         // (The ultimate drift itself is an edge either way.)
         let near_uu = |d: f64| (d.abs() - sp.uu).abs() < 1e-6;
-        for (d, f) in path.iter().zip(drive(&sp, &path)).filter(|(d, _)| !near_uu(**d)) {
+        for (d, f) in path
+            .iter()
+            .zip(drive(&sp, &path))
+            .filter(|(d, _)| !near_uu(**d))
+        {
             let want = backbone(&sp, *d);
-            assert!((f - want).abs() <= 1e-6 * sp.fy, "{rule:?} at {d}: {f} vs {want}");
+            assert!(
+                (f - want).abs() <= 1e-6 * sp.fy,
+                "{rule:?} at {d}: {f} vs {want}"
+            );
         }
         let neg: Vec<f64> = path.iter().map(|d| -d).collect();
-        for (d, f) in neg.iter().zip(drive(&sp, &neg)).filter(|(d, _)| !near_uu(**d)) {
+        for (d, f) in neg
+            .iter()
+            .zip(drive(&sp, &neg))
+            .filter(|(d, _)| !near_uu(**d))
+        {
             let want = -backbone(&sp, -d);
-            assert!((f - want).abs() <= 1e-6 * sp.fy, "{rule:?} at {d}: {f} vs {want}");
+            assert!(
+                (f - want).abs() <= 1e-6 * sp.fy,
+                "{rule:?} at {d}: {f} vs {want}"
+            );
         }
     }
 }
@@ -73,16 +95,22 @@ fn constant_amplitude_cycles_deteriorate_as_opensees() {
     let cases = [
         (
             ImkRule::Bilinear,
-            [327000.0, -306667.0, 286362.0, -267543.0, 248908.0, -231948.0, 215334.0, -200582.0],
+            [
+                327000.0, -306667.0, 286362.0, -267543.0, 248908.0, -231948.0, 215334.0, -200582.0,
+            ],
         ),
         (
             ImkRule::PeakOriented,
-            [327000.0, -306667.0, 296367.0, -286298.0, 276371.0, -266699.0, 257193.0, -247967.0],
+            [
+                327000.0, -306667.0, 296367.0, -286298.0, 276371.0, -266699.0, 257193.0, -247967.0,
+            ],
         ),
     ];
     for (rule, want) in cases {
         let sp = spring(rule, Some(50.0));
-        let path: Vec<f64> = (0..8).map(|i| if i % 2 == 0 { 0.06 } else { -0.06 }).collect();
+        let path: Vec<f64> = (0..8)
+            .map(|i| if i % 2 == 0 { 0.06 } else { -0.06 })
+            .collect();
         let got = drive(&sp, &path);
         for (g, w) in got.iter().zip(want) {
             // OpenSees' steps keep a step's stored energy in each excursion's: ~1e-3.
@@ -116,7 +144,9 @@ fn the_first_bilinear_cycle_is_the_energy_rule_by_hand() {
 fn without_an_energy_capacity_cycles_repeat() {
     for rule in [ImkRule::Bilinear, ImkRule::PeakOriented] {
         let sp = spring(rule, None);
-        let path: Vec<f64> = (0..8).map(|i| if i % 2 == 0 { 0.06 } else { -0.06 }).collect();
+        let path: Vec<f64> = (0..8)
+            .map(|i| if i % 2 == 0 { 0.06 } else { -0.06 })
+            .collect();
         let f = drive(&sp, &path);
         for w in f.windows(2) {
             assert!((w[0] + w[1]).abs() < 1e-6 * sp.fy, "{rule:?}: {f:?}");
@@ -128,7 +158,9 @@ fn without_an_energy_capacity_cycles_repeat() {
 fn once_the_energy_is_spent_no_strength_is_left() {
     for rule in [ImkRule::Bilinear, ImkRule::PeakOriented] {
         let sp = spring(rule, Some(5.0));
-        let path: Vec<f64> = (0..40).map(|i| if i % 2 == 0 { 0.06 } else { -0.06 }).collect();
+        let path: Vec<f64> = (0..40)
+            .map(|i| if i % 2 == 0 { 0.06 } else { -0.06 })
+            .collect();
         let mut st = ImkState::new(&sp);
         let mut at = 0.0;
         for &d in &path {

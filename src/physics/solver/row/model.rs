@@ -4,8 +4,8 @@
 
 use super::algebra::dot;
 use super::storey::StoreyModel;
-use crate::physics::imk::ImkSpring;
 use crate::physics::contact::Contact;
+use crate::physics::imk::ImkSpring;
 use crate::physics::row::{struck_side, LevelSide, Row};
 use crate::physics::shear::{storey_drift_row, Modes};
 use crate::physics::solver::events::fourth_derivative_bound;

@@ -107,7 +107,13 @@ impl StoreyModel {
     /// them, with their rates (for the checks of a step that no event hides inside it): the
     /// band of an elastic storey, the thresholds of an IMK piece; none while it yields.
     #[inline]
-    pub fn mode_edges(&self, mode: StoreyMode, d: f64, rate: f64, p: f64) -> Option<[(f64, f64); 2]> {
+    pub fn mode_edges(
+        &self,
+        mode: StoreyMode,
+        d: f64,
+        rate: f64,
+        p: f64,
+    ) -> Option<[(f64, f64); 2]> {
         match mode {
             StoreyMode::Elastic => Some(self.edges(d, rate, p)),
             StoreyMode::Yielding(_) => None,
@@ -130,7 +136,10 @@ impl StoreyModel {
         bound: f64,
         h: f64,
     ) -> bool {
-        match (self.mode_edges(mode, d0, r0, p), self.mode_edges(mode, d1, r1, p)) {
+        match (
+            self.mode_edges(mode, d0, r0, p),
+            self.mode_edges(mode, d1, r1, p),
+        ) {
             (Some(e0), Some(e1)) => may_reach(e0, e1, bound, h),
             _ => true,
         }

@@ -219,34 +219,38 @@ impl RowModel {
                 e += f * f * (0.5 / piece.slope - 0.5 / sm.k);
             }
         }
-        self.storeys.iter().zip(modes).enumerate().all(|(s, (sm, mode))| {
-            let p = z[self.plastic_slot(s)];
-            // Where the storey's force is zero at rest, and its stiffness about there.
-            let (rest, stiffness) = match mode {
-                StoreyMode::Imk(piece) => (piece.d0 - piece.f0 / piece.slope, piece.slope),
-                _ => (p, sm.k),
-            };
-            let (center, stiffness) = if p_delta {
-                let o = self.buildings[sm.building].off;
-                (dot(&sm.modal_row, &qs[o..]), stiffness - sm.geometric)
-            } else {
-                (rest, stiffness)
-            };
-            if stiffness <= 0.0 {
-                return false;
-            }
-            let reach = (2.0 * e / stiffness).sqrt();
-            match mode {
-                StoreyMode::Imk(piece) => {
-                    let sp = sm.imk.as_ref().expect("an IMK mode has its spring");
-                    let slack = sp.slack();
-                    reach <= sp.rest_reach()
-                        && center - reach >= piece.rest_lo - slack
-                        && center + reach <= piece.rest_hi + slack
+        self.storeys
+            .iter()
+            .zip(modes)
+            .enumerate()
+            .all(|(s, (sm, mode))| {
+                let p = z[self.plastic_slot(s)];
+                // Where the storey's force is zero at rest, and its stiffness about there.
+                let (rest, stiffness) = match mode {
+                    StoreyMode::Imk(piece) => (piece.d0 - piece.f0 / piece.slope, piece.slope),
+                    _ => (p, sm.k),
+                };
+                let (center, stiffness) = if p_delta {
+                    let o = self.buildings[sm.building].off;
+                    (dot(&sm.modal_row, &qs[o..]), stiffness - sm.geometric)
+                } else {
+                    (rest, stiffness)
+                };
+                if stiffness <= 0.0 {
+                    return false;
                 }
-                _ => sm.back_drift(center, p).abs() + reach <= sm.d_y * (1.0 + YIELD_SLACK),
-            }
-        })
+                let reach = (2.0 * e / stiffness).sqrt();
+                match mode {
+                    StoreyMode::Imk(piece) => {
+                        let sp = sm.imk.as_ref().expect("an IMK mode has its spring");
+                        let slack = sp.slack();
+                        reach <= sp.rest_reach()
+                            && center - reach >= piece.rest_lo - slack
+                            && center + reach <= piece.rest_hi + slack
+                    }
+                    _ => sm.back_drift(center, p).abs() + reach <= sm.d_y * (1.0 + YIELD_SLACK),
+                }
+            })
     }
 
     /// Each building with a storey that yields now or may reach a bounding line over the
