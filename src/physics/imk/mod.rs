@@ -390,10 +390,9 @@ impl ImkState {
             },
             Branch::Unloading => {
                 // The new excursion where the force crosses zero (towards the other side;
-                // before the first yield nothing deteriorates, and `IMKBilin` without an
-                // energy capacity has nothing to do there).
-                let matters = sp.rule == ImkRule::PeakOriented || sp.e_t.is_some();
-                if g0 < 0.0 && slope > 0.0 && matters && self.yielded {
+                // before the first yield nothing deteriorates). `IMKBilin` takes it without an
+                // energy capacity too: it keeps the hardening line above the residual there.
+                if g0 < 0.0 && slope > 0.0 && self.yielded {
                     take(x0 - g0 / slope, Mark::Zero);
                 }
                 match sp.rule {
@@ -524,16 +523,19 @@ impl ImkState {
     /// The force crossed zero off the backbone at drift `d`, moving towards side `sign`: that
     /// side's backbone deteriorates by the energy of the half cycle just ended.
     fn new_excursion(&mut self, sp: &ImkSpring, d: f64, sign: f64) {
-        if let Some(e_t) = sp.e_t {
-            let since = (self.work - self.work_mark).max(0.0);
-            match beta(since, e_t - self.work) {
-                Some(b) => {
-                    let x_from = sign * d;
-                    self.sides[idx(sign)].deteriorate(sp, b, (x_from, 0.0, self.kunload));
+        let b = match sp.e_t {
+            Some(e_t) => {
+                let since = (self.work - self.work_mark).max(0.0);
+                self.work_mark = self.work;
+                match beta(since, e_t - self.work) {
+                    Some(b) => b,
+                    None => return self.collapse(d),
                 }
-                None => return self.collapse(d),
             }
-            self.work_mark = self.work;
+            None => 0.0,
+        };
+        if sp.e_t.is_some() || sp.rule == ImkRule::Bilinear {
+            self.sides[idx(sign)].deteriorate(sp, b, (sign * d, 0.0, self.kunload));
         }
         let f = self.piece.force(d);
         match sp.rule {

@@ -193,3 +193,15 @@ fn the_work_on_a_closed_elastic_path_is_zero() {
     assert!(st.work_at(0.0).abs() < 1e-9 * sp.fy);
     assert!(!st.yielded);
 }
+
+/// `IMKBilin` keeps the hardening line above the residual strength at every zero crossing
+/// after yield, with or without an energy capacity (IMKBilin.cpp:166, 189-200): back from the
+/// residual plateau at -0.42 m, the reloading line meets the lowered hardening line. OpenSees
+/// 3.8.0 gives 293142.857 N at 0 (`benches/opensees_imk.py`, case iii).
+#[test]
+fn bilinear_lowers_its_hardening_at_a_zero_crossing_without_an_energy_capacity() {
+    let sp = spring(ImkRule::Bilinear, None);
+    let path = [0.06, -0.06, 0.18, -0.18, 0.30, -0.30, 0.42, -0.42, 0.0];
+    let f = drive(&sp, &path);
+    assert!((f[8] - 293142.857).abs() < 1e-3, "{f:?}");
+}
