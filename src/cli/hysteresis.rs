@@ -50,12 +50,12 @@ enum Of {
     /// A deteriorating (IMK) storey's shear against its drift through a cyclic drift protocol
     /// (physics.md section 13), quasi-static: every vertex of the loops (CSV) and the loops
     /// over the undeteriorated backbone (SVG).
-    Storey(storey::Args),
+    Storey(Box<storey::Args>),
 }
 
 pub fn run(a: Args) -> Result<()> {
     if let Some(Of::Storey(s)) = a.storey {
-        return storey::run(s);
+        return storey::run(*s);
     }
     let law_key = a.law.clone().unwrap_or_default();
     let output = super::default_output(a.output.clone(), "hysteresis.csv");
