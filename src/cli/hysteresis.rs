@@ -1,4 +1,7 @@
-//! `pound hysteresis`: force against penetration through one isolated impact, per e.
+//! `pound hysteresis`: force against penetration through one isolated impact, per e; `pound
+//! hysteresis storey`: an IMK storey's loops under a cyclic drift protocol ([`storey`]).
+
+pub mod storey;
 
 use super::{check_outputs, e_values, Holds};
 use anyhow::{bail, Context, Result};
@@ -8,9 +11,13 @@ use pounding::studies::fidelity;
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct Args {
+    #[command(subcommand)]
+    storey: Option<Of>,
     /// Contact law.
-    law: String,
+    #[arg(required = true)]
+    law: Option<String>,
     /// Restitution formula (laws that take zeta).
     #[arg(long, default_value = "ebrahimi")]
     formula: String,
@@ -37,10 +44,23 @@ pub struct Args {
     figure: super::FigureArgs,
 }
 
+/// What else the command draws the loops of.
+#[derive(clap::Subcommand)]
+enum Of {
+    /// A deteriorating (IMK) storey's shear against its drift through a cyclic drift protocol
+    /// (physics.md section 13), quasi-static: every vertex of the loops (CSV) and the loops
+    /// over the undeteriorated backbone (SVG).
+    Storey(Box<storey::Args>),
+}
+
 pub fn run(a: Args) -> Result<()> {
+    if let Some(Of::Storey(s)) = a.storey {
+        return storey::run(*s);
+    }
+    let law_key = a.law.clone().unwrap_or_default();
     let output = super::default_output(a.output.clone(), "hysteresis.csv");
-    let law = LawKind::from_key(&a.law)
-        .with_context(|| format!("law `{}`: expected one of {}", a.law, LawKind::keys()))?;
+    let law = LawKind::from_key(&law_key)
+        .with_context(|| format!("law `{law_key}`: expected one of {}", LawKind::keys()))?;
     let formula = Formula::from_key(&a.formula).with_context(|| {
         format!(
             "--formula `{}`: expected one of {}",

@@ -103,7 +103,8 @@ pub enum Cmd {
     /// Restitution fidelity: one isolated collision per damped law, formula and e; the
     /// achieved e and the energy taken out against 0.5 m_eff (1 - e^2) v0^2.
     Restitution(restitution::Args),
-    /// Force against penetration through one isolated impact (the seed's Fig. 5), per e.
+    /// Force against penetration through one isolated impact (the seed's Fig. 5), per e; `pound
+    /// hysteresis storey`: a deteriorating (IMK) storey's loops under a cyclic drift protocol.
     Hysteresis(hysteresis::Args),
     /// One run of a sweep, whole (pairs and rows, yielding storeys included): its time
     /// history at every record step and located event (CSV, plot) and its row as the sweep

@@ -1,5 +1,6 @@
 //! What users do with sweeps and single collisions: speed against error ([`accuracy`]),
-//! throughput ([`bench`](mod@bench)), restitution fidelity and hysteresis loops ([`fidelity`]), the
+//! throughput ([`bench`](mod@bench)), restitution fidelity and hysteresis loops ([`fidelity`]), an IMK storey's loops under a
+//! cyclic protocol ([`hysteresis`](mod@hysteresis)), the
 //! formulas' zeta(e) ([`formulas`]), fragility curves ([`fragility`]) with
 //! named damage states ([`damage_states`]), incremental dynamic analysis summaries ([`ida`]), what a study of a table gives ([`report`]), sensitivity plots
 //! ([`sensitivity`]), one run's time history ([`trace`]), the seed paper's checks ([`paper`]), and drawing
@@ -14,6 +15,7 @@ pub mod fidelity;
 pub mod formulas;
 pub mod fragility;
 pub mod gap;
+pub mod hysteresis;
 pub mod ida;
 pub mod paper;
 pub mod plot;

@@ -30,6 +30,7 @@ mod gpu_collapse;
 mod gpu_rows;
 mod gpu_stop;
 mod hard;
+mod hysteresis;
 mod idle_axes;
 mod im_columns;
 mod imk;
