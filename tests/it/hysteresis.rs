@@ -222,12 +222,6 @@ fn the_svg_is_well_formed_with_a_loop_per_cycle() {
 /// steps is up to 1.4e-6), held here to twice that.
 const OPENSEES_TOL: f64 = 1.3e-6;
 
-/// Where pound and OpenSees differ for a reason named: `IMKBilin` lowers the hardening slope
-/// at each new excursion ("candidateKp", IMKBilin.cpp:189-200) even with no cyclic
-/// deterioration (every Lamda 0), which pound does only with an energy capacity: after the
-/// residual plateau, the last return to zero drift (293142.9 N against 291000 N).
-const KNOWN_DIFFERENT: [(&str, &str, usize); 1] = [("residual", "imk_bilinear", 8)];
-
 #[test]
 fn peaks_agree_with_opensees_past_capping_and_on_the_residual_plateau() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/opensees_imk.toml");
@@ -257,9 +251,6 @@ fn peaks_agree_with_opensees_past_capping_and_on_the_residual_plateau() {
         let want = floats(&case["opensees_n"]);
         assert_eq!(peaks.len(), want.len(), "{name} {rule}");
         for (i, (r, w)) in peaks.iter().zip(&want).enumerate() {
-            if KNOWN_DIFFERENT.contains(&(name, rule, i)) {
-                continue;
-            }
             let diff = (r.shear_n - w).abs() / fy;
             worst = worst.max(diff);
             assert!(
