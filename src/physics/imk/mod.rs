@@ -74,13 +74,13 @@ impl ImkSpring {
     /// How close to rest a storey must be before its residual drift is taken, m: the reach of
     /// its motion (from the energy left) about where its force is zero. `IMKBilin` returns to
     /// the same line at each zero crossing (exact at any reach within its piece's rest
-    /// thresholds); a peak-oriented storey reloads towards its peaks through the crossing, a
-    /// softer line, so its rest point still moves by up to the reach: taken once that is below
-    /// 1e-6 of the yield drift.
+    /// thresholds); a peak-oriented storey's small loops (reloading towards its peaks through
+    /// the crossing, unloading at each turn) move its rest point by up to the reach: taken once
+    /// that is below 1e-6 of the yield drift, on any of its pieces.
     pub fn rest_reach(&self) -> f64 {
         match self.rule {
             ImkRule::Bilinear => f64::INFINITY,
-            ImkRule::PeakOriented => 1e-6 * self.fy / self.k,
+            ImkRule::PeakOriented => 1e-4 * self.fy / self.k,
         }
     }
 
@@ -100,9 +100,10 @@ pub struct Piece {
     pub lo: f64,
     pub hi: f64,
     pub heading: f64,
-    /// The thresholds other than the force's zero crossing: a new excursion there moves no
-    /// `IMKBilin` line and only starts a peak-oriented reloading line through the same point,
-    /// so a storey at rest (its force zero) settles within these ([`ImkSpring::rest_reach`]).
+    /// The thresholds other than the force's zero crossing and a local peak: a new excursion
+    /// there moves no `IMKBilin` line, and a peak-oriented storey's small loops about rest
+    /// (unloading, reloading through the crossing, on through the local peak) keep its force
+    /// continuous, so a storey at rest settles within these ([`ImkSpring::rest_reach`]).
     pub rest_lo: f64,
     pub rest_hi: f64,
 }
@@ -372,7 +373,7 @@ impl ImkState {
             if x < best.0 {
                 best = (x, m);
             }
-            if m != Mark::Zero {
+            if m != Mark::Zero && m != Mark::LocalPeak {
                 rest = rest.min(x);
             }
         };

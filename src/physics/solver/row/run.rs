@@ -429,14 +429,14 @@ impl<'m> RowRun<'m> {
         self.levels.iter().any(|l| l.mode != Mode::Free)
     }
 
-    /// Is some storey of a building still standing on a bounding line (or an IMK piece that
-    /// flows one way)?
+    /// Is some bilinear storey of a building still standing on a bounding line? (An IMK
+    /// storey's pieces are judged by [`RowModel::settled`].)
     pub fn any_yielding(&self) -> bool {
         (self.storey_modes.iter().zip(&self.m.storeys)).any(|(m, sm)| {
             let one_way = match m {
                 StoreyMode::Elastic => false,
                 StoreyMode::Yielding(_) => true,
-                StoreyMode::Imk(piece) => piece.heading != 0.0,
+                StoreyMode::Imk(_) => false,
             };
             one_way && !self.gone[sm.building]
         })

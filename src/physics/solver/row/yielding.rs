@@ -28,6 +28,7 @@ use super::storey::StoreyMode;
 // The band's slack, named here as the storeys' model (the GPU shader reads it by this path).
 pub(crate) use super::storey::YIELD_SLACK;
 use crate::physics::model::Forcing;
+use crate::physics::shear::ImkRule;
 use crate::physics::solver::state::Segment;
 
 /// After the record, a run goes on in free vibration for at most this many of its longest
@@ -212,7 +213,20 @@ impl RowModel {
         };
         for (s, (sm, mode)) in self.storeys.iter().zip(modes).enumerate() {
             if let StoreyMode::Imk(piece) = mode {
-                if piece.heading != 0.0 || piece.slope <= 0.0 || (p_delta && piece.slope != sm.k) {
+                // A peak-oriented storey may come to rest on a reloading line (its reach then
+                // bounded as on any piece); an `IMKBilin` one's lines that flow one way are
+                // its backbone's.
+                let loops = sm
+                    .imk
+                    .as_ref()
+                    .is_some_and(|sp| sp.rule == ImkRule::PeakOriented);
+                if (piece.heading != 0.0 && !loops)
+                    || piece.slope <= 0.0
+                    || (p_delta && piece.slope != sm.k)
+                {
+                    if std::env::var("IMK_DEBUG").is_ok() {
+                        eprintln!("s{s} blocks: {piece:?}");
+                    }
                     return false;
                 }
                 let f = sm.k * (drift(sm) - z[self.plastic_slot(s)]);
