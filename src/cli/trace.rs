@@ -16,7 +16,8 @@ pub struct Args {
     /// The time history at every record step and located event. A pair: displacements,
     /// velocities, absolute floor accelerations, penetration, contact force, contact mode. A
     /// row: every floor's displacement, each level's penetration, force and mode, and each
-    /// yielding storey's drift and plastic drift ratios, shear and hysteretic energy.
+    /// yielding storey's drift and plastic drift ratios, shear and hysteretic energy; an IMK
+    /// storey's drift (m), the force its law gives (N) and its branch too.
     /// (default: trace.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,

@@ -44,6 +44,7 @@ pub fn kind(column: &str) -> Kind {
             "_ductility_storey",
             "_collapsed",
             "_collapse_storey",
+            "_capped",
         ]
         .iter()
         .any(|end| c.ends_with(end)) =>

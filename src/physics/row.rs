@@ -390,6 +390,11 @@ pub struct InelasticOutput {
     pub hysteretic_energy: f64,
     /// Storeys that yielded at least once.
     pub yielded_storeys: u32,
+    /// The smallest IMK strength ratio over the storeys ([`StoreyOutput::strength_ratio`]);
+    /// NaN where no storey is IMK.
+    pub strength_ratio: f64,
+    /// IMK storeys that passed their capping point.
+    pub capped_storeys: u32,
 }
 
 /// What one yielding storey reports (with `--columns` asking for it).
@@ -413,9 +418,13 @@ pub struct StoreyOutput {
 
 impl InelasticOutput {
     /// Gather a building's storeys (bottom to top): the largest `|residual|` and ductility with
-    /// their storeys, the hysteretic energies summed, the storeys that yielded.
+    /// their storeys, the hysteretic energies summed, the storeys that yielded, the weakest
+    /// IMK storey's strength ratio and the storeys that passed capping.
     pub fn gather(storeys: &[StoreyOutput]) -> InelasticOutput {
-        let mut out = InelasticOutput::default();
+        let mut out = InelasticOutput {
+            strength_ratio: f64::NAN,
+            ..InelasticOutput::default()
+        };
         let mut residual: f64 = 0.0;
         for (j, st) in storeys.iter().enumerate() {
             if st.residual_drift_ratio.abs() > residual {
@@ -428,6 +437,9 @@ impl InelasticOutput {
             }
             out.hysteretic_energy += st.hysteretic_energy;
             out.yielded_storeys += st.yielded as u32;
+            // `min` takes the other where one is NaN: a bilinear storey's NaN is skipped.
+            out.strength_ratio = out.strength_ratio.min(st.strength_ratio);
+            out.capped_storeys += st.capped as u32;
         }
         out.residual_drift_ratio = residual;
         out

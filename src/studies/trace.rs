@@ -196,6 +196,10 @@ pub const STOREY_COLUMNS: [&str; 4] = [
     "hysteretic_energy_j",
 ];
 
+/// An IMK storey's further trace columns, after its [`STOREY_COLUMNS`]: its drift, the force
+/// its law gives there and the branch that force is on ([`crate::physics::imk::Branch::name`]).
+pub const IMK_STOREY_COLUMNS: [&str; 3] = ["drift_m", "force_n", "branch"];
+
 /// A yielding storey's column prefix (`b2_s1`, both from 1).
 fn storey_prefix(s: &StoreySample) -> String {
     format!("b{}_s{}", s.building + 1, s.storey + 1)
@@ -203,7 +207,8 @@ fn storey_prefix(s: &StoreySample) -> String {
 
 /// A row trace's columns: the time, each building's floor displacements (`b1_f1_u_m`, floors
 /// from 1 at the lowest), each level's penetration, force and mode, then each yielding
-/// storey's drift and plastic drift ratios, shear and hysteretic energy (`b1_s1_shear_n`).
+/// storey's drift and plastic drift ratios, shear and hysteretic energy (`b1_s1_shear_n`), an
+/// IMK storey's with its drift, force and branch (`b1_s1_branch`).
 pub fn row_header(levels: &[String], floors: &[usize], storeys: &[StoreySample]) -> Vec<String> {
     let mut h = vec!["t_s".to_string()];
     for (b, &n) in floors.iter().enumerate() {
@@ -217,6 +222,9 @@ pub fn row_header(levels: &[String], floors: &[usize], storeys: &[StoreySample])
     for s in storeys {
         let prefix = storey_prefix(s);
         h.extend(STOREY_COLUMNS.iter().map(|c| format!("{prefix}_{c}")));
+        if s.imk.is_some() {
+            h.extend(IMK_STOREY_COLUMNS.iter().map(|c| format!("{prefix}_{c}")));
+        }
     }
     h
 }
@@ -248,6 +256,9 @@ fn row_csv(levels: &[String], samples: &[RowSample]) -> String {
                 ]
                 .map(num),
             );
+            if let Some(imk) = &st.imk {
+                cells.extend([num(imk.drift_m), num(imk.force_n), imk.branch.name().into()]);
+            }
         }
         s.push_str(&cells.join(","));
         s.push('\n');

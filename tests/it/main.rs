@@ -35,6 +35,7 @@ mod idle_axes;
 mod im_columns;
 mod imk;
 mod imk_config;
+mod imk_outputs;
 mod inelastic;
 mod inputs;
 mod intensity;

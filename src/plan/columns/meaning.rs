@@ -248,7 +248,7 @@ const ENERGY: [(&str, &str, &str, &str); 2] = [
 ];
 
 /// Per building `k`: suffix, unit, short name, meaning.
-const PER_BUILDING: [(&str, &str, &str, &str); 27] = [
+const PER_BUILDING: [(&str, &str, &str, &str); 29] = [
     ("sa_t1_g", "g", "Sa(T1), building {k}", "Sa(T1, 5 %) of the scaled record at building {k}'s fundamental period b{k}_t1_s, whatever it was scaled to: pseudo-spectral acceleration (w^2 times the peak displacement) of a linear oscillator from rest, exact for the acceleration linear between samples, over the record as simulated (its window if any, not the free tail)"),
     ("storeys", "-", "storeys, building {k}", "storeys of building {k}"),
     ("mass_kg", "kg", "floor mass, building {k}", "floor mass of building {k} (empty where floor masses are given)"),
@@ -272,6 +272,8 @@ const PER_BUILDING: [(&str, &str, &str, &str); 27] = [
     ("ductility_storey", "-", "storey of peak ductility, building {k}", "the storey of that ductility (from 1)"),
     ("hysteretic_energy_j", "J", "hysteretic energy, building {k}", "hysteretic energy of building {k}'s storeys: their work less the elastic energy they hold at the end"),
     ("yielded_storeys", "-", "yielded storeys, building {k}", "storeys of building {k} that yielded"),
+    ("strength_ratio", "-", "strength left, building {k}", "smallest strength ratio over the IMK storeys of building {k} at the end: a storey's capping strength left (its weaker side's) over its initial one, in [0, 1] (1: none lost, 0: no strength left)"),
+    ("capped_storeys", "-", "capped storeys, building {k}", "IMK storeys of building {k} that passed their capping point (0 to its storeys)"),
     ("stability_coefficient", "-", "stability coefficient, building {k}", "largest storey stability coefficient P/(k h) of building {k} (P-Delta): gravity load over storey stiffness times height"),
     ("collapsed", "-", "collapsed, building {k}", "1 where a storey of building {k} reached the collapse limit ([run] collapse_drift_ratio), else 0; the building left the scene there and the others went on"),
     ("collapse_time_s", "s", "collapse time, building {k}", "when building {k} collapsed (empty where it did not); its peaks are over the time before it"),
@@ -403,6 +405,8 @@ pub fn meaning(column: &str) -> Option<Meaning> {
                 "residual_drift_ratio" => Some(("m/m", "residual drift ratio, building {k} storey {j}", "residual drift ratio of storey {j} of building {k} at rest after the motion, signed (empty where the run did not settle)")),
                 "peak_ductility" => Some(("-", "ductility, building {k} storey {j}", "ductility demand of storey {j} of building {k}: its peak drift / its yield drift")),
                 "hysteretic_energy_j" => Some(("J", "hysteretic energy, building {k} storey {j}", "hysteretic energy of storey {j} of building {k}")),
+                "strength_ratio" => Some(("-", "strength left, building {k} storey {j}", "strength ratio of IMK storey {j} of building {k} at the end: its capping strength left (its weaker side's) over its initial one, in [0, 1] (1: none lost, 0: no strength left)")),
+                "capped" => Some(("-", "capped, building {k} storey {j}", "1 where IMK storey {j} of building {k} passed its capping point, else 0")),
                 _ => None,
             };
             if let (Some(k), Some(j), Some((unit, label, text))) = (number(k), number(j), text) {
@@ -467,11 +471,14 @@ mod tests {
         for c in crate::plan::columns::row::BUILDING_OUTPUTS
             .iter()
             .chain(&crate::plan::columns::row::INELASTIC_OUTPUTS)
+            .chain(&crate::plan::columns::row::IMK_OUTPUTS)
         {
             assert!(meaning(&format!("b3_{c}")).is_some(), "{c}");
         }
         assert_eq!(meaning("b2_hysteretic_energy_j").unwrap().unit, "J");
-        for c in crate::plan::columns::row::STOREY_OUTPUTS {
+        for c in (crate::plan::columns::row::STOREY_OUTPUTS.iter())
+            .chain(&crate::plan::columns::row::IMK_STOREY_OUTPUTS)
+        {
             assert!(meaning(&format!("b2_s14_{c}")).is_some(), "{c}");
             assert!(crate::plan::row::RowPlan::asks_storey_columns(&format!(
                 "b2_s14_{c}"

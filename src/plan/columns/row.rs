@@ -46,6 +46,10 @@ pub const INELASTIC_OUTPUTS: [&str; 6] = [
     "yielded_storeys",
 ];
 
+/// An IMK building's further output columns, after its yielding ones: its weakest storey's
+/// strength ratio and the storeys that passed capping.
+pub const IMK_OUTPUTS: [&str; 2] = ["strength_ratio", "capped_storeys"];
+
 /// A yielding storey's output columns with `--columns` (after its `b1_s2_` prefix: building 1,
 /// storey 2 from the ground).
 pub const STOREY_OUTPUTS: [&str; 3] = [
@@ -53,6 +57,10 @@ pub const STOREY_OUTPUTS: [&str; 3] = [
     "peak_ductility",
     "hysteretic_energy_j",
 ];
+
+/// An IMK storey's further columns with `--columns`, after its [`STOREY_OUTPUTS`]: its
+/// strength ratio and whether it passed capping (0 or 1).
+pub const IMK_STOREY_OUTPUTS: [&str; 2] = ["strength_ratio", "capped"];
 
 impl RowPlan {
     /// Does `column` name a yielding storey's own column (`b1_s2_peak_ductility`)?
@@ -63,7 +71,9 @@ impl RowPlan {
             .and_then(|(k, rest)| {
                 let (j, suffix) = rest.split_once('_')?;
                 let digits = |x: &str| !x.is_empty() && x.bytes().all(|c| c.is_ascii_digit());
-                (digits(k) && digits(j) && STOREY_OUTPUTS.contains(&suffix)).then_some(())
+                let known =
+                    STOREY_OUTPUTS.contains(&suffix) || IMK_STOREY_OUTPUTS.contains(&suffix);
+                (digits(k) && digits(j) && known).then_some(())
             })
             .is_some()
     }
@@ -77,6 +87,11 @@ pub const LEVEL_OUTPUTS: [&str; 4] = [
     "impact_velocity_m_s",
 ];
 impl RowPlan {
+    /// Are building `b`'s storeys IMK (capped, deteriorating)? It then has [`IMK_OUTPUTS`].
+    pub fn imk_building(&self, b: usize) -> bool {
+        (self.yielding[b].as_ref()).is_some_and(|y| y.deterioration.is_some())
+    }
+
     /// The contact levels' column prefixes ([`level_name`]).
     pub fn level_names(&self) -> Vec<String> {
         (self.levels().iter())
@@ -168,12 +183,17 @@ impl RowPlan {
                 }
             }
             if y.is_some() {
-                for c in INELASTIC_OUTPUTS {
+                let imk = self.imk_building(b);
+                let imk_outputs = |x: &'static [&'static str]| if imk { x } else { &[] };
+                for c in INELASTIC_OUTPUTS.iter().chain(imk_outputs(&IMK_OUTPUTS)) {
                     h.push(format!("b{}_{c}", b + 1));
                 }
                 if self.storey_columns {
                     for j in 1..=self.buildings[b].storeys() {
-                        for c in STOREY_OUTPUTS {
+                        for c in STOREY_OUTPUTS
+                            .iter()
+                            .chain(imk_outputs(&IMK_STOREY_OUTPUTS))
+                        {
                             h.push(format!("b{}_s{j}_{c}", b + 1));
                         }
                     }
@@ -309,6 +329,12 @@ impl RowPlan {
                     num(ie.hysteretic_energy),
                     ie.yielded_storeys.to_string(),
                 ]);
+                let imk = self.imk_building(k);
+                if imk {
+                    // A run without its storeys' outputs has no strength known: empty.
+                    let strength = b.inelastic.map_or(f64::NAN, |i| i.strength_ratio);
+                    c.extend([known(strength), ie.capped_storeys.to_string()]);
+                }
                 for _ in 0..self.buildings[k].storeys() {
                     let st = storeys.next().copied().unwrap_or(StoreyOutput {
                         residual_drift_ratio: f64::NAN,
@@ -324,6 +350,14 @@ impl RowPlan {
                             known(st.peak_ductility),
                             known(st.hysteretic_energy),
                         ]);
+                        if imk {
+                            // A storey without its outputs has no strength known: empty.
+                            let capped = st.strength_ratio.is_finite().then_some(st.capped);
+                            c.extend([
+                                known(st.strength_ratio),
+                                capped.map(|x| (x as u8).to_string()).unwrap_or_default(),
+                            ]);
+                        }
                     }
                 }
             }

@@ -47,7 +47,7 @@ use crate::physics::row::RowOutput;
 pub use fast::RowFastOptions;
 pub(crate) use model::BuildingModel;
 pub use model::RowModel;
-pub use sample::{RowObserver, RowSample, StoreySample};
+pub use sample::{ImkSample, RowObserver, RowSample, StoreySample};
 
 impl RowScheme {
     pub fn key(&self) -> &'static str {

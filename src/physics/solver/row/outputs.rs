@@ -4,7 +4,7 @@
 use super::exact_step::step_still;
 use super::model::BuildingModel;
 use super::run::RowRun;
-use super::sample::{RowSample, StoreySample};
+use super::sample::{ImkSample, RowSample, StoreySample};
 use super::storey::StoreyMode;
 use crate::physics::model::{EnergyBalance, Status};
 use crate::physics::row::{RowOutput, StoreyOutput};
@@ -347,6 +347,11 @@ impl<'m> RowRun<'m> {
                         plastic_drift_ratio: p / sm.height,
                         shear_n: sm.k * (drift - p),
                         hysteretic_energy_j: self.z[m.plastic_slot(s) + m.storeys.len()],
+                        imk: self.storeys[s].imk.map(|state| ImkSample {
+                            drift_m: drift,
+                            force_n: state.piece().force(drift),
+                            branch: state.branch,
+                        }),
                     }
                 })
                 .collect(),

@@ -1,5 +1,6 @@
 //! What a row run hands its observer after every accepted step and event.
 
+use crate::physics::imk::Branch;
 use crate::physics::solver::state::Mode;
 
 /// A point of a row's time history handed to an observer after every accepted step and
@@ -29,6 +30,17 @@ pub struct StoreySample {
     pub plastic_drift_ratio: f64,
     pub shear_n: f64,
     pub hysteretic_energy_j: f64,
+    /// An IMK storey's law at the sample (None: a bilinear storey).
+    pub imk: Option<ImkSample>,
+}
+
+/// An IMK storey at a sample: its drift, m, the force its law gives there (its current piece's),
+/// N, and the branch that piece is on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImkSample {
+    pub drift_m: f64,
+    pub force_n: f64,
+    pub branch: Branch,
 }
 
 /// What observes a row's run.
