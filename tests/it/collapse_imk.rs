@@ -94,12 +94,14 @@ fn imk_storeys_lose_strength_and_collapse_below_bilinear_ones() {
         );
     }
     let plain_collapse = first_collapse(&plain);
+    let mut firsts = Vec::new();
     for (rule, text) in [
         ("imk_peak_oriented", &peak_oriented),
         ("imk_bilinear", &imk_bilinear),
     ] {
         let outs = runs(text);
         let at = first_collapse(&outs);
+        firsts.push(at);
         assert!(
             at < plain_collapse,
             "{rule}: collapses first at Sa {at} g, the bilinear frame at {plain_collapse} g"
@@ -129,4 +131,16 @@ fn imk_storeys_lose_strength_and_collapse_below_bilinear_ones() {
             }
         }
     }
+    // docs/collapse.md quotes these levels.
+    let doc = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/collapse.md"))
+        .unwrap()
+        .replace('\n', " ");
+    let said = format!(
+        "({} g peak-oriented, {} g IMK bilinear, against {} g)",
+        firsts[0], firsts[1], plain_collapse
+    );
+    assert!(
+        doc.contains(&said),
+        "docs/collapse.md does not say `{said}`"
+    );
 }
