@@ -7,6 +7,7 @@ mod bounds;
 mod cli;
 mod collapse;
 mod collapse_by_building;
+mod collapse_imk;
 mod collapse_limits;
 mod collapse_opensees;
 mod collapse_outputs;
