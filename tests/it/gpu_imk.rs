@@ -78,7 +78,8 @@ fn largest_difference(a: &RowOutput, b: &RowOutput) -> (f64, String) {
         } else {
             (x - y).abs() / x.abs().max(y.abs()).max(scale)
         };
-        if !(d <= worst.0) {
+        // A NaN difference is the worst.
+        if d > worst.0 || d.is_nan() {
             worst = (d, name);
         }
     };
