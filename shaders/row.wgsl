@@ -642,8 +642,10 @@ fn track_column(l: u32, y0: real, y1: real, f0: real, r0: real, f1: real, r1: re
         let s = B_S0[b] + j;
         var pv = array<real, 2>(0.0, 0.0);
         if (SM[s] != SM_ELASTIC) {
-            pv[0] = (1.0 - st_b(s)) * rate[0];
-            pv[1] = (1.0 - st_b(s)) * rate[1];
+            pv[0] = (1.0 - st_b(s)) * rate[0]; // !IMK
+            pv[1] = (1.0 - st_b(s)) * rate[1]; // !IMK
+            pv[0] = storey_flow(s) * rate[0]; // IMK
+            pv[1] = storey_flow(s) * rate[1]; // IMK
         }
         spring[0] = k * (drift[0] - (*z0)[PS0 + s]);
         spring[1] = k * (drift[1] - (*z1)[PS0 + s]);
@@ -1202,6 +1204,7 @@ fn integrate_run(lane: u32) -> u32 {
     SUBSTEPS = rcount[RC + C_SUBSTEPS];
     FREE_STEPS = rcount[RC + C_FREE_STEPS];
     TAU = rstate[RS + S_TAU];
+    imk_begin(); // IMK
     ENDS_VALID = false;
     var z: ZA;
     for (var i = 0u; i < ZLEN; i++) { z[i] = rstate[RS + i]; }

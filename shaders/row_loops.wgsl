@@ -167,7 +167,8 @@ fn plastic_rhs(z: ptr<function, ZA>, out: ptr<function, ZA>) {
             (*out)[o + i] += st_row(s, i) * kp;
         }
         if (SM[s] != SM_ELASTIC) {
-            let dp = (1.0 - st_b(s)) * storey_drift(s, z, NM);
+            let dp = (1.0 - st_b(s)) * storey_drift(s, z, NM); // !IMK
+            let dp = storey_flow(s) * storey_drift(s, z, NM); // IMK
             (*out)[ps] = dp;
             (*out)[ps + NS] = k * (storey_drift(s, z, 0u) - p) * dp;
         }

@@ -58,6 +58,7 @@ fn mode_sign(mode: u32) -> real {
 
 // StoreyModel::event_value: positive once `mode` must end.
 fn storey_event(s: u32, mode: u32, d: real, r: real, p: real) -> real {
+    if (IS_IMK[s]) { return imk_event(s, d, r); } // IMK
     if (mode == SM_ELASTIC) {
         return abs(back_drift(s, d, p)) - st_dy(s) * (1.0 + YIELD_SLACK);
     }
@@ -135,7 +136,8 @@ fn plastic_loads(b: u32, z: ptr<function, ZA>) {
         let kp = k * (*z)[PS0 + s];
         var kdp: real = 0.0;
         if (SM[s] != SM_ELASTIC) {
-            kdp = k * (1.0 - st_b(s)) * storey_drift(s, z, NM);
+            kdp = k * (1.0 - st_b(s)) * storey_drift(s, z, NM); // !IMK
+            kdp = k * storey_flow(s) * storey_drift(s, z, NM); // IMK
         }
         for (var i = 0u; i < n; i++) {
             let r = st_row(s, i);
@@ -207,6 +209,7 @@ fn yield_watch(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) -> bool {
         for (var i = 0u; i < B_N[S_B[s]]; i++) {
             bound += abs(st_row(s, i)) * MBND[o + i];
         }
+        if (IS_IMK[s]) { if (imk_may_reach(s, SD0[s], SR0[s], SD1[s], SR1[s], bound, h)) { watch = true; break; } continue; } // IMK
         if (may_yield(s, SD0[s], SR0[s], SD1[s], SR1[s], (*z0)[PS0 + s], bound, h)) {
             watch = true;
             break;
@@ -221,6 +224,7 @@ fn yield_watch(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) -> bool {
 fn hidden_yield(z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real, best_in: real) -> real {
     var best = best_in;
     for (var s = 0u; s < NS; s++) {
+        if (IS_IMK[s]) { best = imk_hidden(s, h, best); continue; } // IMK
         if (SM[s] != SM_ELASTIC) {
             continue;
         }
@@ -257,6 +261,7 @@ fn storey_transitions(z: ptr<function, ZA>) {
         }
         // The plastic load's rate at the last piece's end was the old state's.
         ENDS_VALID = false;
+        if (IS_IMK[s]) { imk_transition(s, z, d, r, p); continue; } // IMK
         if (mode != SM_ELASTIC) {
             SM[s] = SM_ELASTIC;
             continue;
@@ -282,6 +287,7 @@ fn settles(z: ptr<function, ZA>) -> bool {
             return false;
         }
     }
+    return imk_settles(z); // IMK
     for (var s = 0u; s < NS; s++) {
         if (SM[s] != SM_ELASTIC) {
             return false;

@@ -385,6 +385,7 @@ fn row_kernel_builds_for_every_shape() {
             storeys: vec![1, 1],
             levels: vec![[0, 0, 0]],
             yielding: vec![true, true],
+            imk: vec![false; 2],
             coupled: vec![false, false],
             columns: vec![],
         },
@@ -392,6 +393,7 @@ fn row_kernel_builds_for_every_shape() {
             storeys: vec![3, 6, 2],
             levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [1, 0, 0], [1, 1, 1]],
             yielding: vec![false, true, true],
+            imk: vec![false; 3],
             coupled: vec![false, false, false],
             columns: vec![],
         },
@@ -400,6 +402,7 @@ fn row_kernel_builds_for_every_shape() {
             storeys: vec![3, 6, 2],
             levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [1, 0, 0], [1, 1, 1]],
             yielding: vec![false, true, false],
+            imk: vec![false; 3],
             coupled: vec![true, true, false],
             columns: vec![],
         },
@@ -408,6 +411,7 @@ fn row_kernel_builds_for_every_shape() {
             storeys: vec![9, 4],
             levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [0, 3, 3]],
             yielding: vec![true, true],
+            imk: vec![false; 2],
             coupled: vec![true, false],
             columns: vec![],
         },
@@ -417,6 +421,7 @@ fn row_kernel_builds_for_every_shape() {
             storeys: vec![3, 4],
             levels: vec![[0, 0, 0], [0, 0, 1], [0, 1, 1], [0, 1, 2]],
             yielding: vec![false, true],
+            imk: vec![false; 2],
             coupled: vec![false, false],
             columns: vec![
                 (0, 0, 0.9f64.to_bits()),
@@ -428,15 +433,34 @@ fn row_kernel_builds_for_every_shape() {
             storeys: vec![9, 4],
             levels: vec![[0, 0, 0], [0, 0, 1], [0, 1, 1]],
             yielding: vec![true, false],
+            imk: vec![false; 2],
             coupled: vec![false, false],
             columns: vec![(0, 0, 0.9f64.to_bits()), (1, 1, 0.07f64.to_bits())],
+        },
+        // IMK storeys (shaders/imk.wgsl): beside a bilinear one, written out and as loops with
+        // coupled modes.
+        RowShape {
+            storeys: vec![1, 1],
+            levels: vec![[0, 0, 0]],
+            yielding: vec![true, true],
+            imk: vec![true, false],
+            coupled: vec![false, false],
+            columns: vec![],
+        },
+        RowShape {
+            storeys: vec![9, 4],
+            levels: vec![[0, 0, 0], [0, 1, 1], [0, 2, 2], [0, 3, 3]],
+            yielding: vec![true, true],
+            imk: vec![true, true],
+            coupled: vec![true, false],
+            columns: vec![(0, 0, 0.9f64.to_bits())],
         },
     ];
     // Both ways of writing the per-shape functions are among them.
     assert!(shapes.iter().any(|s| s.unrolled()) && shapes.iter().any(|s| !s.unrolled()));
     for shape in &shapes {
         for precision in [Precision::F32, Precision::F64] {
-            let src = row_source(precision, &shape.wgsl_constants());
+            let src = row_source(precision, &shape.wgsl_constants(), shape.has_imk());
             crate::gpu::parse_source(&src);
         }
     }

@@ -109,8 +109,8 @@ fn a_storey_pushed_past_capping_follows_the_closed_form() {
     }
 }
 
-/// IMK scenes (the GPU does not run them yet).
-fn scenes() -> Vec<Scene> {
+/// IMK scenes (the GPU takes those of low buildings: `gpu_imk`).
+pub(crate) fn scenes() -> Vec<Scene> {
     let synth = |seed, seconds, pga_g| (record(seed, seconds, pga_g), 0.01);
     let mut out = Vec::new();
     let mut push = |name, model, (accel, dt): (Vec<f64>, f64), pounds, collapses| {

@@ -28,6 +28,7 @@ mod gap_collapse;
 mod gap_threshold;
 mod gpu;
 mod gpu_collapse;
+mod gpu_imk;
 mod gpu_rows;
 mod gpu_stop;
 mod hard;

@@ -14,6 +14,8 @@ pub const ROW_WGSL: &str = include_str!("../../../shaders/row.wgsl");
 /// The per-shape functions of `row.wgsl` as loops, for rows too tall to write them out.
 pub const ROW_LOOPS_WGSL: &str = include_str!("../../../shaders/row_loops.wgsl");
 pub const YIELDING_WGSL: &str = include_str!("../../../shaders/yielding.wgsl");
+/// The IMK storey (a row kernel's whose row has one).
+pub const IMK_WGSL: &str = include_str!("../../../shaders/imk.wgsl");
 pub const LANES_WGSL: &str = include_str!("../../../shaders/lanes.wgsl");
 pub const AGGREGATE_WGSL: &str = include_str!("../../../shaders/aggregate.wgsl");
 
@@ -86,15 +88,42 @@ pub const F32_YIELD_SLACK: f64 = 1e-4;
 /// (`RowShape::wgsl_constants`, in `row/`).
 /// Every row kernel carries `yielding.wgsl`; its functions are entered only where the shape
 /// has yielding storeys (`NS > 0`, a constant), so an elastic row's kernel compiles none of it.
-pub fn row_source(precision: Precision, constants: &str) -> String {
+/// A row with IMK storeys (`imk`) adds `imk.wgsl` and the lines marked for it ([`for_imk`]).
+pub fn row_source(precision: Precision, constants: &str, imk: bool) -> String {
     let slack = match precision {
         Precision::F64 => crate::physics::solver::row::yielding::YIELD_SLACK,
         Precision::F32 => F32_YIELD_SLACK,
     };
+    let (row, yielding) = (for_imk(ROW_WGSL, imk), for_imk(YIELDING_WGSL, imk));
+    let imk = if imk { IMK_WGSL } else { "" };
     format!(
-        "{}{constants}const YIELD_SLACK: real = {slack:e};\n{CONTACT_WGSL}{HERMITE_WGSL}{ROW_WGSL}{YIELDING_WGSL}{LANES_WGSL}",
+        "{}{constants}const YIELD_SLACK: real = {slack:e};\n{CONTACT_WGSL}{HERMITE_WGSL}{row}{yielding}{imk}{LANES_WGSL}",
         prelude(precision)
     )
+}
+
+/// `src` for a kernel with IMK storeys or without (`imk`): a line ending in `// IMK` is kept
+/// only with them, one ending in `// !IMK` only without (its mark taken off), so a kernel
+/// without them is the text it was before they came, and carries none of their code.
+pub fn for_imk(src: &str, imk: bool) -> String {
+    let mut out = String::with_capacity(src.len());
+    for line in src.split_inclusive('\n') {
+        let body = line.strip_suffix('\n').unwrap_or(line);
+        let end = &line[body.len()..];
+        if let Some(code) = body.strip_suffix(" // !IMK") {
+            if !imk {
+                out.push_str(code);
+                out.push_str(end);
+            }
+        } else if body.ends_with(" // IMK") {
+            if imk {
+                out.push_str(line);
+            }
+        } else {
+            out.push_str(line);
+        }
+    }
+    out
 }
 
 /// `shaders/aggregate.wgsl` for `precision`, after the prelude: with the sketch's bucket range,

@@ -67,7 +67,7 @@ impl GpuContext {
         self.stage(
             stage,
             precision,
-            || super::shader::row_source(precision, &constants),
+            || super::shader::row_source(precision, &constants, shape.has_imk()),
             stop,
         )
     }
@@ -347,8 +347,22 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> 
                 peak_ductility: s[shape.s_storeys() + k] * st.height / st.d_y,
                 hysteretic_energy: s[ps + ns + k],
                 yielded: c[shape.c_storeys() + SC_STRIDE * k + SC_YIELDED] != 0,
-                strength_ratio: f64::NAN,
-                capped: false,
+                strength_ratio: st.fcap0.map_or(f64::NAN, |fcap0| {
+                    // ImkState::strength_ratio: the weaker side's capping strength left.
+                    let flags = c[shape.c_imk() + IC_STRIDE * k + IC_FLAGS];
+                    let left = |i: usize| {
+                        let failed = flags & (IF_FAILED0 << i) != 0;
+                        let side = shape.s_imk() + IS_STRIDE * k + IR_SIDE * i;
+                        if failed {
+                            0.0
+                        } else {
+                            s[side + IR_FCAP]
+                        }
+                    };
+                    left(0).min(left(1)) / fcap0
+                }),
+                capped: st.fcap0.is_some()
+                    && c[shape.c_imk() + IC_STRIDE * k + IC_FLAGS] & IF_CAPPED != 0,
             })
             .collect();
         let spans: Vec<_> = (shape.first_storeys().into_iter())

@@ -6,8 +6,10 @@ use super::shape::{may_couple, RowShape, P_COLLAPSE};
 use crate::engine::gpu::precision::Precision;
 use crate::engine::gpu::run::GpuRecords;
 use crate::physics::contact::LawKind;
+use crate::physics::imk::ImkSpring;
 use crate::physics::model::{Forcing, Oscillator};
 use crate::physics::propagator::{CoupledPropagator, Propagator};
+use crate::physics::shear::ImkRule;
 use crate::physics::solver::row::yielding::settle_intervals;
 use crate::physics::solver::row::RowModel;
 use crate::physics::solver::FastOptions;
@@ -43,6 +45,8 @@ pub(super) struct StoreyReadout {
     pub(super) d_y: f64,
     /// Its yield force `k d_y`, N.
     pub(super) yield_force: f64,
+    /// An IMK storey's capping strength before any deterioration, N (None: bilinear).
+    pub(super) fcap0: Option<f64>,
     leaning: Option<(usize, Vec<f64>)>,
 }
 
@@ -54,6 +58,7 @@ impl StoreyReadout {
             height: sm.height,
             d_y: sm.d_y,
             yield_force: sm.k * sm.d_y,
+            fcap0: sm.imk.as_ref().map(ImkSpring::fcap0),
             leaning: (sm.geometric != 0.0).then(|| m.residual_row(s)),
         }
     }
@@ -215,8 +220,18 @@ pub(super) fn model_blocks(m: &RowModel, dt: f64) -> Vec<Vec<f64>> {
         .map(|b| {
             let n = b.n();
             let coupled = may_couple(b);
-            let mut block =
-                Vec::with_capacity(RowShape::model_len(n, b.first_storey.is_some(), coupled));
+            let springs: Vec<&ImkSpring> = match b.first_storey {
+                Some(first) => (m.storeys[first..first + n].iter())
+                    .filter_map(|s| s.imk.as_ref())
+                    .collect(),
+                None => Vec::new(),
+            };
+            let mut block = Vec::with_capacity(RowShape::model_len(
+                n,
+                b.first_storey.is_some(),
+                coupled,
+                !springs.is_empty(),
+            ));
             for i in 0..n {
                 let k = b.off + i;
                 let osc = Oscillator {
@@ -272,9 +287,19 @@ pub(super) fn model_blocks(m: &RowModel, dt: f64) -> Vec<Vec<f64>> {
                 block.extend_from_slice(f0);
                 block.extend_from_slice(f1);
             }
+            for sp in &springs {
+                let rule = match sp.rule {
+                    ImkRule::Bilinear => 0.0,
+                    ImkRule::PeakOriented => 1.0,
+                };
+                let (has_et, e_t) = sp.e_t.map_or((0.0, 0.0), |e| (1.0, e));
+                block.extend([
+                    rule, sp.k, sp.fy, sp.kp, sp.up, sp.upc, sp.fres, sp.uu, has_et, e_t,
+                ]);
+            }
             debug_assert_eq!(
                 block.len(),
-                RowShape::model_len(n, b.first_storey.is_some(), coupled)
+                RowShape::model_len(n, b.first_storey.is_some(), coupled, !springs.is_empty())
             );
             block
         })

@@ -87,6 +87,22 @@ pub const MW: usize = 11;
 /// Reals per yielding storey after its building's model block: `k`, `d_y`, `b`, then its
 /// modal row (the drift in the building's modes).
 pub const STOREY_HEAD: usize = 4;
+/// Reals per IMK storey after its building's model block (`IP_*` in `shaders/imk.wgsl`: rule,
+/// `k`, `F_y`, `b k`, `u_p`, `u_pc`, residual strength, ultimate drift, whether it has an energy
+/// capacity, the capacity).
+pub const IMK_PARAMS: usize = 10;
+/// Reals per yielding storey in the state of a row with IMK storeys (`IR_*`: each side's
+/// backbone, the unloading stiffness, the work and its mark, the piece).
+pub const IS_STRIDE: usize = 31;
+/// Where a side's backbone starts in them, and its capping force there (`IR_SIDE`, `fcap`).
+pub const IR_SIDE: usize = 10;
+pub const IR_FCAP: usize = 4;
+/// u32 per yielding storey in the counters of a row with IMK storeys (`IC_*`: branch, its
+/// side, the piece's two marks, flags), and the flags' bits read back.
+pub const IC_STRIDE: usize = 5;
+pub const IC_FLAGS: usize = 4;
+pub const IF_FAILED0: u32 = 1;
+pub const IF_CAPPED: u32 = 8;
 
 /// What a row kernel is built for: each building's storeys, and each contact level's left
 /// building and floors (from 0).
@@ -96,6 +112,9 @@ pub struct RowShape {
     pub levels: Vec<[usize; 3]>,
     /// Each building: do its storeys yield?
     pub yielding: Vec<bool>,
+    /// Each building: are its storeys IMK springs (deteriorating)? Only a kernel whose row has
+    /// one carries their code (`shaders/imk.wgsl`).
+    pub imk: Vec<bool>,
     /// Each building: may its damping couple its modes (P-Delta with Rayleigh damping on
     /// `K0`, several storeys)? Its block then carries the coupling and the exact step of its
     /// modes together (zeros and the per-mode step where a run's storeys lean alike).
@@ -132,6 +151,9 @@ impl RowShape {
                 .iter()
                 .map(|b| b.first_storey.is_some())
                 .collect(),
+            imk: (m.buildings.iter())
+                .map(|b| b.first_storey.is_some_and(|f| m.storeys[f].imk.is_some()))
+                .collect(),
             coupled: m.buildings.iter().map(may_couple).collect(),
         }
     }
@@ -143,6 +165,7 @@ impl RowShape {
         RowShape {
             storeys,
             levels,
+            imk: yielding.clone(),
             yielding,
             coupled,
             columns: Vec::new(),
@@ -244,8 +267,18 @@ impl RowShape {
         self.s_buildings() + BS_STRIDE * self.storeys.len()
     }
 
-    pub(super) fn s_stride(&self) -> usize {
+    /// Does the row have IMK storeys?
+    pub fn has_imk(&self) -> bool {
+        self.imk.iter().any(|&i| i)
+    }
+
+    /// Each yielding storey's IMK reals (`IS_STRIDE`; in a row with IMK storeys).
+    pub(super) fn s_imk(&self) -> usize {
         self.s_storeys() + self.yielding_storeys()
+    }
+
+    pub(super) fn s_stride(&self) -> usize {
+        self.s_imk() + self.has_imk() as usize * IS_STRIDE * self.yielding_storeys()
     }
 
     pub(super) fn c_buildings(&self) -> usize {
@@ -260,8 +293,13 @@ impl RowShape {
         self.c_settled() + 1
     }
 
-    pub(super) fn c_stride(&self) -> usize {
+    /// Each yielding storey's IMK u32s (`IC_STRIDE`; in a row with IMK storeys).
+    pub(super) fn c_imk(&self) -> usize {
         self.c_settled() + self.yields() * (1 + SC_STRIDE * self.yielding_storeys())
+    }
+
+    pub(super) fn c_stride(&self) -> usize {
+        self.c_imk() + self.has_imk() as usize * IC_STRIDE * self.yielding_storeys()
     }
 
     /// The last record interval any run of a chunk with meta blocks `meta` may reach: its
@@ -291,8 +329,14 @@ impl RowShape {
 
     /// Reals of one building's model block: where its modes may couple, whether they do in
     /// this run (1 or 0), the coupling `E` (`N x N`), the exact step of its `[q, q']` (`2N x
-    /// 2N`) and its ground terms (`2 x 2N`).
-    pub(super) fn model_len(n: usize, yields: bool, coupled: bool) -> usize {
+    /// 2N`) and its ground terms (`2 x 2N`); then, where its storeys are IMK springs, theirs
+    /// (`IMK_PARAMS` each).
+    pub(super) fn model_len(n: usize, yields: bool, coupled: bool, imk: bool) -> usize {
+        Self::model_coupled_len(n, yields, coupled) + if imk { n * IMK_PARAMS } else { 0 }
+    }
+
+    /// Where a building's IMK block starts in its model block.
+    pub(super) fn model_coupled_len(n: usize, yields: bool, coupled: bool) -> usize {
         Self::model_head_len(n, yields) + if coupled { 1 + 5 * n * n + 4 * n } else { 0 }
     }
 
@@ -361,7 +405,15 @@ impl RowShape {
         // The settling test each unit passes through (with P-Delta, the static response and
         // each storey's drift in it).
         let settle = (nl + 4 * ns + 8 * nm + 4 * ns * nmax) * yields;
-        (begin + substep + tail + settle + 1) * 11 / 10
+        // IMK storeys (`shaders/imk.wgsl`): a transition takes up to 16 changes of piece, each
+        // two thresholds of up to 6 backbone segments; the set-up at a dispatch's start; their
+        // events, watch and settling (a storey's drift each).
+        let imk = if self.has_imk() {
+            ns * (16 * 2 * 8 + 2 * 8 + 4 + 4 * nmax)
+        } else {
+            0
+        };
+        (begin + substep + tail + settle + imk + 1) * 11 / 10
     }
 }
 

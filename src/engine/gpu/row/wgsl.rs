@@ -5,7 +5,7 @@
 // Every offset of the layout is written out as a WGSL constant.
 use super::shape::*;
 use crate::engine::gpu::layout::STATUS_COLLAPSE;
-use crate::engine::gpu::shader::ROW_LOOPS_WGSL;
+use crate::engine::gpu::shader::{for_imk, ROW_LOOPS_WGSL};
 
 /// The most `sum n^2` over a row's buildings whose per-shape functions are written out
 /// ([`RowShape::unrolled`]).
@@ -174,12 +174,43 @@ impl RowShape {
             self.coupled.iter().any(|&c| c),
             !self.columns.is_empty()
         ));
+        if self.has_imk() {
+            s.push_str(&self.wgsl_imk());
+        }
         s.push_str(&self.wgsl_collapse_reached());
         if self.unrolled() {
             s.push_str(&self.wgsl_unrolled());
         } else {
-            s.push_str(ROW_LOOPS_WGSL);
+            s.push_str(&for_imk(ROW_LOOPS_WGSL, self.has_imk()));
         }
+        s
+    }
+
+    /// A row with IMK storeys: where their parameters, state and counters are
+    /// (`shaders/imk.wgsl`), and which yielding storeys are IMK springs.
+    fn wgsl_imk(&self) -> String {
+        let mut s = String::new();
+        for (name, v) in [
+            ("IMK_PARAMS", IMK_PARAMS),
+            ("S_IMK", self.s_imk()),
+            ("IS_STRIDE", IS_STRIDE),
+            ("C_IMK", self.c_imk()),
+            ("IC_STRIDE", IC_STRIDE),
+        ] {
+            s.push_str(&format!("const {name}: u32 = {v}u;\n"));
+        }
+        let at: Vec<String> = (self.storeys.iter().zip(&self.yielding).zip(&self.coupled))
+            .map(|((&n, &y), &c)| format!("{}u", Self::model_coupled_len(n, y, c)))
+            .collect();
+        let is: Vec<&str> = (self.storeys.iter().zip(&self.imk).zip(&self.yielding))
+            .filter(|(_, &y)| y)
+            .flat_map(|((&n, &i), _)| std::iter::repeat_n(if i { "true" } else { "false" }, n))
+            .collect();
+        s.push_str(&format!(
+            "var<private> IMK_AT: array<u32, NB> = array<u32, NB>({});\nvar<private> IS_IMK: array<bool, NSA> = array<bool, NSA>({});\n",
+            at.join(", "),
+            is.join(", ")
+        ));
         s
     }
 
@@ -542,8 +573,14 @@ impl RowShape {
                         c + i
                     ));
                 }
+                // The plastic drift's rate over the drift's (`storey_flow` with IMK storeys).
+                let flow = if self.has_imk() {
+                    format!("storey_flow({st}u)")
+                } else {
+                    format!("(1.0 - st_b({st}u))")
+                };
                 s.push_str(&format!(
-                    "        if (SM[{st}u] != SM_ELASTIC) {{\n            let dp = (1.0 - st_b({st}u)) * storey_drift({st}u, z, NM);\n            (*out)[{ps}u] = dp;\n            (*out)[{}u] = k * (storey_drift({st}u, z, 0u) - p) * dp;\n        }}\n    }}\n",
+                    "        if (SM[{st}u] != SM_ELASTIC) {{\n            let dp = {flow} * storey_drift({st}u, z, NM);\n            (*out)[{ps}u] = dp;\n            (*out)[{}u] = k * (storey_drift({st}u, z, 0u) - p) * dp;\n        }}\n    }}\n",
                     ps + ns
                 ));
             }
@@ -609,8 +646,8 @@ mod tests {
     #[test]
     fn every_loop_counts() {
         use crate::engine::gpu::shader::{
-            AGGREGATE_WGSL, CONTACT_WGSL, FAST_WGSL, HERMITE_WGSL, LANES_WGSL, ROW_LOOPS_WGSL,
-            ROW_WGSL, TYPES_WGSL, YIELDING_WGSL,
+            AGGREGATE_WGSL, CONTACT_WGSL, FAST_WGSL, HERMITE_WGSL, IMK_WGSL, LANES_WGSL,
+            ROW_LOOPS_WGSL, ROW_WGSL, TYPES_WGSL, YIELDING_WGSL,
         };
         let shape = RowShape::elastic(vec![3, 6], vec![[0, 0, 0], [0, 1, 1]]);
         let written = shape.wgsl_constants();
@@ -622,6 +659,7 @@ mod tests {
             ("row", ROW_WGSL),
             ("row_loops", ROW_LOOPS_WGSL),
             ("yielding", YIELDING_WGSL),
+            ("imk", IMK_WGSL),
             ("lanes", LANES_WGSL),
             ("aggregate", AGGREGATE_WGSL),
             ("written out for 3 + 6 storeys", written.as_str()),
