@@ -224,9 +224,6 @@ impl RowModel {
                     || piece.slope <= 0.0
                     || (p_delta && piece.slope != sm.k)
                 {
-                    if std::env::var("IMK_DEBUG").is_ok() {
-                        eprintln!("s{s} blocks: {piece:?}");
-                    }
                     return false;
                 }
                 let f = sm.k * (drift(sm) - z[self.plastic_slot(s)]);
