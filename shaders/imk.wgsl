@@ -300,7 +300,7 @@ fn imk_take(t: ImkThreshold, x: real, m: u32) -> ImkThreshold {
         o.x = x;
         o.mark = m;
     }
-    if (m != MK_ZERO) {
+    if (m != MK_ZERO && m != MK_LOCAL_PEAK) {
         o.rest = min(o.rest, x);
     }
     return o;
@@ -666,9 +666,9 @@ fn imk_transition(s: u32, z: ptr<function, ZA>, d: real, r: real, p: real) {
     SM[s] = select(SM_IMK, SM_ELASTIC, imk_free(s));
 }
 
-// RowModel::settled_imk (after settles' test of the levels): no storey on a line or on a piece
-// that flows one way, and each within its rest thresholds (bilinear ones in their bands) at the
-// reach of the motion's energy.
+// RowModel::settled_imk (after settles' test of the levels): no bilinear storey on a line, no
+// IMKBilin one on a piece that flows one way, and each within its rest thresholds (bilinear
+// ones in their bands) at the reach of the motion's energy.
 fn imk_settles(z: ptr<function, ZA>) -> bool {
     for (var s = 0u; s < NS; s++) {
         if (!IS_IMK[s] && SM[s] != SM_ELASTIC) {
@@ -704,7 +704,9 @@ fn imk_settles(z: ptr<function, ZA>) -> bool {
             continue;
         }
         let slope = imk_ir(s, IR_SLOPE);
-        if (imk_ir(s, IR_HEADING) != 0.0 || slope <= 0.0 || (p_delta && slope != st_k(s))) {
+        // A peak-oriented storey may come to rest on a reloading line.
+        let one_way = imk_ir(s, IR_HEADING) != 0.0 && !imk_peak_oriented(s);
+        if (one_way || slope <= 0.0 || (p_delta && slope != st_k(s))) {
             return false;
         }
         let f = st_k(s) * (storey_drift(s, z, 0u) - (*z)[PS0 + s]);
@@ -735,7 +737,8 @@ fn imk_settles(z: ptr<function, ZA>) -> bool {
             let slack = imk_slack(s);
             var rest_reach = BIG;
             if (imk_peak_oriented(s)) {
-                rest_reach = 1e-6 * imk_ip(s, IP_FY) / imk_ip(s, IP_K);
+                // ImkSpring::rest_reach.
+                rest_reach = 1e-4 * imk_ip(s, IP_FY) / imk_ip(s, IP_K);
             }
             if (!(reach <= rest_reach && center - reach >= imk_ir(s, IR_REST_LO) - slack
                   && center + reach <= imk_ir(s, IR_REST_HI) + slack)) {

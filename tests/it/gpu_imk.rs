@@ -34,9 +34,12 @@ fn kernels_without_imk_storeys_carry_no_imk_code() {
         let name = cfg.file_stem().unwrap().to_string_lossy().into_owned();
         for p in [Precision::F64, Precision::F32] {
             let src = row_source(p, &shape.wgsl_constants(), shape.has_imk());
-            assert!(
-                !src.contains("imk_"),
-                "{name}: IMK code in a kernel without IMK storeys"
+            // A shape with IMK storeys (configs/collapse-imk.toml) carries the code, the others
+            // none of it.
+            assert_eq!(
+                src.contains("imk_"),
+                shape.has_imk(),
+                "{name}: IMK code where the kernel has IMK storeys, and only there"
             );
             if let Some(dir) = &dump {
                 std::fs::create_dir_all(dir).unwrap();
@@ -68,17 +71,19 @@ fn on_gpu(sc: &Scene, opts: &GpuOptions) -> Option<RowOutput> {
         .flatten()
 }
 
-/// The largest difference of two results of one run over every output (relative to the larger
-/// magnitude, drifts' to the peak drift), and the name of the output where it is.
-fn largest_difference(a: &RowOutput, b: &RowOutput) -> (f64, String) {
+/// The largest difference of two results of one run over every output but the residual drifts
+/// (relative to the larger magnitude), and the name of the output where it is; and the largest
+/// residual drift difference, over the peak drift.
+fn largest_difference(a: &RowOutput, b: &RowOutput) -> (f64, String, f64) {
     let mut worst = (0.0, String::new());
     let mut diff = |name: String, x: f64, y: f64, scale: f64| {
-        let d = if x == y {
+        // Both NaN: neither reports the value (a run that did not settle has no residual).
+        let d = if x == y || (x.is_nan() && y.is_nan()) {
             0.0
         } else {
             (x - y).abs() / x.abs().max(y.abs()).max(scale)
         };
-        // A NaN difference is the worst.
+        // A NaN difference (one side NaN) is the worst.
         if d > worst.0 || d.is_nan() {
             worst = (d, name);
         }
@@ -111,14 +116,15 @@ fn largest_difference(a: &RowOutput, b: &RowOutput) -> (f64, String) {
         drift = drift.max(x.peak_drift_ratio);
     }
     assert_eq!(a.storeys.len(), b.storeys.len());
+    let mut residual: f64 = 0.0;
     for (s, (x, y)) in a.storeys.iter().zip(&b.storeys).enumerate() {
         let at = |what: &str| format!("storey {s} {what}");
-        diff(
-            at("residual"),
-            x.residual_drift_ratio,
-            y.residual_drift_ratio,
-            drift,
-        );
+        let (u, v) = (x.residual_drift_ratio, y.residual_drift_ratio);
+        if u.is_nan() != v.is_nan() {
+            residual = f64::INFINITY;
+        } else if !u.is_nan() {
+            residual = residual.max((u - v).abs() / drift);
+        }
         diff(at("ductility"), x.peak_ductility, y.peak_ductility, 0.0);
         diff(at("energy"), x.hysteretic_energy, y.hysteretic_energy, 0.0);
         if !(x.strength_ratio.is_nan() && y.strength_ratio.is_nan()) {
@@ -137,7 +143,7 @@ fn largest_difference(a: &RowOutput, b: &RowOutput) -> (f64, String) {
             0.0,
         );
     }
-    worst
+    (worst.0, worst.1, residual)
 }
 
 /// The kernel in f64 is the CPU fast scheme's twin on IMK scenes (both rules, with and without
@@ -171,11 +177,30 @@ fn the_kernel_is_the_cpus_twin_on_imk_storeys() {
                     continue;
                 };
                 assert_eq!(gpu.status, Status::Ok, "{}", sc.name);
-                let (d, at) = largest_difference(&gpu, &cpu);
-                eprintln!("{precision:?} {s:>4} {}: {d:.2e} ({at})", sc.name);
+                let (d, at, residual) = largest_difference(&gpu, &cpu);
+                eprintln!(
+                    "{precision:?} {s:>4} {}: {d:.2e} ({at}), residual drifts {residual:.2e}",
+                    sc.name
+                );
                 if precision == Precision::F64 {
                     assert!(d <= 1e-9, "{} at {s}: {d:e} at {at}", sc.name);
-                    assert_eq!(gpu.substeps, cpu.substeps, "{}", sc.name);
+                    // A peak-oriented storey's rest point is taken once its reach is below 1e-4
+                    // of its yield drift (`ImkSpring::rest_reach`): the two may settle a step
+                    // apart, the residual then differing by the motion of that step.
+                    assert!(
+                        residual <= 1e-6,
+                        "{} at {s}: residual drifts {residual:e}",
+                        sc.name
+                    );
+                    // The same substeps, but for a settling tail a step longer or shorter.
+                    let apart = gpu.substeps.abs_diff(cpu.substeps) as f64;
+                    assert!(
+                        apart <= 1e-3 * cpu.substeps as f64,
+                        "{}: {} substeps, the CPU {}",
+                        sc.name,
+                        gpu.substeps,
+                        cpu.substeps
+                    );
                 }
             }
         }
