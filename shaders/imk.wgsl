@@ -666,73 +666,58 @@ fn imk_transition(s: u32, z: ptr<function, ZA>, d: real, r: real, p: real) {
     SM[s] = select(SM_IMK, SM_ELASTIC, imk_free(s));
 }
 
-// RowModel::settled_imk (after settles' test of the levels): no bilinear storey on a line, no
-// IMKBilin one on a piece that flows one way, and each within its rest thresholds (bilinear
-// ones in their bands) at the reach of the motion's energy.
+// RowModel::settled_imk (after settles' test of the levels): each storey on a linear piece
+// `f = a + K d` comes to rest where its spring force is gravity's P-Delta shear `g d`, and the
+// motion's energy about there bounds its reach; no bilinear storey on a line, no IMKBilin one on
+// a piece that flows one way, and each within its rest thresholds (bilinear ones in their bands).
 fn imk_settles(z: ptr<function, ZA>) -> bool {
-    for (var s = 0u; s < NS; s++) {
-        if (!IS_IMK[s] && SM[s] != SM_ELASTIC) {
-            return false;
-        }
-    }
-    var p_delta = false;
-    for (var s = 0u; s < NS; s++) {
-        if (st_geo(s) != 0.0) {
-            p_delta = true;
-        }
-    }
     var e: real = 0.0;
-    if (p_delta) {
-        static_offsets(z);
-        for (var k = 0u; k < NM; k++) {
-            let x = (*z)[k] - QS[k];
-            e += 0.5 * ((*z)[NM + k] * (*z)[NM + k] + W2[k] * x * x);
-        }
-    } else {
-        for (var k = 0u; k < NM; k++) {
-            e += 0.5 * ((*z)[NM + k] * (*z)[NM + k] + W2[k] * (*z)[k] * (*z)[k]);
-        }
-        var c: real = 0.0;
+    for (var k = 0u; k < NM; k++) {
+        e += 0.5 * (*z)[NM + k] * (*z)[NM + k];
+    }
+    for (var b = 0u; b < NB; b++) {
+        var storeys = false;
         for (var s = 0u; s < NS; s++) {
-            let p = (*z)[PS0 + s];
-            c += st_k(s) * p * (0.5 * p - storey_drift(s, z, 0u));
-        }
-        e = max(e + c, 0.0);
-    }
-    for (var s = 0u; s < NS; s++) {
-        if (!IS_IMK[s]) {
-            continue;
-        }
-        let slope = imk_ir(s, IR_SLOPE);
-        // A peak-oriented storey may come to rest on a reloading line.
-        let one_way = imk_ir(s, IR_HEADING) != 0.0 && !imk_peak_oriented(s);
-        if (one_way || slope <= 0.0 || (p_delta && slope != st_k(s))) {
-            return false;
-        }
-        let f = st_k(s) * (storey_drift(s, z, 0u) - (*z)[PS0 + s]);
-        e += f * f * (0.5 / slope - 0.5 / st_k(s));
-    }
-    for (var s = 0u; s < NS; s++) {
-        let p = (*z)[PS0 + s];
-        var rest = p;
-        var stiffness = st_k(s);
-        if (IS_IMK[s]) {
-            stiffness = imk_ir(s, IR_SLOPE);
-            rest = imk_ir(s, IR_D0) - imk_ir(s, IR_F0) / stiffness;
-        }
-        var center = rest;
-        if (p_delta) {
-            let o = B_OFF[S_B[s]];
-            center = 0.0;
-            for (var i = 0u; i < B_N[S_B[s]]; i++) {
-                center += st_row(s, i) * QS[o + i];
+            if (S_B[s] == b) {
+                storeys = true;
             }
-            stiffness = stiffness - st_geo(s);
         }
+        if (!storeys) {
+            for (var i = 0u; i < B_N[b]; i++) {
+                let k = B_OFF[b] + i;
+                e += 0.5 * W2[k] * (*z)[k] * (*z)[k];
+            }
+        }
+    }
+    var rest: array<real, NSA>;
+    var stiff: array<real, NSA>;
+    for (var s = 0u; s < NS; s++) {
+        let d = storey_drift(s, z, 0u);
+        var a: real = 0.0;
+        var slope: real = 0.0;
+        if (IS_IMK[s]) {
+            if (imk_ir(s, IR_HEADING) != 0.0 && !imk_peak_oriented(s)) {
+                return false;
+            }
+            slope = imk_ir(s, IR_SLOPE);
+            a = imk_ir(s, IR_F0) - slope * imk_ir(s, IR_D0);
+        } else {
+            if (SM[s] != SM_ELASTIC) {
+                return false;
+            }
+            slope = st_k(s);
+            a = -st_k(s) * (*z)[PS0 + s];
+        }
+        let stiffness = slope - st_geo(s);
         if (stiffness <= 0.0) {
             return false;
         }
-        let reach = sqrt(2.0 * e / stiffness);
+        rest[s] = -a / stiffness;
+        stiff[s] = stiffness;
+        e += 0.5 * stiffness * (d - rest[s]) * (d - rest[s]);
+    }
+    for (var s = 0u; s < NS; s++) {
+        let reach = sqrt(2.0 * e / stiff[s]);
         if (IS_IMK[s]) {
             let slack = imk_slack(s);
             var rest_reach = BIG;
@@ -740,11 +725,11 @@ fn imk_settles(z: ptr<function, ZA>) -> bool {
                 // ImkSpring::rest_reach.
                 rest_reach = 1e-4 * imk_ip(s, IP_FY) / imk_ip(s, IP_K);
             }
-            if (!(reach <= rest_reach && center - reach >= imk_ir(s, IR_REST_LO) - slack
-                  && center + reach <= imk_ir(s, IR_REST_HI) + slack)) {
+            if (!(reach <= rest_reach && rest[s] - reach >= imk_ir(s, IR_REST_LO) - slack
+                  && rest[s] + reach <= imk_ir(s, IR_REST_HI) + slack)) {
                 return false;
             }
-        } else if (!(abs(back_drift(s, center, p)) + reach <= st_dy(s) * (1.0 + YIELD_SLACK))) {
+        } else if (!(abs(back_drift(s, rest[s], (*z)[PS0 + s])) + reach <= st_dy(s) * (1.0 + YIELD_SLACK))) {
             return false;
         }
     }

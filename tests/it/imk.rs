@@ -1,7 +1,8 @@
 //! Deteriorating (IMK) storeys in whole rows (issue 67, physics.md section 13): a push past
 //! capping against its closed form, and every run's convergence with the substeps (8 to 512)
-//! against the reference, on IMK scenes with and without contact, with and without P-Delta,
-//! past capping and on the residual plateau, both hysteresis rules.
+//! against the reference, on IMK scenes with and without contact, with and without P-Delta
+//! (standing and collapsing), past capping and on the residual plateau, both hysteresis rules;
+//! those that stand apart settle (their residual drifts given).
 
 use crate::convergence::{fast, judge, low_frame, row, soft_frame, truths, Scene};
 use crate::scenes::models::{building, record};
@@ -207,6 +208,27 @@ pub(crate) fn scenes() -> Vec<Scene> {
             LawKind::Linear,
         ),
         synth(8, 8.0, 0.9),
+        false,
+        false,
+    );
+    push(
+        "IMK P-Delta storey past capping that stands (gravity mass ratio 0.3, energy rule)",
+        row(
+            vec![
+                imk(
+                    building(1, 0.6, Damping::Modal(0.05)),
+                    peak,
+                    0.004,
+                    0.03,
+                    RC,
+                )
+                .with_p_delta(0.3),
+                building(1, 0.3, Damping::Modal(0.05)),
+            ],
+            vec![2.0],
+            LawKind::Linear,
+        ),
+        synth(11, 8.0, 0.7),
         false,
         false,
     );

@@ -184,84 +184,68 @@ impl RowModel {
         })
     }
 
-    /// [`RowModel::settled`] with IMK storeys: each on a piece that does not flow one way, a
-    /// linear spring of its slope `K` (the unloading stiffness may have deteriorated below `k`),
-    /// so the motion's energy `E' = E + sum f^2 (1/2K - 1/2k)` (`E` counts each spring as `k`'s)
-    /// can only fall, and bounds the storey's drift within `sqrt(2 E' / K)` of where its force
-    /// is zero. It stays on its piece while that reach is inside the piece's thresholds; a
-    /// bilinear storey beside it stays in its band as in [`RowModel::settled`] with `E'`. With
-    /// P-Delta the plastic drifts' static response is the one of free pieces only (slope `k`):
-    /// a storey on another piece keeps the run going.
+    /// [`RowModel::settled`] with IMK storeys. Each yielding storey is on a linear piece, `f = a
+    /// + K d` (`K` its slope; a bilinear storey in its band: `k (d - p)`), and at rest a shear
+    /// building's every storey carries no net shear, so each comes to rest on its own where its
+    /// spring force is gravity's P-Delta shear `g d` (`g = P/h`, 0 without P-Delta): `d* = -a /
+    /// (K - g)`. The motion's energy `E = 1/2 sum q'^2 + sum 1/2 (K - g)(d - d*)^2` (the elastic
+    /// buildings' modes as in [`RowModel::mechanical_energy`]) can only fall while the pieces
+    /// hold (damping and contact dissipate), so a storey's drift stays within `sqrt(2 E / (K -
+    /// g))` of `d*`: it stays on its piece while that reach is inside the piece's rest thresholds
+    /// (a bilinear storey: in its band). A storey with `K <= g` may run away: not settled. A
+    /// peak-oriented storey may come to rest on a reloading line, once its reach is below
+    /// [`crate::physics::imk::ImkSpring::rest_reach`]; an `IMKBilin` one's lines that flow one
+    /// way are its backbone's.
     fn settled_imk(&self, z: &[f64], modes: &[StoreyMode]) -> bool {
-        let p_delta = self.storeys.iter().any(|sm| sm.geometric != 0.0);
         let n = self.n;
-        let mut qs = vec![0.0; n];
-        let mut e = if p_delta {
-            self.static_offsets(z, &mut qs);
-            (0..n)
-                .map(|i| {
-                    let x = z[i] - qs[i];
-                    0.5 * (z[n + i] * z[n + i] + self.w2[i] * x * x)
-                })
-                .sum()
-        } else {
-            self.mechanical_energy(z).max(0.0)
-        };
-        let drift = |sm: &super::storey::StoreyModel| {
-            let o = self.buildings[sm.building].off;
-            dot(&sm.modal_row, &z[o..])
-        };
-        for (s, (sm, mode)) in self.storeys.iter().zip(modes).enumerate() {
-            if let StoreyMode::Imk(piece) = mode {
-                // A peak-oriented storey may come to rest on a reloading line (its reach then
-                // bounded as on any piece); an `IMKBilin` one's lines that flow one way are
-                // its backbone's.
-                let loops = sm
-                    .imk
-                    .as_ref()
-                    .is_some_and(|sp| sp.rule == ImkRule::PeakOriented);
-                if (piece.heading != 0.0 && !loops)
-                    || piece.slope <= 0.0
-                    || (p_delta && piece.slope != sm.k)
-                {
-                    return false;
-                }
-                let f = sm.k * (drift(sm) - z[self.plastic_slot(s)]);
-                e += f * f * (0.5 / piece.slope - 0.5 / sm.k);
-            }
+        let mut e: f64 = (0..n).map(|i| 0.5 * z[n + i] * z[n + i]).sum();
+        for b in self.buildings.iter().filter(|b| b.first_storey.is_none()) {
+            e += (b.off..b.off + b.n())
+                .map(|i| 0.5 * self.w2[i] * z[i] * z[i])
+                .sum::<f64>();
         }
-        self.storeys
-            .iter()
-            .zip(modes)
-            .enumerate()
-            .all(|(s, (sm, mode))| {
-                let p = z[self.plastic_slot(s)];
-                // Where the storey's force is zero at rest, and its stiffness about there.
-                let (rest, stiffness) = match mode {
-                    StoreyMode::Imk(piece) => (piece.d0 - piece.f0 / piece.slope, piece.slope),
-                    _ => (p, sm.k),
-                };
-                let (center, stiffness) = if p_delta {
-                    let o = self.buildings[sm.building].off;
-                    (dot(&sm.modal_row, &qs[o..]), stiffness - sm.geometric)
-                } else {
-                    (rest, stiffness)
-                };
-                if stiffness <= 0.0 {
-                    return false;
+        let mut rests = Vec::with_capacity(self.storeys.len());
+        for (s, (sm, mode)) in self.storeys.iter().zip(modes).enumerate() {
+            let o = self.buildings[sm.building].off;
+            let d = dot(&sm.modal_row, &z[o..]);
+            let (a, slope) = match mode {
+                StoreyMode::Imk(piece) => {
+                    let loops =
+                        (sm.imk.as_ref()).is_some_and(|sp| sp.rule == ImkRule::PeakOriented);
+                    if piece.heading != 0.0 && !loops {
+                        return false;
+                    }
+                    (piece.f0 - piece.slope * piece.d0, piece.slope)
                 }
+                StoreyMode::Elastic => (-sm.k * z[self.plastic_slot(s)], sm.k),
+                StoreyMode::Yielding(_) => return false,
+            };
+            let stiffness = slope - sm.geometric;
+            if stiffness <= 0.0 {
+                return false;
+            }
+            let rest = -a / stiffness;
+            e += 0.5 * stiffness * (d - rest) * (d - rest);
+            rests.push((rest, stiffness));
+        }
+        (self.storeys.iter().zip(modes).zip(rests).enumerate()).all(
+            |(s, ((sm, mode), (rest, stiffness)))| {
                 let reach = (2.0 * e / stiffness).sqrt();
                 match mode {
                     StoreyMode::Imk(piece) => {
                         let sp = sm.imk.as_ref().expect("an IMK mode has its spring");
                         let slack = sp.slack();
                         reach <= sp.rest_reach()
-                            && center - reach >= piece.rest_lo - slack
-                            && center + reach <= piece.rest_hi + slack
+                            && rest - reach >= piece.rest_lo - slack
+                            && rest + reach <= piece.rest_hi + slack
                     }
-                    _ => sm.back_drift(center, p).abs() + reach <= sm.d_y * (1.0 + YIELD_SLACK),
+                    _ => {
+                        let p = z[self.plastic_slot(s)];
+                        sm.back_drift(rest, p).abs() + reach <= sm.d_y * (1.0 + YIELD_SLACK)
+                    }
                 }
-            })
+            },
+        )
     }
 
     /// Each building with a storey that yields now or may reach a bounding line over the
