@@ -184,16 +184,17 @@ impl RowModel {
         })
     }
 
-    /// [`RowModel::settled`] with IMK storeys. Each yielding storey is on a linear piece, `f = a
-    /// + K d` (`K` its slope; a bilinear storey in its band: `k (d - p)`), and at rest a shear
-    /// building's every storey carries no net shear, so each comes to rest on its own where its
-    /// spring force is gravity's P-Delta shear `g d` (`g = P/h`, 0 without P-Delta): `d* = -a /
-    /// (K - g)`. The motion's energy `E = 1/2 sum q'^2 + sum 1/2 (K - g)(d - d*)^2` (the elastic
-    /// buildings' modes as in [`RowModel::mechanical_energy`]) can only fall while the pieces
-    /// hold (damping and contact dissipate), so a storey's drift stays within `sqrt(2 E / (K -
-    /// g))` of `d*`: it stays on its piece while that reach is inside the piece's rest thresholds
-    /// (a bilinear storey: in its band). A storey with `K <= g` may run away: not settled. A
-    /// peak-oriented storey may come to rest on a reloading line, once its reach is below
+    /// [`RowModel::settled`] with IMK storeys. Each yielding storey is on a linear piece
+    /// `f = a + K d` (`K` its slope; a bilinear storey in its band: `k (d - p)`), and at rest
+    /// a shear building's every storey carries no net shear, so each comes to rest on its own
+    /// where its spring force is gravity's P-Delta shear `g d` (`g = P/h`, 0 without P-Delta):
+    /// `d* = -a / (K - g)`. The motion's energy, half the modal velocities squared plus each
+    /// storey's `(K - g)(d - d*)^2 / 2` (the elastic buildings' modes as in
+    /// [`RowModel::mechanical_energy`]), can only fall while the pieces hold (damping and
+    /// contact dissipate), so a storey's drift stays within `sqrt(2 E / (K - g))` of `d*`: it
+    /// stays on its piece while that reach is inside the piece's rest thresholds (a bilinear
+    /// storey: in its band). A storey with `K <= g` may run away: not settled. A peak-oriented
+    /// storey may come to rest on a reloading line, once its reach is below
     /// [`crate::physics::imk::ImkSpring::rest_reach`]; an `IMKBilin` one's lines that flow one
     /// way are its backbone's.
     fn settled_imk(&self, z: &[f64], modes: &[StoreyMode]) -> bool {
