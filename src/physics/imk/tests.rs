@@ -205,3 +205,59 @@ fn bilinear_lowers_its_hardening_at_a_zero_crossing_without_an_energy_capacity()
     let f = drive(&sp, &path);
     assert!((f[8] - 293142.857).abs() < 1e-3, "{f:?}");
 }
+
+/// Constant-amplitude cycles of an `IMKBilin` storey without hardening (b = 0, below its
+/// capping drift), each half cycle's strength from the energy rule in closed form: the work of
+/// a half cycle between zero crossings is `F^2 / 2K` on the reloading line, `F (u0 - F/K + A)`
+/// along the flat yield line (`u0` where the force crossed zero, `A` the amplitude), less
+/// `F'^2 / 2K'` on the way back to zero (`K'` the unloading stiffness after the reversal's K
+/// rule); the strength of the side the next excursion heads to falls by
+/// `1 - E_i / (E_t - sum E)`.
+#[test]
+fn constant_amplitude_cycles_lose_strength_by_the_energy_rule_in_closed_form() {
+    let (k, h, theta_y, gamma, a) = (2.0e7, 3.0, 0.005, 50.0, 0.06);
+    let sp = ImkSpring::from_ratios(
+        ImkRule::Bilinear,
+        k,
+        h,
+        theta_y,
+        0.0,
+        (0.02, 0.08, 0.2, 0.15),
+        Some(gamma),
+    );
+    let e_t = gamma * sp.fy * theta_y * h;
+    // The first excursion: elastic to the yield drift, then flat at F_y to A.
+    let uy = sp.fy / k;
+    let mut work = 0.5 * sp.fy * uy + sp.fy * (a - uy);
+    let (mut mark, mut ku) = (0.0, k);
+    let mut strength = [sp.fy, sp.fy];
+    let mut peaks = vec![sp.fy];
+    let mut at = a;
+    for i in 1..10 {
+        let f = peaks[i - 1].abs();
+        // The reversal at the peak: the K rule on the energy since the last crossing.
+        let stored = 0.5 * f * f / ku;
+        let bk = ((work - mark - stored) / (e_t - (work - stored))).max(0.0);
+        ku *= 1.0 - bk;
+        // Back to zero force, where the side ahead deteriorates.
+        work -= 0.5 * f * f / ku;
+        let u0 = at.abs() - f / ku;
+        let bs = (work - mark) / (e_t - work);
+        assert!((0.0..1.0).contains(&bs));
+        mark = work;
+        let ahead = i % 2; // 1: the negative side, 0: the positive one
+        strength[ahead] *= 1.0 - bs;
+        let g = strength[ahead];
+        // Reloading with the unloading stiffness to the flat line, then along it to A.
+        work += 0.5 * g * g / ku + g * (u0 - g / ku + a);
+        peaks.push(if ahead == 1 { -g } else { g });
+        at = -at;
+    }
+    let path: Vec<f64> = (0..10).map(|i| if i % 2 == 0 { a } else { -a }).collect();
+    let got = drive(&sp, &path);
+    for (i, (g, w)) in got.iter().zip(&peaks).enumerate() {
+        assert!((g - w).abs() < 1e-9 * sp.fy, "cycle {i}: {g} against {w}");
+    }
+    // It does deteriorate: the tenth peak is well below the first.
+    assert!(peaks[9].abs() < 0.7 * sp.fy, "{peaks:?}");
+}
