@@ -201,7 +201,7 @@ impl Kernel {
             )),
             // The row kernel's IMK storeys are the CPU's twin in f64; f32 does not resolve their
             // thresholds' slack (1e-9 of the yield drift).
-            Kernel::Row if plan_has_imk(plan) && precision == Precision::F32 => {
+            Kernel::Row if matches!(plan, Plan::Row(r) if r.has_imk()) && precision == Precision::F32 => {
                 Some(EngineError::GpuUnfit(
                     "IMK storeys (hysteresis = \"imk_bilinear\" or \"imk_peak_oriented\") run on the GPU in f64 only (add --precision f64)",
                 ))
@@ -213,14 +213,6 @@ impl Kernel {
             }
             Kernel::Row => None,
         }
-    }
-}
-
-/// Does a row plan have a building of IMK (deteriorating) storeys?
-fn plan_has_imk(plan: &Plan) -> bool {
-    match plan {
-        Plan::Row(r) => (r.yielding.iter().flatten()).any(|y| y.deterioration.is_some()),
-        Plan::Pair(_) => false,
     }
 }
 

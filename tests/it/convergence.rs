@@ -458,6 +458,13 @@ fn every_yielding_run_converges_on_the_cpu_paths() {
     let (all, _) = scenes();
     let scenes: Vec<&Scene> = all.iter().collect();
     let truth = truths(&scenes);
+    let bad = cpu_failures(&scenes, &truth);
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+}
+
+/// The failures of `scenes` on both CPU paths (the scheme, and its whole-row twin) against
+/// their references `truth`, at every setting.
+pub(crate) fn cpu_failures(scenes: &[&Scene], truth: &[RowOutput]) -> Vec<String> {
     let mut bad = Vec::new();
     type Path = fn(&Scene, f64) -> RowOutput;
     let paths: [(&str, Path); 2] = [
@@ -474,9 +481,9 @@ fn every_yielding_run_converges_on_the_cpu_paths() {
             .iter()
             .map(|&s| scenes.iter().map(|sc| run(sc, s)).collect())
             .collect();
-        bad.extend(judge(path, &scenes, &truth, &outs));
+        bad.extend(judge(path, scenes, truth, &outs));
     }
-    assert!(bad.is_empty(), "{}", bad.join("\n"));
+    bad
 }
 
 /// The GPU row kernel in f64 converges as its CPU twin on the scenes within lavapipe's loop

@@ -4,13 +4,12 @@
 //! (standing and collapsing), past capping and on the residual plateau, both hysteresis rules;
 //! those that stand apart settle (their residual drifts given).
 
-use crate::convergence::{fast, judge, low_frame, row, soft_frame, truths, Scene};
+use crate::convergence::{cpu_failures, fast, low_frame, row, soft_frame, truths, Scene};
 use crate::scenes::models::{building, record};
 use pounding::physics::contact::LawKind;
 use pounding::physics::model::{Forcing, Status};
-use pounding::physics::row::{Row, RowOutput};
+use pounding::physics::row::Row;
 use pounding::physics::shear::{Damping, Deterioration, ImkRule, ShearBuilding, Yielding};
-use pounding::physics::solver::row::fast::simulate_whole_row;
 use pounding::physics::solver::row::{simulate_row, RowModel, RowScheme};
 use pounding::physics::solver::ReferenceOptions;
 
@@ -285,23 +284,6 @@ fn every_imk_run_converges_on_the_cpu_paths() {
         let lost = t.storeys.iter().any(|s| s.strength_ratio < 1.0);
         assert_eq!(lost, energy_rule, "{}: strength lost", sc.name);
     }
-    let mut bad = Vec::new();
-    type Path = fn(&Scene, f64) -> RowOutput;
-    let paths: [(&str, Path); 2] = [
-        ("cpu", |sc, s| {
-            let scheme = RowScheme::Fast(fast(s));
-            simulate_row(&sc.model, &sc.forcing(), sc.model.at_rest(), &scheme)
-        }),
-        ("cpu whole row", |sc, s| {
-            simulate_whole_row(&sc.model, &sc.forcing(), sc.model.at_rest(), &fast(s))
-        }),
-    ];
-    for (path, run) in paths {
-        let outs: Vec<Vec<RowOutput>> = crate::convergence::SETTINGS
-            .iter()
-            .map(|&s| scenes.iter().map(|sc| run(sc, s)).collect())
-            .collect();
-        bad.extend(judge(path, &scenes, &truth, &outs));
-    }
+    let bad = cpu_failures(&scenes, &truth);
     assert!(bad.is_empty(), "{}", bad.join("\n"));
 }

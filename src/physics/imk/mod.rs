@@ -109,6 +109,20 @@ pub struct Piece {
 }
 
 impl Piece {
+    /// The line through `(d0, f0)` with `slope`, with no threshold and no heading yet.
+    fn line(d0: f64, f0: f64, slope: f64) -> Piece {
+        Piece {
+            d0,
+            f0,
+            slope,
+            lo: f64::NEG_INFINITY,
+            hi: f64::INFINITY,
+            heading: 0.0,
+            rest_lo: f64::NEG_INFINITY,
+            rest_hi: f64::INFINITY,
+        }
+    }
+
     /// The force at drift `d`.
     #[inline]
     pub fn force(&self, d: f64) -> f64 {
@@ -215,16 +229,7 @@ impl ImkState {
             work: 0.0,
             work_mark: 0.0,
             branch: Branch::Elastic,
-            piece: Piece {
-                d0: 0.0,
-                f0: 0.0,
-                slope: sp.k,
-                lo: f64::NEG_INFINITY,
-                hi: f64::INFINITY,
-                heading: 0.0,
-                rest_lo: f64::NEG_INFINITY,
-                rest_hi: f64::INFINITY,
-            },
+            piece: Piece::line(0.0, 0.0, sp.k),
             marks: [Mark::None; 2],
             yielded: false,
             capped: false,
@@ -325,16 +330,7 @@ impl ImkState {
     /// Start a piece `f = f0 + slope (d - d0)` on `branch` at drift `d0`, with its thresholds.
     fn set_piece(&mut self, sp: &ImkSpring, d0: f64, f0: f64, slope: f64, branch: Branch) {
         self.branch = branch;
-        let mut piece = Piece {
-            d0,
-            f0,
-            slope,
-            lo: f64::NEG_INFINITY,
-            hi: f64::INFINITY,
-            heading: 0.0,
-            rest_lo: f64::NEG_INFINITY,
-            rest_hi: f64::INFINITY,
-        };
+        let mut piece = Piece::line(d0, f0, slope);
         let mut marks = [Mark::None; 2];
         // Each side's threshold in its own magnitudes, found from the piece in them.
         for sign in [1.0, -1.0] {
@@ -566,16 +562,7 @@ impl ImkState {
             s.failed = true;
         }
         self.branch = Branch::Collapsed;
-        self.piece = Piece {
-            d0: d,
-            f0: 0.0,
-            slope: 0.0,
-            lo: f64::NEG_INFINITY,
-            hi: f64::INFINITY,
-            heading: 0.0,
-            rest_lo: f64::NEG_INFINITY,
-            rest_hi: f64::INFINITY,
-        };
+        self.piece = Piece::line(d, 0.0, 0.0);
         self.marks = [Mark::None; 2];
     }
 }

@@ -92,6 +92,11 @@ impl RowPlan {
         (self.yielding[b].as_ref()).is_some_and(|y| y.deterioration.is_some())
     }
 
+    /// Has any building IMK storeys?
+    pub fn has_imk(&self) -> bool {
+        (0..self.buildings.len()).any(|b| self.imk_building(b))
+    }
+
     /// The contact levels' column prefixes ([`level_name`]).
     pub fn level_names(&self) -> Vec<String> {
         (self.levels().iter())
