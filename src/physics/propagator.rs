@@ -166,6 +166,20 @@ pub struct CoupledPropagator {
 
 impl CoupledPropagator {
     pub fn new(w2: &[f64], c: &[f64], coupling: &[Vec<f64>], part: &[f64], h: f64) -> Self {
+        Self::with_stiffness(w2, None, c, coupling, part, h)
+    }
+
+    /// As [`CoupledPropagator::new`] with the modes' stiffness coupled too: `q'' + c q' + E q'
+    /// + (w^2 + S) q = -L ag` (`S` row by row; a building whose storeys stand on pieces off
+    /// their initial stiffness).
+    pub fn with_stiffness(
+        w2: &[f64],
+        stiffness: Option<&[Vec<f64>]>,
+        c: &[f64],
+        coupling: &[Vec<f64>],
+        part: &[f64],
+        h: f64,
+    ) -> Self {
         let n = w2.len();
         let m = 2 * n + 2;
         let mut a = vec![0.0; m * m];
@@ -177,6 +191,11 @@ impl CoupledPropagator {
                 a[r + n + k] = -coupling[i][k] * h;
             }
             a[r + n + i] -= c[i] * h;
+            if let Some(s) = stiffness {
+                for k in 0..n {
+                    a[r + k] -= s[i][k] * h;
+                }
+            }
             a[r + 2 * n] = -part[i] * h;
         }
         a[2 * n * m + 2 * n + 1] = h;

@@ -89,12 +89,46 @@ impl CoupledStep {
 
     /// Building `k` of `m` over `h`; None where its modes are not coupled.
     pub fn new(m: &RowModel, k: usize, h: f64, energy: bool) -> Option<CoupledStep> {
+        let e = m.buildings[k].modes.coupling.as_ref()?;
+        Some(Self::build(m, k, h, energy, e, None))
+    }
+
+    /// Building `k` of `m` over `h` with its modes' stiffness coupled by `stiffness` (its
+    /// storeys on pieces off their initial stiffness, [`super::tangent`]), and by its damping
+    /// where that couples them.
+    pub fn tangent(
+        m: &RowModel,
+        k: usize,
+        h: f64,
+        energy: bool,
+        stiffness: &[Vec<f64>],
+    ) -> CoupledStep {
         let b = &m.buildings[k];
-        let e = b.modes.coupling.as_ref()?;
+        let zero;
+        let e = match b.modes.coupling.as_ref() {
+            Some(e) => e,
+            None => {
+                zero = vec![vec![0.0; b.n()]; b.n()];
+                &zero
+            }
+        };
+        Self::build(m, k, h, energy, e, Some(stiffness))
+    }
+
+    fn build(
+        m: &RowModel,
+        k: usize,
+        h: f64,
+        energy: bool,
+        e: &[Vec<f64>],
+        stiffness: Option<&[Vec<f64>]>,
+    ) -> CoupledStep {
+        let b = &m.buildings[k];
         let r = b.off..b.off + b.n();
         let at = |x: f64| {
-            CoupledPropagator::new(
+            CoupledPropagator::with_stiffness(
                 &m.w2[r.clone()],
+                stiffness,
                 &m.two_xi_w[r.clone()],
                 e,
                 &m.part[r.clone()],
@@ -112,14 +146,14 @@ impl CoupledStep {
         } else {
             Vec::new()
         };
-        Some(CoupledStep {
+        CoupledStep {
             k,
             prop: at(h),
             nodes,
             h,
             x0: vec![0.0; 2 * b.n()],
             x: vec![0.0; 2 * b.n()],
-        })
+        }
     }
 
     /// Step the building's modes of `z` (the row's modal state; `qs` the static response to
@@ -149,7 +183,8 @@ impl CoupledStep {
             z1[n + o + i] = x[nb + i];
         }
         let Some(work) = work else { return };
-        let e = b.modes.coupling.as_ref().expect("coupled");
+        // A tangent step's modes may be coupled by their stiffness alone.
+        let e = b.modes.coupling.as_ref();
         for w in work[o..o + nb].iter_mut() {
             *w = (0.0, 0.0);
         }
@@ -158,7 +193,7 @@ impl CoupledStep {
             p.step(x0, ag.0, a, x);
             let v = &x[nb..];
             for i in 0..nb {
-                let dv = m.two_xi_w[o + i] * v[i] + dot(&e[i], v);
+                let dv = m.two_xi_w[o + i] * v[i] + e.map_or(0.0, |e| dot(&e[i], v));
                 let (agv, vv) = &mut work[o + i];
                 *agv += weight * self.h * m.part[o + i] * a * v[i];
                 *vv += weight * self.h * v[i] * dv / m.two_xi_w[o + i];

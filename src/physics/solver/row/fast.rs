@@ -28,6 +28,7 @@ use super::model::{RowModel, FLOOR_SUBSTEPS_FROM};
 use super::rhs::{rhs, Motion};
 use super::run::RowRun;
 use super::sample::RowObserver;
+use super::tangent::Tangent;
 use super::yielding::next_segment;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
@@ -150,6 +151,24 @@ impl Lookout {
     }
 }
 
+/// Each mode's bound on `|q''''|` over the free step `z -> z1` of `seg`
+/// ([`RowModel::fourth_derivative_bounds`]), a building on its tangent stiffness's from its
+/// [`Tangent`] (`on` says which, None: none).
+fn bounds_with(
+    m: &RowModel,
+    (seg, z, z1): (&Segment, &[f64], &[f64]),
+    bounds: &mut Vec<f64>,
+    tangents: &[Option<Tangent>],
+    on: Option<&[bool]>,
+) {
+    m.fourth_derivative_bounds(seg, z, z1, bounds);
+    if let Some(on) = on {
+        for t in tangents.iter().flatten().filter(|t| on[t.building()]) {
+            t.bounds(m, seg, z, z1, bounds);
+        }
+    }
+}
+
 fn mode_oscillator(m: &RowModel, k: usize) -> Oscillator {
     Oscillator {
         m: 1.0,
@@ -177,6 +196,7 @@ pub(crate) fn run(
         forcing,
         z0,
         o,
+        Steps::Tangent,
         false,
         // Shortened to the substep model's life (a coercion `Option` does not make itself).
         observer.map(|o| o as RowObserver<'_>),
@@ -185,9 +205,10 @@ pub(crate) fn run(
 }
 
 /// The fast scheme with every building in every substep: the twin of the GPU row kernel
-/// (`shaders/row.wgsl`), which lets no building stand still, for comparing the two step for
-/// step. The scheme ([`super::simulate_row`]) differs from it by the exact free steps of the
-/// buildings that stand still.
+/// (`shaders/row.wgsl`), which lets no building stand still and takes IMK storeys' pieces off
+/// their initial stiffness in substeps, for comparing the two step for step. The scheme
+/// ([`super::simulate_row`]) differs from it by the exact free steps of the buildings that
+/// stand still and of those on such pieces ([`super::tangent`]).
 pub fn simulate_whole_row(
     m: &RowModel,
     forcing: &Forcing,
@@ -195,7 +216,18 @@ pub fn simulate_whole_row(
     o: &FastOptions,
 ) -> RowOutput {
     let sub = m.substep_model();
-    run_with(m, sub.as_ref(), Standing::None, forcing, z0, o, false, None).0
+    run_with(
+        m,
+        sub.as_ref(),
+        Standing::None,
+        forcing,
+        z0,
+        o,
+        Steps::Modal,
+        false,
+        None,
+    )
+    .0
 }
 
 /// The fast scheme from rest with every building in every substep, tracking the levels'
@@ -209,6 +241,7 @@ pub(crate) fn run_uncoupled(m: &RowModel, forcing: &Forcing, o: &FastOptions) ->
         forcing,
         m.at_rest(),
         o,
+        Steps::Tangent,
         true,
         None,
     )
@@ -230,6 +263,16 @@ enum Standing {
     Grown,
 }
 
+/// Which free steps a building whose IMK storeys stand on pieces off their initial stiffness
+/// takes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Steps {
+    /// Substeps, as the GPU row kernel.
+    Modal,
+    /// Exact steps of its tangent stiffness ([`super::tangent`]).
+    Tangent,
+}
+
 /// Building-steps stood still, and buildings that joined the substeps inside a record step.
 #[derive(Debug, Clone, Copy, Default)]
 struct Tally {
@@ -248,6 +291,7 @@ fn run_with<'a>(
     forcing: &Forcing,
     z0: Vec<f64>,
     o: &FastOptions,
+    steps: Steps,
     closings: bool,
     observer: Option<RowObserver<'a>>,
 ) -> (RowOutput, Tally) {
@@ -315,6 +359,12 @@ fn run_with<'a>(
     let mut q_static = vec![0.0; n];
     let mut storey_modes = Vec::with_capacity(m.storeys.len());
     let mut yield_watch = vec![false; m.buildings.len()];
+    // Buildings on IMK pieces off their initial stiffness: the exact step of each one's
+    // tangent stiffness, kept while its pieces' slopes hold, and whether it takes it this step.
+    let tangent_steps = steps == Steps::Tangent && m.storeys.iter().any(|sm| sm.imk.is_some());
+    let mut tangents: Vec<Option<Tangent>> = m.buildings.iter().map(|_| None).collect();
+    let mut on_tangent = vec![false; m.buildings.len()];
+    let mut slopes = Vec::new();
     let mut i = 0;
     // The step's start, in a buffer kept from step to step (as `z1`, its end).
     let mut z_start = Vec::with_capacity(len);
@@ -329,6 +379,24 @@ fn run_with<'a>(
         let any_gone = run.gone.iter().any(|&g| g);
         z_start.clone_from(&run.z);
         let z = &z_start;
+        let mut any_tangent = false;
+        if tangent_steps {
+            for (k, on) in on_tangent.iter_mut().enumerate() {
+                *on = !run.gone[k] && Tangent::slopes(m, k, &run.storey_modes, &mut slopes);
+                if !*on {
+                    continue;
+                }
+                if !tangents[k].as_ref().is_some_and(|t| t.is_for(&slopes)) {
+                    tangents[k] = Tangent::new(m, k, &slopes, dt, o.energy);
+                }
+                match &mut tangents[k] {
+                    Some(t) => t.prepare(m, z),
+                    None => *on = false,
+                }
+                any_tangent |= *on;
+            }
+        }
+        let tangent_on = any_tangent.then_some(&on_tangent[..]);
         // The exact free step of every mode: the step itself when no level may touch, and the
         // buildings' that stand still through a step of substeps (none in a row of two).
         let any_contact = run.any_contact();
@@ -339,7 +407,10 @@ fn run_with<'a>(
                 m.static_offsets(z, &mut q_static);
             }
             for k in 0..n {
-                if in_coupled[k] || (any_gone && run.gone[mode_building[k]]) {
+                if in_coupled[k]
+                    || (any_gone && run.gone[mode_building[k]])
+                    || tangent_on.is_some_and(|on| on[mode_building[k]])
+                {
                     if forms.is_some() {
                         work.push((0.0, 0.0));
                     }
@@ -358,7 +429,7 @@ fn run_with<'a>(
                 }
             }
             for c in coupled.iter_mut() {
-                if run.gone[c.building()] {
+                if run.gone[c.building()] || tangent_on.is_some_and(|on| on[c.building()]) {
                     continue;
                 }
                 let qs = yields.then_some(&q_static[..]);
@@ -368,6 +439,21 @@ fn run_with<'a>(
                     let b = &m.buildings[c.building()];
                     for (i, &w) in work.iter().enumerate().skip(b.off).take(b.n()) {
                         m.add_free_work(&mut z1, i, w);
+                    }
+                }
+            }
+            if let Some(on) = tangent_on {
+                for t in tangents.iter_mut().flatten() {
+                    if !on[t.building()] {
+                        continue;
+                    }
+                    let w = forms.is_some().then_some(&mut work[..]);
+                    t.step(m, z, (seg.a0, seg.a1), &mut z1, w);
+                    if forms.is_some() {
+                        let b = &m.buildings[t.building()];
+                        for (i, &w) in work.iter().enumerate().skip(b.off).take(b.n()) {
+                            m.add_free_work(&mut z1, i, w);
+                        }
                     }
                 }
             }
@@ -385,9 +471,15 @@ fn run_with<'a>(
         // A storey that yields, or may in the exact free step, moves its building in substeps.
         let mut yielding = false;
         if yields && (can_stand || !any_contact) {
-            m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
+            bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
             bounded = true;
-            yielding = m.yield_watch(&run.storey_modes, (z, &z1), &bounds, dt, &mut yield_watch);
+            yielding = m.yield_watch(
+                (&run.storey_modes, tangent_on),
+                (z, &z1),
+                &bounds,
+                dt,
+                &mut yield_watch,
+            );
         }
         if watched {
             if !yields {
@@ -396,7 +488,7 @@ fn run_with<'a>(
             if can_stand || !any_contact {
                 // Near collapse: in substeps while a storey may reach the limit in the step.
                 if !bounded {
-                    m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
+                    bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
                     bounded = true;
                 }
                 yielding |= run.collapse_watch((z, &z1), &bounds, dt, &mut yield_watch);
@@ -416,7 +508,7 @@ fn run_with<'a>(
         }
         if !any_contact {
             if !bounded {
-                m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
+                bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
                 bounded = true;
             }
             // The floors at both ends are needed for the peaks if the step is free; the levels
@@ -491,6 +583,13 @@ fn run_with<'a>(
                     *a |= *w;
                 }
             }
+            // A building on its tangent stiffness does not stand still (its still step is
+            // the modal one).
+            if let Some(on) = tangent_on {
+                for (a, w) in active.iter_mut().zip(on) {
+                    *a |= *w;
+                }
+            }
         }
         let mut grew = can_stand;
         while grew {
@@ -506,7 +605,7 @@ fn run_with<'a>(
                     && d + 2.0 * r.max(0.0) * dt > 0.0;
                 if !close {
                     if !bounded {
-                        m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
+                        bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
                         bounded = true;
                     }
                     close = *may_touch[l]
@@ -593,7 +692,7 @@ fn run_with<'a>(
         lookouts.clear();
         if any_still {
             if !bounded {
-                m.fourth_derivative_bounds(&seg, z, &z1, &mut bounds);
+                bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
             }
             for (l, lm) in m.levels.iter().enumerate() {
                 let (a, b) = lm.buildings;
@@ -892,7 +991,7 @@ mod tests {
             energy: true,
             ..FastOptions::default()
         };
-        run_with(m, sub, standing, &forcing, m.at_rest(), &o, false, observer)
+        run_with(m, sub, standing, &forcing, m.at_rest(), &o, Steps::Tangent, false, observer)
     }
 
     /// [`run_on`] with the scheme's substep coordinates.

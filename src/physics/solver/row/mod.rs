@@ -40,6 +40,7 @@ mod rhs;
 mod run;
 mod sample;
 mod storey;
+mod tangent;
 pub mod yielding;
 
 use crate::physics::model::Forcing;

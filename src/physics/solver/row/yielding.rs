@@ -251,10 +251,11 @@ impl RowModel {
 
     /// Each building with a storey that yields now or may reach a bounding line over the
     /// exact free step `z -> z1` of length `h` (modal states, each mode's `|q''''|` bound in
-    /// `bounds`), into `out`; whether any.
+    /// `bounds`), into `out`; whether any. A building that `tangent` marks takes the exact
+    /// step of its tangent stiffness, so its storeys' pieces hold it back only at their edges.
     pub(crate) fn yield_watch(
         &self,
-        modes: &[StoreyMode],
+        (modes, tangent): (&[StoreyMode], Option<&[bool]>),
         (z, z1): (&[f64], &[f64]),
         bounds: &[f64],
         h: f64,
@@ -266,8 +267,10 @@ impl RowModel {
                 continue;
             }
             let (ends, bound) = self.drift_over_step(sm.building, &sm.modal_row, (z, z1), bounds);
+            // A building on its tangent stiffness steps every piece it stands on exactly.
+            let free = sm.free(*mode) || tangent.is_some_and(|on| on[sm.building]);
             out[sm.building] =
-                !sm.free(*mode) || sm.may_yield(*mode, ends, z[self.plastic_slot(s)], bound, h);
+                !free || sm.may_yield(*mode, ends, z[self.plastic_slot(s)], bound, h);
         }
         out.iter().any(|&x| x)
     }

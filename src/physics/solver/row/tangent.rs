@@ -1,0 +1,270 @@
+//! The exact free step of a building whose deteriorating (IMK) storeys stand on pieces off
+//! their initial stiffness: a deteriorated unloading line, a peak-oriented storey's line back
+//! from its peak. On such a piece of slope `s` the storey's force is `f = k (d - p)` with `p' =
+//! (1 - s/k) d'`, so `p - (1 - s/k) d` stays as it was and the building is linear: its modes
+//! `q` see the stiffness `W^2 + dS`, `dS = sum_j (s_j - k_j) r_j r_j^T` (`r_j` storey `j`'s
+//! modal row), under the constant load `G = sum_j r_j (k_j p_j - (k_j - s_j) d_j)` from the
+//! step's start. The step is [`CoupledStep`] about the static response `(W^2 + dS)^-1 G`
+//! (exact; a negative tangent gives hyperbolic motion, which the matrix exponential takes as
+//! it comes), and each storey's plastic drift and work follow its drift along the piece in
+//! closed form. A piece that runs one way only (`heading`, a reversal ends it) still takes
+//! substeps, as a bilinear storey on its bounding line does; so does a building whose tangent
+//! stiffness is singular.
+
+use super::exact_step::CoupledStep;
+use super::model::RowModel;
+use super::storey::StoreyMode;
+use crate::physics::solver::state::Segment;
+
+/// One building's tangent step, kept while its storeys stay on pieces of the same slopes.
+pub(super) struct Tangent {
+    building: usize,
+    /// Each of the building's storeys' slope, N/m (its initial stiffness on an elastic piece).
+    slopes: Vec<f64>,
+    /// `(W^2 + dS)^-1`, row-major: the static response to the constant load.
+    inverse: Vec<f64>,
+    /// Each row of `dS`'s `sum_k |dS_ik|` (for the derivative bounds).
+    sums: Vec<f64>,
+    step: CoupledStep,
+    /// The static response this step is taken about, in the row's modes (0 outside the
+    /// building's).
+    offset: Vec<f64>,
+}
+
+impl Tangent {
+    /// Building `k`'s storeys' slopes under `modes` into `out`; false where it takes no
+    /// tangent step: a storey that yields one way, or every storey on its initial stiffness
+    /// (the modal step is exact then).
+    pub fn slopes(m: &RowModel, k: usize, modes: &[StoreyMode], out: &mut Vec<f64>) -> bool {
+        out.clear();
+        let b = &m.buildings[k];
+        let Some(first) = b.first_storey else {
+            return false;
+        };
+        let mut off = false;
+        for (sm, mode) in m.storeys[first..first + b.n()]
+            .iter()
+            .zip(&modes[first..first + b.n()])
+        {
+            let s = match mode {
+                StoreyMode::Elastic => sm.k,
+                StoreyMode::Yielding(_) => return false,
+                StoreyMode::Imk(piece) if piece.heading != 0.0 => return false,
+                StoreyMode::Imk(piece) => piece.slope,
+            };
+            off |= s != sm.k;
+            out.push(s);
+        }
+        off
+    }
+
+    /// The step of building `k` of `m` over `h` on storeys of `slopes`; None where its
+    /// tangent stiffness is singular (to rounding).
+    pub fn new(m: &RowModel, k: usize, slopes: &[f64], h: f64, energy: bool) -> Option<Tangent> {
+        let b = &m.buildings[k];
+        let (o, nb) = (b.off, b.n());
+        let first = b.first_storey.expect("a building with storeys");
+        let mut coupling = vec![vec![0.0; nb]; nb];
+        for (sm, s) in m.storeys[first..first + nb].iter().zip(slopes) {
+            let ds = s - sm.k;
+            if ds == 0.0 {
+                continue;
+            }
+            for (i, row) in coupling.iter_mut().enumerate() {
+                for (c, r) in row.iter_mut().zip(&sm.modal_row) {
+                    *c += ds * sm.modal_row[i] * r;
+                }
+            }
+        }
+        let mut stiffness: Vec<f64> = coupling.iter().flatten().copied().collect();
+        for i in 0..nb {
+            stiffness[i * nb + i] += m.w2[o + i];
+        }
+        let scale = m.w2[o..o + nb].iter().fold(0.0, |a: f64, w| a.max(*w));
+        let inverse = invert(&stiffness, nb, 1e-12 * scale)?;
+        let sums = coupling
+            .iter()
+            .map(|row| row.iter().map(|c| c.abs()).sum())
+            .collect();
+        Some(Tangent {
+            building: k,
+            slopes: slopes.to_vec(),
+            inverse,
+            step: CoupledStep::tangent(m, k, h, energy, &coupling),
+            sums,
+            offset: vec![0.0; m.n],
+        })
+    }
+
+    pub fn building(&self) -> usize {
+        self.building
+    }
+
+    /// Was it built for these slopes?
+    pub fn is_for(&self, slopes: &[f64]) -> bool {
+        self.slopes == slopes
+    }
+
+    /// The static response about which the building moves from modal state `z`, set for
+    /// [`Tangent::step`] and [`Tangent::bounds`].
+    pub fn prepare(&mut self, m: &RowModel, z: &[f64]) {
+        let b = &m.buildings[self.building];
+        let (o, nb, first) = (b.off, b.n(), b.first_storey.expect("storeys"));
+        let mut load = vec![0.0; nb];
+        for (s, (sm, slope)) in m.storeys[first..first + nb]
+            .iter()
+            .zip(&self.slopes)
+            .enumerate()
+        {
+            let p = z[m.plastic_slot(first + s)];
+            let d = sm.drift(z, 0);
+            let g = sm.k * p - (sm.k - slope) * d;
+            for (l, r) in load.iter_mut().zip(&sm.modal_row) {
+                *l += r * g;
+            }
+        }
+        for (i, q) in self.offset[o..o + nb].iter_mut().enumerate() {
+            *q = (0..nb).map(|j| self.inverse[i * nb + j] * load[j]).sum();
+        }
+    }
+
+    /// The exact free step from modal state `z` over `ag` into `z1`: the building's modes, its
+    /// storeys' plastic drifts and plastic work; with `work`, each mode's input and damping
+    /// work as [`CoupledStep::step`] gives them (the caller adds them).
+    pub fn step(
+        &mut self,
+        m: &RowModel,
+        z: &[f64],
+        ag: (f64, f64),
+        z1: &mut [f64],
+        work: Option<&mut [(f64, f64)]>,
+    ) {
+        let b = &m.buildings[self.building];
+        let nb = b.n();
+        self.step.step(m, z, Some(&self.offset), ag, z1, work);
+        let ns = m.storeys.len();
+        let first = b.first_storey.expect("storeys");
+        for (s, slope) in (first..first + nb).zip(&self.slopes) {
+            let sm = &m.storeys[s];
+            let slot = m.plastic_slot(s);
+            let flow = 1.0 - slope / sm.k;
+            if flow == 0.0 {
+                continue;
+            }
+            let (d0, d1) = (sm.drift(z, 0), sm.drift(z1, 0));
+            let (p0, p1) = (z[slot], z[slot] + flow * (d1 - d0));
+            // The force is linear in the drift along the piece: the work `int f dp` is
+            // `flow` times the trapezoid of `f` over the drift.
+            let (f0, f1) = (sm.k * (d0 - p0), sm.k * (d1 - p1));
+            z1[slot] = p1;
+            z1[slot + ns] = z[slot + ns] + flow * 0.5 * (f0 + f1) * (d1 - d0);
+        }
+    }
+
+    /// Each of the building's modes' bound on `|q''''|` over the free step `z -> z1` into
+    /// `bounds` (as [`RowModel::fourth_derivative_bounds`] builds them, with the stiffness
+    /// coupling's terms: `sum_k |dS_ik|` times the largest of the other modes').
+    pub fn bounds(&self, m: &RowModel, seg: &Segment, z: &[f64], z1: &[f64], bounds: &mut [f64]) {
+        let b = &m.buildings[self.building];
+        let (n, o, nb) = (m.n, b.off, b.n());
+        let largest = |x: &[f64]| x.iter().fold(0.0, |a: f64, y| a.max(*y));
+        let q: Vec<f64> = (0..nb)
+            .map(|i| {
+                (z[o + i] - self.offset[o + i])
+                    .abs()
+                    .max((z1[o + i] - self.offset[o + i]).abs())
+            })
+            .collect();
+        let v: Vec<f64> = (0..nb)
+            .map(|i| z[n + o + i].abs().max(z1[n + o + i].abs()))
+            .collect();
+        let damping = |i: usize| b.coupling_sums.get(i).copied().unwrap_or(0.0);
+        let (qm, vm) = (largest(&q), largest(&v));
+        let a2: Vec<f64> = (0..nb)
+            .map(|i| {
+                let k = o + i;
+                m.w2[k] * q[i]
+                    + self.sums[i] * qm
+                    + m.two_xi_w[k] * v[i]
+                    + damping(i) * vm
+                    + (m.part[k] * seg.a0).abs().max((m.part[k] * seg.a1).abs())
+            })
+            .collect();
+        let a2m = largest(&a2);
+        let a3: Vec<f64> = (0..nb)
+            .map(|i| {
+                let k = o + i;
+                m.w2[k] * v[i]
+                    + self.sums[i] * vm
+                    + m.two_xi_w[k] * a2[i]
+                    + damping(i) * a2m
+                    + (m.part[k] * (seg.a1 - seg.a0) / seg.dt).abs()
+            })
+            .collect();
+        let a3m = largest(&a3);
+        for i in 0..nb {
+            let k = o + i;
+            bounds[k] = m.w2[k] * a2[i]
+                + self.sums[i] * a2m
+                + m.two_xi_w[k] * a3[i]
+                + damping(i) * a3m;
+        }
+    }
+}
+
+/// The inverse of the `n x n` row-major `a` by Gauss-Jordan with partial pivoting; None where
+/// a pivot is below `tiny` (singular to rounding).
+fn invert(a: &[f64], n: usize, tiny: f64) -> Option<Vec<f64>> {
+    let mut a = a.to_vec();
+    let mut inv = vec![0.0; n * n];
+    for i in 0..n {
+        inv[i * n + i] = 1.0;
+    }
+    for c in 0..n {
+        let p = (c..n).max_by(|&x, &y| a[x * n + c].abs().total_cmp(&a[y * n + c].abs()))?;
+        if a[p * n + c].abs() <= tiny {
+            return None;
+        }
+        for j in 0..n {
+            a.swap(c * n + j, p * n + j);
+            inv.swap(c * n + j, p * n + j);
+        }
+        let d = a[c * n + c];
+        for j in 0..n {
+            a[c * n + j] /= d;
+            inv[c * n + j] /= d;
+        }
+        for r in 0..n {
+            if r == c {
+                continue;
+            }
+            let f = a[r * n + c];
+            if f == 0.0 {
+                continue;
+            }
+            for j in 0..n {
+                a[r * n + j] -= f * a[c * n + j];
+                inv[r * n + j] -= f * inv[c * n + j];
+            }
+        }
+    }
+    Some(inv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::invert;
+
+    #[test]
+    fn invert_gives_the_inverse_and_refuses_a_singular_matrix() {
+        let a = [4.0, 1.0, 2.0, 0.5, -3.0, 1.0, 2.0, 1.0, 5.0];
+        let inv = invert(&a, 3, 1e-12).unwrap();
+        for i in 0..3 {
+            for j in 0..3 {
+                let x: f64 = (0..3).map(|k| a[i * 3 + k] * inv[k * 3 + j]).sum();
+                assert!((x - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14);
+            }
+        }
+        assert!(invert(&[1.0, 2.0, 2.0, 4.0], 2, 1e-12).is_none());
+    }
+}
