@@ -133,9 +133,20 @@ impl Piece {
     /// against its heading.
     #[inline]
     pub fn event_value(&self, d: f64, rate: f64, slack: f64) -> f64 {
-        (d - self.hi - slack)
-            .max(self.lo - d - slack)
-            .max(-self.heading * rate)
+        let [hi, lo, back] = self.event_parts(d, rate, slack);
+        hi.max(lo).max(back)
+    }
+
+    /// [`Piece::event_value`]'s parts: past `hi`, past `lo`, against the heading (an event is
+    /// located on the parts that fire alone: the others, a drift and a rate, are not on its
+    /// scale, and their maximum has a kink that regula falsi creeps along).
+    #[inline]
+    pub fn event_parts(&self, d: f64, rate: f64, slack: f64) -> [f64; 3] {
+        [
+            d - self.hi - slack,
+            self.lo - d - slack,
+            -self.heading * rate,
+        ]
     }
 }
 

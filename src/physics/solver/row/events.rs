@@ -124,17 +124,44 @@ impl<'m> RowRun<'m> {
     /// event that fires grows from far below: regula falsi on their maximum then creeps from
     /// that end and stalls, and the event is taken late, by up to the whole step.
     pub(super) fn firing_max(&self, z: &[f64]) -> f64 {
-        (self.event_values(z).zip(&self.firing))
-            .filter(|(_, &f)| f)
-            .fold(f64::NEG_INFINITY, |m, (v, _)| m.max(v))
+        let nl = self.m.levels.len();
+        (self.event_values(z).zip(&self.firing).enumerate())
+            .filter(|(_, (_, &f))| f)
+            .map(
+                |(i, (v, _))| match self.firing_parts.get(i.wrapping_sub(nl)) {
+                    Some(&mask) if i >= nl && mask != 0 => self.storey_parts(i - nl, z, mask),
+                    _ => v,
+                },
+            )
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
-    /// Mark the events whose value is positive in `z` as the ones that fire.
+    /// The largest of storey `s`'s IMK event parts in `mask` in state `z`.
+    fn storey_parts(&self, s: usize, z: &[f64], mask: u8) -> f64 {
+        let (sm, n) = (&self.m.storeys[s], self.m.n);
+        let parts = sm.event_parts(self.storey_modes[s], sm.drift(z, 0), sm.drift(z, n));
+        (parts.into_iter().flatten().enumerate())
+            .filter(|(j, _)| mask & (1 << j) != 0)
+            .fold(f64::NEG_INFINITY, |m, (_, v)| m.max(v))
+    }
+
+    /// Mark the events whose value is positive in `z` as the ones that fire (and an IMK
+    /// storey's parts that do).
     pub(super) fn mark_firing(&mut self, z: &[f64]) {
         let mut firing = std::mem::take(&mut self.firing);
         firing.clear();
         firing.extend(self.event_values(z).map(|v| v > 0.0));
         self.firing = firing;
+        if !self.firing_by_parts {
+            return;
+        }
+        let n = self.m.n;
+        for (s, (sm, &mode)) in self.m.storeys.iter().zip(&self.storey_modes).enumerate() {
+            let parts = sm.event_parts(mode, sm.drift(z, 0), sm.drift(z, n));
+            self.firing_parts[s] = parts.map_or(0, |p| {
+                (p.iter().enumerate()).fold(0, |m, (j, v)| if *v > 0.0 { m | 1 << j } else { m })
+            });
+        }
     }
 
     /// The earliest fraction of a step `z0 -> z1` (length `h`) at which an elastic storey's

@@ -21,7 +21,9 @@
 //! 5. Yielding storeys ([`super::yielding`]): free steps are exact about the static response to
 //!    the plastic loads; a step in which a storey yields, or may reach its band edge (bounded as a
 //!    touch), is taken in substeps by its building, yield onset and unloading located as
-//!    events; after the record the run goes on at rest until no storey can yield again.
+//!    events; after the record the run goes on at rest until no storey can yield again. A
+//!    building whose IMK storeys stand on pieces off their initial stiffness takes the exact
+//!    step of its tangent stiffness instead ([`super::tangent`]; not in the GPU kernel's twin).
 
 use super::exact_step::CoupledStep;
 use super::model::{RowModel, FLOOR_SUBSTEPS_FROM};
@@ -158,12 +160,12 @@ fn bounds_with(
     m: &RowModel,
     (seg, z, z1): (&Segment, &[f64], &[f64]),
     bounds: &mut Vec<f64>,
-    tangents: &[Option<Tangent>],
+    tangents: &mut [Vec<Tangent>],
     on: Option<&[bool]>,
 ) {
     m.fourth_derivative_bounds(seg, z, z1, bounds);
     if let Some(on) = on {
-        for t in tangents.iter().flatten().filter(|t| on[t.building()]) {
+        for t in (tangents.iter_mut().filter_map(|k| k.first_mut())).filter(|t| on[t.building()]) {
             t.bounds(m, seg, z, z1, bounds);
         }
     }
@@ -263,11 +265,15 @@ enum Standing {
     Grown,
 }
 
+/// How many sets of pieces' tangent steps a building keeps.
+const KEPT_TANGENTS: usize = 4;
+
 /// Which free steps a building whose IMK storeys stand on pieces off their initial stiffness
 /// takes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Steps {
-    /// Substeps, as the GPU row kernel.
+    /// Substeps, as the GPU row kernel (which locates an IMK storey's events on the maximum
+    /// of its parts, as this does then).
     Modal,
     /// Exact steps of its tangent stiffness ([`super::tangent`]).
     Tangent,
@@ -322,6 +328,7 @@ fn run_with<'a>(
     }
     let mut run = RowRun::start(m, z0, forcing.t0);
     run.energy = o.energy;
+    run.firing_by_parts = steps == Steps::Tangent;
     run.observer = observer;
     if closings {
         debug_assert_eq!(
@@ -359,10 +366,12 @@ fn run_with<'a>(
     let mut q_static = vec![0.0; n];
     let mut storey_modes = Vec::with_capacity(m.storeys.len());
     let mut yield_watch = vec![false; m.buildings.len()];
-    // Buildings on IMK pieces off their initial stiffness: the exact step of each one's
-    // tangent stiffness, kept while its pieces' slopes hold, and whether it takes it this step.
+    // Buildings on IMK pieces off their initial stiffness: the exact steps of each one's
+    // tangent stiffness on the last few sets of pieces it stood on (the one it stands on
+    // first: a peak-oriented storey goes back and forth between two lines), and whether it
+    // takes one this step.
     let tangent_steps = steps == Steps::Tangent && m.storeys.iter().any(|sm| sm.imk.is_some());
-    let mut tangents: Vec<Option<Tangent>> = m.buildings.iter().map(|_| None).collect();
+    let mut tangents: Vec<Vec<Tangent>> = m.buildings.iter().map(|_| Vec::new()).collect();
     let mut on_tangent = vec![false; m.buildings.len()];
     let mut slopes = Vec::new();
     let mut i = 0;
@@ -380,21 +389,33 @@ fn run_with<'a>(
         z_start.clone_from(&run.z);
         let z = &z_start;
         let mut any_tangent = false;
-        if tangent_steps {
+        // Only where the step's free motion is taken (not while a level is in contact in a
+        // row where every building moves).
+        if tangent_steps && (can_stand || !run.any_contact()) {
             for (k, on) in on_tangent.iter_mut().enumerate() {
                 *on = !run.gone[k] && Tangent::slopes(m, k, &run.storey_modes, &mut slopes);
                 if !*on {
                     continue;
                 }
-                if !tangents[k].as_ref().is_some_and(|t| t.is_for(&slopes)) {
-                    tangents[k] = Tangent::new(m, k, &slopes, dt, o.energy);
+                let kept = &mut tangents[k];
+                match kept.iter().position(|t| t.is_for(&slopes)) {
+                    Some(i) => kept[..=i].rotate_right(1),
+                    None => match Tangent::new(m, k, &slopes, dt, o.energy) {
+                        Some(t) => {
+                            kept.insert(0, t);
+                            kept.truncate(KEPT_TANGENTS);
+                        }
+                        None => {
+                            *on = false;
+                            continue;
+                        }
+                    },
                 }
-                match &mut tangents[k] {
-                    Some(t) => t.prepare(m, z),
-                    None => *on = false,
-                }
-                any_tangent |= *on;
+                kept[0].prepare(m, z);
+                any_tangent = true;
             }
+        } else {
+            on_tangent.fill(false);
         }
         let tangent_on = any_tangent.then_some(&on_tangent[..]);
         // The exact free step of every mode: the step itself when no level may touch, and the
@@ -443,7 +464,7 @@ fn run_with<'a>(
                 }
             }
             if let Some(on) = tangent_on {
-                for t in tangents.iter_mut().flatten() {
+                for t in tangents.iter_mut().filter_map(|k| k.first_mut()) {
                     if !on[t.building()] {
                         continue;
                     }
@@ -471,7 +492,7 @@ fn run_with<'a>(
         // A storey that yields, or may in the exact free step, moves its building in substeps.
         let mut yielding = false;
         if yields && (can_stand || !any_contact) {
-            bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
+            bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
             bounded = true;
             yielding = m.yield_watch(
                 (&run.storey_modes, tangent_on),
@@ -480,6 +501,18 @@ fn run_with<'a>(
                 dt,
                 &mut yield_watch,
             );
+            // A storey heading one way on a tangent step: its rate must not turn inside it.
+            if let Some(on) = tangent_on {
+                for t in tangents.iter_mut().filter_map(|k| k.first_mut()) {
+                    let k = t.building();
+                    if on[k]
+                        && !yield_watch[k]
+                        && t.may_reverse(m, &run.storey_modes, (seg.a0, seg.a1), (z, &z1), dt)
+                    {
+                        (yield_watch[k], yielding) = (true, true);
+                    }
+                }
+            }
         }
         if watched {
             if !yields {
@@ -488,7 +521,7 @@ fn run_with<'a>(
             if can_stand || !any_contact {
                 // Near collapse: in substeps while a storey may reach the limit in the step.
                 if !bounded {
-                    bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
+                    bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
                     bounded = true;
                 }
                 yielding |= run.collapse_watch((z, &z1), &bounds, dt, &mut yield_watch);
@@ -508,7 +541,7 @@ fn run_with<'a>(
         }
         if !any_contact {
             if !bounded {
-                bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
+                bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
                 bounded = true;
             }
             // The floors at both ends are needed for the peaks if the step is free; the levels
@@ -605,7 +638,7 @@ fn run_with<'a>(
                     && d + 2.0 * r.max(0.0) * dt > 0.0;
                 if !close {
                     if !bounded {
-                        bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
+                        bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
                         bounded = true;
                     }
                     close = *may_touch[l]
@@ -692,7 +725,7 @@ fn run_with<'a>(
         lookouts.clear();
         if any_still {
             if !bounded {
-                bounds_with(m, (&seg, z, &z1), &mut bounds, &tangents, tangent_on);
+                bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
             }
             for (l, lm) in m.levels.iter().enumerate() {
                 let (a, b) = lm.buildings;
@@ -991,7 +1024,17 @@ mod tests {
             energy: true,
             ..FastOptions::default()
         };
-        run_with(m, sub, standing, &forcing, m.at_rest(), &o, Steps::Tangent, false, observer)
+        run_with(
+            m,
+            sub,
+            standing,
+            &forcing,
+            m.at_rest(),
+            &o,
+            Steps::Tangent,
+            false,
+            observer,
+        )
     }
 
     /// [`run_on`] with the scheme's substep coordinates.

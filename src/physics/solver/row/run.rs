@@ -51,6 +51,12 @@ pub(crate) struct RowRun<'m> {
     pub settled: bool,
     /// Per event (levels, then storeys), whether it fires in the step being located.
     pub(super) firing: Vec<bool>,
+    /// Per storey, which of an IMK piece's event parts fire in the trial end (bits 0-2 of
+    /// [`crate::physics::imk::Piece::event_parts`]); 0 for the other modes.
+    pub(super) firing_parts: Vec<u8>,
+    /// Whether an IMK storey's event is located on its parts that fire (the CPU scheme) or on
+    /// their maximum (the GPU row kernel's twin).
+    pub(super) firing_by_parts: bool,
     /// Per level, its floors' closing and peaks, where asked for ([`RowRun::track_closings`]).
     pub(super) closings: Option<Vec<LevelClosing>>,
     /// Hears every accepted step and event ([`RowRun::emit`]).
@@ -109,6 +115,8 @@ impl<'m> RowRun<'m> {
                 .collect(),
             settled: false,
             firing: Vec::with_capacity(m.levels.len() + m.storeys.len()),
+            firing_parts: vec![0; m.storeys.len()],
+            firing_by_parts: false,
             closings: None,
             observer: None,
             watch: vec![false; m.buildings.len()],
@@ -466,6 +474,22 @@ impl<'m> RowRun<'m> {
             }
         }
         Some(live)
+    }
+
+    /// The storeys' modes with those of the buildings that left the scene elastic, as
+    /// [`RowRun::standing_state`] leaves them at rest with no plastic drift: a collapsed
+    /// building's storeys, frozen on whatever piece they were, do not hold its neighbours'
+    /// settling back.
+    pub(super) fn standing_modes(&self) -> Vec<StoreyMode> {
+        (self.storey_modes.iter().zip(&self.modal.storeys))
+            .map(|(&mode, sm)| {
+                if self.gone[sm.building] {
+                    StoreyMode::Elastic
+                } else {
+                    mode
+                }
+            })
+            .collect()
     }
 
     /// A free record step over `seg` to `z1`, with no possible contact (checked by the caller);

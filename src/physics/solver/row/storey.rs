@@ -74,6 +74,15 @@ impl StoreyModel {
         }
     }
 
+    /// An IMK piece's event parts ([`Piece::event_parts`]); None in the other modes.
+    #[inline]
+    pub fn event_parts(&self, mode: StoreyMode, d: f64, rate: f64) -> Option<[f64; 3]> {
+        match mode {
+            StoreyMode::Imk(piece) => Some(piece.event_parts(d, rate, self.imk_slack())),
+            _ => None,
+        }
+    }
+
     /// The drift an IMK piece's threshold may be passed by before its event fires.
     #[inline]
     fn imk_slack(&self) -> f64 {

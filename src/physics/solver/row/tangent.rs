@@ -7,13 +7,15 @@
 //! step's start. The step is [`CoupledStep`] about the static response `(W^2 + dS)^-1 G`
 //! (exact; a negative tangent gives hyperbolic motion, which the matrix exponential takes as
 //! it comes), and each storey's plastic drift and work follow its drift along the piece in
-//! closed form. A piece that runs one way only (`heading`, a reversal ends it) still takes
-//! substeps, as a bilinear storey on its bounding line does; so does a building whose tangent
-//! stiffness is singular.
+//! closed form. A piece that runs one way only (`heading`: a reversal of the drift rate ends
+//! it, a peak-oriented storey's line to its peak, the backbone) is held back where its rate may
+//! turn inside the step ([`Tangent::may_reverse`]); a bilinear storey yielding on its bounding
+//! line takes substeps as before, and so does a building whose tangent stiffness is singular.
 
+use super::algebra::dot;
 use super::exact_step::CoupledStep;
 use super::model::RowModel;
-use super::storey::StoreyMode;
+use super::storey::{may_reach, StoreyMode};
 use crate::physics::solver::state::Segment;
 
 /// One building's tangent step, kept while its storeys stay on pieces of the same slopes.
@@ -23,18 +25,24 @@ pub(super) struct Tangent {
     slopes: Vec<f64>,
     /// `(W^2 + dS)^-1`, row-major: the static response to the constant load.
     inverse: Vec<f64>,
-    /// Each row of `dS`'s `sum_k |dS_ik|` (for the derivative bounds).
+    /// `dS` row by row, and each row's `sum_k |dS_ik|` (for the derivative bounds).
+    coupling: Vec<Vec<f64>>,
     sums: Vec<f64>,
+    /// Each of the building's modes' bound on `|q'''''|` over the step, from
+    /// [`Tangent::bounds`] (for the reversal checks).
+    fifth: Vec<f64>,
     step: CoupledStep,
     /// The static response this step is taken about, in the row's modes (0 outside the
     /// building's).
     offset: Vec<f64>,
+    /// Room for four of the building's modal vectors (no allocation per step).
+    scratch: Vec<f64>,
 }
 
 impl Tangent {
     /// Building `k`'s storeys' slopes under `modes` into `out`; false where it takes no
-    /// tangent step: a storey that yields one way, or every storey on its initial stiffness
-    /// (the modal step is exact then).
+    /// tangent step: a bilinear storey that yields, or every storey on its initial stiffness
+    /// and none heading one way (the modal step is exact then).
     pub fn slopes(m: &RowModel, k: usize, modes: &[StoreyMode], out: &mut Vec<f64>) -> bool {
         out.clear();
         let b = &m.buildings[k];
@@ -49,8 +57,10 @@ impl Tangent {
             let s = match mode {
                 StoreyMode::Elastic => sm.k,
                 StoreyMode::Yielding(_) => return false,
-                StoreyMode::Imk(piece) if piece.heading != 0.0 => return false,
-                StoreyMode::Imk(piece) => piece.slope,
+                StoreyMode::Imk(piece) => {
+                    off |= piece.heading != 0.0;
+                    piece.slope
+                }
             };
             off |= s != sm.k;
             out.push(s);
@@ -91,8 +101,11 @@ impl Tangent {
             slopes: slopes.to_vec(),
             inverse,
             step: CoupledStep::tangent(m, k, h, energy, &coupling),
+            coupling,
             sums,
+            fifth: vec![0.0; nb],
             offset: vec![0.0; m.n],
+            scratch: vec![0.0; 4 * nb],
         })
     }
 
@@ -110,7 +123,8 @@ impl Tangent {
     pub fn prepare(&mut self, m: &RowModel, z: &[f64]) {
         let b = &m.buildings[self.building];
         let (o, nb, first) = (b.off, b.n(), b.first_storey.expect("storeys"));
-        let mut load = vec![0.0; nb];
+        let load = &mut self.scratch[..nb];
+        load.fill(0.0);
         for (s, (sm, slope)) in m.storeys[first..first + nb]
             .iter()
             .zip(&self.slopes)
@@ -164,50 +178,129 @@ impl Tangent {
     /// Each of the building's modes' bound on `|q''''|` over the free step `z -> z1` into
     /// `bounds` (as [`RowModel::fourth_derivative_bounds`] builds them, with the stiffness
     /// coupling's terms: `sum_k |dS_ik|` times the largest of the other modes').
-    pub fn bounds(&self, m: &RowModel, seg: &Segment, z: &[f64], z1: &[f64], bounds: &mut [f64]) {
+    pub fn bounds(
+        &mut self,
+        m: &RowModel,
+        seg: &Segment,
+        z: &[f64],
+        z1: &[f64],
+        bounds: &mut [f64],
+    ) {
         let b = &m.buildings[self.building];
         let (n, o, nb) = (m.n, b.off, b.n());
         let largest = |x: &[f64]| x.iter().fold(0.0, |a: f64, y| a.max(*y));
-        let q: Vec<f64> = (0..nb)
-            .map(|i| {
-                (z[o + i] - self.offset[o + i])
-                    .abs()
-                    .max((z1[o + i] - self.offset[o + i]).abs())
-            })
-            .collect();
-        let v: Vec<f64> = (0..nb)
-            .map(|i| z[n + o + i].abs().max(z1[n + o + i].abs()))
-            .collect();
-        let damping = |i: usize| b.coupling_sums.get(i).copied().unwrap_or(0.0);
-        let (qm, vm) = (largest(&q), largest(&v));
-        let a2: Vec<f64> = (0..nb)
-            .map(|i| {
-                let k = o + i;
-                m.w2[k] * q[i]
-                    + self.sums[i] * qm
-                    + m.two_xi_w[k] * v[i]
-                    + damping(i) * vm
-                    + (m.part[k] * seg.a0).abs().max((m.part[k] * seg.a1).abs())
-            })
-            .collect();
-        let a2m = largest(&a2);
-        let a3: Vec<f64> = (0..nb)
-            .map(|i| {
-                let k = o + i;
-                m.w2[k] * v[i]
-                    + self.sums[i] * vm
-                    + m.two_xi_w[k] * a2[i]
-                    + damping(i) * a2m
-                    + (m.part[k] * (seg.a1 - seg.a0) / seg.dt).abs()
-            })
-            .collect();
-        let a3m = largest(&a3);
+        let (q, rest) = self.scratch.split_at_mut(nb);
+        let (v, rest) = rest.split_at_mut(nb);
+        let (a2, a3) = rest.split_at_mut(nb);
         for i in 0..nb {
             let k = o + i;
-            bounds[k] = m.w2[k] * a2[i]
-                + self.sums[i] * a2m
-                + m.two_xi_w[k] * a3[i]
-                + damping(i) * a3m;
+            q[i] = (z[k] - self.offset[k])
+                .abs()
+                .max((z1[k] - self.offset[k]).abs());
+            v[i] = z[n + k].abs().max(z1[n + k].abs());
+        }
+        let damping = |i: usize| b.coupling_sums.get(i).copied().unwrap_or(0.0);
+        let (qm, vm) = (largest(q), largest(v));
+        for i in 0..nb {
+            let k = o + i;
+            a2[i] = m.w2[k] * q[i]
+                + self.sums[i] * qm
+                + m.two_xi_w[k] * v[i]
+                + damping(i) * vm
+                + (m.part[k] * seg.a0).abs().max((m.part[k] * seg.a1).abs());
+        }
+        let a2m = largest(a2);
+        for i in 0..nb {
+            let k = o + i;
+            a3[i] = m.w2[k] * v[i]
+                + self.sums[i] * vm
+                + m.two_xi_w[k] * a2[i]
+                + damping(i) * a2m
+                + (m.part[k] * (seg.a1 - seg.a0) / seg.dt).abs();
+        }
+        let a3m = largest(a3);
+        for i in 0..nb {
+            let k = o + i;
+            bounds[k] =
+                m.w2[k] * a2[i] + self.sums[i] * a2m + m.two_xi_w[k] * a3[i] + damping(i) * a3m;
+        }
+        // `q''''' = -(W^2 + dS) q''' - C q''''` (the ground is linear over the step).
+        let a4m = largest(&bounds[o..o + nb]);
+        for (i, (fifth, a3)) in self.fifth.iter_mut().zip(a3.iter()).enumerate() {
+            let k = o + i;
+            *fifth =
+                m.w2[k] * a3 + self.sums[i] * a3m + m.two_xi_w[k] * bounds[k] + damping(i) * a4m;
+        }
+    }
+
+    /// Could a storey on a piece with a heading see its drift rate turn against it inside the
+    /// free step `z -> z1` (after [`Tangent::bounds`] over it)? As a band edge in `may_yield`:
+    /// the edge `-heading d'` with its rate `-heading d''` at both ends, and the bound on
+    /// `|d'''''|` from each mode's.
+    pub fn may_reverse(
+        &mut self,
+        m: &RowModel,
+        modes: &[StoreyMode],
+        (ag0, ag1): (f64, f64),
+        (z, z1): (&[f64], &[f64]),
+        h: f64,
+    ) -> bool {
+        let b = &m.buildings[self.building];
+        let (n, nb, first) = (m.n, b.n(), b.first_storey.expect("storeys"));
+        let mut accels = false;
+        for (sm, mode) in m.storeys[first..first + nb]
+            .iter()
+            .zip(&modes[first..first + nb])
+        {
+            let StoreyMode::Imk(piece) = *mode else {
+                continue;
+            };
+            if piece.heading == 0.0 {
+                continue;
+            }
+            if !accels {
+                self.accel(m, z, ag0, 0);
+                self.accel(m, z1, ag1, 1);
+                accels = true;
+            }
+            let (a0, a1) = (&self.scratch[..nb], &self.scratch[nb..2 * nb]);
+            let edge = |z: &[f64], a: &[f64]| {
+                let e = (
+                    -piece.heading * sm.drift(z, n),
+                    -piece.heading * dot(&sm.modal_row, a),
+                );
+                [e, e]
+            };
+            let bound: f64 = (sm.modal_row.iter().zip(&self.fifth))
+                .map(|(r, f)| r.abs() * f)
+                .sum();
+            if may_reach(edge(z, a0), edge(z1, a1), bound, h) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The building's modal accelerations in modal state `z` under ground acceleration `ag`,
+    /// into the scratch's vector `at` (0 or 1; its last holds the displacements about the
+    /// static response).
+    fn accel(&mut self, m: &RowModel, z: &[f64], ag: f64, at: usize) {
+        let b = &m.buildings[self.building];
+        let (n, o, nb) = (m.n, b.off, b.n());
+        let (out, x) = self.scratch.split_at_mut(3 * nb);
+        let (out, x) = (&mut out[at * nb..(at + 1) * nb], &mut x[..nb]);
+        for (i, x) in x.iter_mut().enumerate() {
+            *x = z[o + i] - self.offset[o + i];
+        }
+        let v = &z[n + o..n + o + nb];
+        for (i, a) in out.iter_mut().enumerate() {
+            let k = o + i;
+            let damping = b.modes.coupling.as_ref().map_or(0.0, |e| dot(&e[i], v));
+            *a = -m.w2[k] * x[i]
+                - dot(&self.coupling[i], x)
+                - m.two_xi_w[k] * v[i]
+                - damping
+                - m.part[k] * ag;
         }
     }
 }

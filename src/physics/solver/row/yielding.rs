@@ -323,7 +323,7 @@ pub(crate) fn next_segment(
         return None;
     }
     let settled = || match run.standing_state(&run.z) {
-        Some(standing) => m.settled(&standing, &run.storey_modes),
+        Some(standing) => m.settled(&standing, &run.standing_modes()),
         None => m.settled(&run.z, &run.storey_modes),
     };
     if !run.any_contact() && !run.any_yielding() && settled() {
