@@ -163,7 +163,7 @@ fn bounds_with(
     tangents: &mut [Vec<Tangent>],
     on: Option<&[bool]>,
 ) {
-    m.fourth_derivative_bounds(seg, z, z1, bounds);
+    m.fourth_derivative_bounds(seg, (z, z1), bounds, on);
     if let Some(on) = on {
         for t in (tangents.iter_mut().filter_map(|k| k.first_mut())).filter(|t| on[t.building()]) {
             t.bounds(m, seg, z, z1, bounds);

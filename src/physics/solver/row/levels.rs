@@ -107,7 +107,7 @@ impl LevelModel {
         v0: f64,
     ) -> bool {
         let mut bounds = Vec::new();
-        m.fourth_derivative_bounds(seg, z0, z1, &mut bounds);
+        m.fourth_derivative_bounds(seg, (z0, z1), &mut bounds, None);
         self.may_touch_bounded(m.n, &bounds, z0, z1, h, v0)
     }
 

@@ -517,13 +517,14 @@ impl RowModel {
 
     /// Each mode's bound on `|q''''|` over a free step from `z0` to `z1` in `seg`
     /// ([`fourth_derivative_bound`] of the mode's oscillator under its share of the ground
-    /// motion), into `out`.
+    /// motion), into `out`; the buildings `skip` marks are left out (their bounds left for
+    /// their tangent steps to give).
     pub(crate) fn fourth_derivative_bounds(
         &self,
         seg: &Segment,
-        z0: &[f64],
-        z1: &[f64],
+        (z0, z1): (&[f64], &[f64]),
         out: &mut Vec<f64>,
+        skip: Option<&[bool]>,
     ) {
         let n = self.n;
         // Scratch after the bounds (no allocation once `out` has grown): each mode's
@@ -541,7 +542,11 @@ impl RowModel {
             self.static_offsets(z0, shift0);
             self.static_offsets(z1, shift1);
         }
-        for k in 0..n {
+        let skipped = |b: usize| skip.is_some_and(|s| s[b]);
+        let kept = (self.buildings.iter().enumerate())
+            .filter(|(b, _)| !skipped(*b))
+            .flat_map(|(_, b)| b.off..b.off + b.n());
+        for k in kept {
             q[k] = (z0[k] - shift0[k]).abs().max((z1[k] - shift1[k]).abs());
             let osc = crate::physics::model::Oscillator {
                 m: 1.0,
@@ -559,8 +564,8 @@ impl RowModel {
         // Modes coupled by their damping: each bound's terms gain the coupling's, at most
         // `sum_k |E_ik|` times the largest of the other modes' (as `fourth_derivative_bound`
         // builds them, from the ends; O(N) where `|E|` times each would be O(N^2)).
-        for b in &self.buildings {
-            if b.coupling_sums.is_empty() {
+        for (bi, b) in self.buildings.iter().enumerate() {
+            if b.coupling_sums.is_empty() || skipped(bi) {
                 continue;
             }
             let (o, nb) = (b.off, b.n());
