@@ -14,7 +14,7 @@ use crate::physics::solver::row::RowScheme;
 use crate::physics::solver::Scheme;
 use crate::plan::axes::{Check, Motions, DAMPING, GAP, PERIOD, POSITIVE};
 use crate::plan::contact::{ContactPlan, ContactRun};
-use crate::plan::deterioration::ImkSpec;
+use crate::plan::deterioration::{ImkKey, ImkSpec};
 use crate::plan::pair::RunSpec;
 
 /// A yield drift ratio: > 0 and at most 0.2.
@@ -190,6 +190,8 @@ pub enum RowSampled {
     YieldDrift(usize),
     /// `building[b].yield_base_shear_coefficient`.
     YieldShear(usize),
+    /// `building[b].<IMK key>`: every IMK storey's value of the key.
+    Imk(usize, ImkKey),
 }
 
 impl RowSampled {
@@ -205,6 +207,7 @@ impl RowSampled {
             RowSampled::Beta => "contact.beta_n_per_m1_5".into(),
             RowSampled::YieldDrift(b) => format!("building[{b}].yield_drift_ratio"),
             RowSampled::YieldShear(b) => format!("building[{b}].yield_base_shear_coefficient"),
+            RowSampled::Imk(b, k) => format!("building[{b}].{}", k.key()),
         }
     }
 
@@ -216,6 +219,7 @@ impl RowSampled {
         all.extend((0..nb - 1).map(Self::Gap));
         all.extend([Self::SharedGap, Self::KLinear, Self::Beta]);
         all.extend((0..nb).flat_map(|b| [Self::YieldDrift(b), Self::YieldShear(b)]));
+        all.extend((0..nb).flat_map(|b| ImkKey::ALL.map(|k| Self::Imk(b, k))));
         all
     }
 
@@ -227,6 +231,7 @@ impl RowSampled {
             RowSampled::Gap(_) | RowSampled::SharedGap => GAP,
             RowSampled::YieldDrift(_) => YIELD_DRIFT,
             RowSampled::YieldShear(_) => YIELD_SHEAR,
+            RowSampled::Imk(_, k) => k.check(),
             _ => POSITIVE,
         }
     }
@@ -242,6 +247,7 @@ impl RowSampled {
                 | RowSampled::Damping(_)
                 | RowSampled::YieldDrift(_)
                 | RowSampled::YieldShear(_)
+                | RowSampled::Imk(..)
         )
     }
 }
@@ -390,6 +396,13 @@ impl RowPlan {
                     RowSampled::KLinear | RowSampled::Beta => {}
                     RowSampled::YieldDrift(b) | RowSampled::YieldShear(b) => {
                         run.yield_value[b] = Some(v)
+                    }
+                    // A sampled IMK key is its building's one-value axis, the draw its value.
+                    RowSampled::Imk(b, k) => {
+                        let axes = self.yielding[b].iter().flat_map(|y| &y.deterioration);
+                        if let Some(i) = axes.flat_map(|d| &d.axes).position(|(a, _)| *a == k) {
+                            run.imk_value[b][i] = v;
+                        }
                     }
                 }
             }

@@ -379,3 +379,105 @@ fn bounds_and_missing_keys_are_named() {
         &["a number (every storey), a list of numbers (one per storey"],
     );
 }
+
+/// The IMK keys under `[sample]`, as the yield keys: each draw reaches every IMK storey of its
+/// run and is the run's parameter column; a sampled key given in the building too, a draw out
+/// of its bounds, a sampled key on a bilinear building and a sampled ultimate drift before
+/// capping are refused with the key named.
+#[test]
+fn imk_keys_are_sampled() {
+    let sample = |axes: &str| {
+        format!(
+            "[sample]
+method = \"latin_hypercube\"
+n = 4
+seed = 9
+{axes}"
+        )
+    };
+    let theta_p = "[[sample.axis]]
+key = \"building[0].plastic_drift_ratio\"
+dist = \"uniform\"
+min = 0.02
+max = 0.05
+";
+    let gamma = "[[sample.axis]]
+key = \"building[0].energy_capacity_ratio\"
+dist = \"lognormal\"
+median = 60
+beta = 0.4
+";
+    let imk = "hysteresis = \"imk_peak_oriented\"
+post_capping_drift_ratio = 0.1";
+    let text = format!("{}\n{}", config(imk), sample(&format!("{theta_p}{gamma}")));
+    let p = plan(&text);
+    // Two gaps crossed with four draws.
+    assert_eq!(p.len(), 8);
+    let mut drawn = Vec::new();
+    for i in 0..p.len() {
+        let d = deterioration(&p, i, 0).unwrap();
+        let (tp, g) = (d.plastic[0], d.energy.as_ref().unwrap()[0]);
+        assert!((0.02..=0.05).contains(&tp), "{tp}");
+        assert!(g > 0.0);
+        assert_eq!(d.plastic, vec![tp; 2]);
+        assert_eq!(d.post_capping, vec![0.1; 2]);
+        drawn.push((tp, g));
+    }
+    drawn.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    drawn.dedup();
+    assert_eq!(drawn.len(), 4, "{drawn:?}");
+
+    let dir = tempdir();
+    let cfg = dir.path().join("sampled.toml");
+    std::fs::write(&cfg, &text).unwrap();
+    let out = dir.path().join("sampled.csv");
+    ok(&sweep_cpu(&cfg, &out, &[]));
+    let rows = table(&out);
+    assert_eq!(rows.len(), 8);
+    for (i, r) in rows.iter().enumerate() {
+        let d = deterioration(&p, i as u64, 0).unwrap();
+        let tp: f64 = r["b1_plastic_drift_ratio"].parse().unwrap();
+        let g: f64 = r["b1_energy_capacity_ratio"].parse().unwrap();
+        assert_eq!(tp, d.plastic[0], "run {i}");
+        assert_eq!(g, d.energy.unwrap()[0], "run {i}");
+        assert!(!r["sample"].is_empty());
+    }
+
+    // Given twice.
+    let twice = format!(
+        "{}\n{}",
+        config(&format!("{imk}\nplastic_drift_ratio = 0.03")),
+        sample(theta_p)
+    );
+    fails(&twice, &["plastic_drift_ratio", "sampled under [sample]"]);
+    // A draw out of bounds: kappa must be below 1.
+    let kappa = "[[sample.axis]]
+key = \"building[0].residual_strength_ratio\"
+dist = \"uniform\"
+min = 0.5
+max = 1.5
+";
+    let bad = format!(
+        "{}\n{}",
+        config(&format!("{imk}\nplastic_drift_ratio = 0.03")),
+        sample(kappa)
+    );
+    fails(&bad, &["residual_strength_ratio"]);
+    // On a bilinear building.
+    let bilinear = format!("{}\n{}", config(""), sample(theta_p));
+    fails(&bilinear, &["plastic_drift_ratio", "IMK storeys only"]);
+    // An ultimate drift drawn at or before capping (0.005 + theta_p, theta_p at least 0.02;
+    // the first of four strata of [0.01, 0.03] is below 0.015).
+    let ultimate = "[[sample.axis]]
+key = \"building[0].ultimate_drift_ratio\"
+dist = \"uniform\"
+min = 0.01
+max = 0.03
+";
+    let early = format!(
+        "{}\n{}",
+        config(imk),
+        sample(&format!("{theta_p}{ultimate}"))
+    );
+    fails(&early, &["ultimate_drift_ratio", "capping"]);
+}

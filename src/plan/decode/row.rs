@@ -12,7 +12,8 @@ use crate::physics::shear::MAX_STOREYS;
 use crate::plan::axes::{check_axis, Check, DAMPING, GAP, MASS, PERIOD, POSITIVE};
 use crate::plan::decode::contact::{parse_contact, unused_contact, Reading, UNUSED_GAP_M};
 use crate::plan::decode::sampled::{draw_sampled, grid_or_sampled, MISSING};
-use crate::plan::decode::yielding::parse_yielding;
+use crate::plan::decode::yielding::{parse_yielding, SampledImk};
+use crate::plan::deterioration::ImkKey;
 use crate::plan::row::{
     stability_at_1s, RowPlan, RowSampled, RowSamples, ShearAxes, YieldSpec, MAX_SAME_LEVEL_M,
     MIN_SAME_LEVEL_M,
@@ -284,8 +285,19 @@ impl RowReader<'_> {
             Some(s.points.iter().map(|p| p[j]).fold(0.0, f64::max))
         });
         let sampled_yield = (sampled_drift, self.sampled(RowSampled::YieldShear(b)));
+        // Each sampled IMK key with its smallest and largest draw.
+        let sampled_imk: Vec<SampledImk> = ImkKey::ALL
+            .into_iter()
+            .filter_map(|k| {
+                let s = self.samples?;
+                let j = s.axes.iter().position(|a| *a == RowSampled::Imk(b, k))?;
+                let draws = s.points.iter().map(|p| p[j]);
+                let lo = draws.clone().fold(f64::INFINITY, f64::min);
+                Some((k, (lo, draws.fold(f64::NEG_INFINITY, f64::max))))
+            })
+            .collect();
         let invalid = |k: &str, m: String| self.invalid(k, m);
-        let yielding = parse_yielding(r, n, sampled_yield, &key, &invalid)?;
+        let yielding = parse_yielding(r, n, sampled_yield, &sampled_imk, &key, &invalid)?;
         let period_s = self.required(RowSampled::Period(b), r.period_s.as_ref())?;
         let damping_ratio = self.required(RowSampled::Damping(b), r.damping_ratio.as_ref())?;
         let p_delta = self.p_delta(r, &key)?;

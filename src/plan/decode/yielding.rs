@@ -83,14 +83,18 @@ impl Storeys<'_> {
 /// A building's yielding storeys as its `[[building]]` gives them (`key` names its keys), or
 /// None where it gives none (elastic).
 ///
-/// `sampled_drift`: the largest yield drift ratio `[sample]` draws, where it samples it.
+/// `sampled_drift`: the largest yield drift ratio `[sample]` draws, where it samples it;
+/// `sampled_imk`: the IMK keys it samples, with their smallest and largest draws.
 pub(crate) fn parse_yielding(
     r: &RawShearBuilding,
     n: usize,
     (sampled_drift, sampled_shear): (Option<f64>, bool),
+    sampled_imk: &[SampledImk],
     key: &dyn Fn(&str) -> String,
     invalid: &dyn Fn(&str, String) -> ConfigError,
 ) -> Result<Option<YieldSpec>, ConfigError> {
+    let imk_sampled = |k: ImkKey| sampled_imk.iter().any(|(s, _)| *s == k);
+    let imk_named = |k: ImkKey| imk_given(r, k).is_some() || imk_sampled(k);
     for (sampled, given, name) in [
         (
             sampled_drift.is_some(),
@@ -129,7 +133,7 @@ pub(crate) fn parse_yielding(
     ];
     let (strength, axis) = match strengths.iter().filter(|&&x| x).count() {
         0 => {
-            let imk = ImkKey::ALL.map(|k| (imk_given(r, k).is_some(), k.key()));
+            let imk = ImkKey::ALL.map(|k| (imk_named(k), k.key()));
             for (given, name) in [
                 (r.post_yield_ratio.is_some(), "post_yield_ratio"),
                 (
@@ -184,9 +188,14 @@ pub(crate) fn parse_yielding(
         _ => None,
     };
     let deterioration = match rule {
-        Some(rule) => Some(imk_storeys(r, rule, theta_y.as_deref(), &storeys)?),
+        Some(rule) => Some(imk_storeys(
+            r,
+            rule,
+            (theta_y.as_deref(), sampled_imk),
+            &storeys,
+        )?),
         None => {
-            if let Some(k) = ImkKey::ALL.into_iter().find(|k| imk_given(r, *k).is_some()) {
+            if let Some(k) = ImkKey::ALL.into_iter().find(|k| imk_named(*k)) {
                 return Err(invalid(
                     &key(k.key()),
                     format!(
@@ -221,19 +230,36 @@ fn imk_given(r: &RawShearBuilding, k: ImkKey) -> Option<&StoreyValues> {
 /// a run takes.
 type Given = (Vec<f64>, Vec<(f64, f64)>);
 
+/// An IMK key `[sample]` draws for a building, with its smallest and largest draw.
+pub(crate) type SampledImk = (ImkKey, (f64, f64));
+
 /// A building's IMK storeys (`hysteresis` names `rule`): `theta_p` and `theta_pc` required,
 /// `kappa` 0, `theta_u` infinite and `gamma` none where absent. `theta_y`: the yield drift
 /// ratio per storey at its largest where the config tells it (a yield drift); the ultimate
 /// drift must lie beyond the capping point `theta_y + theta_p` at its largest, or beyond
 /// `theta_p` where `theta_y` follows each run's stiffness (a force or base-shear strength).
+///
+/// A key `[sample]` draws (`sampled`) is a one-value axis whose value each run's draw replaces
+/// ([`crate::plan::row::RowPlan::run`]); its bounds are checked on the draws' range.
 fn imk_storeys(
     r: &RawShearBuilding,
     rule: ImkRule,
-    theta_y: Option<&[f64]>,
+    (theta_y, sampled): (Option<&[f64]>, &[SampledImk]),
     storeys: &Storeys,
 ) -> Result<ImkSpec, ConfigError> {
     let mut axes = Vec::new();
     let mut read = |k: ImkKey| -> Result<Option<Given>, ConfigError> {
+        if let Some(&(_, (lo, hi))) = sampled.iter().find(|(s, _)| *s == k) {
+            if imk_given(r, k).is_some() {
+                let name = (storeys.key)(k.key());
+                return Err((storeys.invalid)(
+                    &name,
+                    format!("{name} is sampled under [sample]: remove it here"),
+                ));
+            }
+            axes.push((k, vec![lo]));
+            return Ok(Some((vec![lo; storeys.n], vec![(lo, hi); storeys.n])));
+        }
         let Some(v) = imk_given(r, k) else {
             return Ok(None);
         };
