@@ -76,7 +76,7 @@ impl ImkSpring {
     /// the same line at each zero crossing (exact at any reach within its piece's rest
     /// thresholds); a peak-oriented storey's small loops (reloading towards its peaks through
     /// the crossing, unloading at each turn) move its rest point by up to the reach: taken once
-    /// that is below 1e-6 of the yield drift, on any of its pieces.
+    /// that is below 1e-4 of the yield drift, on any of its pieces.
     pub fn rest_reach(&self) -> f64 {
         match self.rule {
             ImkRule::Bilinear => f64::INFINITY,
