@@ -78,6 +78,10 @@ pub struct RawShearBuilding {
     /// With `p_delta`: floor `j` carries the gravity load `g m_j gravity_mass_ratio` (default
     /// 1; 2 or 3 where a leaning column carries gravity the frame does not resist).
     pub gravity_mass_ratio: Option<f64>,
+    /// The share `alpha` (0 < alpha <= 1) of each storey's stiffness and strength that the
+    /// columns a neighbour's slab can strike carry (physics.md section 11): their local
+    /// flexibility at the struck point acts in series with the contact.
+    pub struck_column_share: Option<f64>,
 }
 
 /// `yield_drift_ratio` as written: one value for every storey, one per storey, or a range

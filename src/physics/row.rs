@@ -190,6 +190,20 @@ impl Row {
             for point in contact_points(&pair[0], &pair[1], rule) {
                 let [ma, mb] = [0, 1].map(|k| point.sides[k].point_mass(&pair[k].masses));
                 let (k, m_eff) = (point.share * stiffness, point.share * ma * mb / (ma + mb));
+                let k = match struck_side(&point.sides) {
+                    Some(side) if law == LawKind::Linear => {
+                        let struck = &pair[side];
+                        let j = point.sides[side].floor - 1;
+                        struck.struck_column_share.map_or(k, |alpha| {
+                            let k_loc = local_stiffness(
+                                alpha * struck.stiffness[j],
+                                point.sides[side].weight,
+                            );
+                            k * k_loc / (k + k_loc)
+                        })
+                    }
+                    _ => k,
+                };
                 levels.push(Level {
                     left: a,
                     sides: point.sides,
@@ -216,6 +230,25 @@ impl Row {
     pub fn storeys(&self) -> usize {
         self.buildings.iter().map(|b| b.storeys()).sum()
     }
+}
+
+/// The local stiffness of fixed-fixed columns of lateral stiffness `k_col = 12 EI / h^3`
+/// under a point load at `xi` up them, `3 EI h^3 / (a^3 b^3) = k_col / (4 xi^3 (1 - xi)^3)`
+/// (physics.md section 11), from the point's share `s = 3 xi^2 - 2 xi^3` of the storey's top
+/// floor (`s` rises from 0 to 1 with `xi`: bisected to rounding).
+pub fn local_stiffness(k_col: f64, s: f64) -> f64 {
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    for _ in 0..64 {
+        let xi = 0.5 * (lo + hi);
+        if xi * xi * (3.0 - 2.0 * xi) < s {
+            lo = xi;
+        } else {
+            hi = xi;
+        }
+    }
+    let xi = 0.5 * (lo + hi);
+    let c = xi * (1.0 - xi);
+    k_col / (4.0 * c * c * c)
 }
 
 /// A contact point of two neighbours ([`contact_points`]).
@@ -348,9 +381,12 @@ pub struct LevelOutput {
     pub dissipated_energy: f64,
     /// Where a floor strikes a column: the struck storey's largest column shear while in
     /// contact, N (the storey's spring force with the share of the contact force each
-    /// segment of the column carries: `max(|V - s F|, |V + (1 - s) F|)`); 0 elsewhere.
+    /// segment of the column carries: `max(|V - s F|, |V + (1 - s) F|)`; with
+    /// `struck_column_share` `alpha`, the struck columns' `alpha V` in place of `V`); 0
+    /// elsewhere.
     pub column_shear: f64,
-    /// That shear over the storey's yield force, where it yields (0 elsewhere).
+    /// That shear over the storey's yield force (`alpha` of it with the key), where it yields
+    /// (0 elsewhere).
     pub column_shear_ratio: f64,
 }
 

@@ -59,6 +59,11 @@ pub struct ShearBuilding {
     /// P-Delta: each storey's geometric stiffness `P_j / h_j`, N/m, `P_j` the gravity load it
     /// carries (None: no P-Delta; [`ShearBuilding::with_p_delta`]).
     pub geometric: Option<Vec<f64>>,
+    /// The share `alpha` of each storey's stiffness that the columns a neighbour's slab strikes
+    /// carry: their local stiffness at the struck point, `alpha k_j / (4 xi^3 (1 - xi)^3)`, is
+    /// in series with the contact (physics.md section 11; [`crate::physics::row::Row`]). None:
+    /// the struck point is rigid.
+    pub struck_column_share: Option<f64>,
 }
 
 /// Storeys that yield: storey `j` is a bilinear spring with kinematic hardening (physics.md
@@ -149,6 +154,7 @@ impl ShearBuilding {
             damping,
             yielding: None,
             geometric: None,
+            struck_column_share: None,
         };
         let w1 = b.eigen().0[0].sqrt();
         let target = 2.0 * std::f64::consts::PI / period;
@@ -168,6 +174,7 @@ impl ShearBuilding {
             damping: Damping::Modal(xi),
             yielding: None,
             geometric: None,
+            struck_column_share: None,
         }
     }
 
@@ -504,6 +511,7 @@ mod tests {
             damping,
             yielding: None,
             geometric: None,
+            struck_column_share: None,
         }
     }
 
@@ -538,6 +546,7 @@ mod tests {
             damping: Damping::Rayleigh(0.05),
             yielding: None,
             geometric: None,
+            struck_column_share: None,
         };
         let md = b.modes();
         let n = b.storeys();
@@ -655,6 +664,7 @@ mod tests {
         }
         let elastic = ShearBuilding {
             geometric: None,
+            struck_column_share: None,
             ..b.clone()
         };
         let w0 = elastic.modes().omega;
@@ -705,6 +715,7 @@ mod tests {
         .with_p_delta(2.0);
         let elastic = ShearBuilding {
             geometric: None,
+            struck_column_share: None,
             ..b.clone()
         };
         let (a0, a1) = elastic.rayleigh(&elastic.modes().omega).unwrap();

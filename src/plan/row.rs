@@ -144,7 +144,7 @@ impl YieldSpec {
 }
 
 /// A row config as written.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct ShearAxes {
     pub heights: Vec<f64>,
     /// Fixed floor masses, or None where `mass` is swept.
@@ -161,6 +161,30 @@ pub struct ShearAxes {
     /// `T` it is this times `T^2` (the storey stiffnesses scale as `1 / T^2`, the gravity loads
     /// and the stiffnesses alike with a uniform floor mass).
     pub stability_at_1s: f64,
+    /// The share of its storeys that the columns a neighbour's slab strikes carry (None: the
+    /// struck point is rigid, [`crate::physics::shear::ShearBuilding::struck_column_share`]).
+    pub struck_column_share: Option<f64>,
+}
+
+// The plan's fingerprint hashes this text: a building without `struck_column_share` reads as
+// it did before the key, so its sidecars still match.
+impl std::fmt::Debug for ShearAxes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = f.debug_struct("ShearAxes");
+        d.field("heights", &self.heights)
+            .field("floor_masses", &self.floor_masses)
+            .field("mass", &self.mass)
+            .field("profile", &self.profile)
+            .field("period", &self.period)
+            .field("damping", &self.damping)
+            .field("modal", &self.modal)
+            .field("p_delta", &self.p_delta)
+            .field("stability_at_1s", &self.stability_at_1s);
+        if let Some(alpha) = &self.struck_column_share {
+            d.field("struck_column_share", alpha);
+        }
+        d.finish()
+    }
 }
 
 impl ShearAxes {
@@ -655,9 +679,13 @@ impl RowPlan {
                 s.yielding = self.yielding[b]
                     .as_ref()
                     .map(|y| y.of(&s, run.yield_value[b], &run.imk_value[b]));
-                match a.p_delta {
+                let s = match a.p_delta {
                     Some(ratio) => s.with_p_delta(ratio),
                     None => s,
+                };
+                ShearBuilding {
+                    struck_column_share: a.struck_column_share,
+                    ..s
                 }
             })
             .collect();

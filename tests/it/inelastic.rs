@@ -322,6 +322,7 @@ fn opensees_cross_check() {
                     deterioration: None,
                 }),
                 geometric: None,
+                struck_column_share: None,
             })
             .collect();
         let row = Row::new(buildings, floats(&scene["gaps_m"]), LawKind::Linear, k, 0.0);

@@ -55,6 +55,7 @@ pub mod scenes;
 mod shared;
 mod spellings;
 mod start;
+mod struck_column;
 mod studies;
 pub mod support;
 mod table_columns;

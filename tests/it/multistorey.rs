@@ -101,6 +101,7 @@ fn forced_response_matches_an_independent_floor_integration() {
         damping: Damping::Rayleigh(0.05),
         yielding: None,
         geometric: None,
+        struck_column_share: None,
     };
     let w = |i: usize| {
         2.0 * (k / mass).sqrt() * ((2 * i + 1) as f64 * PI / (2.0 * (2 * n + 1) as f64)).sin()
@@ -392,6 +393,7 @@ fn opensees_cross_check() {
                 damping: Damping::Rayleigh(xi),
                 yielding: None,
                 geometric: None,
+                struck_column_share: None,
             })
             .collect();
         let row = Row::new(buildings, floats(&scene["gaps_m"]), LawKind::Linear, k, 0.0);

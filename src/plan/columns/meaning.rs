@@ -305,13 +305,13 @@ const PER_LEVEL: [(&str, &str, &str, &str); 6] = [
         "column_shear_n",
         "N",
         "column shear, {level}",
-        "largest shear in the struck storey's columns while in contact at {level}: the storey's spring force with the share of the contact force each column segment carries, max(|V - s F|, |V + (1 - s) F|), s = 3 xi^2 - 2 xi^3 at the height xi up the storey (0 if never in contact)",
+        "largest shear in the struck storey's columns while in contact at {level}: the storey's spring force with the share of the contact force each column segment carries, max(|V - s F|, |V + (1 - s) F|), s = 3 xi^2 - 2 xi^3 at the height xi up the storey; with the struck building's struck_column_share alpha, the struck columns' own: alpha V in place of V (0 if never in contact)",
     ),
     (
         "column_shear_ratio",
         "-",
         "column shear / yield force, {level}",
-        "that largest column shear at {level} over the struck storey's yield force (storeys that yield)",
+        "that largest column shear at {level} over the struck storey's yield force, alpha of it with struck_column_share (storeys that yield)",
     ),
 ];
 

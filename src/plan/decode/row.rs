@@ -7,6 +7,7 @@ use crate::config::axis::Axis;
 use crate::config::error::ConfigError;
 use crate::config::row::{PerStorey, RawLevels, RawRowConfig, RawShearBuilding};
 use crate::config::sections::{CollapseLimit, RawContact, RawRun};
+use crate::physics::contact::LawKind;
 use crate::physics::row::LevelRule;
 use crate::physics::shear::MAX_STOREYS;
 use crate::plan::axes::{check_axis, Check, DAMPING, GAP, MASS, PERIOD, POSITIVE};
@@ -189,6 +190,7 @@ pub(crate) fn parse_row_as(
         struck: Vec::new(),
     };
     plan.struck = plan.struck_columns();
+    check_struck_columns(&plan).map_err(|(k, m)| invalid(&k, m))?;
     // A gap study runs no contact and no gap axis: none of them can repeat its runs.
     if reading == Reading::Sweep {
         let shared_values = (rc.gap_m.as_ref()).map_or(0, |a| a.count().unwrap_or(1));
@@ -301,6 +303,18 @@ impl RowReader<'_> {
         let period_s = self.required(RowSampled::Period(b), r.period_s.as_ref())?;
         let damping_ratio = self.required(RowSampled::Damping(b), r.damping_ratio.as_ref())?;
         let p_delta = self.p_delta(r, &key)?;
+        let struck_column_share = match r.struck_column_share {
+            Some(alpha) if !(alpha > 0.0 && alpha <= 1.0) => {
+                return Err(self.invalid(
+                    &key("struck_column_share"),
+                    format!(
+                        "{} is out of range: expected a share > 0 and <= 1 (of the storey's stiffness and strength the struck columns carry)",
+                        crate::show(alpha)
+                    ),
+                ))
+            }
+            alpha => alpha,
+        };
         let axes = ShearAxes {
             heights,
             floor_masses,
@@ -311,6 +325,7 @@ impl RowReader<'_> {
             modal,
             p_delta,
             stability_at_1s: 0.0,
+            struck_column_share,
         };
         Ok((axes, yielding))
     }
@@ -580,6 +595,43 @@ fn level_rule(raw: &RawLevels) -> Result<LevelRule, (&'static str, String)> {
         rule.floor_column = on;
     }
     Ok(rule)
+}
+
+/// Each building with `struck_column_share`: a neighbour's floor strikes its columns at some
+/// level, and every law of the sweep is the linear one, whose series spring is exact as `k_eff
+/// = k k_loc / (k + k_loc)` (the other laws need the struck point as an internal coordinate,
+/// not built yet). Err: the key and why.
+fn check_struck_columns(plan: &RowPlan) -> Result<(), (String, String)> {
+    let levels = if plan.is_empty() {
+        Vec::new()
+    } else {
+        plan.levels()
+    };
+    for (b, a) in plan.buildings.iter().enumerate() {
+        if a.struck_column_share.is_none() {
+            continue;
+        }
+        let key = format!("building[{b}].struck_column_share");
+        if let Some(law) = (plan.contact.spec.laws.iter()).find(|l| **l != LawKind::Linear) {
+            return Err((
+                key,
+                format!(
+                    "applies with law = \"linear\" only so far (its series spring with the columns is exact as k_eff = k k_loc / (k + k_loc)); `{}` needs the struck point as an internal coordinate, which is not built yet: use the linear law or remove the key",
+                    law.key()
+                ),
+            ));
+        }
+        let struck = levels.iter().any(|l| {
+            crate::physics::row::struck_side(&l.sides).is_some_and(|side| l.left + side == b)
+        });
+        if !struck {
+            return Err((
+                key,
+                "no neighbour's floor strikes this building's columns (every level is floor against floor, or floor_column is off): remove the key".into(),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Every P-Delta building stable under gravity alone at every period it takes (`taken`): each

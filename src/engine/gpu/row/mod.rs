@@ -307,9 +307,10 @@ fn output(shape: &RowShape, s: &[f64], c: &[u32], storeys: &[StoreyReadout]) -> 
                 contact_time: ls[LS_CONTACT_TIME],
                 dissipated_energy: ls[LS_DISSIPATED],
                 column_shear: ls[LS_COLUMN_SHEAR],
-                column_shear_ratio: shape
-                    .struck_storey(l)
-                    .map_or(0.0, |st| ls[LS_COLUMN_SHEAR] / storeys[st].yield_force),
+                column_shear_ratio: shape.struck_storey(l).map_or(0.0, |st| {
+                    let st = &storeys[st];
+                    ls[LS_COLUMN_SHEAR] / (st.column_share * st.yield_force)
+                }),
             }
         })
         .collect();

@@ -45,6 +45,9 @@ pub(super) struct StoreyReadout {
     pub(super) d_y: f64,
     /// Its yield force `k d_y`, N.
     pub(super) yield_force: f64,
+    /// The share of it the columns a neighbour's floor strikes carry (1 without
+    /// `struck_column_share`): their shear is read against that share of the yield force.
+    pub(super) column_share: f64,
     /// An IMK storey's capping strength before any deterioration, N (None: bilinear).
     pub(super) fcap0: Option<f64>,
     leaning: Option<(usize, Vec<f64>)>,
@@ -58,6 +61,9 @@ impl StoreyReadout {
             height: sm.height,
             d_y: sm.d_y,
             yield_force: sm.k * sm.d_y,
+            column_share: (m.levels.iter().filter_map(|l| l.column))
+                .find(|c| c.yielding == Some(s))
+                .map_or(1.0, |c| c.share),
             fcap0: sm.imk.as_ref().map(ImkSpring::fcap0),
             leaning: (sm.geometric != 0.0).then(|| m.residual_row(s)),
         }

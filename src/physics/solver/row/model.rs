@@ -147,7 +147,11 @@ pub(crate) struct StruckColumn {
     pub storey: usize,
     /// The share `s` of the force on the floor above (`1 - s` on the floor below).
     pub weight: f64,
-    /// The storey's initial stiffness, N/m.
+    /// The share `alpha` of the storey the struck columns carry (`struck_column_share`; 1
+    /// without it: the storey's columns together).
+    pub share: f64,
+    /// The struck columns' initial stiffness, `alpha` times the storey's, N/m: their shear is
+    /// `alpha V` plus the contact's share.
     pub k: f64,
     /// Its index in [`RowModel::storeys`] where it yields.
     pub yielding: Option<usize>,
@@ -301,12 +305,14 @@ impl RowModel {
                     column: struck_side(&l.sides).map(|side| {
                         let building = l.left + side;
                         let storey = l.sides[side].floor - 1;
+                        let share = row.buildings[building].struck_column_share.unwrap_or(1.0);
                         StruckColumn {
                             side,
                             building,
                             storey,
                             weight: l.sides[side].weight,
-                            k: row.buildings[building].stiffness[storey],
+                            share,
+                            k: share * row.buildings[building].stiffness[storey],
                             yielding: buildings[building].first_storey.map(|f| f + storey),
                         }
                     }),

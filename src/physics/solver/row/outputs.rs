@@ -390,9 +390,12 @@ impl<'m> RowRun<'m> {
             if ls.mode != Mode::Free {
                 ls.end_impact();
             }
-            if let Some(s) = lm.column.and_then(|c| c.yielding) {
-                let sm = &m.storeys[s];
-                ls.out.column_shear_ratio = ls.out.column_shear / (sm.k * sm.d_y);
+            if let Some(c) = lm.column {
+                if let Some(s) = c.yielding {
+                    // Against the struck columns' yield force, `alpha F_y`.
+                    let sm = &m.storeys[s];
+                    ls.out.column_shear_ratio = ls.out.column_shear / (c.share * (sm.k * sm.d_y));
+                }
             }
         }
         // At rest a storey's drift is its plastic drift, but with P-Delta gravity leans on it:

@@ -29,6 +29,7 @@ fn sdof(m: f64, t: f64, xi: f64, d_y: f64, b: f64) -> ShearBuilding {
             deterioration: None,
         }),
         geometric: None,
+        struck_column_share: None,
     }
 }
 
