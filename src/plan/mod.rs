@@ -42,6 +42,7 @@ pub mod intensity;
 pub mod limits;
 pub mod pair;
 pub mod row;
+pub mod row_sampled;
 pub mod sample;
 pub mod scene;
 pub mod settings;

@@ -287,15 +287,13 @@ impl RowReader<'_> {
             Some(s.points.iter().map(|p| p[j]).fold(0.0, f64::max))
         });
         let sampled_yield = (sampled_drift, self.sampled(RowSampled::YieldShear(b)));
-        // Each sampled IMK key with its smallest and largest draw.
+        // Each sampled IMK key with its draws, sample by sample.
         let sampled_imk: Vec<SampledImk> = ImkKey::ALL
             .into_iter()
             .filter_map(|k| {
                 let s = self.samples?;
                 let j = s.axes.iter().position(|a| *a == RowSampled::Imk(b, k))?;
-                let draws = s.points.iter().map(|p| p[j]);
-                let lo = draws.clone().fold(f64::INFINITY, f64::min);
-                Some((k, (lo, draws.fold(f64::NEG_INFINITY, f64::max))))
+                Some((k, s.points.iter().map(|p| p[j]).collect()))
             })
             .collect();
         let invalid = |k: &str, m: String| self.invalid(k, m);

@@ -7,7 +7,8 @@ use crate::config::row::{PerStorey, RawShearBuilding, StoreyValues, YieldDrift};
 use crate::physics::shear::{Deterioration, ImkRule};
 use crate::plan::axes::{check_axis, Check};
 use crate::plan::deterioration::{hysteresis, ImkKey, ImkSpec, HYSTERESIS_WORDS};
-use crate::plan::row::{YieldSpec, YieldStrength, YIELD_DRIFT, YIELD_SHEAR};
+use crate::plan::row::{YieldSpec, YieldStrength};
+use crate::plan::row_sampled::{YIELD_DRIFT, YIELD_SHEAR};
 
 /// The keys of one building's storeys: `n` of them; `key` names a key, `invalid` makes its
 /// error.
@@ -84,7 +85,7 @@ impl Storeys<'_> {
 /// None where it gives none (elastic).
 ///
 /// `sampled_drift`: the largest yield drift ratio `[sample]` draws, where it samples it;
-/// `sampled_imk`: the IMK keys it samples, with their smallest and largest draws.
+/// `sampled_imk`: the IMK keys it samples, with their draws.
 pub(crate) fn parse_yielding(
     r: &RawShearBuilding,
     n: usize,
@@ -230,8 +231,8 @@ fn imk_given(r: &RawShearBuilding, k: ImkKey) -> Option<&StoreyValues> {
 /// a run takes.
 type Given = (Vec<f64>, Vec<(f64, f64)>);
 
-/// An IMK key `[sample]` draws for a building, with its smallest and largest draw.
-pub(crate) type SampledImk = (ImkKey, (f64, f64));
+/// An IMK key `[sample]` draws for a building, with its draws, sample by sample.
+pub(crate) type SampledImk = (ImkKey, Vec<f64>);
 
 /// A building's IMK storeys (`hysteresis` names `rule`): `theta_p` and `theta_pc` required,
 /// `kappa` 0, `theta_u` infinite and `gamma` none where absent. `theta_y`: the yield drift
@@ -240,7 +241,8 @@ pub(crate) type SampledImk = (ImkKey, (f64, f64));
 /// `theta_p` where `theta_y` follows each run's stiffness (a force or base-shear strength).
 ///
 /// A key `[sample]` draws (`sampled`) is a one-value axis whose value each run's draw replaces
-/// ([`crate::plan::row::RowPlan::run`]); its bounds are checked on the draws' range.
+/// ([`crate::plan::row::RowPlan::run`]); the ultimate drift is checked against capping draw by
+/// draw, each sample's against its own `theta_p`.
 fn imk_storeys(
     r: &RawShearBuilding,
     rule: ImkRule,
@@ -249,7 +251,9 @@ fn imk_storeys(
 ) -> Result<ImkSpec, ConfigError> {
     let mut axes = Vec::new();
     let mut read = |k: ImkKey| -> Result<Option<Given>, ConfigError> {
-        if let Some(&(_, (lo, hi))) = sampled.iter().find(|(s, _)| *s == k) {
+        if let Some((_, draws)) = sampled.iter().find(|(s, _)| *s == k) {
+            let lo = draws.iter().cloned().fold(f64::INFINITY, f64::min);
+            let hi = draws.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
             if imk_given(r, k).is_some() {
                 let name = (storeys.key)(k.key());
                 return Err((storeys.invalid)(
@@ -302,8 +306,30 @@ fn imk_storeys(
     let residual = read(ImkKey::Residual)?.map_or(vec![0.0; storeys.n], |(v, _)| v);
     let ultimate = read(ImkKey::Ultimate)?;
     let energy = read(ImkKey::Energy)?.map(|(v, _)| v);
-    if let Some((_, range)) = &ultimate {
-        check_ultimate(r, range, &plastic_range, theta_y, storeys)?;
+    let drawn = |k: ImkKey| sampled.iter().find(|(s, _)| *s == k).map(|(_, d)| d);
+    match (&ultimate, drawn(ImkKey::Ultimate), drawn(ImkKey::Plastic)) {
+        (Some((_, range)), None, None) => {
+            check_ultimate(r, range, &plastic_range, theta_y, storeys, None)?;
+        }
+        // A sampled theta_u or theta_p: each sample's pair, the other key as given.
+        (Some((_, range)), u_draws, p_draws) => {
+            let samples = u_draws.or(p_draws).map_or(0, Vec::len);
+            for k in 0..samples {
+                let at =
+                    |d: Option<&Vec<f64>>, given: &[(f64, f64)], hi: bool| -> Vec<(f64, f64)> {
+                        match d {
+                            Some(d) => vec![(d[k], d[k]); storeys.n],
+                            None => given
+                                .iter()
+                                .map(|&(lo, h)| if hi { (h, h) } else { (lo, lo) })
+                                .collect(),
+                        }
+                    };
+                let (u, p) = (at(u_draws, range, false), at(p_draws, &plastic_range, true));
+                check_ultimate(r, &u, &p, theta_y, storeys, Some(k))?;
+            }
+        }
+        _ => {}
     }
     Ok(ImkSpec {
         deterioration: Deterioration {
@@ -327,8 +353,10 @@ fn check_ultimate(
     plastic: &[(f64, f64)],
     theta_y: Option<&[f64]>,
     storeys: &Storeys,
+    sample: Option<usize>,
 ) -> Result<(), ConfigError> {
     let show = crate::plan::limits::show;
+    let drawn = sample.map_or_else(String::new, |k| format!("in [sample]'s sample {k}, "));
     for (i, (&(u, _), &(_, p))) in ultimate.iter().zip(plastic).enumerate() {
         let (capping, what) = match theta_y {
             Some(y) => (
@@ -358,7 +386,7 @@ fn check_ultimate(
             return Err((storeys.invalid)(
                 &at,
                 format!(
-                    "{} is at or before storey {}'s {what}: expected an ultimate drift ratio beyond it",
+                    "{drawn}{} is at or before storey {}'s {what}: expected an ultimate drift ratio beyond it",
                     show(u),
                     i + 1
                 ),

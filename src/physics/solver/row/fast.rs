@@ -30,7 +30,7 @@ use super::model::{RowModel, FLOOR_SUBSTEPS_FROM};
 use super::rhs::{rhs, Motion};
 use super::run::RowRun;
 use super::sample::RowObserver;
-use super::tangent::Tangent;
+use super::tangent::TangentSteps;
 use super::yielding::next_segment;
 use crate::physics::model::{Forcing, Oscillator, Status};
 use crate::physics::propagator::{EnergyForms, Propagator};
@@ -153,24 +153,6 @@ impl Lookout {
     }
 }
 
-/// Each mode's bound on `|q''''|` over the free step `z -> z1` of `seg`
-/// ([`RowModel::fourth_derivative_bounds`]), a building on its tangent stiffness's from its
-/// [`Tangent`] (`on` says which, None: none).
-fn bounds_with(
-    m: &RowModel,
-    (seg, z, z1): (&Segment, &[f64], &[f64]),
-    bounds: &mut Vec<f64>,
-    tangents: &mut [Vec<Tangent>],
-    on: Option<&[bool]>,
-) {
-    m.fourth_derivative_bounds(seg, (z, z1), bounds, on);
-    if let Some(on) = on {
-        for t in (tangents.iter_mut().filter_map(|k| k.first_mut())).filter(|t| on[t.building()]) {
-            t.bounds(m, seg, z, z1, bounds);
-        }
-    }
-}
-
 fn mode_oscillator(m: &RowModel, k: usize) -> Oscillator {
     Oscillator {
         m: 1.0,
@@ -264,9 +246,6 @@ enum Standing {
     /// rate takes the substeps from the step's start (the scheme).
     Grown,
 }
-
-/// How many sets of pieces' tangent steps a building keeps.
-const KEPT_TANGENTS: usize = 4;
 
 /// Which free steps a building whose IMK storeys stand on pieces off their initial stiffness
 /// takes.
@@ -366,14 +345,10 @@ fn run_with<'a>(
     let mut q_static = vec![0.0; n];
     let mut storey_modes = Vec::with_capacity(m.storeys.len());
     let mut yield_watch = vec![false; m.buildings.len()];
-    // Buildings on IMK pieces off their initial stiffness: the exact steps of each one's
-    // tangent stiffness on the last few sets of pieces it stood on (the one it stands on
-    // first: a peak-oriented storey goes back and forth between two lines), and whether it
-    // takes one this step.
-    let tangent_steps = steps == Steps::Tangent && m.storeys.iter().any(|sm| sm.imk.is_some());
-    let mut tangents: Vec<Vec<Tangent>> = m.buildings.iter().map(|_| Vec::new()).collect();
+    // Buildings on IMK pieces off their initial stiffness: their exact tangent steps, and
+    // which take one this step.
+    let mut tangents = TangentSteps::new(m, steps == Steps::Tangent, dt, o.energy);
     let mut on_tangent = vec![false; m.buildings.len()];
-    let mut slopes = Vec::new();
     let mut i = 0;
     // The step's start, in a buffer kept from step to step (as `z1`, its end).
     let mut z_start = Vec::with_capacity(len);
@@ -388,35 +363,11 @@ fn run_with<'a>(
         let any_gone = run.gone.iter().any(|&g| g);
         z_start.clone_from(&run.z);
         let z = &z_start;
-        let mut any_tangent = false;
         // Only where the step's free motion is taken (not while a level is in contact in a
         // row where every building moves).
-        if tangent_steps && (can_stand || !run.any_contact()) {
-            for (k, on) in on_tangent.iter_mut().enumerate() {
-                *on = !run.gone[k] && Tangent::slopes(m, k, &run.storey_modes, &mut slopes);
-                if !*on {
-                    continue;
-                }
-                let kept = &mut tangents[k];
-                match kept.iter().position(|t| t.is_for(&slopes)) {
-                    Some(i) => kept[..=i].rotate_right(1),
-                    None => match Tangent::new(m, k, &slopes, dt, o.energy) {
-                        Some(t) => {
-                            kept.insert(0, t);
-                            kept.truncate(KEPT_TANGENTS);
-                        }
-                        None => {
-                            *on = false;
-                            continue;
-                        }
-                    },
-                }
-                kept[0].prepare(m, z);
-                any_tangent = true;
-            }
-        } else {
-            on_tangent.fill(false);
-        }
+        let free = can_stand || !run.any_contact();
+        let any_tangent =
+            tangents.select(m, (&run.storey_modes, &run.gone), z, free, &mut on_tangent);
         let tangent_on = any_tangent.then_some(&on_tangent[..]);
         // The exact free step of every mode: the step itself when no level may touch, and the
         // buildings' that stand still through a step of substeps (none in a row of two).
@@ -464,19 +415,8 @@ fn run_with<'a>(
                 }
             }
             if let Some(on) = tangent_on {
-                for t in tangents.iter_mut().filter_map(|k| k.first_mut()) {
-                    if !on[t.building()] {
-                        continue;
-                    }
-                    let w = forms.is_some().then_some(&mut work[..]);
-                    t.step(m, z, (seg.a0, seg.a1), &mut z1, w);
-                    if forms.is_some() {
-                        let b = &m.buildings[t.building()];
-                        for (i, &w) in work.iter().enumerate().skip(b.off).take(b.n()) {
-                            m.add_free_work(&mut z1, i, w);
-                        }
-                    }
-                }
+                let w = forms.is_some().then_some(&mut work[..]);
+                tangents.step(m, on, (z, (seg.a0, seg.a1)), &mut z1, w);
             }
         }
         if prepare_ends && !any_contact {
@@ -492,7 +432,7 @@ fn run_with<'a>(
         // A storey that yields, or may in the exact free step, moves its building in substeps.
         let mut yielding = false;
         if yields && (can_stand || !any_contact) {
-            bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
+            tangents.bounds(m, (&seg, z, &z1), &mut bounds, tangent_on);
             bounded = true;
             yielding = m.yield_watch(
                 (&run.storey_modes, tangent_on),
@@ -503,15 +443,14 @@ fn run_with<'a>(
             );
             // A storey heading one way on a tangent step: its rate must not turn inside it.
             if let Some(on) = tangent_on {
-                for t in tangents.iter_mut().filter_map(|k| k.first_mut()) {
-                    let k = t.building();
-                    if on[k]
-                        && !yield_watch[k]
-                        && t.may_reverse(m, &run.storey_modes, (seg.a0, seg.a1), (z, &z1), dt)
-                    {
-                        (yield_watch[k], yielding) = (true, true);
-                    }
-                }
+                let ag = (seg.a0, seg.a1);
+                yielding |= tangents.may_reverse(
+                    m,
+                    (on, &run.storey_modes),
+                    ag,
+                    (z, &z1),
+                    &mut yield_watch,
+                );
             }
         }
         if watched {
@@ -521,7 +460,7 @@ fn run_with<'a>(
             if can_stand || !any_contact {
                 // Near collapse: in substeps while a storey may reach the limit in the step.
                 if !bounded {
-                    bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
+                    tangents.bounds(m, (&seg, z, &z1), &mut bounds, tangent_on);
                     bounded = true;
                 }
                 yielding |= run.collapse_watch((z, &z1), &bounds, dt, &mut yield_watch);
@@ -541,7 +480,7 @@ fn run_with<'a>(
         }
         if !any_contact {
             if !bounded {
-                bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
+                tangents.bounds(m, (&seg, z, &z1), &mut bounds, tangent_on);
                 bounded = true;
             }
             // The floors at both ends are needed for the peaks if the step is free; the levels
@@ -638,7 +577,7 @@ fn run_with<'a>(
                     && d + 2.0 * r.max(0.0) * dt > 0.0;
                 if !close {
                     if !bounded {
-                        bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
+                        tangents.bounds(m, (&seg, z, &z1), &mut bounds, tangent_on);
                         bounded = true;
                     }
                     close = *may_touch[l]
@@ -725,7 +664,7 @@ fn run_with<'a>(
         lookouts.clear();
         if any_still {
             if !bounded {
-                bounds_with(m, (&seg, z, &z1), &mut bounds, &mut tangents, tangent_on);
+                tangents.bounds(m, (&seg, z, &z1), &mut bounds, tangent_on);
             }
             for (l, lm) in m.levels.iter().enumerate() {
                 let (a, b) = lm.buildings;

@@ -18,6 +18,135 @@ use super::model::RowModel;
 use super::storey::{may_reach, StoreyMode};
 use crate::physics::solver::state::Segment;
 
+/// How many sets of pieces' tangent steps a building keeps.
+const KEPT_TANGENTS: usize = 4;
+
+/// A run's tangent steps: each building's on the last few sets of pieces it stood on (the one
+/// it stands on first: a peak-oriented storey goes back and forth between two lines).
+pub(super) struct TangentSteps {
+    /// Whether the run takes tangent steps (the CPU scheme with IMK storeys).
+    enabled: bool,
+    kept: Vec<Vec<Tangent>>,
+    slopes: Vec<f64>,
+    h: f64,
+    energy: bool,
+}
+
+impl TangentSteps {
+    pub fn new(m: &RowModel, enabled: bool, h: f64, energy: bool) -> TangentSteps {
+        TangentSteps {
+            enabled: enabled && m.storeys.iter().any(|sm| sm.imk.is_some()),
+            kept: m.buildings.iter().map(|_| Vec::new()).collect(),
+            slopes: Vec::new(),
+            h,
+            energy,
+        }
+    }
+
+    /// Mark in `on` each building that takes its tangent step from modal state `z` (its
+    /// storeys in `modes`, not `gone`; none unless `free`, the step's free motion taken), its
+    /// step made ready; whether any.
+    pub fn select(
+        &mut self,
+        m: &RowModel,
+        (modes, gone): (&[StoreyMode], &[bool]),
+        z: &[f64],
+        free: bool,
+        on: &mut [bool],
+    ) -> bool {
+        on.fill(false);
+        if !(self.enabled && free) {
+            return false;
+        }
+        let mut any = false;
+        for (k, on) in on.iter_mut().enumerate() {
+            if gone[k] || !Tangent::slopes(m, k, modes, &mut self.slopes) {
+                continue;
+            }
+            let kept = &mut self.kept[k];
+            match kept.iter().position(|t| t.is_for(&self.slopes)) {
+                Some(i) => kept[..=i].rotate_right(1),
+                None => match Tangent::new(m, k, &self.slopes, self.h, self.energy) {
+                    Some(t) => {
+                        kept.insert(0, t);
+                        kept.truncate(KEPT_TANGENTS);
+                    }
+                    None => continue,
+                },
+            }
+            kept[0].prepare(m, z);
+            (*on, any) = (true, true);
+        }
+        any
+    }
+
+    /// The buildings `on` marks, in use.
+    fn taken<'a>(&'a mut self, on: &'a [bool]) -> impl Iterator<Item = &'a mut Tangent> {
+        (self.kept.iter_mut().filter_map(|k| k.first_mut())).filter(|t| on[t.building()])
+    }
+
+    /// Each marked building's exact step from `z` under the ground `ag` into `z1`, with each
+    /// mode's input and damping work into `z1` where `work` is given (as the coupled steps).
+    pub fn step(
+        &mut self,
+        m: &RowModel,
+        on: &[bool],
+        (z, ag): (&[f64], (f64, f64)),
+        z1: &mut [f64],
+        mut work: Option<&mut [(f64, f64)]>,
+    ) {
+        for t in self.taken(on) {
+            t.step(m, z, ag, z1, work.as_deref_mut());
+            if let Some(work) = work.as_deref() {
+                let b = &m.buildings[t.building()];
+                for (i, &w) in work.iter().enumerate().skip(b.off).take(b.n()) {
+                    m.add_free_work(z1, i, w);
+                }
+            }
+        }
+    }
+
+    /// Each mode's bound on `|q''''|` over the free step `z -> z1` of `seg`
+    /// ([`RowModel::fourth_derivative_bounds`]), a marked building's from its tangent step
+    /// (`on` None: none marked).
+    pub fn bounds(
+        &mut self,
+        m: &RowModel,
+        (seg, z, z1): (&Segment, &[f64], &[f64]),
+        bounds: &mut Vec<f64>,
+        on: Option<&[bool]>,
+    ) {
+        m.fourth_derivative_bounds(seg, (z, z1), bounds, on);
+        if let Some(on) = on {
+            for t in self.taken(on) {
+                t.bounds(m, seg, z, z1, bounds);
+            }
+        }
+    }
+
+    /// Mark in `watch` each marked building (`on`, storeys in `modes`) whose storey heading one
+    /// way may turn inside the free step `z -> z1` under `ag` ([`Tangent::may_reverse`]; after
+    /// [`TangentSteps::bounds`] over it); whether any.
+    pub fn may_reverse(
+        &mut self,
+        m: &RowModel,
+        (on, modes): (&[bool], &[StoreyMode]),
+        ag: (f64, f64),
+        (z, z1): (&[f64], &[f64]),
+        watch: &mut [bool],
+    ) -> bool {
+        let h = self.h;
+        let mut any = false;
+        for t in self.taken(on) {
+            let k = t.building();
+            if !watch[k] && t.may_reverse(m, modes, ag, (z, z1), h) {
+                (watch[k], any) = (true, true);
+            }
+        }
+        any
+    }
+}
+
 /// One building's tangent step, kept while its storeys stay on pieces of the same slopes.
 pub(super) struct Tangent {
     building: usize,
