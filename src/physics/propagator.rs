@@ -160,42 +160,10 @@ fn expm_pade(a: &[f64], n: usize) -> Vec<f64> {
     let v: Vec<f64> = (0..n * n)
         .map(|i| C[0] * eye(i) + C[2] * a2[i] + C[4] * a4[i] + C[6] * a6[i])
         .collect();
-    // (V - U) R = V + U, by Gauss elimination with partial pivoting on every column of R.
-    let mut d: Vec<f64> = v.iter().zip(&u).map(|(v, u)| v - u).collect();
-    let mut r: Vec<f64> = v.iter().zip(&u).map(|(v, u)| v + u).collect();
-    for c in 0..n {
-        let p = (c..n)
-            .max_by(|&x, &y| d[x * n + c].abs().total_cmp(&d[y * n + c].abs()))
-            .expect("a column");
-        if p != c {
-            for j in 0..n {
-                d.swap(c * n + j, p * n + j);
-                r.swap(c * n + j, p * n + j);
-            }
-        }
-        let pivot = d[c * n + c];
-        for row in c + 1..n {
-            let x = d[row * n + c] / pivot;
-            if x == 0.0 {
-                continue;
-            }
-            for j in c..n {
-                d[row * n + j] -= x * d[c * n + j];
-            }
-            for j in 0..n {
-                r[row * n + j] -= x * r[c * n + j];
-            }
-        }
-    }
-    for c in (0..n).rev() {
-        for j in 0..n {
-            let mut x = r[c * n + j];
-            for k in c + 1..n {
-                x -= d[c * n + k] * r[k * n + j];
-            }
-            r[c * n + j] = x / d[c * n + c];
-        }
-    }
+    // (V - U) R = V + U.
+    let d: Vec<f64> = v.iter().zip(&u).map(|(v, u)| v - u).collect();
+    let r: Vec<f64> = v.iter().zip(&u).map(|(v, u)| v + u).collect();
+    let mut r = solve_dyn(d, r, n, 0.0).expect("the Padé denominator is regular");
     for _ in 0..s {
         r = mul_dyn(&r, &r, n);
     }
@@ -203,6 +171,50 @@ fn expm_pade(a: &[f64], n: usize) -> Vec<f64> {
     (0..n * n)
         .map(|i| r[i] * scale[i / n] / scale[i % n])
         .collect()
+}
+
+/// `X` with `A X = B` (`A` `n x n`, `B` `n x m`, both row-major, `m` from `b`'s length), by
+/// Gauss elimination with partial pivoting; None where a pivot is at or below `tiny` in size
+/// (singular to that).
+pub(crate) fn solve_dyn(mut a: Vec<f64>, mut b: Vec<f64>, n: usize, tiny: f64) -> Option<Vec<f64>> {
+    let m = b.len() / n;
+    for c in 0..n {
+        let p = (c..n).max_by(|&x, &y| a[x * n + c].abs().total_cmp(&a[y * n + c].abs()))?;
+        if a[p * n + c].abs() <= tiny {
+            return None;
+        }
+        if p != c {
+            for j in 0..n {
+                a.swap(c * n + j, p * n + j);
+            }
+            for j in 0..m {
+                b.swap(c * m + j, p * m + j);
+            }
+        }
+        let pivot = a[c * n + c];
+        for row in c + 1..n {
+            let x = a[row * n + c] / pivot;
+            if x == 0.0 {
+                continue;
+            }
+            for j in c..n {
+                a[row * n + j] -= x * a[c * n + j];
+            }
+            for j in 0..m {
+                b[row * m + j] -= x * b[c * m + j];
+            }
+        }
+    }
+    for c in (0..n).rev() {
+        for j in 0..m {
+            let mut x = b[c * m + j];
+            for k in c + 1..n {
+                x -= a[c * n + k] * b[k * m + j];
+            }
+            b[c * m + j] = x / a[c * n + c];
+        }
+    }
+    Some(b)
 }
 
 /// Powers of 2 `d` for which `D^-1 A D` has each row's and column's off-diagonal norms alike

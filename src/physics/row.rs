@@ -49,11 +49,17 @@ pub struct LevelSide {
     /// `s = 3 xi^2 - 2 xi^3` at `xi` up the storey, the rest `1 - s` on the floor below (none on
     /// the ground).
     pub weight: f64,
+    /// The height fraction `xi` up the struck storey (1 on a floor).
+    pub xi: f64,
 }
 
 impl LevelSide {
     pub fn floor(floor: usize) -> LevelSide {
-        LevelSide { floor, weight: 1.0 }
+        LevelSide {
+            floor,
+            weight: 1.0,
+            xi: 1.0,
+        }
     }
 
     /// The column of storey `storey` (from 1) at `xi` up it (`0 < xi < 1`).
@@ -61,6 +67,7 @@ impl LevelSide {
         LevelSide {
             floor: storey,
             weight: xi * xi * (3.0 - 2.0 * xi),
+            xi,
         }
     }
 
@@ -195,10 +202,8 @@ impl Row {
                         let struck = &pair[side];
                         let j = point.sides[side].floor - 1;
                         struck.struck_column_share.map_or(k, |alpha| {
-                            let k_loc = local_stiffness(
-                                alpha * struck.stiffness[j],
-                                point.sides[side].weight,
-                            );
+                            let k_loc =
+                                local_stiffness(alpha * struck.stiffness[j], point.sides[side].xi);
                             k * k_loc / (k + k_loc)
                         })
                     }
@@ -234,19 +239,8 @@ impl Row {
 
 /// The local stiffness of fixed-fixed columns of lateral stiffness `k_col = 12 EI / h^3`
 /// under a point load at `xi` up them, `3 EI h^3 / (a^3 b^3) = k_col / (4 xi^3 (1 - xi)^3)`
-/// (physics.md section 11), from the point's share `s = 3 xi^2 - 2 xi^3` of the storey's top
-/// floor (`s` rises from 0 to 1 with `xi`: bisected to rounding).
-pub fn local_stiffness(k_col: f64, s: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0f64, 1.0f64);
-    for _ in 0..64 {
-        let xi = 0.5 * (lo + hi);
-        if xi * xi * (3.0 - 2.0 * xi) < s {
-            lo = xi;
-        } else {
-            hi = xi;
-        }
-    }
-    let xi = 0.5 * (lo + hi);
+/// (physics.md section 11).
+pub fn local_stiffness(k_col: f64, xi: f64) -> f64 {
     let c = xi * (1.0 - xi);
     k_col / (4.0 * c * c * c)
 }

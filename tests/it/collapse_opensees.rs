@@ -3,7 +3,7 @@
 //! sweep` with it, through configs with the keys a user writes (`p_delta = true`,
 //! `gravity_mass_ratio`, `[run] collapse_drift_ratio`).
 
-use crate::support::{ok, pound, records_dir, table, tempdir};
+use crate::support::{floats, ok, pound, records_dir, table, tempdir};
 use pounding::record::{read_record, ReadOptions};
 
 /// The scene's config, as a user would write it: each building's storeys from the data file's
@@ -12,13 +12,6 @@ use pounding::record::{read_record, ReadOptions};
 /// samples (a window on its own clock) scaled by the file's factor, no tail (the residual drift
 /// is the engine's settled one).
 fn config(data: &toml::Table, scene: &toml::Value, window: [f64; 2]) -> String {
-    let floats = |v: &toml::Value| -> Vec<f64> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_float().unwrap())
-            .collect()
-    };
     let list = |v: &[f64]| {
         let items: Vec<String> = v.iter().map(|x| format!("{x:?}")).collect();
         format!("[{}]", items.join(", "))
@@ -116,13 +109,6 @@ fn opensees_cross_check() {
         "/tests/data/opensees_pdelta.toml"
     );
     let data: toml::Table = std::fs::read_to_string(path).unwrap().parse().unwrap();
-    let floats = |v: &toml::Value| -> Vec<f64> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_float().unwrap())
-            .collect()
-    };
     let limit = data["collapse_drift_ratio"].as_float().unwrap();
     let dir = records_dir();
     let tmp = tempdir();

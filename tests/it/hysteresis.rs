@@ -5,7 +5,7 @@
 //! `tests/data/opensees_imk.toml`).
 
 use crate::support::cli::{fails_with, refused};
-use crate::support::{ok, pound, tempdir};
+use crate::support::{floats, ok, pound, tempdir};
 
 /// One CSV row of the loop.
 #[derive(Debug)]
@@ -226,13 +226,6 @@ const OPENSEES_TOL: f64 = 1.3e-6;
 fn peaks_agree_with_opensees_past_capping_and_on_the_residual_plateau() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/opensees_imk.toml");
     let data: toml::Table = std::fs::read_to_string(path).unwrap().parse().unwrap();
-    let floats = |v: &toml::Value| -> Vec<f64> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_float().unwrap())
-            .collect()
-    };
     let mut worst: f64 = 0.0;
     let cases = data["case"].as_array().unwrap();
     assert!(cases.len() >= 12);

@@ -3,7 +3,7 @@
 //! sweep's cells, the studies taking the new columns by name, and clear errors where the
 //! config or the backend cannot serve.
 
-use crate::support::{ok, pound, sweep_cpu, table, tempdir};
+use crate::support::{floats, ok, pound, sweep_cpu, table, tempdir};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -295,13 +295,6 @@ fn opensees_cross_check() {
         "/tests/data/opensees_inelastic.toml"
     );
     let data: toml::Table = std::fs::read_to_string(path).unwrap().parse().unwrap();
-    let floats = |v: &toml::Value| -> Vec<f64> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_float().unwrap())
-            .collect()
-    };
     let k = data["contact_k_n_per_m"].as_float().unwrap();
     let xi = data["damping_ratio"].as_float().unwrap();
     let dir = crate::support::records_dir();

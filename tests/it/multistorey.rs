@@ -4,7 +4,7 @@
 
 use crate::scenes::models::{building, forcing, record, single_storey_scenes};
 use crate::scenes::ROW_CONFIG;
-use crate::support::rel;
+use crate::support::{floats, rel};
 use pounding::physics::contact::LawKind;
 use pounding::physics::model::{Forcing, Initial, Status};
 use pounding::physics::row::{Row, RowOutput};
@@ -370,13 +370,6 @@ fn opensees_cross_check() {
         "/tests/data/opensees_multistorey.toml"
     );
     let data: toml::Table = std::fs::read_to_string(path).unwrap().parse().unwrap();
-    let floats = |v: &toml::Value| -> Vec<f64> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_float().unwrap())
-            .collect()
-    };
     let k = data["contact_k_n_per_m"].as_float().unwrap();
     let xi = data["damping_ratio"].as_float().unwrap();
     let dir = crate::support::records_dir();

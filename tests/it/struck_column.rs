@@ -5,7 +5,7 @@
 //! ends, and against OpenSees with explicit fixed-fixed columns split at the impact point
 //! (`benches/opensees_struck_column.py`, `tests/data/opensees_struck_column.toml`).
 
-use crate::support::{ok, pound, records_dir, table, tempdir};
+use crate::support::{floats, ok, pound, records_dir, sweep_cpu, table, tempdir};
 use pounding::physics::contact::LawKind;
 use pounding::physics::row::{local_stiffness, struck_side, LevelRule, Row};
 use pounding::physics::shear::{Damping, ShearBuilding};
@@ -33,8 +33,7 @@ fn the_local_stiffness_is_a_fixed_fixed_beams() {
     let (ei, h) = (3.2e8, 3.5);
     let k_col = 12.0 * ei / (h * h * h);
     for xi in [0.02, 1.0 / 6.0, 0.25, 1.0 / 3.0, 0.5, 0.6, 0.8, 0.97] {
-        let s = xi * xi * (3.0 - 2.0 * xi);
-        let ours = local_stiffness(k_col, s);
+        let ours = local_stiffness(k_col, xi);
         let beam = beam_point_stiffness(ei, h, xi * h);
         assert!(
             (ours - beam).abs() <= 1e-9 * beam,
@@ -43,7 +42,7 @@ fn the_local_stiffness_is_a_fixed_fixed_beams() {
     }
     // 16 k_col at mid-height, 93.3 at a sixth (physics.md section 11).
     assert!((local_stiffness(k_col, 0.5) / k_col - 16.0).abs() < 1e-12);
-    let sixth = local_stiffness(k_col, 2.0 / 27.0) / k_col;
+    let sixth = local_stiffness(k_col, 1.0 / 6.0) / k_col;
     assert!((sixth - 93.312).abs() < 1e-9, "{sixth}");
 }
 
@@ -87,7 +86,7 @@ fn the_linear_law_takes_the_series_stiffness() {
                 Some(side) if a.left + side == 1 => {
                     let storey = a.sides[side].floor - 1;
                     let k_j = r.buildings[1].stiffness[storey];
-                    let k_loc = local_stiffness(alpha * k_j, a.sides[side].weight);
+                    let k_loc = local_stiffness(alpha * k_j, a.sides[side].xi);
                     let k_eff = k * k_loc / (k + k_loc);
                     let got = a.contact.stiffness;
                     assert!(
@@ -115,13 +114,12 @@ fn the_series_stiffness_is_continuous_at_the_storeys_ends() {
     let (k, k_col) = (1e9, 2.7e8);
     let mut last = 0.0;
     for xi in [0.2, 0.1, 0.05, 0.02, 0.01, 0.001] {
-        let s = xi * xi * (3.0 - 2.0 * xi);
-        let k_loc = local_stiffness(k_col, s);
+        let k_loc = local_stiffness(k_col, xi);
         let k_eff = k * k_loc / (k + k_loc);
         assert!(k_eff > last, "xi {xi}: {k_eff} after {last}");
         last = k_eff;
         // The same from the top of the storey.
-        let top = local_stiffness(k_col, 1.0 - s);
+        let top = local_stiffness(k_col, 1.0 - xi);
         assert!(
             (top - k_loc).abs() <= 1e-6 * k_loc,
             "xi {xi}: {top} vs {k_loc}"
@@ -144,14 +142,6 @@ fn linear_law_against_opensees_with_explicit_columns() {
     let data: toml::Table = std::fs::read_to_string(path).unwrap().parse().unwrap();
     let records = records_dir();
     let tmp = tempdir();
-    let floats = |v: &toml::Value| -> Vec<f64> {
-        (v.as_array().unwrap().iter())
-            .map(|x| {
-                x.as_float()
-                    .unwrap_or_else(|| x.as_integer().unwrap() as f64)
-            })
-            .collect()
-    };
     let mut compared = 0;
     for scene in data["scene"].as_array().unwrap() {
         if scene["law"].as_str() != Some("linear") {
@@ -187,14 +177,7 @@ fn linear_law_against_opensees_with_explicit_columns() {
             let cfg = tmp.path().join(format!("{name}-{kind}-{alpha}.toml"));
             std::fs::write(&cfg, &text).unwrap();
             let out = tmp.path().join(format!("{name}-{kind}-{alpha}.csv"));
-            ok(&pound(&[
-                "sweep",
-                cfg.to_str().unwrap(),
-                "-o",
-                out.to_str().unwrap(),
-                "--backend",
-                "cpu",
-            ]));
+            ok(&sweep_cpu(&cfg, &out, &[]));
             let rows = table(&out);
             let r = &rows[0];
             let value = |c: &str| -> f64 {
@@ -203,7 +186,10 @@ fn linear_law_against_opensees_with_explicit_columns() {
                     .parse()
                     .unwrap()
             };
-            let (forces, impacts) = (floats(&model["peak_force_n"]), floats(&model["impacts"]));
+            let forces = floats(&model["peak_force_n"]);
+            let impacts: Vec<f64> = (model["impacts"].as_array().unwrap().iter())
+                .map(|x| x.as_integer().unwrap() as f64)
+                .collect();
             let mut worst: f64 = 0.0;
             for (l, level) in levels.iter().enumerate() {
                 let f = value(&format!("{level}_peak_force_n"));

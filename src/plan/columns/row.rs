@@ -116,11 +116,8 @@ impl RowPlan {
             let (kind, xi, s) = match struck_side(&l.sides) {
                 None => ("floor/floor", String::new(), String::new()),
                 Some(k) => {
-                    let b = &row.buildings[l.left + k];
-                    let j = l.sides[k].floor;
-                    let below: f64 = b.heights[..j - 1].iter().sum();
-                    let xi = (l.elevation - below) / b.heights[j - 1];
-                    let s = l.sides[k].weight;
+                    let side = &l.sides[k];
+                    let (xi, s) = (side.xi, side.weight);
                     ("floor/column", format!("{xi:.3}"), format!("{s:.3}"))
                 }
             };

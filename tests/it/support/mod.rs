@@ -88,6 +88,15 @@ pub fn without_work(o: &RunOutput) -> RunOutput {
 }
 
 /// Relative difference with a floor.
+/// A TOML array of floats (the OpenSees cross-checks' reference data).
+pub fn floats(v: &toml::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_float().unwrap())
+        .collect()
+}
+
 pub fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / b.abs().max(1e-300)
 }

@@ -567,47 +567,79 @@ impl RowModel {
             let qd = z0[n + k].abs().max(z1[n + k].abs());
             bound[k] = fourth_derivative_bound(&osc, q[k], qd, &s);
         }
-        // Modes coupled by their damping: each bound's terms gain the coupling's, at most
-        // `sum_k |E_ik|` times the largest of the other modes' (as `fourth_derivative_bound`
-        // builds them, from the ends; O(N) where `|E|` times each would be O(N^2)).
         for (bi, b) in self.buildings.iter().enumerate() {
             if b.coupling_sums.is_empty() || skipped(bi) {
                 continue;
             }
             let (o, nb) = (b.off, b.n());
-            let (v, rest) = scratch.split_at_mut(nb);
-            let (a2, rest) = rest.split_at_mut(nb);
-            let a3 = &mut rest[..nb];
-            for (i, v) in v.iter_mut().enumerate() {
-                *v = z0[n + o + i].abs().max(z1[n + o + i].abs());
-            }
-            let largest = |x: &[f64]| x.iter().fold(0.0, |m: f64, y| m.max(*y));
-            let sums = &b.coupling_sums;
-            let coupled = |x: f64, i: usize| -> f64 { sums[i] * x };
-            let vm = largest(v);
-            for i in 0..nb {
-                let k = o + i;
-                a2[i] = self.w2[k] * q[k]
-                    + self.two_xi_w[k] * v[i]
-                    + (self.part[k] * seg.a0)
-                        .abs()
-                        .max((self.part[k] * seg.a1).abs())
-                    + coupled(vm, i);
-            }
-            let a2m = largest(a2);
-            for i in 0..nb {
-                let k = o + i;
-                a3[i] = self.w2[k] * v[i]
-                    + self.two_xi_w[k] * a2[i]
-                    + (self.part[k] * (seg.a1 - seg.a0) / seg.dt).abs()
-                    + coupled(a2m, i);
-            }
-            let a3m = largest(a3);
-            for i in 0..nb {
-                let k = o + i;
-                bound[k] = self.w2[k] * a2[i] + self.two_xi_w[k] * a3[i] + coupled(a3m, i);
-            }
+            let q = &q[o..o + nb];
+            self.coupled_mode_bounds(bi, seg, (z0, z1), q, None, scratch, &mut bound[o..o + nb]);
         }
         out.truncate(n);
+    }
+
+    /// Building `k`'s modes' bounds on `|q''''|` over the free step `z0 -> z1` of `seg` where
+    /// its modes are coupled: by its damping (`coupling_sums`, where it has them) and, on a
+    /// tangent step, by its stiffness (`stiffness`: each row's `sum_k |dS_ik|`). Each term of
+    /// [`fourth_derivative_bound`]'s gains the couplings', at most each sum times the largest
+    /// of the other modes' (from the ends; O(N) where the couplings times each would be
+    /// O(N^2)). `q`: each mode's displacement amplitude about the static response the motion
+    /// is free about; the bounds into `bound` (the building's modes from 0). `scratch` holds
+    /// three of the building's vectors, the last each mode's bound on `|q'''|` on return.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn coupled_mode_bounds(
+        &self,
+        k: usize,
+        seg: &Segment,
+        (z0, z1): (&[f64], &[f64]),
+        q: &[f64],
+        stiffness: Option<&[f64]>,
+        scratch: &mut [f64],
+        bound: &mut [f64],
+    ) {
+        let b = &self.buildings[k];
+        let (n, o, nb) = (self.n, b.off, b.n());
+        let (v, rest) = scratch.split_at_mut(nb);
+        let (a2, rest) = rest.split_at_mut(nb);
+        let a3 = &mut rest[..nb];
+        for (i, v) in v.iter_mut().enumerate() {
+            *v = z0[n + o + i].abs().max(z1[n + o + i].abs());
+        }
+        let largest = |x: &[f64]| x.iter().fold(0.0, |m: f64, y| m.max(*y));
+        // The couplings' terms, each after the mode's own (damping, then stiffness).
+        let coupled = |i: usize, damped: f64, stiff: f64| -> f64 {
+            let mut x = 0.0;
+            if let Some(s) = b.coupling_sums.get(i) {
+                x = s * damped;
+            }
+            match stiffness {
+                Some(s) if b.coupling_sums.is_empty() => s[i] * stiff,
+                Some(s) => x + s[i] * stiff,
+                None => x,
+            }
+        };
+        let (qm, vm) = (largest(q), largest(v));
+        for i in 0..nb {
+            let k = o + i;
+            a2[i] = self.w2[k] * q[i]
+                + self.two_xi_w[k] * v[i]
+                + (self.part[k] * seg.a0)
+                    .abs()
+                    .max((self.part[k] * seg.a1).abs())
+                + coupled(i, vm, qm);
+        }
+        let a2m = largest(a2);
+        for i in 0..nb {
+            let k = o + i;
+            a3[i] = self.w2[k] * v[i]
+                + self.two_xi_w[k] * a2[i]
+                + (self.part[k] * (seg.a1 - seg.a0) / seg.dt).abs()
+                + coupled(i, a2m, vm);
+        }
+        let a3m = largest(a3);
+        for i in 0..nb {
+            let k = o + i;
+            bound[i] = self.w2[k] * a2[i] + self.two_xi_w[k] * a3[i] + coupled(i, a3m, a2m);
+        }
     }
 }

@@ -16,6 +16,7 @@ use super::algebra::dot;
 use super::exact_step::CoupledStep;
 use super::model::RowModel;
 use super::storey::{may_reach, StoreyMode};
+use crate::physics::propagator::solve_dyn;
 use crate::physics::solver::state::Segment;
 
 /// How many sets of pieces' tangent steps a building keeps.
@@ -220,7 +221,10 @@ impl Tangent {
             stiffness[i * nb + i] += m.w2[o + i];
         }
         let scale = m.w2[o..o + nb].iter().fold(0.0, |a: f64, w| a.max(*w));
-        let inverse = invert(&stiffness, nb, 1e-12 * scale)?;
+        let eye = (0..nb * nb)
+            .map(|i| if i.is_multiple_of(nb + 1) { 1.0 } else { 0.0 })
+            .collect();
+        let inverse = solve_dyn(stiffness, eye, nb, 1e-12 * scale)?;
         let sums = coupling
             .iter()
             .map(|row| row.iter().map(|c| c.abs()).sum())
@@ -316,49 +320,33 @@ impl Tangent {
         bounds: &mut [f64],
     ) {
         let b = &m.buildings[self.building];
-        let (n, o, nb) = (m.n, b.off, b.n());
+        let (o, nb) = (b.off, b.n());
         let largest = |x: &[f64]| x.iter().fold(0.0, |a: f64, y| a.max(*y));
         let (q, rest) = self.scratch.split_at_mut(nb);
-        let (v, rest) = rest.split_at_mut(nb);
-        let (a2, a3) = rest.split_at_mut(nb);
-        for i in 0..nb {
+        for (i, q) in q.iter_mut().enumerate() {
             let k = o + i;
-            q[i] = (z[k] - self.offset[k])
+            *q = (z[k] - self.offset[k])
                 .abs()
                 .max((z1[k] - self.offset[k]).abs());
-            v[i] = z[n + k].abs().max(z1[n + k].abs());
         }
-        let damping = |i: usize| b.coupling_sums.get(i).copied().unwrap_or(0.0);
-        let (qm, vm) = (largest(q), largest(v));
-        for i in 0..nb {
-            let k = o + i;
-            a2[i] = m.w2[k] * q[i]
-                + self.sums[i] * qm
-                + m.two_xi_w[k] * v[i]
-                + damping(i) * vm
-                + (m.part[k] * seg.a0).abs().max((m.part[k] * seg.a1).abs());
-        }
-        let a2m = largest(a2);
-        for i in 0..nb {
-            let k = o + i;
-            a3[i] = m.w2[k] * v[i]
-                + self.sums[i] * vm
-                + m.two_xi_w[k] * a2[i]
-                + damping(i) * a2m
-                + (m.part[k] * (seg.a1 - seg.a0) / seg.dt).abs();
-        }
-        let a3m = largest(a3);
-        for i in 0..nb {
-            let k = o + i;
-            bounds[k] =
-                m.w2[k] * a2[i] + self.sums[i] * a2m + m.two_xi_w[k] * a3[i] + damping(i) * a3m;
-        }
+        let bound = &mut bounds[o..o + nb];
+        m.coupled_mode_bounds(
+            self.building,
+            seg,
+            (z, z1),
+            q,
+            Some(&self.sums),
+            rest,
+            bound,
+        );
         // `q''''' = -(W^2 + dS) q''' - C q''''` (the ground is linear over the step).
-        let a4m = largest(&bounds[o..o + nb]);
-        for (i, (fifth, a3)) in self.fifth.iter_mut().zip(a3.iter()).enumerate() {
+        let a3 = &rest[2 * nb..3 * nb];
+        let (a3m, a4m) = (largest(a3), largest(bound));
+        let damping = |i: usize| b.coupling_sums.get(i).copied().unwrap_or(0.0);
+        for (i, (fifth, a3)) in self.fifth.iter_mut().zip(a3).enumerate() {
             let k = o + i;
             *fifth =
-                m.w2[k] * a3 + self.sums[i] * a3m + m.two_xi_w[k] * bounds[k] + damping(i) * a4m;
+                m.w2[k] * a3 + self.sums[i] * a3m + m.two_xi_w[k] * bound[i] + damping(i) * a4m;
         }
     }
 
@@ -434,59 +422,27 @@ impl Tangent {
     }
 }
 
-/// The inverse of the `n x n` row-major `a` by Gauss-Jordan with partial pivoting; None where
-/// a pivot is below `tiny` (singular to rounding).
-fn invert(a: &[f64], n: usize, tiny: f64) -> Option<Vec<f64>> {
-    let mut a = a.to_vec();
-    let mut inv = vec![0.0; n * n];
-    for i in 0..n {
-        inv[i * n + i] = 1.0;
-    }
-    for c in 0..n {
-        let p = (c..n).max_by(|&x, &y| a[x * n + c].abs().total_cmp(&a[y * n + c].abs()))?;
-        if a[p * n + c].abs() <= tiny {
-            return None;
-        }
-        for j in 0..n {
-            a.swap(c * n + j, p * n + j);
-            inv.swap(c * n + j, p * n + j);
-        }
-        let d = a[c * n + c];
-        for j in 0..n {
-            a[c * n + j] /= d;
-            inv[c * n + j] /= d;
-        }
-        for r in 0..n {
-            if r == c {
-                continue;
-            }
-            let f = a[r * n + c];
-            if f == 0.0 {
-                continue;
-            }
-            for j in 0..n {
-                a[r * n + j] -= f * a[c * n + j];
-                inv[r * n + j] -= f * inv[c * n + j];
-            }
-        }
-    }
-    Some(inv)
-}
-
 #[cfg(test)]
 mod tests {
-    use super::invert;
+    use crate::physics::propagator::solve_dyn;
 
+    /// The solve the tangent steps invert their stiffness with: the inverse to rounding, and
+    /// None for a singular matrix.
     #[test]
-    fn invert_gives_the_inverse_and_refuses_a_singular_matrix() {
+    fn the_solve_inverts_and_refuses_a_singular_matrix() {
         let a = [4.0, 1.0, 2.0, 0.5, -3.0, 1.0, 2.0, 1.0, 5.0];
-        let inv = invert(&a, 3, 1e-12).unwrap();
+        let eye = |n: usize| {
+            (0..n * n)
+                .map(|i| if i.is_multiple_of(n + 1) { 1.0 } else { 0.0 })
+                .collect()
+        };
+        let inv = solve_dyn(a.to_vec(), eye(3), 3, 1e-12).unwrap();
         for i in 0..3 {
             for j in 0..3 {
                 let x: f64 = (0..3).map(|k| a[i * 3 + k] * inv[k * 3 + j]).sum();
                 assert!((x - if i == j { 1.0 } else { 0.0 }).abs() < 1e-14);
             }
         }
-        assert!(invert(&[1.0, 2.0, 2.0, 4.0], 2, 1e-12).is_none());
+        assert!(solve_dyn(vec![1.0, 2.0, 2.0, 4.0], eye(2), 2, 1e-12).is_none());
     }
 }
