@@ -19,8 +19,6 @@ use pounding::physics::solver::Scheme;
 use pounding::plan::{PairPlan, RunSpec};
 use std::path::PathBuf;
 
-/// The real-records directory (`POUND_RECORDS_DIR`, default `../shared/records`). Tests that need
-/// it fail, never skip, when it is missing: CI has it beside the clone.
 /// The fast scheme at 64 substeps per contact, the default before the contact substeps got
 /// their order back (issue 34): the setting at which the tight bounds of the model tests (closed
 /// forms, GPU against CPU to rounding) were measured. The default (16) is held to its calibrated
@@ -32,6 +30,8 @@ pub fn precise_fast() -> pounding::physics::solver::FastOptions {
     }
 }
 
+/// The real-records directory (`POUND_RECORDS_DIR`, default `../shared/records`). Tests that need
+/// it fail, never skip, when it is missing: CI has it beside the clone.
 pub fn records_dir() -> PathBuf {
     let d = pounding::plan::config::records_dir();
     assert!(
@@ -39,7 +39,8 @@ pub fn records_dir() -> PathBuf {
         "records directory {} not found (set POUND_RECORDS_DIR)",
         d.display()
     );
-    d
+    // Absolute, so a config written to a temporary folder names its record wherever pound runs.
+    std::fs::canonicalize(&d).unwrap()
 }
 
 pub fn tempdir() -> tempfile::TempDir {
