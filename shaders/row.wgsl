@@ -186,6 +186,11 @@ fn fli(e: u32, q: u32, k: u32) -> u32 {
 // its lanes reaches. The same values, so the same bits. A record interval's start sets them
 // for its exact free step (D0 and R0 alone where a level is in contact).
 var<private> D0: array<real, NLA>;
+// Per level on a struck column (by L_CI) over the tracked piece: its force and rate at both
+// ends, a bound on |F|, and whether the piece begins at the touch or ends at the separation.
+var<private> CLOAD: array<array<real, 4>, NCA>;
+var<private> CBOUND: array<real, NCA>;
+var<private> CTOUCH: array<bool, NCA>;
 var<private> R0: array<real, NLA>;
 var<private> D1: array<real, NLA>;
 var<private> R1: array<real, NLA>;
@@ -582,48 +587,98 @@ fn track(tau0: real, h: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, ag0:
         }
         rstate[lsi(l, LS_IMP_PEAK)] = raise_force_peak(rstate[lsi(l, LS_IMP_PEAK)], f0, r0, f, r1, h);
         if (column) {
-            track_column(l, y0, y1, f0, r0, f, r1, z0, z1, h);
+            let ci = L_CI[l];
+            CLOAD[ci] = array<real, 4>(f0, r0, f, r1);
+            var bound = max(abs(f0), abs(f));
+            if (r1 < 0.0 && r0 > 0.0) {
+                bound = max(bound, hermite_range(f0, r0, f, r1, h).hi);
+            }
+            CBOUND[ci] = bound;
+            CTOUCH[ci] = y0 <= 0.0 || y1 <= 0.0;
+        }
+    }
+    if (HAS_COLUMNS) {
+        for (var l = 0u; l < NL; l++) {
+            if (L_CS[l] < 2u && LMODE[l] != MODE_FREE) {
+                track_column(l, z0, z1, h);
+            }
         }
     }
 }
 
-// row/outputs.rs raise_column_peak: `peak` raised to the largest |V + share F| over a contact
-// piece, the ends and the hump's cubic held within max |V| + |share| max F.
-fn raise_column_peak(peak: real, v0: real, vr0: real, v1: real, vr1: real, f0: real, r0: real, f1: real, r1: real, share: real, touches: bool, h: real) -> real {
-    let y0 = v0 + share * f0;
-    let y1 = v1 + share * f1;
+// row/outputs.rs raise_column_peak: `peak` raised to the largest |V + L| over a contact piece
+// (L the contact forces' shares on a column segment), the ends and the hump's cubic held
+// within max |V| + load_bound.
+fn raise_column_peak(peak: real, v0: real, vr0: real, v1: real, vr1: real, l0: real, lr0: real, l1: real, lr1: real, load_bound: real, touches: bool, h: real) -> real {
+    let y0 = v0 + l0;
+    let y1 = v1 + l1;
     let ends = max(peak, max(abs(y0), abs(y1)));
     if (touches) {
         return ends;
     }
-    let hump = raise_hump_peak(ends, y0, vr0 + share * r0, y1, vr1 + share * r1, h);
+    let hump = raise_hump_peak(ends, y0, vr0 + lr0, y1, vr1 + lr1, h);
     if (hump <= ends) {
         return ends;
     }
-    var f_max = max(abs(f0), abs(f1));
-    if (r1 < 0.0 && r0 > 0.0) {
-        f_max = max(f_max, hermite_range(f0, r0, f1, r1, h).hi);
-    }
-    let bound = raise_cubic_peak(0.0, v0, vr0, v1, vr1, h) + abs(share) * f_max;
+    let bound = raise_cubic_peak(0.0, v0, vr0, v1, vr1, h) + load_bound;
     return max(ends, min(hump, bound));
 }
 
-// RowRun::track's struck column (row/outputs.rs): the largest shear of the struck storey's two
-// column segments over a contact piece, its spring force `V` with the share of the force on
-// the struck building each segment carries to its floor (`V - s F` above the point,
-// `V + (1 - s) F` below), by the hump's cubic, or at the piece's ends alone where it begins at
-// the touch or ends at the separation (the force's rate unbounded there).
-fn track_column(l: u32, y0: real, y1: real, f0: real, r0: real, f1: real, r1: real, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) {
-    let side = L_CS[l];
-    let b = L_A[l] + side;
-    var j = L_FA[l];
-    var w = L_WA[l];
-    var on_struck: real = -1.0;
-    if (side == 1u) {
-        j = L_FB[l];
-        w = L_WB[l];
-        on_struck = 1.0;
+// Level l's struck building and storey (its side's floor above the point, from 0).
+fn struck_storey(l: u32) -> vec2<u32> {
+    if (L_CS[l] == 1u) {
+        return vec2<u32>(L_A[l] + 1u, L_FB[l]);
     }
+    return vec2<u32>(L_A[l], L_FA[l]);
+}
+
+// Level l's weight s on its struck side and the sign of its force on the struck building.
+fn struck_weight(l: u32) -> vec2<real> {
+    if (L_CS[l] == 1u) {
+        return vec2<real>(L_WB[l], 1.0);
+    }
+    return vec2<real>(L_WA[l], -1.0);
+}
+
+// Level m is in contact on the columns of storey `at` (building, storey).
+fn strikes(m: u32, at: vec2<u32>) -> bool {
+    return L_CS[m] < 2u && LMODE[m] != MODE_FREE && all(struck_storey(m) == at);
+}
+
+// `peak` raised by the column segment of storey `at` below the points whose weight is at least
+// `cut_s` (2: the segment above every point): `V + sum_i w_i F_i`, `w_i = 1 - s_i` below point
+// i, `-s_i` above it, each force signed onto the struck building.
+fn column_segment(peak: real, at: vec2<u32>, cut_s: real, v0: real, vr0: real, v1: real, vr1: real, touches: bool, h: real) -> real {
+    var load = array<real, 4>(0.0, 0.0, 0.0, 0.0);
+    var bound: real = 0.0;
+    for (var m = 0u; m < NL; m++) {
+        if (!strikes(m, at)) {
+            continue;
+        }
+        let sw = struck_weight(m);
+        var share = -sw.x;
+        if (sw.x >= cut_s) {
+            share = 1.0 - sw.x;
+        }
+        share = sw.y * share;
+        let f = CLOAD[L_CI[m]];
+        for (var i = 0u; i < 4u; i++) {
+            load[i] += share * f[i];
+        }
+        bound += abs(share) * CBOUND[L_CI[m]];
+    }
+    return raise_column_peak(peak, v0, vr0, v1, vr1, load[0], load[1], load[2], load[3], bound, touches, h);
+}
+
+// RowRun::track_columns (row/outputs.rs): the largest shear of the struck storey's column
+// segments over a contact piece, its spring force `V` with the shares of every contact force
+// on that storey's columns at once (above every point `V - sum s_i F_i`, below point k `F_i`
+// more for each point at or above it), by the hump's cubic, or at the piece's ends alone where
+// one of them begins at the touch or ends at the separation (the force's rate unbounded there).
+fn track_column(l: u32, z0: ptr<function, ZA>, z1: ptr<function, ZA>, h: real) {
+    let at = struck_storey(l);
+    let b = at.x;
+    let j = at.y;
     let k = rp(P_COLUMNS + L_CI[l]);
     let o = B_OFF[b];
     var drift: array<real, 2>;
@@ -652,14 +707,18 @@ fn track_column(l: u32, y0: real, y1: real, f0: real, r0: real, f1: real, r1: re
         spring_rate[0] = k * (rate[0] - pv[0]);
         spring_rate[1] = k * (rate[1] - pv[1]);
     }
-    let touches = y0 <= 0.0 || y1 <= 0.0;
-    var peak = rstate[lsi(l, LS_COLUMN_SHEAR)];
-    for (var x = 0u; x < 2u; x++) {
-        var share = -w;
-        if (x == 1u) {
-            share = 1.0 - w;
+    var touches = false;
+    for (var m = 0u; m < NL; m++) {
+        if (strikes(m, at)) {
+            touches = touches || CTOUCH[L_CI[m]];
         }
-        peak = raise_column_peak(peak, spring[0], spring_rate[0], spring[1], spring_rate[1], f0, r0, f1, r1, on_struck * share, touches, h);
+    }
+    // The segment above every point, then the one below each point.
+    var peak = column_segment(rstate[lsi(l, LS_COLUMN_SHEAR)], at, 2.0, spring[0], spring_rate[0], spring[1], spring_rate[1], touches, h);
+    for (var cut = 0u; cut < NL; cut++) {
+        if (strikes(cut, at)) {
+            peak = column_segment(peak, at, struck_weight(cut).x, spring[0], spring_rate[0], spring[1], spring_rate[1], touches, h);
+        }
     }
     rstate[lsi(l, LS_COLUMN_SHEAR)] = peak;
 }

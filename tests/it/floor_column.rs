@@ -16,12 +16,30 @@ use pounding::physics::contact::LawKind;
 use pounding::physics::model::Status;
 use pounding::physics::row::{LevelRule, Row, RowOutput};
 use pounding::physics::shear::{Damping, ShearBuilding};
-use pounding::physics::solver::row::{simulate_row, RowModel, RowScheme};
+use pounding::physics::solver::row::{
+    simulate_row, simulate_row_observed, RowModel, RowSample, RowScheme,
+};
+use pounding::physics::solver::Mode;
 use pounding::physics::solver::{FastOptions, ReferenceOptions};
 
 /// `n` storeys of `h` m, floor masses `m` kg.
 fn frame(n: usize, h: f64, m: f64, period: f64, damping: Damping) -> ShearBuilding {
     ShearBuilding::from_period(vec![m; n], &vec![1.0; n], vec![h; n], period, damping)
+}
+
+/// 4 storeys of 3 m (floors at 3, 6, 9, 12 m) beside a building whose first storey is 13 m
+/// tall: four floors strike one storey's columns, often together.
+fn four_on_one() -> Vec<ShearBuilding> {
+    vec![
+        frame(4, 3.0, 2e5, 0.5, Damping::Modal(0.05)),
+        ShearBuilding::from_period(
+            vec![3e5; 2],
+            &[1.0; 2],
+            vec![13.0, 3.0],
+            0.7,
+            Damping::Modal(0.05),
+        ),
+    ]
 }
 
 /// 3 storeys of 3.5 m (floors at 3.5, 7, 10.5 m) and 4 of 3 m at period `t1`: no floor of one
@@ -116,6 +134,12 @@ fn scenes() -> Vec<(&'static str, Row, Vec<f64>, bool)> {
                 LawKind::NonlinearViscoelastic,
             ),
             record(11, 8.0, 0.5),
+            true,
+        ),
+        (
+            "4 storeys of 3 m beside a first storey of 13 m (four floors on one storey's columns)",
+            row(four_on_one(), 0.005, LawKind::KelvinVoigtNoTension),
+            record(13, 8.0, 0.5),
             true,
         ),
         (
@@ -232,6 +256,75 @@ fn the_energy_balance_closes_with_floor_column_contact() {
         assert!(o.impacts > 0, "{name}");
         assert!(e.residual.abs() < 1e-6, "{name}: residual {}", e.residual);
     }
+}
+
+/// Four floors striking one 13 m storey's columns: each level's column shear is the storey's
+/// spring force with the shares of every force on those columns at that instant, on the worst
+/// segment between the points (above them all `V - sum s_i F_i`, below point k `F_i` more for
+/// each point at or above it), as the reference's every accepted step gives it (`s` from the
+/// floors' heights); and it is larger than any one level's force alone gives (the scene tests
+/// the sum).
+#[test]
+fn a_storeys_column_shear_sums_every_floor_striking_it() {
+    let r = row(four_on_one(), 0.005, LawKind::KelvinVoigtNoTension);
+    let k = r.buildings[1].stiffness[0];
+    let m = RowModel::new(&r);
+    let accel = record(13, 8.0, 0.5);
+    let f = forcing(&accel);
+    let s_of = |z: f64| {
+        let xi = z / 13.0;
+        3.0 * xi * xi - 2.0 * xi * xi * xi
+    };
+    let points: Vec<(usize, f64)> = (r.levels.iter().enumerate())
+        .filter(|(_, l)| l.floor_column())
+        .map(|(i, l)| (i, s_of(l.elevation)))
+        .collect();
+    assert_eq!(points.len(), 4, "{:?}", r.levels);
+    let (mut together, mut alone) = (vec![0.0f64; r.levels.len()], vec![0.0f64; r.levels.len()]);
+    let mut observer = |x: &RowSample| {
+        let v = k * x.floors[1][0];
+        // The left building's floors push the struck building to the right.
+        let on = |i: usize| x.modes[i] != Mode::Free;
+        let load = |below: &dyn Fn(f64) -> bool| -> f64 {
+            (points.iter().filter(|&&(i, _)| on(i)))
+                .map(|&(i, s)| x.forces[i] * if below(s) { 1.0 - s } else { -s })
+                .sum()
+        };
+        let mut worst = (v + load(&|_| false)).abs();
+        for &(_, at) in &points {
+            worst = worst.max((v + load(&|s| s >= at)).abs());
+        }
+        for &(i, s) in &points {
+            if on(i) {
+                together[i] = together[i].max(worst);
+                let own = (v - s * x.forces[i])
+                    .abs()
+                    .max((v + (1.0 - s) * x.forces[i]).abs());
+                alone[i] = alone[i].max(own);
+            }
+        }
+    };
+    let o = simulate_row_observed(&m, &f, m.at_rest(), &reference(), &mut observer);
+    assert_eq!(o.status, Status::Ok);
+    for &(i, _) in &points {
+        let got = o.levels[i].column_shear;
+        eprintln!(
+            "level {i}: {got:.6e} N; sampled {:.6e} ({:.1e} above), alone {:.6e}",
+            together[i],
+            got / together[i] - 1.0,
+            alone[i]
+        );
+        assert!(together[i] > 0.0, "level {i} strikes");
+        assert!(
+            got >= together[i] * (1.0 - 1e-9) && got <= together[i] * (1.0 + 1e-6),
+            "level {i}: {got} against {} sampled",
+            together[i]
+        );
+    }
+    assert!(
+        points.iter().any(|&(i, _)| together[i] > 1.05 * alone[i]),
+        "the floors strike together: {together:?} against {alone:?}"
+    );
 }
 
 /// As the right building's storey height passes through the left's floor height (3 m), the

@@ -704,8 +704,9 @@ fn row_kernel_yields_as_the_cpu_twin() {
 /// Floors that strike columns (issue 50) on the device: a 3-storey of 3.5 m storeys beside a
 /// 4-storey of 3 m storeys (every level floor against column; written out), elastic and
 /// yielding, at two gaps, a 9-storey of 3.2 m storeys beside it (the loops), and floors 1.5 cm
-/// apart (points sharing the contact's stiffness, which each level reads): f64 gives the
-/// CPU twin's impacts, substeps and peaks (the struck columns' shear among them).
+/// apart (points sharing the contact's stiffness, which each level reads), and four floors on
+/// one 13 m storey's columns (their shear summing the four forces): f64 gives the CPU twin's
+/// impacts, substeps and peaks (the struck columns' shear among them).
 #[test]
 fn floors_that_strike_columns_on_the_gpu_are_the_cpu_twin() {
     if ctx().is_none() {
@@ -745,6 +746,17 @@ fn floors_that_strike_columns_on_the_gpu_are_the_cpu_twin() {
         (frame(9, 3.2, 0.9), frame(4, 3.0, 0.55)),
         // Floors 1.5 cm apart: two points, each with a share of the contact's stiffness.
         (frame(3, 3.0, 0.45), frame(3, 3.015, 0.35)),
+        // Four floors on one 13 m storey's columns: its shear sums their forces.
+        (
+            frame(4, 3.0, 0.5),
+            ShearBuilding::from_period(
+                vec![2.5e5; 2],
+                &[1.0; 2],
+                vec![13.0, 3.0],
+                0.7,
+                Damping::Modal(0.05),
+            ),
+        ),
     ] {
         let models: Vec<RowModel> = [0.0, 0.004]
             .iter()

@@ -305,7 +305,7 @@ const PER_LEVEL: [(&str, &str, &str, &str); 6] = [
         "column_shear_n",
         "N",
         "column shear, {level}",
-        "largest shear in the struck storey's columns while in contact at {level}: the storey's spring force with the share of the contact force each column segment carries, max(|V - s F|, |V + (1 - s) F|), s = 3 xi^2 - 2 xi^3 at the height xi up the storey; with the struck building's struck_column_share alpha, the struck columns' own: alpha V in place of V (0 if never in contact)",
+        "largest shear in the struck storey's columns while in contact at {level}: the storey's spring force V with the shares of every contact force on that storey's columns at that instant (floors of both neighbours, this level's among them) on the worst segment between the points: above them all V - sum s_i F_i, below a point F_i more for each point at or above it (one point: max(|V - s F|, |V + (1 - s) F|)), s = 3 xi^2 - 2 xi^3 at the height xi up the storey; with the struck building's struck_column_share alpha, the struck columns' own: alpha V in place of V (0 if never in contact)",
     ),
     (
         "column_shear_ratio",

@@ -37,6 +37,7 @@ impl RowShape {
         c("NM", self.modes());
         c("NL", nl);
         c("NLA", nla);
+        c("NCA", self.columns.len().max(1));
         c("NS", ns);
         c("NSA", ns.max(1));
         c("PS0", self.plastic_slot0());

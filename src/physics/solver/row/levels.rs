@@ -185,6 +185,10 @@ pub(crate) struct LevelState {
     pub v0: f64,
     pub t_onset: f64,
     pub(super) imp_peak: f64,
+    /// On a struck column, the contact force and its rate at the tracked piece's two ends
+    /// (`[F0, F0', F1, F1']`), a bound on `|F|` over it, and whether the piece begins at the
+    /// touch or ends at the separation: the storey's column shear sums every level's.
+    pub(super) column_load: ([f64; 4], f64, bool),
     pub out: LevelOutput,
 }
 

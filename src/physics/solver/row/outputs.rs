@@ -236,46 +236,82 @@ impl<'m> RowRun<'m> {
             };
             // The start's force and rate, where a struck column needs them too.
             let mut known = None;
-            if let Some(c) = &lm.column {
-                // The struck storey's two column segments: the storey's spring force `V` and
-                // the share of the force on the struck building each carries to its floor.
+            if lm.column.is_some() {
                 let (f0, r0) = start();
                 known = Some((f0, r0));
-                let on_struck = if c.side == 0 { -1.0 } else { 1.0 };
-                let fl = &self.floors[c.building];
-                let j = c.storey;
-                let drift = |x: &[f64]| x[j] - if j > 0 { x[j - 1] } else { 0.0 };
-                let spring = |e: usize, z: &[f64]| -> (f64, f64) {
-                    let (d, dv) = (drift(&fl[e].u), drift(&fl[e].v));
-                    match c.yielding {
-                        Some(s) => {
-                            let sm = &m.storeys[s];
-                            let p = z[m.plastic_slot(s)];
-                            let pv = match self.storey_modes[s] {
-                                StoreyMode::Elastic => 0.0,
-                                mode => sm.flow(mode) * dv,
-                            };
-                            (c.k * (d - p), c.k * (dv - pv))
-                        }
-                        None => (c.k * d, c.k * dv),
-                    }
-                };
-                let ((v0, vr0), (v1, vr1)) = (spring(0, z0), spring(1, z1));
-                let mut peak = ls.out.column_shear;
-                for share in [-c.weight, 1.0 - c.weight] {
-                    let share = on_struck * share;
-                    peak = raise_column_peak(
-                        peak,
-                        [v0, vr0, v1, vr1],
-                        [f0, r0, f, r1],
-                        share,
-                        y0 <= 0.0 || y1 <= 0.0,
-                        h,
-                    );
+                let mut bound = f0.abs().max(f.abs());
+                if r1 < 0.0 && r0 > 0.0 {
+                    bound = bound.max(hermite_range(f0, r0, f, r1, h).1);
                 }
-                ls.out.column_shear = peak;
+                ls.column_load = ([f0, r0, f, r1], bound, y0 <= 0.0 || y1 <= 0.0);
             }
             ls.imp_peak = raise_force_peak(ls.imp_peak, f, r1, h, || known.unwrap_or_else(start));
+        }
+        if m.levels.iter().any(|lm| lm.column.is_some()) {
+            self.track_columns(z0, z1, h);
+        }
+    }
+
+    /// The struck columns' shear over a contact piece (physics.md section 11): for each level
+    /// in contact on a column, its storey's spring force `V` with the shares of every contact
+    /// force on that storey's columns at once (floors of both neighbours at several heights),
+    /// on each column segment between the points: above all of them `V - sum s_i F_i`, and
+    /// below point `k` `F_i` more for each point at or above it.
+    fn track_columns(&mut self, z0: &[f64], z1: &[f64], h: f64) {
+        let m = self.m;
+        for (l, lm) in m.levels.iter().enumerate() {
+            let Some(c) = &lm.column else { continue };
+            if self.levels[l].mode == Mode::Free {
+                continue;
+            }
+            let fl = &self.floors[c.building];
+            let j = c.storey;
+            let drift = |x: &[f64]| x[j] - if j > 0 { x[j - 1] } else { 0.0 };
+            let spring = |e: usize, z: &[f64]| -> (f64, f64) {
+                let (d, dv) = (drift(&fl[e].u), drift(&fl[e].v));
+                match c.yielding {
+                    Some(s) => {
+                        let sm = &m.storeys[s];
+                        let p = z[m.plastic_slot(s)];
+                        let pv = match self.storey_modes[s] {
+                            StoreyMode::Elastic => 0.0,
+                            mode => sm.flow(mode) * dv,
+                        };
+                        (c.k * (d - p), c.k * (dv - pv))
+                    }
+                    None => (c.k * d, c.k * dv),
+                }
+            };
+            let ((v0, vr0), (v1, vr1)) = (spring(0, z0), spring(1, z1));
+            // The levels in contact on the same storey's columns, this one among them: each
+            // force on the struck building with its share `s` on the floor above.
+            let together = || {
+                (m.levels.iter().zip(&self.levels)).filter_map(|(lk, sk)| {
+                    let ck = lk.column.as_ref()?;
+                    let same = ck.building == c.building && ck.storey == j;
+                    (same && sk.mode != Mode::Free).then(|| {
+                        let on_struck = if ck.side == 0 { -1.0 } else { 1.0 };
+                        (ck.weight, on_struck, sk.column_load)
+                    })
+                })
+            };
+            let touches = together().any(|(_, _, (_, _, t))| t);
+            // The segment above every point, then the one below each point.
+            let mut peak = self.levels[l].out.column_shear;
+            let cuts = std::iter::once(None).chain(together().map(|(s, _, _)| Some(s)));
+            for cut in cuts {
+                let (mut load, mut bound) = ([0.0; 4], 0.0);
+                for (s, on_struck, (force, f_bound, _)) in together() {
+                    let below = cut.is_some_and(|at| s >= at);
+                    let share = on_struck * (if below { 1.0 - s } else { -s });
+                    for (x, f) in load.iter_mut().zip(force) {
+                        *x += share * f;
+                    }
+                    bound += share.abs() * f_bound;
+                }
+                peak = raise_column_peak(peak, [v0, vr0, v1, vr1], load, bound, touches, h);
+            }
+            self.levels[l].out.column_shear = peak;
         }
     }
 
@@ -454,38 +490,34 @@ impl<'m> RowRun<'m> {
     }
 }
 
-/// `peak` raised to the largest `|V + share F|` over a contact piece of length `h`: a struck
-/// column segment's shear, from the storey's spring force `V` and the contact force `F` (with
-/// their rates) at both ends, `spring = [V0, V0', V1, V1']`, `force = [F0, F0', F1, F1']`.
-/// The ends, and where `|V + share F|` humps inside, the cubic Hermite's largest value, held
-/// within `max |V| + |share| max F` (the cubic of `V`, the force's own peak as
-/// `tracker::raise_force_peak` takes it): the force's rate grows without bound as the
-/// penetration nears 0 (the nonlinear viscoelastic law's `delta^(1/4)` damping), where the
-/// cubic would overshoot. A piece that begins at the touch or ends at the separation
-/// (`touches`) takes its ends alone.
+/// `peak` raised to the largest `|V + L|` over a contact piece of length `h`: a struck column
+/// segment's shear, from the storey's spring force `V` and the contact forces' shares on the
+/// segment `L = sum_i w_i F_i` (with their rates) at both ends, `spring = [V0, V0', V1, V1']`,
+/// `load = [L0, L0', L1, L1']`. The ends, and where `|V + L|` humps inside, the cubic
+/// Hermite's largest value, held within `max |V| + load_bound` (the cubic of `V`; `load_bound =
+/// sum_i |w_i| max F_i`, each force's own peak as `tracker::raise_force_peak` takes it): the
+/// force's rate grows without bound as the penetration nears 0 (the nonlinear viscoelastic
+/// law's `delta^(1/4)` damping), where the cubic would overshoot. A piece that begins at a
+/// touch or ends at a separation (`touches`) takes its ends alone.
 pub(super) fn raise_column_peak(
     peak: f64,
     spring: [f64; 4],
-    force: [f64; 4],
-    share: f64,
+    load: [f64; 4],
+    load_bound: f64,
     touches: bool,
     h: f64,
 ) -> f64 {
     let [v0, vr0, v1, vr1] = spring;
-    let [f0, r0, f1, r1] = force;
-    let (y0, y1) = (v0 + share * f0, v1 + share * f1);
+    let [l0, lr0, l1, lr1] = load;
+    let (y0, y1) = (v0 + l0, v1 + l1);
     let ends = peak.max(y0.abs()).max(y1.abs());
     if touches {
         return ends;
     }
-    let hump = raise_hump_peak(ends, y0, vr0 + share * r0, y1, vr1 + share * r1, h);
+    let hump = raise_hump_peak(ends, y0, vr0 + lr0, y1, vr1 + lr1, h);
     if hump <= ends {
         return ends;
     }
-    let mut f_max = f0.abs().max(f1.abs());
-    if r1 < 0.0 && r0 > 0.0 {
-        f_max = f_max.max(hermite_range(f0, r0, f1, r1, h).1);
-    }
-    let bound = raise_cubic_peak(0.0, v0, vr0, v1, vr1, h) + share.abs() * f_max;
+    let bound = raise_cubic_peak(0.0, v0, vr0, v1, vr1, h) + load_bound;
     ends.max(hump.min(bound))
 }
