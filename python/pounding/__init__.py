@@ -547,7 +547,9 @@ def fragility(
     beta) and, with ``bootstrap`` replicates over ``by`` (records), 90 % bands.
 
     ``table``: a table from :func:`sweep` (or any Arrow table or DataFrame) or a results CSV's
-    path. ``info["report"]`` holds the command's report (the fits as a Markdown table).
+    path. ``info["fits"]`` holds the fitted curves as a table (``pound fragility --fits``: per
+    threshold or state the median, beta, their standard errors, log-likelihood, deviance, p,
+    runs, levels, and with ``bootstrap`` the 90 % bands); ``info["report"]`` the command's report.
     """
     args = (
         _text("im", im),
@@ -560,9 +562,11 @@ def fragility(
         _where(where),
     )
     source, kind = _study_input(table)
-    inner, report, notices = _engine.fragility(source, kind, *args)
+    inner, tables, report, notices = _engine.fragility(source, kind, *args)
     _say(notices)
-    return Table(inner, {"report": report, "notices": notices})
+    info = {"report": report, "notices": notices}
+    info.update((name, Table(t)) for name, t in tables)
+    return Table(inner, info)
 
 
 def ida(
@@ -576,12 +580,15 @@ def ida(
     """Incremental dynamic analysis from a sweep's results, as ``pound ida``: per record (or
     the columns ``by`` names) the demand ``edp`` against the intensity ``im``, and the 16, 50
     and 84 % fractiles across the curves at each intensity level (a collapse is an infinite
-    demand). ``info["report"]`` holds the command's report."""
+    demand). ``info["long"]`` holds the curves in long form (``pound ida --long``: curve,
+    intensity, demand, collapsed); ``info["report"]`` the command's report."""
     args = (_text("im", im), _text("edp", edp, optional=False), _names(by, "by") or [])
     source, kind = _study_input(table)
-    inner, report, notices = _engine.ida(source, kind, *args, _where(where))
+    inner, tables, report, notices = _engine.ida(source, kind, *args, _where(where))
     _say(notices)
-    return Table(inner, {"report": report, "notices": notices})
+    info = {"report": report, "notices": notices}
+    info.update((name, Table(t)) for name, t in tables)
+    return Table(inner, info)
 
 
 def record(

@@ -685,8 +685,9 @@ fn study_input(table: &Bound<'_, PyAny>, kind: &str) -> PyResult<pounding::io::t
     }
 }
 
-/// A study's report: its table, what the command prints on standard output, and its notices.
-type Studied = (Table, String, Vec<String>);
+/// A study's report: its table, its other tables by name (a fragility's `fits`, an IDA's
+/// `long`), what the command prints on standard output, and its notices.
+type Studied = (Table, Vec<(String, Table)>, String, Vec<String>);
 
 /// A study of a table of results, as its command runs it: its settings `check`ed before the
 /// table is read, then the `study` (the GIL released), its refusals `refused` as exceptions.
@@ -705,7 +706,14 @@ fn run_study<E: Send + 'static>(
     let t = py
         .detach(|| study_table(&r.csv, &[]))
         .map_err(PoundingError::new_err)?;
-    Ok((t, r.said, r.notices))
+    let mut tables = Vec::new();
+    for (name, csv) in &r.tables {
+        let table = py
+            .detach(|| study_table(csv, &[]))
+            .map_err(PoundingError::new_err)?;
+        tables.push((name.to_string(), table));
+    }
+    Ok((t, tables, r.said, r.notices))
 }
 
 /// `pounding.fragility`: `pound fragility` on a table of results.

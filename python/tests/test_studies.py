@@ -98,23 +98,45 @@ def test_columns_are_the_command_lines_list(pound):
 )
 def test_fragility_is_the_command_lines_on_the_sweeps_table(flags, kwargs, pound, tmp_path):
     runs_csv, out = tmp_path / "runs.csv", tmp_path / "fragility.csv"
+    fits = tmp_path / "fits.csv"
     pound("sweep", CONFIGS / "inelastic-fragility.toml", "-o", runs_csv, "--backend", "cpu")
-    shown = pound("fragility", runs_csv, *flags, "-o", out)
+    shown = pound("fragility", runs_csv, *flags, "-o", out, "--fits", fits)
     runs = pounding.sweep(CONFIGS / "inelastic-fragility.toml", backend="cpu", progress=False)
     # From the sweep's table, from a pandas DataFrame, and from the CSV's path: the same study.
     for given in (runs, runs.to_pandas(), runs.to_polars(), runs_csv):
         curves = pounding.fragility(given, **kwargs)
         assert_same_cells(curves, out)
+        assert_same_cells(curves.info["fits"], fits)
         assert curves.info["report"] == shown.stdout
+    # The fits table is the report's, unrounded: each fitted row's median and beta round to the
+    # report's cells.
+    table = pa.table(curves.info["fits"]).to_pylist()
+    fitted = [r for r in table if r["fit"].startswith("ok")]
+    assert fitted, table
+    for r in fitted:
+        assert f"| {r['median']:.4f} | {r['beta']:.4f} | {r['se_ln_median']:.4f} |" in shown.stdout
+    if kwargs.get("bootstrap"):
+        assert all(r["median_p5"] <= r["median"] <= r["median_p95"] for r in fitted)
 
 
 def test_ida_is_the_command_lines(pound, tmp_path):
     runs_csv, out = tmp_path / "runs.csv", tmp_path / "ida.csv"
     pound("sweep", CONFIGS / "collapse-ida.toml", "-o", runs_csv, "--backend", "cpu")
-    shown = pound("ida", runs_csv, "--edp", "b1_peak_drift_ratio", "-o", out)
+    long = tmp_path / "long.csv"
+    shown = pound("ida", runs_csv, "--edp", "b1_peak_drift_ratio", "-o", out, "--long", long)
     runs = pounding.sweep(CONFIGS / "collapse-ida.toml", backend="cpu", progress=False)
     curves = pounding.ida(runs, edp="b1_peak_drift_ratio")
     assert_same_cells(curves, out)
+    assert_same_cells(curves.info["long"], long)
+    # The long form holds the wide table's every value: a row per curve and level.
+    wide = pa.table(curves).to_pylist()
+    im = curves.column_names[0]
+    rows = pa.table(curves.info["long"]).to_pylist()
+    assert len(rows) == sum(1 for w in wide for c in curves.column_names[7:] if w[c] is not None)
+    for r in rows:
+        (w,) = [w for w in wide if w[im] == r[im]]
+        assert w[r["record"]] == r["b1_peak_drift_ratio"]
+        assert r["collapsed"] == (r["b1_peak_drift_ratio"] == float("inf"))
     assert curves.info["report"] == shown.stdout
     # A collapsed curve's demand is infinite: a real column holding inf, as the CSV's `inf`.
     demands = pa.table(curves).select(curves.column_names[7:]).to_pylist()

@@ -58,6 +58,11 @@ pub struct Args {
     /// (default: fragility.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// The fitted curves as a table (CSV): per threshold or damage state, the median, beta,
+    /// their standard errors, log-likelihood, deviance, p, runs and levels, and with
+    /// --bootstrap the 90 % bands of median and beta (the report's table, as data).
+    #[arg(long, value_name = "FILE")]
+    fits: Option<PathBuf>,
     /// Observed fractions and fitted curves (.svg or .png).
     #[arg(long)]
     plot: Option<PathBuf>,
@@ -90,6 +95,7 @@ pub fn run(a: Args) -> Result<()> {
         &other,
         &[
             ("-o", Some(&output), Holds::Csv),
+            ("--fits", a.fits.as_deref(), Holds::Csv),
             ("--plot", a.plot.as_deref(), Holds::Plot),
         ],
     )?;
@@ -115,5 +121,6 @@ pub fn run(a: Args) -> Result<()> {
     };
     report.tell(super::say_text, |n| note!("{n}"))?;
     let plot = a.plot.as_deref().map(|p| (p, report.panels, 1));
-    super::write_and_plot(&output, report.csv.as_bytes(), plot, &a.figure)
+    super::write_and_plot(&output, report.csv.as_bytes(), plot, &a.figure)?;
+    super::write_tables(&report.tables, &[("fits", a.fits.as_deref())])
 }

@@ -33,6 +33,10 @@ pub struct Args {
     /// (default: ida.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// The curves in long form (CSV): a row per curve and level, its --by cells, the
+    /// intensity, the demand (`inf` from its first collapse) and whether it has collapsed (1/0).
+    #[arg(long, value_name = "FILE")]
+    long: Option<PathBuf>,
     /// The curves and the fractiles (.svg or .png), with a second panel of the share of curves
     /// collapsed per level where any collapsed.
     #[arg(long)]
@@ -48,6 +52,7 @@ pub fn run(a: Args) -> Result<()> {
         &[],
         &[
             ("-o", Some(&output), Holds::Csv),
+            ("--long", a.long.as_deref(), Holds::Csv),
             ("--plot", a.plot.as_deref(), Holds::Plot),
         ],
     )?;
@@ -66,5 +71,6 @@ pub fn run(a: Args) -> Result<()> {
         let cols = report.panels.len();
         (p, report.panels, cols)
     });
-    super::write_and_plot(&output, report.csv.as_bytes(), plot, &a.figure)
+    super::write_and_plot(&output, report.csv.as_bytes(), plot, &a.figure)?;
+    super::write_tables(&report.tables, &[("long", a.long.as_deref())])
 }

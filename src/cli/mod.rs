@@ -288,6 +288,17 @@ pub fn write_and_plot(
     Ok(())
 }
 
+/// Write each of a study's other `tables` that `paths` asks for (by name; None: not asked).
+pub fn write_tables(tables: &[(&str, String)], paths: &[(&str, Option<&Path>)]) -> Result<()> {
+    for (name, path) in paths {
+        let Some(path) = path else { continue };
+        let (_, csv) = (tables.iter().find(|(n, _)| n == name))
+            .with_context(|| format!("the study gave no {name} table"))?;
+        write_file(path, csv.as_bytes())?;
+    }
+    Ok(())
+}
+
 /// Save a plot, saying where.
 pub fn save_plot(
     path: &Path,

@@ -346,6 +346,38 @@ impl Ida {
         s
     }
 
+    /// The curves in long form, a row per curve and level where it has a value: the curve (its
+    /// `--by` cells joined by `/`, under their names so joined; `curve` where that would name a
+    /// column twice), the intensity, the demand (`inf` from its first collapse) and whether it
+    /// has collapsed there (1 or 0).
+    pub fn long_csv(&self, spec: &IdaSpec) -> String {
+        let quote = |s: &str| {
+            if s.contains([',', '"', '\n', '\r']) {
+                format!("\"{}\"", s.replace('"', "\"\""))
+            } else {
+                s.to_string()
+            }
+        };
+        let mut head = vec![spec.by.join("/"), spec.im.clone(), spec.edp.clone()];
+        head.push("collapsed".into());
+        if crate::io::table::duplicate_column(&head).is_some() {
+            head[0] = "curve".into();
+        }
+        let mut s = (head.iter().map(|h| quote(h)))
+            .collect::<Vec<_>>()
+            .join(",");
+        s.push('\n');
+        for (name, values) in &self.curves {
+            for (im, v) in self.ims.iter().zip(values) {
+                if let Some(x) = v {
+                    let collapsed = u8::from(x.is_infinite());
+                    s.push_str(&format!("{},{im},{x},{collapsed}\n", quote(name)));
+                }
+            }
+        }
+        s
+    }
+
     /// A line through `(demand, intensity)` per level (None: no point there) up to its first
     /// infinite demand, and its flatline there: from the last finite point it rises at that
     /// demand to the intensity of the collapse, and runs along it to `right` (from `left` where
@@ -771,6 +803,7 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
     panels.extend(ida.collapse_panel(&spec));
     Ok(StudyReport {
         csv: ida.csv(&spec),
+        tables: vec![("long", ida.long_csv(&spec))],
         said: t.said,
         notices: t.notices,
         notices_at: t.notices_at,

@@ -9,6 +9,9 @@ use crate::studies::plot::Panel;
 pub struct StudyReport {
     /// The study's table: the bytes of the CSV (`-o`).
     pub csv: String,
+    /// Its other tables, each by name and as CSV: a fragility's `fits` (`--fits`), an IDA's
+    /// `long` form (`--long`).
+    pub tables: Vec<(&'static str, String)>,
     /// The summary and its tables, with their line ends (standard output).
     pub said: String,
     /// Notices, a line each with no line end (standard error).

@@ -515,3 +515,76 @@ fn fragility_command_counts_and_fits() {
     assert!(svg.contains("P(impacts &gt; threshold)") || svg.contains("P(impacts > threshold)"));
     assert!(svg.contains("&gt; 0: observed") || svg.contains("> 0: observed"));
 }
+
+/// `--fits` writes the report's fitted curves as data: each row's median, beta and standard
+/// errors are the maximum-likelihood fit of the counts `-o` writes (refitted here from them,
+/// equal to the last bit), the runs and levels are those counts', a curve that cannot be fitted
+/// says why with empty cells, and the report's rounded cells are these values.
+#[test]
+fn the_fits_table_is_the_fit_of_the_counts() {
+    let d = tempdir();
+    let runs = drifts(
+        d.path(),
+        &counts(&[(0.1, 0, 2), (0.2, 1, 6), (0.4, 5, 9), (0.8, 12, 6)]),
+    );
+    let (csv, fits) = (d.path().join("f.csv"), d.path().join("fits.csv"));
+    let out = ok(&pound(&[
+        "fragility",
+        &s(&runs),
+        "--edp",
+        "b1_peak_drift_ratio",
+        "--threshold",
+        "0.005,0.01,0.05",
+        "-o",
+        &s(&csv),
+        "--fits",
+        &s(&fits),
+    ]));
+    let counted = table(&csv);
+    let rows = table(&fits);
+    assert_eq!(rows.len(), 3);
+    let num = |r: &std::collections::HashMap<String, String>, c: &str| -> f64 {
+        r[c].parse().unwrap_or_else(|_| panic!("{c}: {:?}", r[c]))
+    };
+    let mut fitted_rows = 0;
+    for r in &rows {
+        assert_eq!(
+            (r["edp"].as_str(), r["im"].as_str()),
+            ("b1_peak_drift_ratio", "pga_g")
+        );
+        let levels: Vec<Level> = (counted.iter())
+            .filter(|c| c["threshold"] == r["threshold"])
+            .map(|c| Level {
+                im: num(c, "pga_g"),
+                n: num(c, "runs") as u64,
+                exceed: num(c, "exceed") as u64,
+            })
+            .collect();
+        assert_eq!(levels.len(), 4);
+        assert_eq!(num(r, "runs"), 80.0);
+        assert_eq!(num(r, "levels"), 4.0);
+        match fit(&levels) {
+            Ok(f) => {
+                fitted_rows += 1;
+                assert_eq!(r["fit"], "ok");
+                assert_eq!(num(r, "median"), f.median);
+                assert_eq!(num(r, "beta"), f.beta);
+                assert_eq!(num(r, "se_ln_median"), f.se_ln_median);
+                assert_eq!(num(r, "se_beta"), f.se_beta);
+                assert_eq!(num(r, "deviance"), f.deviance);
+                assert_eq!(num(r, "p_fit"), f.p_fit.unwrap());
+                let cells = format!(
+                    "| {:.4} | {:.4} | {:.4} |",
+                    f.median, f.beta, f.se_ln_median
+                );
+                assert!(out.contains(&cells), "{cells} in {out}");
+            }
+            Err(e) => {
+                assert_eq!(r["fit"], format!("no fit: {e}"));
+                assert!(r["median"].is_empty() && r["beta"].is_empty());
+            }
+        }
+    }
+    // 0.005 and 0.01 are fitted; none exceeds 0.05.
+    assert_eq!(fitted_rows, 2, "{rows:?}");
+}

@@ -22,7 +22,7 @@ pub use crate::studies::stats::{
 };
 pub use demand::*;
 pub use grouping::{levels, Grouped, Undecided};
-pub use table::{collapse_probability, csv, csv_header, panel, threshold_name};
+pub use table::{collapse_probability, csv, csv_header, fits_csv, panel, threshold_name};
 
 use crate::io::table::{Filter, Table, TableError};
 use crate::studies::damage_states::DamageStates;
@@ -530,8 +530,16 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
     } else if bands.iter().any(|b| b.is_some()) {
         pl.title.push_str(" (grey: 90 % bands)");
     }
+    let fits = fits_csv(
+        &spec,
+        state_names,
+        &lv,
+        &fits,
+        (o.bootstrap > 0).then_some(&bands[..]),
+    );
     Ok(StudyReport {
         csv: csv(&spec, state_names, &grouped),
+        tables: vec![("fits", fits)],
         said: t.said,
         notices: t.notices,
         notices_at: t.notices_at,

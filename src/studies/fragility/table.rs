@@ -4,7 +4,7 @@ use super::demand::{collapse_building, FragilitySpec};
 use super::grouping::Grouped;
 use crate::io::table::{caption, label};
 use crate::studies::plot::{Panel, Series};
-use crate::studies::stats::{Fit, Level, NoFit};
+use crate::studies::stats::{Band, Fit, Level, NoFit};
 
 /// The counts as CSV, a row per threshold and level: the state's name (with `states`), the
 /// threshold, the intensity, the runs decided, those exceeding, the runs among them that
@@ -71,6 +71,113 @@ pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -
         }
     }
     s
+}
+
+/// The fitted curves as CSV, a row per threshold (or damage state; the collapse fragility's one
+/// curve): the demand and intensity columns, the state's name (with `states`) and the threshold
+/// (none for a collapse fragility), the lognormal's median and beta with their standard errors
+/// (`se_ln_median` of `ln median`), the log-likelihood, the deviance against each level's own
+/// share with its degrees of freedom and p (empty with no degree of freedom, and where every
+/// level is `0/n` or `n/n`: no power), the runs counted and the levels they are at, and `fit`:
+/// `ok` or why no curve was fitted (its cells then empty). With `bootstrap`, the 90 % band of the
+/// median and beta (5 and 95 % of the replicates fitted) and the replicates fitted and not.
+pub fn fits_csv(
+    spec: &FragilitySpec,
+    states: Option<&[String]>,
+    levels: &[Vec<Level>],
+    fits: &[Result<Fit, NoFit>],
+    bands: Option<&[Option<Band>]>,
+) -> String {
+    let mut head: Vec<&str> = vec!["edp", "im"];
+    if states.is_some() {
+        head.push("state");
+    }
+    if !spec.is_collapse() {
+        head.push("threshold");
+    }
+    head.extend([
+        "median",
+        "beta",
+        "se_ln_median",
+        "se_beta",
+        "log_likelihood",
+        "deviance",
+        "dof",
+        "p_fit",
+        "runs",
+        "levels",
+        "fit",
+    ]);
+    if bands.is_some() {
+        head.extend([
+            "median_p5",
+            "median_p95",
+            "beta_p5",
+            "beta_p95",
+            "replicates_fitted",
+            "replicates_unfitted",
+        ]);
+    }
+    let mut s = head.join(",");
+    s.push('\n');
+    for (i, f) in fits.iter().enumerate() {
+        let mut row: Vec<String> = vec![quote(&spec.edp), quote(&spec.im)];
+        if let Some(names) = states {
+            row.push(quote(&names[i]));
+        }
+        if !spec.is_collapse() {
+            row.push(crate::show(spec.thresholds[i]));
+        }
+        let counted = levels.get(i).map_or(&[][..], |l| &l[..]);
+        let runs: u64 = counted.iter().map(|l| l.n).sum();
+        let at = counted.iter().filter(|l| l.n > 0).count();
+        match f {
+            Ok(f) => {
+                row.extend(
+                    [f.median, f.beta, f.se_ln_median, f.se_beta]
+                        .into_iter()
+                        .chain([f.log_likelihood, f.deviance])
+                        .map(|x| x.to_string()),
+                );
+                row.push(f.dof.to_string());
+                row.push(f.p_fit.map_or(String::new(), |p| p.to_string()));
+                row.extend([runs.to_string(), at.to_string()]);
+                row.push(if f.no_power { "ok (no power)" } else { "ok" }.into());
+            }
+            Err(e) => {
+                row.extend(std::iter::repeat_n(String::new(), 8));
+                row.extend([runs.to_string(), at.to_string()]);
+                let why = match collapse_building(&spec.edp) {
+                    _ if !spec.is_collapse() => e.to_string(),
+                    k => e.collapse_of(k),
+                };
+                row.push(quote(&format!("no fit: {why}")));
+            }
+        }
+        if let Some(bands) = bands {
+            match &bands[i] {
+                Some(b) => {
+                    row.extend(
+                        [b.median[0], b.median[1], b.beta[0], b.beta[1]].map(|x| x.to_string()),
+                    );
+                    row.extend([b.fitted.to_string(), b.unfitted.to_string()]);
+                }
+                None => row.extend(std::iter::repeat_n(String::new(), 6)),
+            }
+        }
+        s.push_str(&row.join(","));
+        s.push('\n');
+    }
+    s
+}
+
+/// A CSV cell: quoted where it holds a comma, a quote or a line end.
+fn quote(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
 }
 
 /// The names of [`csv`]'s columns (`states`: with damage states' names).
