@@ -75,7 +75,12 @@ impl Columns {
                 Builder::Real(b) => Arc::new(b.finish()),
                 Builder::Text(b) => Arc::new(b.finish()),
             };
-            fields.push(Field::new(name, a.data_type().clone(), true));
+            // Each column's unit (as `pound columns` gives it) in its field's metadata.
+            let mut field = Field::new(name, a.data_type().clone(), true);
+            if let Some(m) = pounding::plan::meaning::meaning(name) {
+                field = field.with_metadata(HashMap::from([("unit".into(), m.unit.into())]));
+            }
+            fields.push(field);
             arrays.push(a);
         }
         let meta: HashMap<String, String> = meta.iter().cloned().collect();

@@ -70,6 +70,12 @@ def test_record_and_spectrum_are_the_command_lines(pound, tmp_path):
         pounding.spectrum(rec, [0.0])
 
 
+def test_a_columns_unit_is_in_its_fields_metadata():
+    runs = pa.table(pounding.sweep(CONFIGS / "row-3-6.toml", backend="cpu", progress=False))
+    for name, unit in [("peak_force_n", "N"), ("b2_peak_accel_m_s2", "m/s^2"), ("run", "-")]:
+        assert runs.schema.field(name).metadata[b"unit"] == unit.encode()
+
+
 def test_columns_are_the_command_lines_list(pound):
     listed = pound("columns", CONFIGS / "row-3-6.toml").stdout
     table = pa.table(pounding.columns(CONFIGS / "row-3-6.toml"))

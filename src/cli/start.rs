@@ -63,6 +63,10 @@ pub struct ColumnsArgs {
     /// A sweep config: its own columns (a row's name each building and contact level);
     /// without one, a pair's.
     config: Option<PathBuf>,
+    /// Every column the config can give: a row's storeys' and floors' too, written only when
+    /// `pound sweep --columns` asks for them (`+storeys`, `+floors` or by name).
+    #[arg(long)]
+    all: bool,
 }
 
 pub fn init(a: InitArgs) -> Result<()> {
@@ -78,7 +82,13 @@ pub fn columns(a: ColumnsArgs) -> Result<()> {
         Some(path) => Some(config::load_text(&config::read_text(path)?, path)?),
         None => None,
     };
-    let names = match &plan {
+    // With --all, a row's columns written only when asked too (its storeys' and floors'
+    // groups), in the order a sweep writes them with every group on.
+    let mut all = plan.clone();
+    if let (true, Some(pounding::plan::Plan::Row(row))) = (a.all, &mut all) {
+        row.ask_columns(&["+storeys".to_string(), "+floors".to_string()]);
+    }
+    let names = match &all {
         Some(plan) => plan.header(),
         None => pounding::plan::columns::header()
             .into_iter()
@@ -91,6 +101,19 @@ pub fn columns(a: ColumnsArgs) -> Result<()> {
     if let Some(pounding::plan::Plan::Row(row)) = &plan {
         if !row.is_empty() && !row.level_names().is_empty() {
             note!("\ncontact levels:\n{}", row.level_table().trim_end());
+        }
+        if !a.all {
+            let mut every = row.clone();
+            every.ask_columns(&["+storeys".to_string(), "+floors".to_string()]);
+            let more = every.header().len() - names.len();
+            let groups: Vec<String> = (pounding::plan::columns::row::COLUMN_GROUPS.iter())
+                .map(|(g, what)| format!("{g}: {what}"))
+                .collect();
+            note!(
+                "\n{more} more columns when asked, by name or by group with `pound sweep --columns` ({}); `pound columns {} --all` lists them",
+                groups.join("; "),
+                a.config.as_deref().map_or(String::new(), |p| p.display().to_string())
+            );
         }
     }
     Ok(())

@@ -4,7 +4,7 @@
 
 use crate::engine::Summary;
 use crate::physics::model::{Initial, RunOutput};
-use crate::physics::row::RowOutput;
+use crate::physics::row::{BuildingDemands, RowOutput};
 use crate::physics::solver::row::{near_collapse, simulate_row, RowModel, RowScheme};
 use crate::physics::solver::{
     simulate, simulate_shared, simulate_tracking_accel, FastOptions, FreeResponse, Scheme,
@@ -144,13 +144,26 @@ pub(crate) fn row_of_pair(
     run: &RunOutput,
     o: &FastOptions,
 ) -> RowOutput {
-    let row = RowOutput::of_pair(run, plan.pair_heights());
+    let mut row = RowOutput::of_pair(run, plan.pair_heights());
     if near_collapse(&row, plan.collapse_drift_ratio) {
-        let model = RowModel::new(&plan.row(spec));
+        let model = row_model(plan, spec);
         let forcing = plan.forcing(spec);
         return simulate_row(&model, &forcing, model.at_rest(), &RowScheme::Fast(*o));
     }
+    if plan.tracks_demands() {
+        row.demands = (row.buildings.iter())
+            .map(BuildingDemands::of_one_storey)
+            .collect();
+    }
     row
+}
+
+/// The model of run `spec` of `plan`, tracking its storeys' and floors' demands where the sweep
+/// writes them.
+fn row_model(plan: &RowPlan, spec: &RowRunSpec) -> RowModel {
+    let mut model = RowModel::new(&plan.row(spec));
+    model.track_demands = plan.tracks_demands();
+    model
 }
 
 /// Run the runs `runs` of `plan` with `scheme`, `chunk` runs per task, on the current rayon pool;
@@ -220,7 +233,7 @@ pub fn run_rows_until<E>(
         ids.take_while(|_| !stopped(stop))
             .map(|i| {
                 let spec = plan.run(i);
-                let model = RowModel::new(&plan.row(&spec));
+                let model = row_model(plan, &spec);
                 let out = simulate_row(&model, &plan.forcing(&spec), model.at_rest(), &scheme);
                 (spec, out)
             })

@@ -180,6 +180,11 @@ impl Kernel {
     /// Why `plan` cannot run on the GPU kernel at `precision`, if it cannot; `calibrated`:
     /// `--target-error` chose its setting.
     fn gpu_refusal(plan: &Plan, precision: Precision, calibrated: bool) -> Option<EngineError> {
+        if matches!(plan, Plan::Row(r) if r.tracks_demands()) {
+            return Some(EngineError::GpuUnfit(
+                "every storey's and floor's demands (--columns +storeys, +floors or one of their columns) are tracked on the CPU only",
+            ));
+        }
         let fast = match plan.scheme() {
             Scheme::Fast(o) => o,
             Scheme::Reference(_) => {

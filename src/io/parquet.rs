@@ -101,13 +101,23 @@ impl ParquetOut {
             .with_fields(fields)
             .build()
             .map_err(err)?;
+        // Each column's unit (as `pound columns` gives it), as one JSON object: Parquet's
+        // schema has no field metadata outside an embedded Arrow schema.
+        let units: Vec<String> = (columns.iter())
+            .filter_map(|c| {
+                let m = crate::plan::meaning::meaning(c)?;
+                Some(format!("{:?}:{:?}", c, m.unit))
+            })
+            .collect();
+        let mut key_values: Vec<KeyValue> = (meta.key_values().into_iter())
+            .map(|(k, v)| KeyValue::new(k, v))
+            .collect();
+        key_values.push(KeyValue::new(
+            "units".to_string(),
+            format!("{{{}}}", units.join(",")),
+        ));
         let props = WriterProperties::builder()
-            .set_key_value_metadata(Some(
-                meta.key_values()
-                    .into_iter()
-                    .map(|(k, v)| KeyValue::new(k, v))
-                    .collect(),
-            ))
+            .set_key_value_metadata(Some(key_values))
             .build();
         let (partial, file, sink): (_, _, Box<dyn Write + Send>) = match (target, lock) {
             (Target::File(p), Some(lock)) => {

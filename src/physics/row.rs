@@ -506,6 +506,29 @@ pub struct RowOutput {
     /// The run's first collapse (status `collapsed`): the earliest of the buildings'
     /// ([`BuildingOutput::collapse`]).
     pub collapse: Option<Collapse>,
+    /// Per building, each storey's and floor's peaks, where the run was asked to track them
+    /// (`RowModel::track_demands`); empty otherwise.
+    pub demands: Vec<BuildingDemands>,
+}
+
+/// A building's demands storey by storey and floor by floor (bottom to top), over the whole
+/// simulated time (up to its collapse, where it collapsed: its collapsed storey at the limit).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BuildingDemands {
+    /// Each storey's `max |u_j - u_(j-1)| / h_j`.
+    pub peak_drift_ratio: Vec<f64>,
+    /// Each floor's (from floor 1) max |absolute acceleration|, m/s^2.
+    pub peak_accel: Vec<f64>,
+}
+
+impl BuildingDemands {
+    /// A one-storey building's, from its peaks (a row that runs on the pair's kernels).
+    pub fn of_one_storey(b: &BuildingOutput) -> BuildingDemands {
+        BuildingDemands {
+            peak_drift_ratio: vec![b.peak_drift_ratio],
+            peak_accel: vec![b.peak_accel],
+        }
+    }
 }
 
 /// Where and when a run collapsed: the first storey whose drift ratio reached the limit.

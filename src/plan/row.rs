@@ -233,6 +233,12 @@ pub struct RowPlan {
     /// Write each yielding storey's columns too (`bk_sj_...`, [`STOREY_OUTPUTS`]): set where
     /// `--columns` asks for one ([`RowPlan::asks_storey_columns`]).
     pub storey_columns: bool,
+    /// Write every building's storey demands (`bk_sj_peak_drift_ratio`, and an elastic one's
+    /// `bk_sj_residual_drift_ratio`) and floor accelerations (`bk_fj_peak_accel_m_s2`, floor 0
+    /// the ground): set where `--columns` asks for `+storeys`, `+floors` or one of their columns
+    /// ([`RowPlan::ask_demands`]).
+    pub storey_demands: bool,
+    pub floor_demands: bool,
 }
 
 /// One run of a row sweep, decoded.

@@ -68,11 +68,13 @@ impl Plan {
         }
     }
 
-    /// Write each yielding storey's own columns too, where `columns` (`--columns`) asks for one
-    /// of them (`b1_s2_peak_ductility`); a pair has none.
-    pub fn ask_storey_columns(&mut self, columns: &[String]) {
+    /// Write the columns `columns` (`--columns`) asks for that a sweep writes only when asked
+    /// ([`RowPlan::ask_columns`]): each yielding storey's own (`b1_s2_peak_ductility`), every
+    /// building's storeys and floors (`+storeys`, `+floors`); a pair has none.
+    pub fn ask_columns(&mut self, columns: &[String]) {
         if let Plan::Row(r) = self {
             r.storey_columns |= columns.iter().any(|c| RowPlan::asks_storey_columns(c));
+            r.ask_columns(columns);
         }
     }
 

@@ -149,6 +149,43 @@ pub fn picked_columns(plan: &Plan, asked: Option<&[String]>) -> Result<Picked, S
             "--columns: `{twice}` is given twice: give each column once"
         )));
     }
+    // A group (`+storeys`) adds its columns; groups alone add them to every column.
+    use crate::plan::columns::row::{column_group, COLUMN_GROUPS};
+    let (groups, names): (Vec<&String>, Vec<&String>) =
+        asked.iter().partition(|c| c.starts_with('+'));
+    for g in &groups {
+        let known = COLUMN_GROUPS.iter().any(|(name, _)| name == g);
+        let listed: Vec<String> = (COLUMN_GROUPS.iter())
+            .map(|(name, what)| format!("{name} ({what})"))
+            .collect();
+        if !known {
+            return Err(SettingsError(format!(
+                "--columns: `{g}` is no column group: the groups are {}",
+                listed.join(", ")
+            )));
+        }
+        if let Plan::Pair(_) = plan {
+            return Err(SettingsError(format!(
+                "--columns: `{g}`: a pair's buildings have one storey each, whose peak displacements are its columns already (peak_u1_m, peak_u2_m); give the scene as a row of [[building]] sections for the groups {}",
+                listed.join(", ")
+            )));
+        }
+    }
+    if names.is_empty() && !groups.is_empty() {
+        return Ok(Picked {
+            indices: None,
+            names: header,
+        });
+    }
+    let mut asked: Vec<String> = names.into_iter().cloned().collect();
+    for c in &header {
+        if (column_group(c)).is_some_and(|g| groups.iter().any(|x| x.as_str() == g))
+            && !asked.contains(c)
+        {
+            asked.push(c.clone());
+        }
+    }
+    let asked = &asked[..];
     let indices = crate::plan::columns::select_in(&header, asked).map_err(|bad| {
         SettingsError(format!(
             "--columns: `{bad}` is not a column of this sweep ({}); its columns are: {}",

@@ -55,7 +55,7 @@ impl Prepared {
         for w in settled.warnings {
             say(Said::Warning(format!("{}: {w}", config.display())));
         }
-        plan.ask_storey_columns(options.columns.as_deref().unwrap_or_default());
+        plan.ask_columns(options.columns.as_deref().unwrap_or_default());
         let gpu = gpu_for(
             &plan,
             options.backend,

@@ -17,6 +17,7 @@ mod config;
 mod convergence;
 mod damage;
 mod damage_states;
+mod demands;
 mod docs;
 mod fast_vs_reference;
 mod fidelity;

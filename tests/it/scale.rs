@@ -411,6 +411,13 @@ fn parquet_and_columns_hold_the_csv_values() {
         sidecar.contains(&format!("plan = \"{plan_fp}\"")),
         "{sidecar}"
     );
+    // Every column's unit, as `pound columns` gives it, in one JSON object.
+    let units = (kv.iter().find(|k| k.key == "units"))
+        .and_then(|k| k.value.clone())
+        .unwrap();
+    for (name, unit) in [("peak_force_n", "N"), ("gap_m", "m"), ("run", "-")] {
+        assert!(units.contains(&format!("\"{name}\":\"{unit}\"")), "{units}");
+    }
     let mut r = csv::Reader::from_path(&csv_out).unwrap();
     let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
     let rows: Vec<csv::StringRecord> = r.records().map(|x| x.unwrap()).collect();

@@ -402,7 +402,8 @@ pub fn meaning(column: &str) -> Option<Meaning> {
     if let Some((k, rest)) = column.strip_prefix('b').and_then(|r| r.split_once("_s")) {
         if let Some((j, suffix)) = rest.split_once('_') {
             let text = match suffix {
-                "residual_drift_ratio" => Some(("m/m", "residual drift ratio, building {k} storey {j}", "residual drift ratio of storey {j} of building {k} at rest after the motion, signed (empty where the run did not settle)")),
+                "residual_drift_ratio" => Some(("m/m", "residual drift ratio, building {k} storey {j}", "residual drift ratio of storey {j} of building {k} at rest after the motion, signed (empty where the run did not settle; 0 where the building is elastic)")),
+                "peak_drift_ratio" => Some(("m/m", "peak drift ratio, building {k} storey {j}", "largest interstorey drift ratio, abs(u_j - u_(j-1)) / h_j, of storey {j} of building {k} (--columns +storeys; at the collapse limit in the storey that collapsed)")),
                 "peak_ductility" => Some(("-", "ductility, building {k} storey {j}", "ductility demand of storey {j} of building {k}: its peak drift / its yield drift")),
                 "hysteretic_energy_j" => Some(("J", "hysteretic energy, building {k} storey {j}", "hysteretic energy of storey {j} of building {k}")),
                 "strength_ratio" => Some(("-", "strength left, building {k} storey {j}", "strength ratio of IMK storey {j} of building {k} at the end: its capping strength left (its weaker side's) over its initial one, in [0, 1] (1: none lost, 0: no strength left)")),
@@ -418,6 +419,29 @@ pub fn meaning(column: &str) -> Option<Meaning> {
                     unit,
                     label: fill(label),
                     text: fill(text),
+                });
+            }
+        }
+    }
+    // bK_fJ_peak_accel_m_s2: a floor's peak acceleration (floor 0: the ground)
+    if let Some((k, rest)) = column.strip_prefix('b').and_then(|r| r.split_once("_f")) {
+        if let Some((j, "peak_accel_m_s2")) = rest.split_once('_') {
+            if let (Some(k), Some(j)) = (number(k), number(j)) {
+                let (label, text) = if j == 0 {
+                    (
+                        format!("peak ground acceleration, building {k}"),
+                        format!("floor 0 of building {k}, the ground: the scaled record's PGA (--columns +floors)"),
+                    )
+                } else {
+                    (
+                        format!("peak acceleration, building {k} floor {j}"),
+                        format!("largest absolute acceleration of floor {j} of building {k}, relative acceleration plus the ground's (--columns +floors)"),
+                    )
+                };
+                return Some(Meaning {
+                    unit: "m/s^2",
+                    label,
+                    text,
                 });
             }
         }

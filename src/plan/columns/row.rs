@@ -62,7 +62,53 @@ pub const STOREY_OUTPUTS: [&str; 3] = [
 /// strength ratio and whether it passed capping (0 or 1).
 pub const IMK_STOREY_OUTPUTS: [&str; 2] = ["strength_ratio", "capped"];
 
+/// The column groups `--columns` may add to a row's columns: every building's storeys
+/// (`bK_sJ_...`: each storey's peak drift ratio, its residual, and a yielding storey's own
+/// columns) and floors (`bK_fJ_peak_accel_m_s2`, floor 0 the ground).
+pub const COLUMN_GROUPS: [(&str, &str); 2] = [
+    ("+storeys", "every building's storeys: peak and residual drift ratio, and a yielding storey's own columns"),
+    ("+floors", "every building's floors: peak absolute acceleration, floor 0 the ground"),
+];
+
+/// The group of `column` (`+storeys` for `b1_s2_...`, `+floors` for `b1_f0_...`), if any.
+pub fn column_group(column: &str) -> Option<&'static str> {
+    let digits = |x: &str| !x.is_empty() && x.bytes().all(|c| c.is_ascii_digit());
+    let rest = column.strip_prefix('b')?;
+    let (k, rest) = rest.split_once('_')?;
+    let (group, rest) = match rest.as_bytes().first()? {
+        b's' => ("+storeys", &rest[1..]),
+        b'f' => ("+floors", &rest[1..]),
+        _ => return None,
+    };
+    let (j, suffix) = rest.split_once('_')?;
+    (digits(k) && digits(j) && !suffix.is_empty()).then_some(group)
+}
+
 impl RowPlan {
+    /// Turn on the columns `columns` (`--columns`) asks for that a sweep writes only when
+    /// asked: a group (`+storeys`, `+floors`), or one of its columns.
+    pub fn ask_columns(&mut self, columns: &[String]) {
+        for c in columns {
+            let group = match c.as_str() {
+                "+storeys" | "+floors" => Some(c.as_str()),
+                _ => column_group(c),
+            };
+            match group {
+                Some("+storeys") => {
+                    self.storey_demands = true;
+                    self.storey_columns = true;
+                }
+                Some("+floors") => self.floor_demands = true,
+                _ => {}
+            }
+        }
+    }
+
+    /// Does the sweep track its buildings' demands storey by storey or floor by floor?
+    pub fn tracks_demands(&self) -> bool {
+        self.storey_demands || self.floor_demands
+    }
+
     /// Does `column` name a yielding storey's own column (`b1_s2_peak_ductility`)?
     pub fn asks_storey_columns(column: &str) -> bool {
         column
@@ -201,6 +247,20 @@ impl RowPlan {
                     }
                 }
             }
+            let n = self.buildings[b].storeys();
+            if self.storey_demands {
+                for j in 1..=n {
+                    h.push(format!("b{}_s{j}_peak_drift_ratio", b + 1));
+                    if y.is_none() {
+                        h.push(format!("b{}_s{j}_residual_drift_ratio", b + 1));
+                    }
+                }
+            }
+            if self.floor_demands {
+                for j in 0..=n {
+                    h.push(format!("b{}_f{j}_peak_accel_m_s2", b + 1));
+                }
+            }
         }
         for (l, struck) in self.level_names().iter().zip(&self.struck) {
             for c in LEVEL_OUTPUTS {
@@ -254,6 +314,35 @@ impl RowPlan {
                     && !c.ends_with("_ductility_storey")
             })
             .collect()
+    }
+
+    /// Building `k`'s storey and floor demands, where asked ([`RowPlan::storey_demands`],
+    /// [`RowPlan::floor_demands`]): each storey's peak drift ratio (and an elastic building's
+    /// residual, 0 where it stood to the end of a run that did not fail), each floor's peak
+    /// absolute acceleration from floor 0, the ground's (the scaled record's PGA). Empty cells
+    /// where the run did not track them (it failed before).
+    fn demand_cells(&self, c: &mut Vec<String>, k: usize, run: &RowRunSpec, out: &RowOutput) {
+        let n = self.buildings[k].storeys();
+        let d = out.demands.get(k);
+        let known = |x: Option<f64>| x.filter(|x| x.is_finite()).map(num).unwrap_or_default();
+        if self.storey_demands {
+            let settled = matches!(
+                out.status,
+                crate::physics::model::Status::Ok | crate::physics::model::Status::Collapsed
+            ) && out.buildings[k].collapse.is_none();
+            for j in 0..n {
+                c.push(known(d.map(|d| d.peak_drift_ratio[j])));
+                if self.yielding[k].is_none() {
+                    c.push(if settled { "0".into() } else { String::new() });
+                }
+            }
+        }
+        if self.floor_demands {
+            c.push(num(run.contact.pga_g * crate::record::G));
+            for j in 0..n {
+                c.push(known(d.map(|d| d.peak_accel[j])));
+            }
+        }
     }
 
     /// The fields of one run, in [`RowPlan::header`] order.
@@ -363,6 +452,7 @@ impl RowPlan {
                     }
                 }
             }
+            self.demand_cells(&mut c, k, run, out);
         }
         for (l, struck) in out.levels.iter().zip(&self.struck) {
             c.extend([

@@ -187,6 +187,8 @@ pub(crate) fn parse_row_as(
         yield_dim: layout.yield_dim,
         imk_dim: layout.imk_dim,
         storey_columns: false,
+        storey_demands: false,
+        floor_demands: false,
         struck: Vec::new(),
     };
     plan.struck = plan.struck_columns();

@@ -174,6 +174,10 @@ pub struct RowModel {
     /// every building as its collapse event sees it (empty without a limit).
     pub(crate) collapse_limit: f64,
     pub(crate) drifts: Vec<DriftRow>,
+    /// Track every storey's peak drift ratio and every floor's peak acceleration
+    /// ([`crate::physics::row::RowOutput::demands`]): off unless asked (a sweep's `--columns
+    /// +storeys,+floors`).
+    pub track_demands: bool,
 }
 
 /// A storey's drift in the model's coordinates, for its collapse event:
@@ -351,6 +355,7 @@ impl RowModel {
             storeys,
             collapse_limit,
             drifts,
+            track_demands: false,
         }
     }
 

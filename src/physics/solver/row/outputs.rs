@@ -170,6 +170,10 @@ impl<'m> RowRun<'m> {
                     out.peak_drift_ratio = p;
                     out.drift_storey = j as u32 + 1;
                 }
+                if let Some(dm) = &mut self.demands {
+                    let peak = &mut dm[k].peak_drift_ratio[j];
+                    *peak = raise(*peak, y, d, a);
+                }
                 if let Some(first) = bm.first_storey {
                     let st = &mut self.storeys[first + j];
                     st.peak_drift_ratio = raise(st.peak_drift_ratio, y, d, a);
@@ -189,6 +193,14 @@ impl<'m> RowRun<'m> {
                 if p > out.peak_accel {
                     out.peak_accel = p;
                     out.accel_floor = j as u32 + 1;
+                }
+                if let Some(dm) = &mut self.demands {
+                    let peak = &mut dm[k].peak_accel[j];
+                    *peak = if free {
+                        raise_cubic_peak(*peak, s0.a_abs[j], s0.jerk[j], s1.a_abs[j], s1.jerk[j], h)
+                    } else {
+                        peak.max(s0.a_abs[j].abs()).max(s1.a_abs[j].abs())
+                    };
                 }
             }
         }
@@ -476,6 +488,7 @@ impl<'m> RowRun<'m> {
             storeys,
             closings: self.closings.unwrap_or_default(),
             collapse: self.collapse,
+            demands: self.demands.unwrap_or_default(),
             ..RowOutput::default()
         };
         if ns > 0 {

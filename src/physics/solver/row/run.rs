@@ -9,7 +9,7 @@ use super::model::{LevelModel, RowModel};
 use super::sample::RowObserver;
 use super::storey::StoreyMode;
 use crate::physics::imk::ImkState;
-use crate::physics::row::{BuildingOutput, Collapse, LevelClosing};
+use crate::physics::row::{BuildingDemands, BuildingOutput, Collapse, LevelClosing};
 use crate::physics::solver::hermite::{quintic_max_bound, quintic_range, raise_quintic_peak};
 use crate::physics::solver::state::{Mode, Segment};
 
@@ -71,6 +71,9 @@ pub(crate) struct RowRun<'m> {
     /// stands frozen as it was at its collapse (no further work, its peaks kept), never moves
     /// again in substeps or free steps, and its levels are dead (no contact, no check).
     pub(super) gone: Vec<bool>,
+    /// Each storey's and floor's peaks, where the model asks for them
+    /// ([`RowModel::track_demands`]).
+    pub(super) demands: Option<Vec<BuildingDemands>>,
 }
 
 /// A building's storeys are watched for collapse once its peak drift ratio reaches this share
@@ -122,6 +125,14 @@ impl<'m> RowRun<'m> {
             watch: vec![false; m.buildings.len()],
             collapse: None,
             gone: vec![false; m.buildings.len()],
+            demands: m.track_demands.then(|| {
+                (m.buildings.iter())
+                    .map(|b| BuildingDemands {
+                        peak_drift_ratio: vec![0.0; b.n()],
+                        peak_accel: vec![0.0; b.n()],
+                    })
+                    .collect()
+            }),
             z,
         };
         let z = run.z.clone();
@@ -206,6 +217,9 @@ impl<'m> RowRun<'m> {
         let b = &mut self.buildings[k];
         b.collapse = Some(cl);
         (b.peak_drift_ratio, b.drift_storey) = (limit, cl.storey);
+        if let Some(d) = &mut self.demands {
+            d[k].peak_drift_ratio[storey] = limit;
+        }
         if let Some(first) = self.m.buildings[k].first_storey {
             self.storeys[first + storey].peak_drift_ratio = limit;
         }

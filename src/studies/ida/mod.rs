@@ -20,6 +20,8 @@
 //! the demand (a residual drift where the run did not settle) is left out and counted at its
 //! level, and the fractiles there are over the others, and say so.
 
+mod table;
+
 use crate::engine::quantile::{quantile, Interpolation::Linear};
 use crate::io::table::{caption, label, name, order_key, Filter, Table, TableError};
 use crate::studies::fragility::{demand_rows, CollapseOf, Demand, LeftOut};
@@ -306,76 +308,6 @@ impl Ida {
             "the IDA table would have two columns `{column}` (columns {}): {what}; rename the record (its `name` in the config's [[record]]) and rerun the sweep, or name the curves by other columns with --by",
             at.iter().map(|i| (i + 1).to_string()).collect::<Vec<_>>().join(", ")
         )))
-    }
-
-    /// One row per level: the intensity, the curves there, the fractiles, the curves collapsed
-    /// there and their share, each curve's demand. A collapse is an infinite demand, written
-    /// `inf` (a fractile it reaches too); an empty cell is no value (no run there, or none left).
-    pub fn csv(&self, spec: &IdaSpec) -> String {
-        let quote = |s: &str| {
-            if s.contains([',', '"', '\n']) {
-                format!("\"{}\"", s.replace('"', "\"\""))
-            } else {
-                s.to_string()
-            }
-        };
-        let head: Vec<String> = self.header(spec).iter().map(|h| quote(h)).collect();
-        let mut s = head.join(",");
-        s.push('\n');
-        for (l, im) in self.ims.iter().enumerate() {
-            s.push_str(&format!("{im},{}", self.counts[l]));
-            for f in self.fractiles[l] {
-                // No fractile of no runs: an empty cell.
-                s.push(',');
-                if self.counts[l] > 0 {
-                    s.push_str(&f.to_string());
-                }
-            }
-            s.push_str(&format!(",{},", self.collapsed[l]));
-            if let Some(f) = self.collapsed_fraction(l) {
-                s.push_str(&f.to_string());
-            }
-            for (_, v) in &self.curves {
-                s.push(',');
-                if let Some(x) = v[l] {
-                    s.push_str(&x.to_string());
-                }
-            }
-            s.push('\n');
-        }
-        s
-    }
-
-    /// The curves in long form, a row per curve and level where it has a value: the curve (its
-    /// `--by` cells joined by `/`, under their names so joined; `curve` where that would name a
-    /// column twice), the intensity, the demand (`inf` from its first collapse) and whether it
-    /// has collapsed there (1 or 0).
-    pub fn long_csv(&self, spec: &IdaSpec) -> String {
-        let quote = |s: &str| {
-            if s.contains([',', '"', '\n', '\r']) {
-                format!("\"{}\"", s.replace('"', "\"\""))
-            } else {
-                s.to_string()
-            }
-        };
-        let mut head = vec![spec.by.join("/"), spec.im.clone(), spec.edp.clone()];
-        head.push("collapsed".into());
-        if crate::io::table::duplicate_column(&head).is_some() {
-            head[0] = "curve".into();
-        }
-        let mut s = (head.iter().map(|h| quote(h)))
-            .collect::<Vec<_>>()
-            .join(",");
-        s.push('\n');
-        for (name, values) in &self.curves {
-            for (im, v) in self.ims.iter().zip(values) {
-                if let Some(x) = v {
-                    let collapsed = u8::from(x.is_infinite());
-                    s.push_str(&format!("{},{im},{x},{collapsed}\n", quote(name)));
-                }
-            }
-        }
-        s
     }
 
     /// A line through `(demand, intensity)` per level (None: no point there) up to its first

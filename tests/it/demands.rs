@@ -1,0 +1,187 @@
+//! Demands storey by storey and floor by floor (issue 69): `--columns +storeys,+floors` adds
+//! every building's per-storey peak and residual drift ratios and per-floor peak absolute
+//! accelerations (floor 0 the ground), and changes no other cell.
+//!
+//! Checks: on an elastic row, a yielding row, a row whose buildings collapse and a row that
+//! runs on the pair's kernels, every cell of the default table is the same with the groups on;
+//! each building's largest storey drift and floor acceleration are its `bK_peak_drift_ratio`
+//! and `bK_peak_accel_m_s2` to the bit, floor 0 is the scaled record's PGA, an elastic storey's
+//! residual is 0, a yielding building's largest `|residual|` is its `bK_residual_drift_ratio`,
+//! a collapsed storey's peak drift is the limit; the groups are refused where they cannot be
+//! written, naming why.
+
+use crate::support::{ok, pound, table, tempdir};
+use std::collections::HashMap;
+
+type Row = HashMap<String, String>;
+
+fn sweep(config: &str, out: &std::path::Path, extra: &[&str]) -> Vec<Row> {
+    let mut args = vec![
+        "sweep",
+        config,
+        "-o",
+        out.to_str().unwrap(),
+        "--backend",
+        "cpu",
+    ];
+    args.extend_from_slice(extra);
+    ok(&pound(&args));
+    table(out)
+}
+
+fn num(r: &Row, c: &str) -> f64 {
+    r.get(c)
+        .unwrap_or_else(|| panic!("no column {c}"))
+        .parse()
+        .unwrap_or_else(|_| panic!("{c}: {:?}", r[c]))
+}
+
+#[test]
+fn storeys_and_floors_are_the_buildings_peaks_one_by_one() {
+    let d = tempdir();
+    let mut checked = (0, 0, 0);
+    for config in [
+        "configs/row-3-6.toml",
+        "configs/inelastic-row.toml",
+        "configs/collapse-fragility.toml",
+        "configs/row-of-two.toml",
+    ] {
+        let plain = sweep(config, &d.path().join("plain.csv"), &[]);
+        let rows = sweep(
+            config,
+            &d.path().join("demands.csv"),
+            &["--columns", "+storeys,+floors"],
+        );
+        assert_eq!(plain.len(), rows.len(), "{config}");
+        // `pound columns --all` names every column the groups write, in the sweep's order, each
+        // with a unit and a meaning.
+        let listed = ok(&pound(&["columns", config, "--all"]));
+        let names: Vec<&str> = (listed.lines().skip(2))
+            .map(|l| {
+                let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+                assert!(!cells[2].is_empty() && cells[3].len() > 3, "{l}");
+                cells[1].trim_matches('`')
+            })
+            .collect();
+        let header = std::fs::read_to_string(d.path().join("demands.csv")).unwrap();
+        let written: Vec<&str> = header.lines().next().unwrap().split(',').collect();
+        assert_eq!(names, written, "{config}");
+        let limit = rows[0].get("collapse_time_s").map(|_| 0.10);
+        for (p, r) in plain.iter().zip(&rows) {
+            for (c, v) in p {
+                assert_eq!(&r[c], v, "{config} run {}: {c}", p["run"]);
+            }
+            let mut b = 1;
+            while r.contains_key(&format!("b{b}_peak_drift_ratio")) {
+                let storeys =
+                    (1..).take_while(|j| r.contains_key(&format!("b{b}_s{j}_peak_drift_ratio")));
+                let n = storeys.count();
+                assert!(n >= 1, "{config}: building {b} has storey columns");
+                let drift = |j: usize| num(r, &format!("b{b}_s{j}_peak_drift_ratio"));
+                let accel = |j: usize| num(r, &format!("b{b}_f{j}_peak_accel_m_s2"));
+                let top = (1..=n).map(drift).fold(0.0, f64::max);
+                assert_eq!(
+                    top,
+                    num(r, &format!("b{b}_peak_drift_ratio")),
+                    "{config} b{b}"
+                );
+                let top = (1..=n).map(accel).fold(0.0, f64::max);
+                assert_eq!(
+                    top,
+                    num(r, &format!("b{b}_peak_accel_m_s2")),
+                    "{config} b{b}"
+                );
+                let ground = accel(0) / pounding::record::G;
+                assert!(
+                    (ground - num(r, "pga_g")).abs() <= 1e-12 * ground,
+                    "{config}"
+                );
+                let collapsed = r.get(&format!("b{b}_collapsed")).is_some_and(|x| x == "1");
+                let residuals: Vec<&String> = (1..=n)
+                    .map(|j| &r[&format!("b{b}_s{j}_residual_drift_ratio")])
+                    .collect();
+                if collapsed {
+                    let j: usize = r[&format!("b{b}_collapse_storey")].parse().unwrap();
+                    assert_eq!(drift(j), limit.unwrap(), "{config} b{b}");
+                    assert!(residuals.iter().all(|x| x.is_empty()));
+                    checked.2 += 1;
+                } else if r.contains_key(&format!("b{b}_residual_drift_ratio")) {
+                    let said = &r[&format!("b{b}_residual_drift_ratio")];
+                    if said.is_empty() {
+                        // A run that did not settle has no residual drift, storey by storey.
+                        assert!(residuals.iter().all(|x| x.is_empty()), "{config} b{b}");
+                    } else {
+                        let largest = (residuals.iter())
+                            .map(|x| x.parse::<f64>().unwrap().abs())
+                            .fold(0.0, f64::max);
+                        assert_eq!(largest, said.parse::<f64>().unwrap(), "{config} b{b}");
+                        checked.1 += 1;
+                    }
+                } else if r["status"] == "ok" {
+                    assert!(residuals.iter().all(|x| *x == "0"), "{config} b{b}");
+                    checked.0 += 1;
+                }
+                b += 1;
+            }
+        }
+    }
+    assert!(
+        checked.0 > 0 && checked.1 > 0 && checked.2 > 0,
+        "{checked:?}"
+    );
+}
+
+#[test]
+fn the_groups_are_refused_where_they_cannot_be_written() {
+    let d = tempdir();
+    let out = d.path().join("x.csv");
+    let o = out.to_str().unwrap();
+    let refused = |args: &[&str]| -> String {
+        let r = pound(args);
+        assert!(!r.status.success(), "{args:?} succeeded");
+        String::from_utf8_lossy(&r.stderr).into_owned()
+    };
+    let e = refused(&[
+        "sweep",
+        "configs/row-3-6.toml",
+        "-o",
+        o,
+        "--columns",
+        "+nope",
+    ]);
+    assert!(
+        e.contains("`+nope` is no column group") && e.contains("+storeys"),
+        "{e}"
+    );
+    let e = refused(&[
+        "sweep",
+        "configs/quickstart.toml",
+        "-o",
+        o,
+        "--columns",
+        "+floors",
+    ]);
+    assert!(e.contains("a pair's buildings have one storey each"), "{e}");
+    let e = refused(&[
+        "sweep",
+        "configs/row-3-6.toml",
+        "-o",
+        o,
+        "--columns",
+        "+storeys",
+        "--backend",
+        "gpu",
+    ]);
+    assert!(e.contains("tracked on the CPU only"), "{e}");
+    // A group beside named columns adds its own to them.
+    let rows = sweep(
+        "configs/row-3-6.toml",
+        &out,
+        &["--columns", "run,status,+floors"],
+    );
+    let mut names: Vec<&String> = rows[0].keys().collect();
+    names.sort();
+    let floors = names.iter().filter(|c| c.contains("_f")).count();
+    assert_eq!(names.len(), 2 + floors, "{names:?}");
+    assert_eq!(floors, 4 + 7);
+}
