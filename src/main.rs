@@ -56,6 +56,7 @@ fn run(cmd: cli::Cmd) -> anyhow::Result<()> {
         Cmd::Plot(a) => cli::plot::run(a),
         Cmd::Fragility(a) => cli::fragility::run(a),
         Cmd::Ida(a) => cli::ida::run(a),
+        Cmd::Demands(a) => cli::demands::run(a),
         Cmd::Gap(a) => cli::gap::run(a),
         Cmd::Merge(a) => cli::merge::run(a),
         Cmd::Paper => cli::paper::run(),

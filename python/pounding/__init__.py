@@ -45,6 +45,7 @@ __all__ = [
     "trace",
     "fragility",
     "ida",
+    "demands",
     "record",
     "spectrum",
     "columns",
@@ -589,6 +590,28 @@ def ida(
     info = {"report": report, "notices": notices}
     info.update((name, Table(t)) for name, t in tables)
     return Table(inner, info)
+
+
+def demands(
+    table: Any,
+    *,
+    building: int,
+    where: Union[None, str, Iterable[str]] = None,
+    path: Union[None, str, "os.PathLike[str]"] = None,
+) -> str:
+    """One building's demands in the SimCenter format pelicun reads, as ``pound demands``: a
+    row per run of a sweep written with ``columns=["+storeys", "+floors"]``, ``1-PID-j-1``,
+    ``1-RID-j-1``, ``1-PFA-j-1``, ``1-COL-0-1`` and a units row. Returns the file's text (to
+    ``path`` too where given): ``pelicun``'s ``DemandModel.load_sample(path)`` reads it."""
+    source, kind = _study_input(table)
+    text, _report, notices = _engine.demands(
+        source, kind, _count("building", building, 1, _U64), _where(where)
+    )
+    _say(notices)
+    if path is not None:
+        with open(path, "w", newline="") as f:
+            f.write(text)
+    return text
 
 
 def record(

@@ -793,6 +793,27 @@ fn ida(
     )
 }
 
+/// `pounding.demands`: `pound demands` on a table of results; the SimCenter demand file's text,
+/// what the command prints on standard output, and its notices.
+#[pyfunction]
+#[pyo3(signature = (table, table_kind, building, filters))]
+fn demands(
+    py: Python<'_>,
+    table: &Bound<'_, PyAny>,
+    table_kind: &str,
+    building: usize,
+    filters: Vec<String>,
+) -> PyResult<(String, String, Vec<String>)> {
+    use pounding::studies::demands::{study, DemandsError, DemandsOptions};
+    let rows = study_input(table, table_kind)?;
+    let options = DemandsOptions { building, filters };
+    let r = py.detach(|| study(&rows, &options)).map_err(|e| match e {
+        DemandsError::Table(e) => TableError::new_err(e.to_string()),
+        e => SettingsError::new_err(e.to_string()),
+    })?;
+    Ok((r.csv, r.said, r.notices))
+}
+
 #[pymodule]
 fn _pounding(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -811,6 +832,7 @@ fn _pounding(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(fragility, m)?)?;
     m.add_function(wrap_pyfunction!(ida, m)?)?;
+    m.add_function(wrap_pyfunction!(demands, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The bounds the Python layer names when a keyword is past them (the engine checks too).
     let limits = PyDict::new(py);

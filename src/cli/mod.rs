@@ -47,6 +47,7 @@ pub fn tables_on_stderr() -> bool {
 
 pub mod accuracy;
 pub mod bench;
+pub mod demands;
 pub mod formulas;
 pub mod fragility;
 pub mod gap;
@@ -90,6 +91,9 @@ pub enum Cmd {
     /// Incremental dynamic analysis from a results CSV: per record the demand against the
     /// intensity, and the 16, 50 and 84 % fractiles across records at each intensity level.
     Ida(ida::Args),
+    /// One building's demands from a results CSV in the SimCenter format pelicun reads: per run
+    /// each storey's peak and residual drift ratio, each floor's peak acceleration, collapse.
+    Demands(demands::Args),
     /// The separation each adjacent pair of a sweep's buildings needs: exactly from the time
     /// histories (the largest closing of the uncoupled responses), and by the ABS, SRSS and DDC
     /// rules from the same peaks; their ratios, and the probability of pounding against the gap.

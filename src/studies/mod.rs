@@ -11,6 +11,7 @@
 pub mod accuracy;
 pub mod bench;
 pub mod damage_states;
+pub mod demands;
 pub mod fidelity;
 pub mod formulas;
 pub mod fragility;

@@ -36,6 +36,13 @@ fn num(r: &Row, c: &str) -> f64 {
         .unwrap_or_else(|_| panic!("{c}: {:?}", r[c]))
 }
 
+/// `pound ARGS`' standard error, where it fails.
+fn refused(args: &[&str]) -> String {
+    let r = pound(args);
+    assert!(!r.status.success(), "{args:?} succeeded");
+    String::from_utf8_lossy(&r.stderr).into_owned()
+}
+
 #[test]
 fn storeys_and_floors_are_the_buildings_peaks_one_by_one() {
     let d = tempdir();
@@ -136,11 +143,6 @@ fn the_groups_are_refused_where_they_cannot_be_written() {
     let d = tempdir();
     let out = d.path().join("x.csv");
     let o = out.to_str().unwrap();
-    let refused = |args: &[&str]| -> String {
-        let r = pound(args);
-        assert!(!r.status.success(), "{args:?} succeeded");
-        String::from_utf8_lossy(&r.stderr).into_owned()
-    };
     let e = refused(&[
         "sweep",
         "configs/row-3-6.toml",
@@ -184,4 +186,61 @@ fn the_groups_are_refused_where_they_cannot_be_written() {
     let floors = names.iter().filter(|c| c.contains("_f")).count();
     assert_eq!(names.len(), 2 + floors, "{names:?}");
     assert_eq!(floors, 4 + 7);
+}
+
+/// `pound demands` writes a row per run that did not fail, its columns from the storeys' and
+/// floors' and the units row pelicun reads; it refuses a table without them (naming the flag
+/// that writes them) and a building the table does not have.
+#[test]
+fn pound_demands_writes_the_simcenter_form_or_says_what_is_missing() {
+    let d = tempdir();
+    let runs = d.path().join("runs.csv");
+    let rows = sweep(
+        "configs/row-3-6.toml",
+        &runs,
+        &["--columns", "+storeys,+floors"],
+    );
+    let out = d.path().join("demands.csv");
+    let (r, o) = (runs.to_str().unwrap(), out.to_str().unwrap());
+    ok(&pound(&["demands", r, "--building", "2", "-o", o]));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let units: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!((head[0], units[0]), ("", "Units"));
+    assert_eq!(head.len(), 1 + 2 * 6 + 7 + 1, "{head:?}");
+    for (h, u) in head.iter().zip(&units).skip(1) {
+        let unit = match h.split('-').nth(1).unwrap() {
+            "PID" | "RID" => "rad",
+            "PFA" => "mps2",
+            "COL" => "unitless",
+            other => panic!("{other}"),
+        };
+        assert_eq!(*u, unit, "{h}");
+    }
+    let body: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(body.len(), rows.len());
+    for (cells, r) in body.iter().zip(&rows) {
+        assert_eq!(cells[0], r["run"]);
+        for (h, c) in head.iter().zip(cells).skip(1) {
+            let parts: Vec<&str> = h.split('-').collect();
+            let column = match parts[1] {
+                "PID" => format!("b2_s{}_peak_drift_ratio", parts[2]),
+                "RID" => format!("b2_s{}_residual_drift_ratio", parts[2]),
+                "PFA" => format!("b2_f{}_peak_accel_m_s2", parts[2]),
+                _ => {
+                    assert_eq!(*c, "0", "an elastic row never collapses");
+                    continue;
+                }
+            };
+            assert_eq!(c.parse::<f64>().unwrap(), num(r, &column), "{h}");
+        }
+    }
+    let plain = d.path().join("plain.csv");
+    sweep("configs/row-3-6.toml", &plain, &[]);
+    let p = plain.to_str().unwrap();
+    let e = refused(&["demands", p, "--building", "1", "-o", o]);
+    assert!(e.contains("--columns +storeys,+floors"), "{e}");
+    let e = refused(&["demands", r, "--building", "3", "-o", o]);
+    assert!(e.contains("no building 3 (the table has 2"), "{e}");
 }

@@ -1,0 +1,159 @@
+//! A sweep's demands in the SimCenter format pelicun reads (`pound demands`): one building's
+//! storeys and floors, a row per run, columns `{event}-{EDP}-{location}-{direction}` with a
+//! units row, as FEMA P-58 loss assessments take them.
+//!
+//! Per storey `j`: `1-PID-j-1`, the peak interstorey drift ratio, and `1-RID-j-1`, the residual
+//! drift ratio's magnitude (pelicun compares it with its irreparable limit, unsigned); per floor
+//! `j` from 0, the ground: `1-PFA-j-1`, the peak absolute acceleration in m/s^2 (`mps2`); and
+//! `1-COL-0-1`, 1 where the building collapsed in the simulation, else 0: pelicun's
+//! `CollapseLimits` `{"COL": 0.5}` drops those realizations from the demand sample, collapse
+//! being the collapse fragility's (`pound fragility --edp bK_collapsed --fits`). The index is
+//! the run number. A residual drift that is not known (a run that did not settle, or a building
+//! that collapsed) is an empty cell, counted in a notice; failed runs are left out, counted.
+
+use crate::io::table::{Filter, Table, TableError};
+use crate::studies::report::{StudyReport, Telling};
+
+/// What to export.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DemandsOptions {
+    /// The building (from 1).
+    pub building: usize,
+    pub filters: Vec<String>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum DemandsError {
+    #[error(transparent)]
+    Table(#[from] TableError),
+    #[error("{0}")]
+    Refused(String),
+}
+
+/// `pound demands` of `table`: the SimCenter demand file of building `o.building`.
+pub fn study(table: &Table, o: &DemandsOptions) -> Result<StudyReport, DemandsError> {
+    table.check_columns()?;
+    let k = o.building;
+    if k == 0 {
+        return Err(DemandsError::Refused(
+            "--building 0: buildings are numbered from 1, left to right".into(),
+        ));
+    }
+    let has = |c: &str| table.header.iter().any(|h| h == c);
+    if !has(&format!("b{k}_peak_drift_ratio")) {
+        let buildings = (1..)
+            .take_while(|b| has(&format!("b{b}_peak_drift_ratio")))
+            .count();
+        return Err(DemandsError::Refused(format!(
+            "{}: no building {k} (the table has {buildings}: b1_ ... b{buildings}_ columns)",
+            table.path.display()
+        )));
+    }
+    let storeys = (1..)
+        .take_while(|j| has(&format!("b{k}_s{j}_peak_drift_ratio")))
+        .count();
+    let floors = (0..)
+        .take_while(|j| has(&format!("b{k}_f{j}_peak_accel_m_s2")))
+        .count();
+    if storeys == 0 || floors != storeys + 1 {
+        return Err(DemandsError::Refused(format!(
+            "{}: building {k}'s storeys and floors are not in the table (b{k}_s1_peak_drift_ratio, b{k}_f0_peak_accel_m_s2, ...): run the sweep with --columns +storeys,+floors",
+            table.path.display()
+        )));
+    }
+    let filters = Filter::parse_all(&o.filters)?;
+    let rows = table.select(&filters)?;
+    let (run, status) = (table.col("run")?, table.col("status")?);
+    let collapsed_col = table
+        .header
+        .iter()
+        .position(|h| *h == format!("b{k}_collapsed"));
+    let mut head = vec![String::new()];
+    let mut units = vec!["Units".to_string()];
+    let mut cols = Vec::new();
+    for j in 1..=storeys {
+        for (edp, column) in [("PID", "peak_drift_ratio"), ("RID", "residual_drift_ratio")] {
+            head.push(format!("1-{edp}-{j}-1"));
+            units.push("rad".into());
+            cols.push(table.col(&format!("b{k}_s{j}_{column}"))?);
+        }
+    }
+    for j in 0..floors {
+        head.push(format!("1-PFA-{j}-1"));
+        units.push("mps2".into());
+        cols.push(table.col(&format!("b{k}_f{j}_peak_accel_m_s2"))?);
+    }
+    head.push("1-COL-0-1".into());
+    units.push("unitless".into());
+    let mut csv = format!("{}\n{}\n", head.join(","), units.join(","));
+    let (mut written, mut failed, mut collapsed, mut no_residual) = (0, 0, 0, 0);
+    for &i in &rows {
+        let st = table.rows[i][status].trim();
+        if st != "ok" && st != "collapsed" {
+            failed += 1;
+            continue;
+        }
+        let gone = match collapsed_col {
+            Some(c) => table.num(i, c)? == Some(1.0),
+            None => false,
+        };
+        let mut line = vec![table.rows[i][run].trim().to_string()];
+        let mut unknown = false;
+        for (x, &c) in cols.iter().enumerate() {
+            let residual = x < 2 * storeys && x % 2 == 1;
+            line.push(match table.num(i, c)? {
+                Some(v) if residual => v.abs().to_string(),
+                Some(v) => v.to_string(),
+                None if residual => {
+                    unknown = true;
+                    String::new()
+                }
+                None => {
+                    return Err(DemandsError::Refused(format!(
+                        "{}, line {}: `{}` is empty in a run that did not fail",
+                        table.path.display(),
+                        i + 2,
+                        table.header[c]
+                    )))
+                }
+            });
+        }
+        line.push(u8::from(gone).to_string());
+        csv.push_str(&line.join(","));
+        csv.push('\n');
+        written += 1;
+        collapsed += usize::from(gone);
+        no_residual += usize::from(unknown && !gone);
+    }
+    if written == 0 {
+        return Err(DemandsError::Refused(format!(
+            "{}: no run left to export ({} rows, {} kept by --where, {failed} failed)",
+            table.path.display(),
+            table.rows.len(),
+            rows.len()
+        )));
+    }
+    let mut t = Telling::default();
+    t.say(format_args!(
+        "{written} runs of building {k} ({storeys} storeys, floors 0 to {}): {collapsed} collapsed (1-COL-0-1 = 1)",
+        floors - 1
+    ));
+    if failed > 0 {
+        t.note(format_args!(
+            "notice: {failed} failed runs (status neither ok nor collapsed) are left out"
+        ));
+    }
+    if no_residual > 0 {
+        t.note(format_args!(
+            "notice: {no_residual} runs that did not settle have no residual drift: their RID cells are empty (pelicun's residual drift inference can stand in for them)"
+        ));
+    }
+    Ok(StudyReport {
+        csv,
+        tables: Vec::new(),
+        said: t.said,
+        notices: t.notices,
+        notices_at: t.notices_at,
+        panels: Vec::new(),
+    })
+}
