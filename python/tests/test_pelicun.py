@@ -34,7 +34,7 @@ def test_pelicun_loads_pound_demands_with_every_value_the_sweeps(pound, tmp_path
     expected_columns = {("PID", str(j), "1") for j in range(1, storeys + 1)}
     expected_columns |= {("RID", str(j), "1") for j in range(1, storeys + 1)}
     expected_columns |= {("PFA", str(j), "1") for j in range(0, storeys + 1)}
-    expected_columns |= {("COL", "0", "1")}
+    expected_columns |= {("SA_T1", "0", "1"), ("COL", "0", "1")}
     assert set(sample.columns) == expected_columns
     assert units[("PID", "1", "1")] == "rad" and units[("PFA", "0", "1")] == "mps2"
 
@@ -58,6 +58,8 @@ def test_pelicun_loads_pound_demands_with_every_value_the_sweeps(pound, tmp_path
         for j in range(0, storeys + 1):
             assert same(got[("PFA", str(j), "1")], r[f"b1_f{j}_peak_accel_m_s2"])
         assert got[("COL", "0", "1")] == float(r["b1_collapsed"])
+        # pelicun holds accelerations in m/s^2: the target in g times standard gravity.
+        assert math.isclose(got[("SA_T1", "0", "1")], float(r["target_sa_g"]) * 9.80665, rel_tol=1e-15)
         collapsed += r["b1_collapsed"] == "1"
     assert 0 < collapsed < len(kept)
 

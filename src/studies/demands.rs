@@ -5,7 +5,8 @@
 //! Per storey `j`: `1-PID-j-1`, the peak interstorey drift ratio, and `1-RID-j-1`, the residual
 //! drift ratio's magnitude (pelicun compares it with its irreparable limit, unsigned); per floor
 //! `j` from 0, the ground: `1-PFA-j-1`, the peak absolute acceleration in m/s^2 (`mps2`); and
-//! `1-COL-0-1`, 1 where the building collapsed in the simulation, else 0: pelicun's
+//! `1-SA_T-0-1`, the target Sa(T) in g the runs were scaled to (`SA_T1` where each run's T is its
+//! building's own, sampled: the demand a collapse fragility reads); `1-COL-0-1`, 1 where the building collapsed in the simulation, else 0: pelicun's
 //! `CollapseLimits` `{"COL": 0.5}` drops those realizations from the demand sample, collapse
 //! being the collapse fragility's (`pound fragility --edp bK_collapsed --fits`). The index is
 //! the run number. A residual drift that is not known (a run that did not settle, or a building
@@ -28,6 +29,32 @@ pub enum DemandsError {
     Table(#[from] TableError),
     #[error("{0}")]
     Refused(String),
+}
+
+/// The column of the target Sa the kept `rows` were scaled to and the demand type it is written
+/// as: `SA_T` where every row shares the period `T`, `SA_T1` where each run was scaled at its
+/// own building's (sampled) period, with the range of those periods; None where a row has no
+/// target Sa.
+#[allow(clippy::type_complexity)]
+fn sa_column(
+    table: &Table,
+    rows: &[usize],
+) -> Result<Option<(usize, String, Option<(f64, f64)>)>, DemandsError> {
+    let (Ok(sa), Ok(at)) = (table.col("target_sa_g"), table.col("sa_period_s")) else {
+        return Ok(None);
+    };
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &i in rows {
+        match (table.num(i, sa)?, table.num(i, at)?) {
+            (Some(_), Some(t)) => (lo, hi) = (lo.min(t), hi.max(t)),
+            _ => return Ok(None),
+        }
+    }
+    Ok(match lo == hi {
+        true => Some((sa, format!("SA_{}", crate::show(lo)), None)),
+        false if lo <= hi => Some((sa, "SA_T1".into(), Some((lo, hi)))),
+        false => None,
+    })
 }
 
 /// `pound demands` of `table`: the SimCenter demand file of building `o.building`.
@@ -83,6 +110,13 @@ pub fn study(table: &Table, o: &DemandsOptions) -> Result<StudyReport, DemandsEr
         units.push("mps2".into());
         cols.push(table.col(&format!("b{k}_f{j}_peak_accel_m_s2"))?);
     }
+    // The spectral acceleration the runs were scaled to, where they share its period: the
+    // demand a collapse fragility of `pound fragility` reads (`SA_T`, in g).
+    let sa = sa_column(table, &rows)?;
+    if let Some((_, kind, _)) = &sa {
+        head.push(format!("1-{kind}-0-1"));
+        units.push("g".into());
+    }
     head.push("1-COL-0-1".into());
     units.push("unitless".into());
     let mut csv = format!("{}\n{}\n", head.join(","), units.join(","));
@@ -118,6 +152,9 @@ pub fn study(table: &Table, o: &DemandsOptions) -> Result<StudyReport, DemandsEr
                 }
             });
         }
+        if let Some((c, _, _)) = &sa {
+            line.push(table.rows[i][*c].trim().to_string());
+        }
         line.push(u8::from(gone).to_string());
         csv.push_str(&line.join(","));
         csv.push('\n');
@@ -138,6 +175,11 @@ pub fn study(table: &Table, o: &DemandsOptions) -> Result<StudyReport, DemandsEr
         "{written} runs of building {k} ({storeys} storeys, floors 0 to {}): {collapsed} collapsed (1-COL-0-1 = 1)",
         floors - 1
     ));
+    if let Some((_, kind, Some((lo, hi)))) = &sa {
+        t.note(format_args!(
+            "notice: each run was scaled to Sa at its own building's period ({lo:.3} to {hi:.3} s): 1-{kind}-0-1 holds those targets, Sa(T1) run by run"
+        ));
+    }
     if failed > 0 {
         t.note(format_args!(
             "notice: {failed} failed runs (status neither ok nor collapsed) are left out"
