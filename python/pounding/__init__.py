@@ -541,6 +541,7 @@ def fragility(
     seed: Optional[int] = None,
     by: Optional[str] = None,
     where: Union[None, str, Iterable[str]] = None,
+    series: Optional[str] = None,
 ) -> Table:
     """Fragility curves from a sweep's results, as ``pound fragility``: per threshold (or named
     damage state: ``"hazus-c1l-high"``, ``"fema-p58-residual"``, a TOML file) and intensity
@@ -551,6 +552,8 @@ def fragility(
     path. ``info["fits"]`` holds the fitted curves as a table (``pound fragility --fits``: per
     threshold or state the median, beta, their standard errors, log-likelihood, deviance, p,
     runs, levels, and with ``bootstrap`` the 90 % bands); ``info["report"]`` the command's report.
+    ``series``: a column whose every value gets its own curves (``--series``), that column first
+    in both tables.
     """
     args = (
         _text("im", im),
@@ -561,6 +564,7 @@ def fragility(
         _count("seed", seed, 0, _U64),
         _text("by", by),
         _where(where),
+        _text("series", series),
     )
     source, kind = _study_input(table)
     inner, tables, report, notices = _engine.fragility(source, kind, *args)

@@ -718,7 +718,7 @@ fn run_study<E: Send + 'static>(
 
 /// `pounding.fragility`: `pound fragility` on a table of results.
 #[pyfunction]
-#[pyo3(signature = (table, table_kind, im, edp, thresholds, damage_states, bootstrap, seed, by, filters))]
+#[pyo3(signature = (table, table_kind, im, edp, thresholds, damage_states, bootstrap, seed, by, filters, series))]
 #[allow(clippy::too_many_arguments)]
 fn fragility(
     py: Python<'_>,
@@ -732,6 +732,7 @@ fn fragility(
     seed: Option<u64>,
     by: Option<String>,
     filters: Vec<String>,
+    series: Option<String>,
 ) -> PyResult<Studied> {
     use pounding::studies::fragility::{study, FragilityError, FragilityOptions};
     let options = FragilityOptions {
@@ -743,6 +744,7 @@ fn fragility(
         seed,
         by,
         filters,
+        series,
     };
     let refused = |e: FragilityError| match e {
         FragilityError::Table(e) => TableError::new_err(e.to_string()),

@@ -97,6 +97,10 @@ def test_columns_are_the_command_lines_list(pound):
             {"edp": "b1_peak_drift_ratio", "damage_states": "hazus-c1l-high", "bootstrap": 200, "seed": 3},
         ),
         (
+            ["--edp", "b1_peak_drift_ratio", "--threshold", "0.01", "--series", "gap_1_2_m"],
+            {"edp": "b1_peak_drift_ratio", "thresholds": [0.01], "series": "gap_1_2_m"},
+        ),
+        (
             ["--edp", "b1_residual_drift_ratio", "--damage-states", "fema-p58-residual", "--where", "gap_1_2_m<=0.01"],
             {"edp": "b1_residual_drift_ratio", "damage_states": "fema-p58-residual", "where": "gap_1_2_m<=0.01"},
         ),

@@ -54,6 +54,10 @@ pub struct Args {
     /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
     #[arg(long = "where", value_name = "FILTER")]
     filters: Vec<String>,
+    /// Fit and draw the curves of each value of COLUMN (e.g. gap_1_2_m) in one figure, with
+    /// COLUMN first in the counts' and fits' tables (2 to 12 values).
+    #[arg(long, value_name = "COLUMN")]
+    series: Option<String>,
     /// Counts per threshold and level (CSV).
     /// (default: fragility.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
@@ -108,6 +112,7 @@ pub fn run(a: Args) -> Result<()> {
         seed: a.seed,
         by: a.by,
         filters: a.filters,
+        series: a.series,
     };
     // The settings are checked before the results are read.
     options.check()?;

@@ -8,6 +8,7 @@ use crate::support::csv_column as column;
 use crate::support::{ok, pound, table, tempdir};
 use pounding::plan::sample::{phi, Rng};
 use pounding::studies::fragility::{fit, Level};
+use std::collections::HashMap;
 use std::path::Path;
 
 fn s(p: &Path) -> String {
@@ -587,4 +588,97 @@ fn the_fits_table_is_the_fit_of_the_counts() {
     }
     // 0.005 and 0.01 are fitted; none exceeds 0.05.
     assert_eq!(fitted_rows, 2, "{rows:?}");
+}
+
+/// A CSV's rows by column name.
+type Rows = Vec<HashMap<String, String>>;
+
+/// `--series COLUMN` fits each value's curves as `--where COLUMN=VALUE` does, value by value
+/// (its fits and counts rows those of the study of that value alone, with the value first), and
+/// draws them in one figure; one value is refused, naming it.
+#[test]
+fn a_series_is_the_study_of_each_value() {
+    let d = tempdir();
+    let runs = drifts(
+        d.path(),
+        &counts(&[(0.1, 0, 2), (0.2, 1, 6), (0.4, 5, 9), (0.8, 12, 6)]),
+    );
+    // Two "gaps": the table's records split in halves.
+    let text = std::fs::read_to_string(&runs).unwrap();
+    let mut lines = text.lines();
+    let mut with = format!("{},gap_m\n", lines.next().unwrap());
+    for (k, l) in lines.enumerate() {
+        with.push_str(&format!("{l},{}\n", if k % 2 == 0 { "0" } else { "0.02" }));
+    }
+    std::fs::write(&runs, with).unwrap();
+    let run = |extra: &[&str], tag: &str| -> (Rows, Rows) {
+        let (csv, fits) = (
+            d.path().join(format!("{tag}.csv")),
+            d.path().join(format!("{tag}-fits.csv")),
+        );
+        let mut args = vec![
+            "fragility".to_string(),
+            s(&runs),
+            "--edp".into(),
+            "b1_peak_drift_ratio".into(),
+            "--threshold".into(),
+            "0.005,0.01".into(),
+            "-o".into(),
+            s(&csv),
+            "--fits".into(),
+            s(&fits),
+        ];
+        args.extend(extra.iter().map(|x| x.to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        ok(&pound(&args));
+        (table(&csv), table(&fits))
+    };
+    let svg = d.path().join("series.svg");
+    let (counted, fitted) = run(
+        &["--series", "gap_m", "--plot", svg.to_str().unwrap()],
+        "series",
+    );
+    let mut compared = 0;
+    for gap in ["0", "0.02"] {
+        let (c, f) = run(&["--where", &format!("gap_m={gap}")], gap);
+        let pick = |rows: &[HashMap<String, String>]| -> Rows {
+            (rows.iter().filter(|r| r["gap_m"] == gap))
+                .map(|r| {
+                    let mut r = r.clone();
+                    r.remove("gap_m");
+                    r
+                })
+                .collect()
+        };
+        assert_eq!(pick(&counted), c, "gap {gap}: counts");
+        assert_eq!(pick(&fitted), f, "gap {gap}: fits");
+        compared += f.len();
+    }
+    assert_eq!(compared, 4);
+    let svg = std::fs::read_to_string(&svg).unwrap();
+    for gap in ["0 m", "0.02 m"] {
+        assert!(
+            svg.contains(&format!("= {gap}, &gt; 0.5 %: observed"))
+                || svg.contains(&format!("= {gap}, > 0.5 %: observed")),
+            "{gap}"
+        );
+    }
+    let e = refused(&[
+        "fragility",
+        &s(&runs),
+        "--edp",
+        "b1_peak_drift_ratio",
+        "--threshold",
+        "0.01",
+        "--series",
+        "gap_m",
+        "--where",
+        "gap_m=0",
+        "-o",
+        &s(&d.path().join("x.csv")),
+    ]);
+    assert!(
+        e.contains("--series gap_m: 1 value among the rows kept (0)"),
+        "{e}"
+    );
 }

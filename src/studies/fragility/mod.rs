@@ -22,6 +22,8 @@ pub use crate::studies::stats::{
 };
 pub use demand::*;
 pub use grouping::{levels, Grouped, Undecided};
+mod series;
+
 pub use table::{collapse_probability, csv, csv_header, fits_csv, panel, threshold_name};
 
 use crate::io::table::{Filter, Table, TableError};
@@ -61,6 +63,9 @@ pub struct FragilityOptions {
     pub by: Option<String>,
     /// `--where` filters as typed (`COLUMN=VALUE`, `!=`, `<`, `<=`, `>`, `>=`), all kept.
     pub filters: Vec<String>,
+    /// A column whose every value gets its own curves, in one figure and one table
+    /// ([`series::study_series`]); None: one study of every row kept.
+    pub series: Option<String>,
 }
 
 impl Default for FragilityOptions {
@@ -74,6 +79,7 @@ impl Default for FragilityOptions {
             seed: None,
             by: None,
             filters: Vec::new(),
+            series: None,
         }
     }
 }
@@ -221,6 +227,9 @@ impl FragilityOptions {
 /// out of order, replicates with no fit, no run collapsed, a median extrapolated beyond the
 /// levels run, a building's collapse read from the run's status).
 pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, FragilityError> {
+    if let Some(column) = &o.series {
+        return series::study_series(table, o, column);
+    }
     let Settled {
         collapse,
         states,
