@@ -319,6 +319,17 @@ def _count(name: str, value: Any, least: int = 0, most: int = _U64) -> Optional[
     return int(value)
 
 
+def _renamed(given: Any, old: Any, old_name: str, name: str) -> Any:
+    """A keyword under its name or its old spelling, which still works with a notice: ``by``
+    meant two things (ida's curves, fragility's bootstrap groups)."""
+    if old is not None:
+        if given is not None:
+            raise SettingsError(f"{old_name}= and {name}= are one setting: give {name}= only")
+        _say([f"notice: {old_name}= is spelled {name}= now (what it does); {old_name}= still works"])
+        return old
+    return given
+
+
 def _say(lines: Sequence[str]) -> None:
     for line in lines:
         print(line, file=sys.stderr)
@@ -539,14 +550,16 @@ def fragility(
     damage_states: Optional[str] = None,
     bootstrap: int = 0,
     seed: Optional[int] = None,
-    by: Optional[str] = None,
+    bootstrap_groups: Optional[str] = None,
     where: Union[None, str, Iterable[str]] = None,
     series: Optional[str] = None,
+    by: Optional[str] = None,
 ) -> Table:
     """Fragility curves from a sweep's results, as ``pound fragility``: per threshold (or named
     damage state: ``"hazus-c1l-high"``, ``"fema-p58-residual"``, a TOML file) and intensity
     level, the runs that exceed it, with the lognormal fitted by maximum likelihood (median,
-    beta) and, with ``bootstrap`` replicates over ``by`` (records), 90 % bands.
+    beta) and, with ``bootstrap`` replicates over the groups of ``bootstrap_groups`` (default:
+    records), 90 % bands (``by``: its old spelling, which still works with a notice).
 
     ``table``: a table from :func:`sweep` (or any Arrow table or DataFrame) or a results CSV's
     path. ``info["fits"]`` holds the fitted curves as a table (``pound fragility --fits``: per
@@ -562,7 +575,10 @@ def fragility(
         _text("damage_states", damage_states),
         _count("bootstrap", bootstrap, 0, _LIMITS["bootstrap"]),
         _count("seed", seed, 0, _U64),
-        _text("by", by),
+        _text(
+            "by" if by is not None else "bootstrap_groups",
+            _renamed(bootstrap_groups, by, "by", "bootstrap_groups"),
+        ),
         _where(where),
         _text("series", series),
     )
@@ -579,15 +595,21 @@ def ida(
     *,
     edp: str,
     im: Optional[str] = None,
-    by: Union[None, str, Iterable[str]] = None,
+    curves: Union[None, str, Iterable[str]] = None,
     where: Union[None, str, Iterable[str]] = None,
+    by: Union[None, str, Iterable[str]] = None,
 ) -> Table:
     """Incremental dynamic analysis from a sweep's results, as ``pound ida``: per record (or
-    the columns ``by`` names) the demand ``edp`` against the intensity ``im``, and the 16, 50
+    the columns ``curves`` names; ``by``: its old spelling, which still works with a notice) the demand ``edp`` against the intensity ``im``, and the 16, 50
     and 84 % fractiles across the curves at each intensity level (a collapse is an infinite
     demand). ``info["long"]`` holds the curves in long form (``pound ida --long``: curve,
     intensity, demand, collapsed); ``info["report"]`` the command's report."""
-    args = (_text("im", im), _text("edp", edp, optional=False), _names(by, "by") or [])
+    named = _renamed(curves, by, "by", "curves")
+    args = (
+        _text("im", im),
+        _text("edp", edp, optional=False),
+        _names(named, "curves" if curves is not None else "by") or [],
+    )
     source, kind = _study_input(table)
     inner, tables, report, notices = _engine.ida(source, kind, *args, _where(where))
     _say(notices)

@@ -134,6 +134,8 @@ def test_a_bool_where_a_number_is_expected_is_refused_naming_it(call, name, runs
         (lambda r, p: pounding.trace(small_pair(), "0"), "run"),
         (lambda r, p: pounding.fragility(r, thresholds=[1e5], where=3), "where"),
         (lambda r, p: pounding.fragility(r, thresholds=[1e5], by=["record"]), "by"),
+        (lambda r, p: pounding.fragility(r, thresholds=[1e5], bootstrap_groups=3), "bootstrap_groups"),
+        (lambda r, p: pounding.ida(r, edp="peak_force_n", curves=3), "curves"),
         (lambda r, p: pounding.fragility(r, thresholds=[1e5], im=3), "im"),
         (lambda r, p: pounding.fragility(r, thresholds=[1e5], edp=None), "edp"),
         (lambda r, p: pounding.fragility(r, thresholds=[1e5], damage_states=1), "damage_states"),

@@ -137,6 +137,9 @@ def test_ida_is_the_command_lines(pound, tmp_path):
     runs = pounding.sweep(CONFIGS / "collapse-ida.toml", backend="cpu", progress=False)
     curves = pounding.ida(runs, edp="b1_peak_drift_ratio")
     assert_same_cells(curves, out)
+    # `curves=` names the curves; `by=`, its old spelling, still works.
+    assert_same_cells(pounding.ida(runs, edp="b1_peak_drift_ratio", curves="record"), out)
+    assert_same_cells(pounding.ida(runs, edp="b1_peak_drift_ratio", by="record"), out)
     assert_same_cells(curves.info["long"], long)
     # The long form holds the wide table's every value: a row per curve and level.
     wide = pa.table(curves).to_pylist()

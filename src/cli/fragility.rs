@@ -40,7 +40,7 @@ pub struct Args {
     /// limits.
     #[arg(long, value_name = "SET")]
     damage_states: Option<String>,
-    /// Bootstrap replicates over the groups of `--by` (records), for 90 % bands of each
+    /// Bootstrap replicates over the groups of `--bootstrap-groups` (records), for 90 % bands of each
     /// fitted median, beta and curve (0: none; else at least 100).
     #[arg(long, default_value_t = 0)]
     bootstrap: usize,
@@ -49,7 +49,10 @@ pub struct Args {
     seed: Option<u64>,
     /// The column whose groups the bootstrap draws with replacement (with --bootstrap; default
     /// record).
-    #[arg(long)]
+    #[arg(long, value_name = "COLUMN")]
+    bootstrap_groups: Option<String>,
+    /// The old spelling of --bootstrap-groups.
+    #[arg(long, hide = true, conflicts_with = "bootstrap_groups")]
     by: Option<String>,
     /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
     #[arg(long = "where", value_name = "FILTER")]
@@ -110,7 +113,7 @@ pub fn run(a: Args) -> Result<()> {
         damage_states: a.damage_states,
         bootstrap: a.bootstrap,
         seed: a.seed,
-        by: a.by,
+        by: super::renamed(a.bootstrap_groups, a.by, "--by", "--bootstrap-groups"),
         filters: a.filters,
         series: a.series,
     };

@@ -23,7 +23,10 @@ pub struct Args {
     edp: String,
     /// The columns that name a curve, comma-separated (default: record, and sample where the
     /// CSV has samples).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_name = "COLUMNS")]
+    curves: Vec<String>,
+    /// The old spelling of --curves.
+    #[arg(long, value_delimiter = ',', hide = true, conflicts_with = "curves")]
     by: Vec<String>,
     /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
     #[arg(long = "where", value_name = "FILTER")]
@@ -33,7 +36,7 @@ pub struct Args {
     /// (default: ida.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// The curves in long form (CSV): a row per curve and level, its --by cells, the
+    /// The curves in long form (CSV): a row per curve and level, its --curves cells, the
     /// intensity, the demand (`inf` from its first collapse) and whether it has collapsed (1/0).
     #[arg(long, value_name = "FILE")]
     long: Option<PathBuf>,
@@ -59,7 +62,13 @@ pub fn run(a: Args) -> Result<()> {
     let options = IdaOptions {
         im: a.im,
         edp: a.edp,
-        by: a.by,
+        by: super::renamed(
+            Some(a.curves).filter(|c| !c.is_empty()),
+            Some(a.by).filter(|c| !c.is_empty()),
+            "--by",
+            "--curves",
+        )
+        .unwrap_or_default(),
         filters: a.filters,
     };
     // The settings are checked before the results are read.

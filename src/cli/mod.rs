@@ -292,6 +292,16 @@ pub fn write_and_plot(
     Ok(())
 }
 
+/// A flag's value under its name or under its old spelling, which still works with a notice:
+/// `--by` meant three things (plot's series, ida's curves, fragility's bootstrap groups) and is
+/// spelled for what it does now.
+pub fn renamed<T>(given: Option<T>, old: Option<T>, old_name: &str, name: &str) -> Option<T> {
+    if old.is_some() {
+        note!("notice: {old_name} is spelled {name} now (what it does); {old_name} still works");
+    }
+    given.or(old)
+}
+
 /// Write each of a study's other `tables` that `paths` asks for (by name; None: not asked).
 pub fn write_tables(tables: &[(&str, String)], paths: &[(&str, Option<&Path>)]) -> Result<()> {
     for (name, path) in paths {

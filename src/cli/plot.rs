@@ -18,7 +18,10 @@ pub struct Args {
     #[arg(long)]
     y: String,
     /// One series per value of this column (e.g. record, law).
-    #[arg(long)]
+    #[arg(long, value_name = "COLUMN")]
+    series: Option<String>,
+    /// The old spelling of --series.
+    #[arg(long, hide = true, conflicts_with = "series")]
     by: Option<String>,
     /// Keep only rows with COLUMN=VALUE (also !=, <, <=, >, >=); repeat to combine.
     #[arg(long = "where", value_name = "FILTER")]
@@ -70,7 +73,7 @@ pub fn run(a: Args) -> Result<()> {
     let spec = PlotSpec {
         x: a.x,
         y: a.y,
-        by: a.by,
+        by: super::renamed(a.series, a.by, "--by", "--series"),
         filters: Filter::parse_all(&a.filters)?,
         aggregate: match a.agg {
             AggArg::Max => Aggregate::Max,

@@ -185,7 +185,7 @@ fn plot_says_how_many_runs_collapsed_at_each_x() {
             "pga_g",
             "--y",
             "b1_peak_drift_ratio",
-            "--by",
+            "--series",
             "record",
         ],
     );

@@ -158,7 +158,7 @@ fn legends_cover_no_point_and_styles_are_distinct() {
         "gap_m",
         "--y",
         "peak_force_n",
-        "--by",
+        "--series",
         "t2_s",
         "-o",
         &s(&plot),
@@ -173,7 +173,7 @@ fn legends_cover_no_point_and_styles_are_distinct() {
         "gap_m",
         "--y",
         "peak_force_n",
-        "--by",
+        "--series",
         "formula",
         "--where",
         "t2_s=0.4",
@@ -199,7 +199,7 @@ fn legends_cover_no_point_and_styles_are_distinct() {
         "gap_m",
         "--y",
         "peak_force_n",
-        "--by",
+        "--series",
         "formula",
         "--size",
         "400x320",
@@ -553,7 +553,7 @@ fn every_row_left_out_is_counted() {
         "pga_g",
         "--y",
         "b1_residual_drift_ratio",
-        "--by",
+        "--series",
         "record",
         "-o",
         plot.to_str().unwrap(),
@@ -591,7 +591,7 @@ fn every_row_left_out_is_counted() {
 /// Class 6 where it arises in filters and series: a scaled PGA computed per record
 /// (`0.19999999999999998`, `0.20000000000000004`) is one value to `--where` and `--by`, as it
 /// is one level to `pound fragility`. `--where pga_g=0.2` silently dropped a record's rows, and
-/// `--by pga_g` drew twelve series for eight levels.
+/// `--series pga_g` drew twelve series for eight levels.
 #[test]
 fn one_value_computed_per_record_is_one_value() {
     let dir = tempdir();
@@ -648,7 +648,7 @@ fn one_value_computed_per_record_is_one_value() {
         "gap_m",
         "--y",
         "peak_force_n",
-        "--by",
+        "--series",
         "pga_g",
         "-o",
         dir.path().join("p.svg").to_str().unwrap(),
@@ -682,7 +682,7 @@ fn a_title_stands_over_its_panel() {
         "gap_m",
         "--y",
         "peak_force_n",
-        "--by",
+        "--series",
         "record",
         "--where",
         "pga_g>=0.5",

@@ -239,7 +239,7 @@ fn runs_without_a_value_are_decided_or_bounded() {
         "pga_g",
         "--edp",
         "b1_residual_drift_ratio",
-        "--by",
+        "--curves",
         "record",
         "-o",
         &s(&dir.path().join("ida.csv")),
@@ -385,7 +385,7 @@ fn small_ones_in_studies() {
             "{e}"
         );
     }
-    for flag in [["--by", "record"], ["--seed", "3"]] {
+    for flag in [["--bootstrap-groups", "record"], ["--seed", "3"]] {
         let e = refused(&with_args(
             &r,
             &f,

@@ -319,7 +319,7 @@ fn studies(dir: &Path, csv: &Path, im: &str, edp: &str, threshold: &str, by: &st
         im,
         "--edp",
         edp,
-        "--by",
+        "--curves",
         by,
         "-o",
         &s(&i),

@@ -515,7 +515,7 @@ fn names_do_not_collide() {
                 "pga_g",
                 "--edp",
                 "b1_peak_drift_ratio",
-                "--by",
+                "--curves",
                 "record,record",
                 "-o",
                 &o("i.csv"),

@@ -506,7 +506,7 @@ fn row_config_sweeps_to_csv_matching_the_library() {
         "gap_1_2_m",
         "--y",
         "b2_peak_drift_ratio",
-        "--by",
+        "--series",
         "law",
         "-o",
         svg.to_str().unwrap(),

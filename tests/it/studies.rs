@@ -51,7 +51,7 @@ fn plots_from_a_small_sweep() {
         "pga_g",
         "--y",
         "peak_force_n",
-        "--by",
+        "--series",
         "law",
         "--where",
         "t2_s=0.9",
@@ -62,6 +62,26 @@ fn plots_from_a_small_sweep() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("2 series, 6 points"));
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
+    // The old spelling `--by` draws the same figure, and says the flag's name now.
+    let old = d.path().join("old.svg");
+    let said = pound(&[
+        "plot",
+        runs.to_str().unwrap(),
+        "--x",
+        "pga_g",
+        "--y",
+        "peak_force_n",
+        "--by",
+        "law",
+        "--where",
+        "t2_s=0.9",
+        "-o",
+        old.to_str().unwrap(),
+    ]);
+    ok(&said);
+    assert!(String::from_utf8_lossy(&said.stderr)
+        .contains("notice: --by is spelled --series now (what it does); --by still works"));
+    assert_eq!(std::fs::read_to_string(&old).unwrap(), text);
     for name in [
         "contact law = hertz",
         "contact law = nonlinear_viscoelastic",
@@ -85,7 +105,7 @@ fn plots_from_a_small_sweep() {
         "gap_m",
         "--y",
         "peak_force_n",
-        "--by",
+        "--series",
         "pga_g",
         "--agg",
         "none",
@@ -105,7 +125,7 @@ fn plots_from_a_small_sweep() {
             "gap_m",
             "--y",
             "peak_force_n",
-            "--by",
+            "--series",
             "pga_g",
             "--size",
             "400x320",
@@ -257,7 +277,7 @@ fn plotted_values_are_the_chosen_aggregate_at_each_x() {
             "gap_m",
             "--y",
             "peak_force_n",
-            "--by",
+            "--series",
             "law",
             "--agg",
             agg,

@@ -177,7 +177,7 @@ fn an_ida_table_never_names_a_column_twice() {
         assert!(
             e.contains(&format!("the IDA table would have two columns `{label}`"))
                 && e.contains(&format!("the curve `{label}`"))
-                && e.contains("--by"),
+                && e.contains("--curves"),
             "{label}: {e}"
         );
         assert!(!out.exists(), "{label}: written");
@@ -195,7 +195,7 @@ fn an_ida_table_never_names_a_column_twice() {
         &s(&p),
         "--edp",
         "b1_peak_drift_ratio",
-        "--by",
+        "--curves",
         "record,sample",
         "-o",
         &s(&out),

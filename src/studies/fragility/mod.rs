@@ -154,7 +154,10 @@ impl FragilityOptions {
             ));
         }
         // Flags of the bootstrap mean nothing without it.
-        for (flag, given) in [("--by", self.by.is_some()), ("--seed", self.seed.is_some())] {
+        for (flag, given) in [
+            ("--bootstrap-groups", self.by.is_some()),
+            ("--seed", self.seed.is_some()),
+        ] {
             if given && self.bootstrap == 0 {
                 return refuse(format!("{flag} applies to the bootstrap bands: give --bootstrap N (N >= {MIN_BOOTSTRAP}) with it, or leave {flag} out"));
             }

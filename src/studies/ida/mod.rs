@@ -79,7 +79,7 @@ pub struct Ida {
 pub enum IdaError {
     #[error(transparent)]
     Table(#[from] TableError),
-    #[error("{path}: rows {first} and {second} are both curve `{curve}` at {im} = {level}: name the columns that tell them apart with --by (e.g. --by record,sample,gap_m) or keep one with --where")]
+    #[error("{path}: rows {first} and {second} are both curve `{curve}` at {im} = {level}: name the columns that tell them apart with --curves (e.g. --curves record,sample,gap_m) or keep one with --where")]
     Duplicate {
         path: String,
         curve: String,
@@ -140,7 +140,7 @@ pub fn read(table: &Table, spec: &IdaSpec) -> Result<(Ida, LeftOut), IdaError> {
         let name = cells.join("/");
         if let Some(other) = named.get(&name).filter(|o| **o != cells) {
             return Err(IdaError::Refused(format!(
-                "{}: the curves of --by {} cells `{}` and `{}` would both be named `{name}` (a curve is named by its cells joined by `/`): name the curves by other columns with --by, or rename the records",
+                "{}: the curves of --curves {} cells `{}` and `{}` would both be named `{name}` (a curve is named by its cells joined by `/`): name the curves by other columns with --curves, or rename the records",
                 table.path.display(),
                 spec.by.join(","),
                 other.join("`, `"),
@@ -305,7 +305,7 @@ impl Ida {
             )
         };
         Err(IdaError::Refused(format!(
-            "the IDA table would have two columns `{column}` (columns {}): {what}; rename the record (its `name` in the config's [[record]]) and rerun the sweep, or name the curves by other columns with --by",
+            "the IDA table would have two columns `{column}` (columns {}): {what}; rename the record (its `name` in the config's [[record]]) and rerun the sweep, or name the curves by other columns with --curves",
             at.iter().map(|i| (i + 1).to_string()).collect::<Vec<_>>().join(", ")
         )))
     }
@@ -522,7 +522,7 @@ impl IdaOptions {
     pub fn check(&self) -> Result<(), IdaError> {
         if let Some(twice) = crate::config::name_given_twice(&self.by) {
             return Err(IdaError::Refused(format!(
-                "--by: `{twice}` is given twice: give each column once"
+                "--curves: `{twice}` is given twice: give each column once"
             )));
         }
         Ok(())
@@ -670,7 +670,7 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
     if ida.curves.len() == 1 {
         // Fractiles across one curve are that curve: no spread across records to read.
         t.note(format_args!(
-            "notice: one curve ({}): its 16, 50 and 84 % fractiles are its own demands, with no spread across records; an IDA's fractiles need several curves (records, or the columns --by names)",
+            "notice: one curve ({}): its 16, 50 and 84 % fractiles are its own demands, with no spread across records; an IDA's fractiles need several curves (records, or the columns --curves names)",
             ida.curves[0].0
         ));
     }
@@ -862,7 +862,7 @@ mod tests {
         let e = read(&table(text), &spec(&["record"]))
             .unwrap_err()
             .to_string();
-        assert!(e.contains("rows 2 and 3") && e.contains("--by"), "{e}");
+        assert!(e.contains("rows 2 and 3") && e.contains("--curves"), "{e}");
         let (ida, _) = read(&table(text), &spec(&["record", "sample"])).unwrap();
         assert_eq!(ida.curves.len(), 2);
         assert_eq!(ida.curves[1].0, "a/1");
@@ -923,7 +923,7 @@ mod tests {
         };
         assert_eq!(
             twice.check().unwrap_err().to_string(),
-            "--by: `record` is given twice: give each column once"
+            "--curves: `record` is given twice: give each column once"
         );
         assert!(matches!(study(&table, &twice), Err(IdaError::Refused(_))));
     }
