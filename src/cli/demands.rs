@@ -17,8 +17,9 @@ pub struct Args {
     /// intensity level: --where target_sa_g=0.5).
     #[arg(long = "where", value_name = "FILTER")]
     filters: Vec<String>,
-    /// The demand sample (CSV: a row per run, `1-PID-j-1`, `1-RID-j-1`, `1-PFA-j-1` and
-    /// `1-COL-0-1` columns, a units row).
+    /// The demand sample (CSV: a row per run, `1-PID-j-1`, `1-RID-j-1`, `1-PFA-j-1`, the target
+    /// Sa as `1-SA_T-0-1` where the runs were scaled to one, and `1-COL-0-1` columns, a units
+    /// row).
     /// (default: demands.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,

@@ -36,7 +36,7 @@ pub struct Args {
     /// (default: ida.csv, numbered `-2`, `-3`, ... where that file exists)
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// The curves in long form (CSV): a row per curve and level, its --curves cells, the
+    /// The curves in long form (CSV): a row per curve and level, its --curves cells joined by `/`, the
     /// intensity, the demand (`inf` from its first collapse) and whether it has collapsed (1/0).
     #[arg(long, value_name = "FILE")]
     long: Option<PathBuf>,

@@ -241,6 +241,25 @@ fn pound_demands_writes_the_simcenter_form_or_says_what_is_missing() {
     let p = plain.to_str().unwrap();
     let e = refused(&["demands", p, "--building", "1", "-o", o]);
     assert!(e.contains("--columns +storeys,+floors"), "{e}");
+    // A table that left out the building's collapse column cannot tell its collapsed runs.
+    let partial = d.path().join("partial.csv");
+    sweep(
+        "configs/collapse-fragility.toml",
+        &partial,
+        &["--columns", "status,target_sa_g,+storeys,+floors"],
+    );
+    let e = refused(&[
+        "demands",
+        partial.to_str().unwrap(),
+        "--building",
+        "1",
+        "-o",
+        o,
+    ]);
+    assert!(e.contains("no b1_collapsed column"), "{e}");
     let e = refused(&["demands", r, "--building", "3", "-o", o]);
-    assert!(e.contains("no building 3 (the table has 2"), "{e}");
+    assert!(
+        e.contains("no building 3 (the table's columns name buildings 1 to 2)"),
+        "{e}"
+    );
 }

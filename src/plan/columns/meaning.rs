@@ -435,7 +435,7 @@ pub fn meaning(column: &str) -> Option<Meaning> {
                 } else {
                     (
                         format!("peak acceleration, building {k} floor {j}"),
-                        format!("largest absolute acceleration of floor {j} of building {k}, relative acceleration plus the ground's (--columns +floors)"),
+                        format!("largest absolute acceleration of floor {j} of building {k}, relative acceleration plus the ground's (--columns +floors; floors 1 and up are those of bK_peak_accel_m_s2)"),
                     )
                 };
                 return Some(Meaning {

@@ -67,7 +67,12 @@ pub(super) fn study_series(
         let at = out.said.len() + heading.len();
         out.said.push_str(&heading);
         out.notices_at.extend(r.notices_at.iter().map(|k| at + k));
-        out.notices.extend(r.notices);
+        // A notice names the value it is about.
+        out.notices
+            .extend(r.notices.into_iter().map(|n| match n.split_once(": ") {
+                Some((kind, rest)) => format!("{kind}: ({column} = {v}) {rest}"),
+                None => format!("({column} = {v}) {n}"),
+            }));
         out.said.push_str(&r.said);
         prefix_rows(&mut out.csv, &r.csv, column, v);
         if let Some((_, fits)) = r.tables.iter().find(|(n, _)| *n == "fits") {
