@@ -82,15 +82,16 @@ pub fn columns(a: ColumnsArgs) -> Result<()> {
         Some(path) => Some(config::load_text(&config::read_text(path)?, path)?),
         None => None,
     };
-    // With --all, a row's columns written only when asked too (its storeys' and floors'
-    // groups), in the order a sweep writes them with every group on.
-    let mut all = plan.clone();
-    if let (true, Some(pounding::plan::Plan::Row(row))) = (a.all, &mut all) {
-        row.ask_columns(&["+storeys".to_string(), "+floors".to_string()]);
-    }
-    let names = match &all {
-        Some(plan) => plan.header(),
-        None => pounding::plan::columns::header()
+    // A row with every group on: its columns written only when asked too (its storeys' and
+    // floors'), in the order a sweep writes them.
+    let every = match &plan {
+        Some(pounding::plan::Plan::Row(row)) => Some(row.with_every_group()),
+        _ => None,
+    };
+    let names = match (&plan, &every) {
+        (_, Some(every)) if a.all => every.header(),
+        (Some(plan), _) => plan.header(),
+        (None, _) => pounding::plan::columns::header()
             .into_iter()
             .map(String::from)
             .collect(),
@@ -102,9 +103,7 @@ pub fn columns(a: ColumnsArgs) -> Result<()> {
         if !row.is_empty() && !row.level_names().is_empty() {
             note!("\ncontact levels:\n{}", row.level_table().trim_end());
         }
-        if !a.all {
-            let mut every = row.clone();
-            every.ask_columns(&["+storeys".to_string(), "+floors".to_string()]);
+        if let (false, Some(every)) = (a.all, &every) {
             let more = every.header().len() - names.len();
             let groups: Vec<String> = (pounding::plan::columns::row::COLUMN_GROUPS.iter())
                 .map(|(g, what)| format!("{g}: {what}"))

@@ -73,7 +73,6 @@ impl Plan {
     /// building's storeys and floors (`+storeys`, `+floors`); a pair has none.
     pub fn ask_columns(&mut self, columns: &[String]) {
         if let Plan::Row(r) = self {
-            r.storey_columns |= columns.iter().any(|c| RowPlan::asks_storey_columns(c));
             r.ask_columns(columns);
         }
     }

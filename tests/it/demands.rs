@@ -10,6 +10,7 @@
 //! a collapsed storey's peak drift is the limit; the groups are refused where they cannot be
 //! written, naming why.
 
+use crate::support::cli::refusal as refused;
 use crate::support::{ok, pound, table, tempdir};
 use std::collections::HashMap;
 
@@ -34,13 +35,6 @@ fn num(r: &Row, c: &str) -> f64 {
         .unwrap_or_else(|| panic!("no column {c}"))
         .parse()
         .unwrap_or_else(|_| panic!("{c}: {:?}", r[c]))
-}
-
-/// `pound ARGS`' standard error, where it fails.
-fn refused(args: &[&str]) -> String {
-    let r = pound(args);
-    assert!(!r.status.success(), "{args:?} succeeded");
-    String::from_utf8_lossy(&r.stderr).into_owned()
 }
 
 #[test]
@@ -175,6 +169,20 @@ fn the_groups_are_refused_where_they_cannot_be_written() {
         "gpu",
     ]);
     assert!(e.contains("tracked on the CPU only"), "{e}");
+    // A yielding storey's own column is written from what every run reports: no demand is
+    // tracked, so the GPU takes the sweep.
+    ok(&pound(&[
+        "sweep",
+        "configs/inelastic-row.toml",
+        "-o",
+        o,
+        "--columns",
+        "run,b1_s1_peak_ductility",
+        "--backend",
+        "gpu",
+        "--precision",
+        "f64",
+    ]));
     // A group beside named columns adds its own to them.
     let rows = sweep(
         "configs/row-3-6.toml",

@@ -4,6 +4,7 @@
 //! says why, and the study flags mean what they say (issue 47's classes 8, 9, 10 and 13).
 
 use crate::scenes::sampled_runs as sweep;
+use crate::support::cli::refusal as refused;
 use crate::support::csv_column as column;
 use crate::support::{ok, pound, table, tempdir};
 use pounding::plan::sample::{phi, Rng};
@@ -13,17 +14,6 @@ use std::path::Path;
 
 fn s(p: &Path) -> String {
     p.to_str().unwrap().to_string()
-}
-
-/// `pound ARGS`' standard error, where it fails.
-fn refused(args: &[&str]) -> String {
-    let out = pound(args);
-    assert!(
-        !out.status.success(),
-        "pound {args:?} succeeded: {}",
-        String::from_utf8_lossy(&out.stdout)
-    );
-    String::from_utf8_lossy(&out.stderr).to_string()
 }
 
 /// A results CSV of `record, status, pga_g, b1_peak_drift_ratio`: at each level, runs of the

@@ -70,38 +70,60 @@ pub const COLUMN_GROUPS: [(&str, &str); 2] = [
     ("+floors", "every building's floors: peak absolute acceleration, floor 0 the ground"),
 ];
 
+/// A storey's or floor's column `bK_sJ_<suffix>` or `bK_fJ_<suffix>`: `b's'` or `b'f'`, the
+/// building K (from 1) and the suffix.
+fn storey_or_floor(column: &str) -> Option<(u8, usize, &str)> {
+    let digits = |x: &str| !x.is_empty() && x.bytes().all(|c| c.is_ascii_digit());
+    let (k, rest) = column.strip_prefix('b')?.split_once('_')?;
+    let kind = *rest.as_bytes().first()?;
+    let (j, suffix) = rest[1..].split_once('_')?;
+    if !(matches!(kind, b's' | b'f') && digits(k) && digits(j) && !suffix.is_empty()) {
+        return None;
+    }
+    Some((kind, k.parse().ok()?, suffix))
+}
+
 /// The group of `column` (`+storeys` for `b1_s2_...`, `+floors` for `b1_f0_...`), if any.
 pub fn column_group(column: &str) -> Option<&'static str> {
-    let digits = |x: &str| !x.is_empty() && x.bytes().all(|c| c.is_ascii_digit());
-    let rest = column.strip_prefix('b')?;
-    let (k, rest) = rest.split_once('_')?;
-    let (group, rest) = match rest.as_bytes().first()? {
-        b's' => ("+storeys", &rest[1..]),
-        b'f' => ("+floors", &rest[1..]),
-        _ => return None,
-    };
-    let (j, suffix) = rest.split_once('_')?;
-    (digits(k) && digits(j) && !suffix.is_empty()).then_some(group)
+    match storey_or_floor(column)? {
+        (b's', ..) => Some("+storeys"),
+        _ => Some("+floors"),
+    }
 }
 
 impl RowPlan {
     /// Turn on the columns `columns` (`--columns`) asks for that a sweep writes only when
-    /// asked: a group (`+storeys`, `+floors`), or one of its columns.
+    /// asked: a group (`+storeys`, `+floors`), a yielding storey's own column
+    /// (`b1_s2_peak_ductility`: written from what every run reports), or a demand column of a
+    /// storey or floor (tracked on the CPU only).
     pub fn ask_columns(&mut self, columns: &[String]) {
         for c in columns {
-            let group = match c.as_str() {
-                "+storeys" | "+floors" => Some(c.as_str()),
-                _ => column_group(c),
-            };
-            match group {
-                Some("+storeys") => {
-                    self.storey_demands = true;
-                    self.storey_columns = true;
-                }
-                Some("+floors") => self.floor_demands = true,
-                _ => {}
+            match c.as_str() {
+                "+storeys" => (self.storey_demands, self.storey_columns) = (true, true),
+                "+floors" => self.floor_demands = true,
+                _ => match storey_or_floor(c) {
+                    Some((b's', k, suffix)) => {
+                        let yields = (k.checked_sub(1))
+                            .and_then(|b| self.yielding.get(b))
+                            .is_some_and(Option::is_some);
+                        if yields && Self::asks_storey_columns(c) {
+                            self.storey_columns = true;
+                        } else if suffix == "peak_drift_ratio" || suffix == "residual_drift_ratio" {
+                            self.storey_demands = true;
+                        }
+                    }
+                    Some(_) => self.floor_demands = true,
+                    None => {}
+                },
             }
         }
+    }
+
+    /// A copy with every column group on (`pound columns --all`).
+    pub fn with_every_group(&self) -> RowPlan {
+        let mut every = self.clone();
+        every.ask_columns(&COLUMN_GROUPS.map(|(g, _)| g.to_string()));
+        every
     }
 
     /// Does the sweep track its buildings' demands storey by storey or floor by floor?
@@ -111,17 +133,10 @@ impl RowPlan {
 
     /// Does `column` name a yielding storey's own column (`b1_s2_peak_ductility`)?
     pub fn asks_storey_columns(column: &str) -> bool {
-        column
-            .strip_prefix('b')
-            .and_then(|r| r.split_once("_s"))
-            .and_then(|(k, rest)| {
-                let (j, suffix) = rest.split_once('_')?;
-                let digits = |x: &str| !x.is_empty() && x.bytes().all(|c| c.is_ascii_digit());
-                let known =
-                    STOREY_OUTPUTS.contains(&suffix) || IMK_STOREY_OUTPUTS.contains(&suffix);
-                (digits(k) && digits(j) && known).then_some(())
-            })
-            .is_some()
+        storey_or_floor(column).is_some_and(|(kind, _, suffix)| {
+            kind == b's'
+                && (STOREY_OUTPUTS.contains(&suffix) || IMK_STOREY_OUTPUTS.contains(&suffix))
+        })
     }
 }
 

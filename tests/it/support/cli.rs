@@ -53,6 +53,19 @@ pub fn refused(o: &Output, needle: &str, out: Option<&Path>) {
     }
 }
 
+/// `pound ARGS`' standard error, where it fails (without a panic).
+pub fn refusal(args: &[&str]) -> String {
+    let o = pound(args);
+    let err = stderr(&o);
+    assert!(
+        !o.status.success(),
+        "pound {args:?} succeeded: {}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
 /// Fails with `needle` in its message, without a panic ([`refused`] with no output to check).
 pub fn fails_with(o: &Output, needle: &str) {
     refused(o, needle, None);
