@@ -319,6 +319,14 @@ def _count(name: str, value: Any, least: int = 0, most: int = _U64) -> Optional[
     return int(value)
 
 
+def _studied(inner: Any, tables: Sequence, report: str, notices: Sequence[str]) -> "Table":
+    """A study's table, its notices told, its report and other tables (by name) in ``info``."""
+    _say(notices)
+    info = {"report": report, "notices": notices}
+    info.update((name, Table(t)) for name, t in tables)
+    return Table(inner, info)
+
+
 def _renamed(given: Any, old: Any, old_name: str, name: str) -> Any:
     """A keyword under its name or its old spelling, which still works with a notice: ``by``
     meant two things (ida's curves, fragility's bootstrap groups)."""
@@ -583,11 +591,7 @@ def fragility(
         _text("series", series),
     )
     source, kind = _study_input(table)
-    inner, tables, report, notices = _engine.fragility(source, kind, *args)
-    _say(notices)
-    info = {"report": report, "notices": notices}
-    info.update((name, Table(t)) for name, t in tables)
-    return Table(inner, info)
+    return _studied(*_engine.fragility(source, kind, *args))
 
 
 def ida(
@@ -611,11 +615,7 @@ def ida(
         _names(named, "curves" if curves is not None else "by") or [],
     )
     source, kind = _study_input(table)
-    inner, tables, report, notices = _engine.ida(source, kind, *args, _where(where))
-    _say(notices)
-    info = {"report": report, "notices": notices}
-    info.update((name, Table(t)) for name, t in tables)
-    return Table(inner, info)
+    return _studied(*_engine.ida(source, kind, *args, _where(where)))
 
 
 def demands(

@@ -46,6 +46,16 @@ where
     w.into_inner().expect("writing to memory")
 }
 
+/// A cell of a CSV a study writes by hand: quoted where it holds a comma, a quote or a line
+/// end (its quotes doubled), else as it is.
+pub fn quote_cell(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
 /// CSV lines of rows of cells, as written.
 pub fn encode_rows(rows: &[Vec<String>]) -> Vec<u8> {
     lines(rows)

@@ -44,40 +44,31 @@ fn plots_from_a_small_sweep() {
     let d = tempdir();
     let runs = sweep(d.path());
     let svg = d.path().join("force.svg");
-    let out = pound(&[
-        "plot",
-        runs.to_str().unwrap(),
-        "--x",
-        "pga_g",
-        "--y",
-        "peak_force_n",
-        "--series",
-        "law",
-        "--where",
-        "t2_s=0.9",
-        "-o",
-        svg.to_str().unwrap(),
-    ]);
+    // Peak force against PGA, a series per law, with `flag` naming the series.
+    let plot = |flag: &str, svg: &std::path::Path| {
+        pound(&[
+            "plot",
+            runs.to_str().unwrap(),
+            "--x",
+            "pga_g",
+            "--y",
+            "peak_force_n",
+            flag,
+            "law",
+            "--where",
+            "t2_s=0.9",
+            "-o",
+            svg.to_str().unwrap(),
+        ])
+    };
+    let out = plot("--series", &svg);
     ok(&out);
     assert!(String::from_utf8_lossy(&out.stderr).contains("2 series, 6 points"));
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
     // The old spelling `--by` draws the same figure, and says the flag's name now.
     let old = d.path().join("old.svg");
-    let said = pound(&[
-        "plot",
-        runs.to_str().unwrap(),
-        "--x",
-        "pga_g",
-        "--y",
-        "peak_force_n",
-        "--by",
-        "law",
-        "--where",
-        "t2_s=0.9",
-        "-o",
-        old.to_str().unwrap(),
-    ]);
+    let said = plot("--by", &old);
     ok(&said);
     assert!(String::from_utf8_lossy(&said.stderr)
         .contains("notice: --by is spelled --series now (what it does); --by still works"));

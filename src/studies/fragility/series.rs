@@ -122,11 +122,7 @@ fn prefix_rows(into: &mut String, csv: &str, column: &str, value: &str) {
     if into.is_empty() {
         into.push_str(&format!("{column},{head}\n"));
     }
-    let cell = if value.contains([',', '"']) {
-        format!("\"{}\"", value.replace('"', "\"\""))
-    } else {
-        value.to_string()
-    };
+    let cell = crate::io::csv::quote_cell(value);
     for l in lines {
         into.push_str(&format!("{cell},{l}\n"));
     }

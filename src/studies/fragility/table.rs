@@ -2,6 +2,7 @@
 
 use super::demand::{collapse_building, FragilitySpec};
 use super::grouping::Grouped;
+use crate::io::csv::quote_cell as quote;
 use crate::io::table::{caption, label};
 use crate::studies::plot::{Panel, Series};
 use crate::studies::stats::{Band, Fit, Level, NoFit};
@@ -13,13 +14,6 @@ use crate::studies::stats::{Band, Fit, Level, NoFit};
 /// and as all exceeding. The collapse fragility ([`FragilitySpec::is_collapse`]) has a row per
 /// level: the intensity, the runs, those that collapsed and their fraction.
 pub fn csv(spec: &FragilitySpec, states: Option<&[String]>, grouped: &Grouped) -> String {
-    let quote = |s: &str| {
-        if s.contains([',', '"', '\n', '\r']) {
-            format!("\"{}\"", s.replace('"', "\"\""))
-        } else {
-            s.to_string()
-        }
-    };
     let ratio = |k: u64, n: u64| {
         if n > 0 {
             (k as f64 / n as f64).to_string()
@@ -169,15 +163,6 @@ pub fn fits_csv(
         s.push('\n');
     }
     s
-}
-
-/// A CSV cell: quoted where it holds a comma, a quote or a line end.
-fn quote(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 /// The names of [`csv`]'s columns (`states`: with damage states' names).

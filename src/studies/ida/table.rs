@@ -2,19 +2,13 @@
 //! column) and the long form of `--long` (a row per curve and level).
 
 use super::{Ida, IdaSpec};
+use crate::io::csv::quote_cell as quote;
 
 impl Ida {
     /// One row per level: the intensity, the curves there, the fractiles, the curves collapsed
     /// there and their share, each curve's demand. A collapse is an infinite demand, written
     /// `inf` (a fractile it reaches too); an empty cell is no value (no run there, or none left).
     pub fn csv(&self, spec: &IdaSpec) -> String {
-        let quote = |s: &str| {
-            if s.contains([',', '"', '\n']) {
-                format!("\"{}\"", s.replace('"', "\"\""))
-            } else {
-                s.to_string()
-            }
-        };
         let head: Vec<String> = self.header(spec).iter().map(|h| quote(h)).collect();
         let mut s = head.join(",");
         s.push('\n');
@@ -43,17 +37,10 @@ impl Ida {
     }
 
     /// The curves in long form, a row per curve and level where it has a value: the curve (its
-    /// `--by` cells joined by `/`, under their names so joined; `curve` where that would name a
+    /// `--curves` cells joined by `/`, under their names so joined; `curve` where that would name a
     /// column twice), the intensity, the demand (`inf` from its first collapse) and whether it
     /// has collapsed there (1 or 0).
     pub fn long_csv(&self, spec: &IdaSpec) -> String {
-        let quote = |s: &str| {
-            if s.contains([',', '"', '\n', '\r']) {
-                format!("\"{}\"", s.replace('"', "\"\""))
-            } else {
-                s.to_string()
-            }
-        };
         let mut head = vec![spec.by.join("/"), spec.im.clone(), spec.edp.clone()];
         head.push("collapsed".into());
         if crate::io::table::duplicate_column(&head).is_some() {

@@ -178,29 +178,23 @@ impl<'m> RowRun<'m> {
                     let st = &mut self.storeys[first + j];
                     st.peak_drift_ratio = raise(st.peak_drift_ratio, y, d, a);
                 }
-                let p = if free {
-                    raise_cubic_peak(
-                        out.peak_accel,
-                        s0.a_abs[j],
-                        s0.jerk[j],
-                        s1.a_abs[j],
-                        s1.jerk[j],
-                        h,
-                    )
-                } else {
-                    out.peak_accel.max(s0.a_abs[j].abs()).max(s1.a_abs[j].abs())
+                // Floor j's acceleration peak over the piece, raised from `peak`.
+                let raise_accel = |peak: f64| {
+                    let (a0, a1) = (s0.a_abs[j], s1.a_abs[j]);
+                    if free {
+                        raise_cubic_peak(peak, a0, s0.jerk[j], a1, s1.jerk[j], h)
+                    } else {
+                        peak.max(a0.abs()).max(a1.abs())
+                    }
                 };
+                let p = raise_accel(out.peak_accel);
                 if p > out.peak_accel {
                     out.peak_accel = p;
                     out.accel_floor = j as u32 + 1;
                 }
                 if let Some(dm) = &mut self.demands {
                     let peak = &mut dm[k].peak_accel[j];
-                    *peak = if free {
-                        raise_cubic_peak(*peak, s0.a_abs[j], s0.jerk[j], s1.a_abs[j], s1.jerk[j], h)
-                    } else {
-                        peak.max(s0.a_abs[j].abs()).max(s1.a_abs[j].abs())
-                    };
+                    *peak = raise_accel(*peak);
                 }
             }
         }
