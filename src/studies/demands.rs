@@ -193,6 +193,14 @@ pub fn study(table: &Table, o: &DemandsOptions) -> Result<StudyReport, DemandsEr
             // The cell as the sweep wrote it (a residual unsigned).
             let cell = table.rows[i][c].trim();
             line.push(match table.num(i, c)? {
+                Some(v) if !v.is_finite() => {
+                    return Err(DemandsError::Refused(format!(
+                        "{}, line {}: `{}` is {cell}: a demand is a finite number",
+                        table.path.display(),
+                        i + 2,
+                        table.header[c]
+                    )))
+                }
                 Some(_) if residual => cell.trim_start_matches('-').to_string(),
                 Some(_) => cell.to_string(),
                 None if residual => {

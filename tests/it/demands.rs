@@ -265,6 +265,24 @@ fn pound_demands_writes_the_simcenter_form_or_says_what_is_missing() {
         o,
     ]);
     assert!(e.contains("no b1_collapsed column"), "{e}");
+    // A demand that is not a number is refused, naming its line and column.
+    let text = std::fs::read_to_string(&runs).unwrap();
+    let head: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let at = head
+        .iter()
+        .position(|h| *h == "b2_s2_peak_drift_ratio")
+        .unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[1].split(',').map(String::from).collect();
+    cells[at] = "NaN".into();
+    lines[1] = cells.join(",");
+    let nan = d.path().join("nan.csv");
+    std::fs::write(&nan, lines.join("\n") + "\n").unwrap();
+    let e = refused(&["demands", nan.to_str().unwrap(), "--building", "2", "-o", o]);
+    assert!(
+        e.contains("line 2: `b2_s2_peak_drift_ratio` is NaN: a demand is a finite number"),
+        "{e}"
+    );
     let e = refused(&["demands", r, "--building", "3", "-o", o]);
     assert!(
         e.contains("no building 3 (the table's columns name buildings 1 to 2)"),
