@@ -131,15 +131,117 @@ fn mul_dyn(a: &[f64], b: &[f64], n: usize) -> Vec<f64> {
 /// [`expm_dyn`]'s Taylor series takes 24 products. For the propagators built while a run goes
 /// (a building's tangent stiffness at each change of its storeys' pieces).
 fn expm_pade(a: &[f64], n: usize) -> Vec<f64> {
-    const C: [f64; 7] = [
-        1.0,
-        0.5,
-        5.0 / 44.0,
-        1.0 / 66.0,
-        1.0 / 792.0,
-        1.0 / 15_840.0,
-        1.0 / 665_280.0,
-    ];
+    // The sizes of buildings of 1 to 7 storeys on the stack, so that the products unroll: the
+    // same operations in the same order as the general one, so the same bits.
+    match n {
+        4 => expm_pade_fixed::<4>(a),
+        6 => expm_pade_fixed::<6>(a),
+        8 => expm_pade_fixed::<8>(a),
+        10 => expm_pade_fixed::<10>(a),
+        12 => expm_pade_fixed::<12>(a),
+        14 => expm_pade_fixed::<14>(a),
+        16 => expm_pade_fixed::<16>(a),
+        _ => expm_pade_dyn(a, n),
+    }
+}
+
+/// The `[6/6]` Padé approximant's coefficients.
+const PADE6: [f64; 7] = [
+    1.0,
+    0.5,
+    5.0 / 44.0,
+    1.0 / 66.0,
+    1.0 / 792.0,
+    1.0 / 15_840.0,
+    1.0 / 665_280.0,
+];
+
+/// [`expm_pade`] of an `N x N` matrix (row-major in `a`), on the stack.
+fn expm_pade_fixed<const N: usize>(a: &[f64]) -> Vec<f64> {
+    type M<const N: usize> = [[f64; N]; N];
+    fn product<const N: usize>(a: &M<N>, b: &M<N>) -> M<N> {
+        let mut r = [[0.0; N]; N];
+        for (ri, ai) in r.iter_mut().zip(a) {
+            for (&x, bk) in ai.iter().zip(b) {
+                if x == 0.0 {
+                    continue;
+                }
+                for (r, b) in ri.iter_mut().zip(bk) {
+                    *r += x * b;
+                }
+            }
+        }
+        r
+    }
+    let c = PADE6;
+    let d = balance(a, N);
+    let mut x: M<N> = std::array::from_fn(|i| std::array::from_fn(|j| a[i * N + j] * d[j] / d[i]));
+    let s = halvings_of(x.iter().map(|r| &r[..]), 0.5);
+    let f = 0.5f64.powi(s);
+    for v in x.iter_mut().flatten() {
+        *v *= f;
+    }
+    let x2 = product(&x, &x);
+    let x4 = product(&x2, &x2);
+    let x6 = product(&x4, &x2);
+    let eye = |i: usize, j: usize| if i == j { 1.0 } else { 0.0 };
+    let odd: M<N> = std::array::from_fn(|i| {
+        std::array::from_fn(|j| c[1] * eye(i, j) + c[3] * x2[i][j] + c[5] * x4[i][j])
+    });
+    let u = product(&x, &odd);
+    let v: M<N> = std::array::from_fn(|i| {
+        std::array::from_fn(|j| {
+            c[0] * eye(i, j) + c[2] * x2[i][j] + c[4] * x4[i][j] + c[6] * x6[i][j]
+        })
+    });
+    // (V - U) R = V + U, by solve_dyn's elimination.
+    let mut l: M<N> = std::array::from_fn(|i| std::array::from_fn(|j| v[i][j] - u[i][j]));
+    let mut r: M<N> = std::array::from_fn(|i| std::array::from_fn(|j| v[i][j] + u[i][j]));
+    for col in 0..N {
+        let p = (col..N)
+            .max_by(|&x, &y| l[x][col].abs().total_cmp(&l[y][col].abs()))
+            .expect("a column");
+        assert!(l[p][col].abs() > 0.0, "the Padé denominator is regular");
+        if p != col {
+            l.swap(col, p);
+            r.swap(col, p);
+        }
+        let (lp, lb) = l.split_at_mut(col + 1);
+        let (rp, rb) = r.split_at_mut(col + 1);
+        let (lp, rp) = (&lp[col], &rp[col]);
+        for (lr, rr) in lb.iter_mut().zip(rb.iter_mut()) {
+            let x = lr[col] / lp[col];
+            if x == 0.0 {
+                continue;
+            }
+            for (a, b) in lr[col..].iter_mut().zip(&lp[col..]) {
+                *a -= x * b;
+            }
+            for (a, b) in rr.iter_mut().zip(rp) {
+                *a -= x * b;
+            }
+        }
+    }
+    for col in (0..N).rev() {
+        let (top, below) = r.split_at_mut(col + 1);
+        let lc = &l[col];
+        for (j, rc) in top[col].iter_mut().enumerate() {
+            let x = (below.iter().zip(&lc[col + 1..])).fold(*rc, |x, (rk, lk)| x - lk * rk[j]);
+            *rc = x / lc[col];
+        }
+    }
+    for _ in 0..s {
+        r = product(&r, &r);
+    }
+    // exp(A) = D exp(D^-1 A D) D^-1.
+    (0..N * N)
+        .map(|i| r[i / N][i % N] * d[i / N] / d[i % N])
+        .collect()
+}
+
+/// [`expm_pade`] of any size.
+fn expm_pade_dyn(a: &[f64], n: usize) -> Vec<f64> {
+    const C: [f64; 7] = PADE6;
     // Balanced first (`D^-1 A D`, `D` powers of 2, exact): a mode's `w^2 h` and `h` become
     // about `w h` each, so far fewer squarings are needed.
     let scale = balance(a, n);
@@ -220,13 +322,15 @@ pub(crate) fn solve_dyn(mut a: Vec<f64>, mut b: Vec<f64>, n: usize, tiny: f64) -
 /// Powers of 2 `d` for which `D^-1 A D` has each row's and column's off-diagonal norms alike
 /// (Parlett and Reinsch's balancing, a few sweeps).
 fn balance(a: &[f64], n: usize) -> Vec<f64> {
-    let mut d = vec![1.0; n];
+    // `d` and its reciprocals are powers of 2, so a product with one is a division by the
+    // other, exactly.
+    let (mut d, mut inv) = (vec![1.0; n], vec![1.0; n]);
     for _ in 0..4 {
         for i in 0..n {
             let (mut row, mut col) = (0.0, 0.0);
             for j in (0..n).filter(|&j| j != i) {
-                row += (a[i * n + j] * d[j] / d[i]).abs();
-                col += (a[j * n + i] * d[i] / d[j]).abs();
+                row += (a[i * n + j] * d[j] * inv[i]).abs();
+                col += (a[j * n + i] * d[i] * inv[j]).abs();
             }
             if row == 0.0 || col == 0.0 {
                 continue;
@@ -234,6 +338,7 @@ fn balance(a: &[f64], n: usize) -> Vec<f64> {
             // Scaling d_i by 2^e scales the row by 2^-e and the column by 2^e.
             let e = (0.5 * (row / col).log2()).round();
             d[i] *= e.exp2();
+            inv[i] = 1.0 / d[i];
         }
     }
     d
@@ -295,23 +400,7 @@ impl CoupledPropagator {
     ) -> Self {
         let n = w2.len();
         let m = 2 * n + 2;
-        let mut a = vec![0.0; m * m];
-        for i in 0..n {
-            a[i * m + n + i] = h;
-            let r = (n + i) * m;
-            a[r + i] = -w2[i] * h;
-            for k in 0..n {
-                a[r + n + k] = -coupling[i][k] * h;
-            }
-            a[r + n + i] -= c[i] * h;
-            if let Some(s) = stiffness {
-                for k in 0..n {
-                    a[r + k] -= s[i][k] * h;
-                }
-            }
-            a[r + 2 * n] = -part[i] * h;
-        }
-        a[2 * n * m + 2 * n + 1] = h;
+        let a = Self::augmented((w2, stiffness, c, coupling, part), h);
         // The modal propagators of a run's start as before; a tangent's, built as the run goes,
         // by the cheaper approximant.
         let e = if stiffness.is_some() {
@@ -330,6 +419,41 @@ impl CoupledPropagator {
             f1[i] = eg / h;
         }
         CoupledPropagator { n, p, f0, f1 }
+    }
+
+    /// `A h` of the augmented system `[q, q', f, g]` (`2N + 2` square, row-major) of the modes'
+    /// `w^2`, their stiffness coupling, `c`, damping coupling and participations.
+    #[allow(clippy::type_complexity)]
+    fn augmented(
+        (w2, stiffness, c, coupling, part): (
+            &[f64],
+            Option<&[Vec<f64>]>,
+            &[f64],
+            &[Vec<f64>],
+            &[f64],
+        ),
+        h: f64,
+    ) -> Vec<f64> {
+        let n = w2.len();
+        let m = 2 * n + 2;
+        let mut a = vec![0.0; m * m];
+        for i in 0..n {
+            a[i * m + n + i] = h;
+            let r = (n + i) * m;
+            a[r + i] = -w2[i] * h;
+            for k in 0..n {
+                a[r + n + k] = -coupling[i][k] * h;
+            }
+            a[r + n + i] -= c[i] * h;
+            if let Some(s) = stiffness {
+                for k in 0..n {
+                    a[r + k] -= s[i][k] * h;
+                }
+            }
+            a[r + 2 * n] = -part[i] * h;
+        }
+        a[2 * n * m + 2 * n + 1] = h;
+        a
     }
 
     /// Its coefficients: the step `P` (`2N x 2N`, row-major) and the ground's `f0`, `f1`.
@@ -594,6 +718,48 @@ mod tests {
                 }
                 let (pp, _, _) = pade.coefficients();
                 assert!((pp[0] - p[0]).abs() <= 1e-13 * scale);
+            }
+        }
+    }
+
+    /// The stack exponentials of small matrices are the general one's, bit for bit (the same
+    /// operations in the same order), on augmented systems of 1 to 7 modes and on a dense one.
+    #[test]
+    fn stack_pade_exponentials_are_the_general_ones() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut draw = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for modes in 1..=7 {
+            let w2: Vec<f64> = (0..modes)
+                .map(|i| 40.0 * (1 + i * i) as f64 * (1.0 + draw()))
+                .collect();
+            let c: Vec<f64> = (0..modes).map(|_| 0.5 + draw()).collect();
+            let part: Vec<f64> = (0..modes).map(|_| draw()).collect();
+            let coupling: Vec<Vec<f64>> = (0..modes)
+                .map(|_| (0..modes).map(|_| 0.1 * draw()).collect())
+                .collect();
+            let stiffness: Vec<Vec<f64>> = (0..modes)
+                .map(|_| (0..modes).map(|_| 300.0 * draw()).collect())
+                .collect();
+            for h in [0.005, 0.02, 0.3] {
+                let m = 2 * modes + 2;
+                let a =
+                    CoupledPropagator::augmented((&w2, Some(&stiffness), &c, &coupling, &part), h);
+                let dense: Vec<f64> = (0..m * m).map(|_| 3.0 * draw()).collect();
+                for a in [a, dense] {
+                    let (fixed, general) = (expm_pade(&a, m), expm_pade_dyn(&a, m));
+                    assert!(
+                        fixed
+                            .iter()
+                            .zip(&general)
+                            .all(|(x, y)| x.to_bits() == y.to_bits()),
+                        "{modes} modes, h {h}"
+                    );
+                }
             }
         }
     }
