@@ -72,7 +72,8 @@ fn parse_window(text: &str) -> Result<[f64; 2]> {
 
 #[derive(clap::Subcommand)]
 pub enum Cmd {
-    /// Print npts, dt, duration, PGA, PGV, PGD and Sa at a few periods of a record file.
+    /// Print npts, dt, duration, PGA, PGV, PGD and Sa at a few periods of a record file; of a
+    /// folder of PEER NGA-West2 records (its `_SearchResults.csv`), the set as a CSV table.
     Info {
         #[command(flatten)]
         record: FileArgs,
@@ -239,6 +240,10 @@ fn spectrum(
 
 fn info(record: &FileArgs) -> Result<()> {
     let file = &record.file;
+    let named = file.file_name().and_then(|n| n.to_str());
+    if file.is_dir() || named == Some(pounding::record::set::SEARCH_RESULTS) {
+        return set_info(record);
+    }
     let rec = record.read()?;
     let pga = rec.pga();
     // Bounded however large or small the record's numbers are.
@@ -290,5 +295,63 @@ fn info(record: &FileArgs) -> Result<()> {
             if pga.value / G > 100.0 { "cm/s2" } else { "m/s2 or cm/s2" }
         );
     }
+    Ok(())
+}
+
+/// `pound record info DIR`: a PEER search's record set as a table (CSV on stdout), one row per
+/// record and component, `record` the label its runs carry in a sweep (`[[record]] set =
+/// "DIR"`), with each file's samples, step and PGA as read.
+fn set_info(args: &FileArgs) -> Result<()> {
+    use pounding::io::csv::quote_cell;
+    use pounding::record::set::{read_set, COMPONENTS};
+    if args.window.is_some() || args.dt.is_some() || args.skip_lines != 0 {
+        bail!("--window, --dt and --skip-lines read one record file: give them in a set's [[record]] (window_s, dt_s, skip_lines), not to `record info` of a set");
+    }
+    let set = read_set(&args.file)?;
+    let show = pounding::show;
+    let opt = |x: Option<f64>| x.map_or(String::new(), show);
+    let mut out = String::from("record,rsn,component,event,year,station,magnitude,mechanism,rjb_km,rrup_km,vs30_m_s,scale_factor,file,npts,dt_s,pga_g\n");
+    for r in &set.records {
+        for (c, file) in r.files.iter().enumerate() {
+            let Some(file) = file else { continue };
+            let rec = FileArgs {
+                file: file.clone(),
+                format: args.format.clone(),
+                dt: None,
+                units: args.units.clone(),
+                skip_lines: 0,
+                window: None,
+            }
+            .read()?;
+            let cells = [
+                r.label(c),
+                r.rsn.to_string(),
+                COMPONENTS[c].to_string(),
+                r.event.clone(),
+                r.year.clone(),
+                r.station.clone(),
+                opt(r.magnitude),
+                r.mechanism.clone(),
+                opt(r.rjb_km),
+                opt(r.rrup_km),
+                opt(r.vs30_m_s),
+                opt(r.scale_factor),
+                file.file_name()
+                    .map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+                rec.npts().to_string(),
+                pounding::show_derived(rec.dt),
+                show(rec.pga().value / G),
+            ];
+            let row: Vec<String> = cells.iter().map(|c| quote_cell(c)).collect();
+            out.push_str(&row.join(","));
+            out.push('\n');
+        }
+    }
+    super::say_text(&out)?;
+    eprintln!(
+        "{} records in {}; `[[record]] set = \"...\"` runs their horizontal components (components = [...] picks) under these labels",
+        set.records.len(),
+        set.results.display()
+    );
     Ok(())
 }

@@ -4,6 +4,8 @@
 use crate::config::error::{toml_error, ConfigError};
 use crate::config::pair::RawConfig;
 use crate::config::row::RawRowConfig;
+use crate::config::sections::RawRecord;
+use crate::record::set::{read_set, COMPONENTS};
 use std::path::{Path, PathBuf};
 
 /// Default directory of real records when `POUND_RECORDS_DIR` is unset (relative to the working
@@ -110,6 +112,10 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
             Err(_) => return Vec::new(),
         },
     };
+    // A set's records are its files.
+    let Ok(raw_records) = expand_sets(raw_records, path) else {
+        return Vec::new();
+    };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let records = records_dir_for(&base);
     raw_records
@@ -141,10 +147,141 @@ pub fn from_text(text: &str, path: &Path) -> Result<Config, ConfigError> {
 
 /// Config `text` read as a pair's (`[building1]` and `[building2]`).
 pub fn pair_from_text(text: &str, path: &Path) -> Result<RawConfig, ConfigError> {
-    toml::from_str(text).map_err(|e| toml_error(path, e))
+    let mut raw: RawConfig = toml::from_str(text).map_err(|e| toml_error(path, e))?;
+    raw.records = expand_sets(std::mem::take(&mut raw.records), path)?;
+    Ok(raw)
 }
 
 /// Config `text` read as a row's (`[[building]]` entries).
 pub fn row_from_text(text: &str, path: &Path) -> Result<RawRowConfig, ConfigError> {
-    toml::from_str(text).map_err(|e| toml_error(path, e))
+    let mut raw: RawRowConfig = toml::from_str(text).map_err(|e| toml_error(path, e))?;
+    raw.records = expand_sets(std::mem::take(&mut raw.records), path)?;
+    Ok(raw)
+}
+
+/// Each `[[record]] set = "DIR"` of a config at `path` as the records its search lists, one
+/// per record and component (`path =` its file, labelled `RSN6_H1`, scaled by the search's
+/// factor where `search_scale`); the other records as written.
+fn expand_sets(records: Vec<RawRecord>, path: &Path) -> Result<Vec<RawRecord>, ConfigError> {
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let invalid = |key: String, message: String| ConfigError::Invalid {
+        path: path.into(),
+        key,
+        message,
+    };
+    let mut out = Vec::with_capacity(records.len());
+    for (i, r) in records.into_iter().enumerate() {
+        let Some(dir) = &r.set else {
+            if let Some(k) = [
+                ("components", r.components.is_some()),
+                ("search_scale", r.search_scale.is_some()),
+            ]
+            .iter()
+            .find(|(_, given)| *given)
+            {
+                return Err(invalid(
+                    format!("record[{i}].{}", k.0),
+                    "applies to a record set (set = \"DIR\"), not to one record".into(),
+                ));
+            }
+            out.push(r);
+            continue;
+        };
+        if r.file.is_some() || r.path.is_some() || r.synthetic.is_some() {
+            return Err(invalid(
+                format!("record[{i}]"),
+                "give exactly one of file, path, synthetic or set".into(),
+            ));
+        }
+        if r.name.is_some() {
+            return Err(invalid(
+                format!("record[{i}].name"),
+                "a set's records are labelled by RSN and component (RSN6_H1): leave name out"
+                    .into(),
+            ));
+        }
+        let components: Vec<usize> = match &r.components {
+            None => vec![0, 1],
+            Some(list) => {
+                let mut picked = Vec::new();
+                for c in list {
+                    let at = COMPONENTS
+                        .iter()
+                        .position(|k| k.eq_ignore_ascii_case(c.trim()));
+                    match at {
+                        Some(at) if !picked.contains(&at) => picked.push(at),
+                        Some(_) => {
+                            return Err(invalid(
+                                format!("record[{i}].components"),
+                                format!("`{c}` is given twice"),
+                            ))
+                        }
+                        None => {
+                            return Err(invalid(
+                                format!("record[{i}].components"),
+                                format!("`{c}`: expected any of \"H1\", \"H2\", \"V\""),
+                            ))
+                        }
+                    }
+                }
+                if picked.is_empty() {
+                    return Err(invalid(
+                        format!("record[{i}].components"),
+                        "is empty: expected any of \"H1\", \"H2\", \"V\"".into(),
+                    ));
+                }
+                picked
+            }
+        };
+        let set = read_set(&base.join(dir)).map_err(|error| ConfigError::Record {
+            path: path.into(),
+            key: format!("record[{i}].set"),
+            error,
+        })?;
+        for rec in &set.records {
+            for &c in &components {
+                let Some(file) = &rec.files[c] else {
+                    return Err(invalid(
+                        format!("record[{i}].components"),
+                        format!(
+                            "RSN {} has no {} file in {} (line {}): leave {} out of components",
+                            rec.rsn,
+                            COMPONENTS[c],
+                            set.results.display(),
+                            rec.line,
+                            COMPONENTS[c]
+                        ),
+                    ));
+                };
+                let factor = match (r.search_scale.unwrap_or(false), rec.scale_factor) {
+                    (false, _) => None,
+                    (true, Some(f)) if f > 0.0 => Some(f),
+                    (true, f) => {
+                        return Err(invalid(
+                            format!("record[{i}].search_scale"),
+                            format!(
+                                "RSN {} has {} in {} (line {}): expected a scale factor > 0",
+                                rec.rsn,
+                                f.map_or("no Scale Factor".into(), |f| format!(
+                                    "a Scale Factor of {f}"
+                                )),
+                                set.results.display(),
+                                rec.line
+                            ),
+                        ))
+                    }
+                };
+                out.push(RawRecord {
+                    path: Some(file.to_string_lossy().into_owned()),
+                    name: Some(rec.label(c)),
+                    set: None,
+                    components: None,
+                    search_scale: None,
+                    factor,
+                    ..r.clone()
+                });
+            }
+        }
+    }
+    Ok(out)
 }

@@ -128,6 +128,17 @@ pub struct RawRecord {
     pub skip_lines: Option<usize>,
     /// `[start, end]`, s: simulate only this part of the record.
     pub window_s: Option<[f64; 2]>,
+    /// A folder of PEER NGA-West2 records with the search's `_SearchResults.csv`, relative to
+    /// the config's folder: one record per listed record and component, labelled `RSN6_H1`
+    /// (expanded when the config is read, [`crate::config::read`]).
+    pub set: Option<String>,
+    /// A set's components: any of "H1", "H2", "V" (default both horizontals).
+    pub components: Option<Vec<String>>,
+    /// Scale a set's records by the search's scale factors (default false: as recorded).
+    pub search_scale: Option<bool>,
+    /// The factor a set's record is scaled by as read (the search's), set by the expansion.
+    #[serde(skip)]
+    pub factor: Option<f64>,
 }
 
 impl RawRecord {

@@ -6,6 +6,7 @@
 pub mod intensity;
 mod read;
 pub mod rng;
+pub mod set;
 mod synthetic;
 
 pub use read::{read_record, Format, ReadOptions, Units};

@@ -48,6 +48,7 @@ mod messages;
 mod multistorey;
 mod oracles;
 mod outputs;
+mod record_sets;
 mod records;
 mod resume_and_merge;
 mod row_sweeps;
