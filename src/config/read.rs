@@ -278,6 +278,7 @@ fn expand_sets(records: Vec<RawRecord>, path: &Path) -> Result<Vec<RawRecord>, C
                     components: None,
                     search_scale: None,
                     factor,
+                    meta: Some(rec.meta(c)),
                     ..r.clone()
                 });
             }

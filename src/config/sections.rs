@@ -139,6 +139,9 @@ pub struct RawRecord {
     /// The factor a set's record is scaled by as read (the search's), set by the expansion.
     #[serde(skip)]
     pub factor: Option<f64>,
+    /// A set's record's metadata, set by the expansion (its runs' `record_...` columns).
+    #[serde(skip)]
+    pub meta: Option<crate::record::set::RecordMeta>,
 }
 
 impl RawRecord {

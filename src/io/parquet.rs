@@ -34,7 +34,8 @@ pub fn kind(column: &str) -> Kind {
         "run" | "impacts" | "substeps" | "sample" => Kind::Int,
         // The counts of a study's table (fragility, IDA): no sweep column has these names.
         "runs" | "exceed" | "collapsed" | "undecided" | "curves" | "pounding" => Kind::Int,
-        "law" | "formula" | "record" | "status" => Kind::Text,
+        "law" | "formula" | "record" | "status" | "record_component" | "record_event" => Kind::Text,
+        "record_rsn" => Kind::Int,
         c if [
             "_impacts",
             "_storeys",

@@ -30,6 +30,9 @@ pub struct ContactSpec {
     /// N/m^1.5, for Hertz-type laws
     pub beta: Vec<f64>,
     pub records: Vec<Arc<Record>>,
+    /// Each record's metadata where it came from a record set (`[[record]] set = "DIR"`):
+    /// its runs' [`crate::plan::columns::RECORD_META`] columns.
+    pub record_meta: Vec<Option<crate::record::set::RecordMeta>>,
     pub intensities: Vec<Intensity>,
     pub scheme: Scheme,
     /// Free vibration after each record, s.
@@ -182,6 +185,12 @@ pub struct ContactRun {
 }
 
 impl ContactPlan {
+    /// Did any record come from a record set (its runs then carry
+    /// [`crate::plan::columns::RECORD_META`])?
+    pub fn has_record_meta(&self) -> bool {
+        self.spec.record_meta.iter().any(Option::is_some)
+    }
+
     /// Validate the shared axes (the buildings' periods that a spectral target reads are the
     /// scene's to check: [`intensity::check_periods`]).
     pub(crate) fn new(spec: ContactSpec) -> Result<ContactPlan, PlanError> {

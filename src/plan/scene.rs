@@ -178,7 +178,7 @@ impl Plan {
     /// row's, which follows its buildings and levels ([`RowPlan::header`]).
     pub fn header(&self) -> Vec<String> {
         match self {
-            Plan::Pair(_) => columns::header().into_iter().map(String::from).collect(),
+            Plan::Pair(p) => columns::pair_header(p),
             Plan::Row(r) => r.header(),
         }
     }

@@ -49,6 +49,31 @@ impl SetRecord {
     pub fn label(&self, component: usize) -> String {
         format!("RSN{}_{}", self.rsn, COMPONENTS[component])
     }
+
+    /// What a sweep writes of component `component`'s runs ([`RecordMeta`]).
+    pub fn meta(&self, component: usize) -> RecordMeta {
+        RecordMeta {
+            rsn: self.rsn,
+            component: COMPONENTS[component],
+            event: self.event.clone(),
+            magnitude: self.magnitude,
+            rjb_km: self.rjb_km,
+            rrup_km: self.rrup_km,
+            vs30_m_s: self.vs30_m_s,
+        }
+    }
+}
+
+/// A set's record as its runs' rows name it: the search's metadata of one component.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordMeta {
+    pub rsn: u32,
+    pub component: &'static str,
+    pub event: String,
+    pub magnitude: Option<f64>,
+    pub rjb_km: Option<f64>,
+    pub rrup_km: Option<f64>,
+    pub vs30_m_s: Option<f64>,
 }
 
 /// A set: its search-results file and records, in the file's order.

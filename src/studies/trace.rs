@@ -77,10 +77,7 @@ fn trace_pair(pair: &PairPlan, run: u64) -> Trace {
         Some(&mut |s: &Sample| samples.push(*s)),
     );
     Trace {
-        header: crate::plan::columns::header()
-            .iter()
-            .map(|s| s.to_string())
-            .collect(),
+        header: crate::plan::columns::pair_header(pair),
         row: crate::plan::columns::row(pair, &spec, &output),
         history: History::Pair {
             spec: Box::new(spec),

@@ -79,8 +79,9 @@ scale = 1.0
 }
 
 /// A set runs each record's horizontal components, labelled by RSN and component; each run is
-/// the run of its file given by `path =` under that name, to the byte, and with
-/// `search_scale` each record is scaled by its search's factor (PGA 1.25 and 0.8 times).
+/// the run of its file given by `path =` under that name, to the byte, with the search's
+/// metadata after every other column (a pair's and a row's); with `search_scale` each record
+/// is scaled by its search's factor (PGA 1.25 and 0.8 times).
 #[test]
 fn a_set_runs_each_listed_component_as_its_file_would() {
     let dir = tempdir();
@@ -109,7 +110,46 @@ fn a_set_runs_each_listed_component_as_its_file_would() {
     let cfg2 = write(dir.path(), "hand.toml", &config(&by_hand));
     let out2 = dir.path().join("hand.csv");
     ok(&sweep(&cfg2, &out2, &[]));
-    assert_eq!(text, std::fs::read_to_string(&out2).unwrap());
+    // Every column but the set's metadata, which the set's runs carry after all others.
+    let meta = pounding::plan::columns::RECORD_META;
+    let without_meta = |t: &str| -> String {
+        t.lines()
+            .map(|l| {
+                let cells: Vec<&str> = l.split(',').collect();
+                cells[..cells.len() - meta.len()].join(",")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let hand = std::fs::read_to_string(&out2).unwrap();
+    assert_eq!(without_meta(&text), hand.trim_end());
+    assert_eq!(csv_column(&text, "record_rsn"), ["6", "6", "1106", "1106"]);
+    assert_eq!(
+        csv_column(&text, "record_component"),
+        ["H1", "H2", "H1", "H2"]
+    );
+    assert_eq!(csv_column(&text, "record_event")[2], "Kobe_ Japan");
+    assert_eq!(csv_column(&text, "record_magnitude")[0], "6.95");
+    assert_eq!(csv_column(&text, "record_rjb_km")[2], "0.94");
+    assert_eq!(csv_column(&text, "record_rrup_km")[2], "0.96");
+    assert_eq!(csv_column(&text, "record_vs30_m_s")[0], "213.44");
+    // A row's runs carry them too.
+    let row = config("[[record]]\nset = \"peer\"\ncomponents = [\"H2\"]")
+        .replace(
+            "[building1]",
+            "[[building]]\nstoreys = 1\nstorey_height_m = 3.0",
+        )
+        .replace(
+            "[building2]",
+            "[[building]]\nstoreys = 1\nstorey_height_m = 3.0",
+        );
+    let cfg_row = write(dir.path(), "row.toml", &row);
+    let out_row = dir.path().join("row.csv");
+    ok(&sweep(&cfg_row, &out_row, &[]));
+    let rows = std::fs::read_to_string(&out_row).unwrap();
+    assert_eq!(csv_column(&rows, "record"), ["RSN6_H2", "RSN1106_H2"]);
+    assert_eq!(csv_column(&rows, "record_rsn"), ["6", "1106"]);
+    assert_eq!(csv_column(&rows, "record_component"), ["H2", "H2"]);
     // At the search's scale factors.
     let cfg3 = write(
         dir.path(),

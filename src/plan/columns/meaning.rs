@@ -14,7 +14,7 @@ pub struct Meaning {
 }
 
 /// The columns of one run that do not depend on the scene: name, unit, short name, meaning.
-const FIXED: [(&str, &str, &str, &str); 44] = [
+const FIXED: [(&str, &str, &str, &str); 51] = [
     ("run", "-", "run", "run number"),
     ("law", "-", "contact law", "contact law"),
     (
@@ -48,6 +48,38 @@ const FIXED: [(&str, &str, &str, &str); 44] = [
         "contact stiffness of a Hertz-type law",
     ),
     ("record", "-", "record", "record label"),
+    (
+        "record_rsn",
+        "-",
+        "RSN",
+        "the record's PEER record sequence number (a record set's search results)",
+    ),
+    (
+        "record_component",
+        "-",
+        "component",
+        "the record's component: H1, H2 (horizontal) or V (vertical)",
+    ),
+    ("record_event", "-", "event", "the record's earthquake, as its search names it"),
+    ("record_magnitude", "-", "magnitude", "the earthquake's moment magnitude"),
+    (
+        "record_rjb_km",
+        "km",
+        "Rjb",
+        "the station's Joyner-Boore distance to the rupture",
+    ),
+    (
+        "record_rrup_km",
+        "km",
+        "Rrup",
+        "the station's closest distance to the rupture",
+    ),
+    (
+        "record_vs30_m_s",
+        "m/s",
+        "Vs30",
+        "the station's time-averaged shear-wave speed over the top 30 m",
+    ),
     (
         "target_pga_g",
         "g",

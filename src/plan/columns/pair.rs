@@ -149,7 +149,52 @@ pub fn row(plan: &PairPlan, spec: &RunSpec, out: &RunOutput) -> Vec<String> {
         opt(out.energy.map(|e| e.damping)),
         opt(out.energy.map(|e| e.residual)),
     ]);
+    cells.extend(record_meta_cells(&plan.contact, &spec.contact));
     cells
+}
+
+/// A record set's columns ([`crate::record::set`]), after every other column of a sweep
+/// whose records came from one ([`ContactPlan::has_record_meta`]): the search's RSN, the
+/// component, the event, its magnitude, the distances and the station's Vs30.
+pub const RECORD_META: [&str; 7] = [
+    "record_rsn",
+    "record_component",
+    "record_event",
+    "record_magnitude",
+    "record_rjb_km",
+    "record_rrup_km",
+    "record_vs30_m_s",
+];
+
+/// A run's [`RECORD_META`] cells where its plan has those columns (empty where its own record
+/// is not a set's), none where it has not.
+pub fn record_meta_cells(plan: &ContactPlan, spec: &ContactRun) -> Vec<String> {
+    if !plan.has_record_meta() {
+        return Vec::new();
+    }
+    let opt = |x: Option<f64>| x.map(num).unwrap_or_default();
+    match &plan.spec.record_meta[spec.record] {
+        Some(m) => vec![
+            m.rsn.to_string(),
+            m.component.to_string(),
+            m.event.clone(),
+            opt(m.magnitude),
+            opt(m.rjb_km),
+            opt(m.rrup_km),
+            opt(m.vs30_m_s),
+        ],
+        None => vec![String::new(); RECORD_META.len()],
+    }
+}
+
+/// A pair's columns: [`HEADER`], and [`RECORD_META`] where its records came from a set.
+pub fn pair_header(plan: &PairPlan) -> Vec<String> {
+    let meta: &[&str] = if plan.contact.has_record_meta() {
+        &RECORD_META
+    } else {
+        &[]
+    };
+    HEADER.iter().chain(meta).map(|c| c.to_string()).collect()
 }
 
 /// The first [`CONTACT_AND_MOTION`] fields of a row.

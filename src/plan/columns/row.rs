@@ -291,6 +291,9 @@ impl RowPlan {
         for c in ["input_energy_j", "damping_energy_j", "energy_residual"] {
             h.push(c.into());
         }
+        if self.contact.has_record_meta() {
+            h.extend(columns::RECORD_META.iter().map(|c| c.to_string()));
+        }
         h
     }
 
@@ -488,6 +491,7 @@ impl RowPlan {
             opt(out.energy.map(|e| e.damping)),
             opt(out.energy.map(|e| e.residual)),
         ]);
+        c.extend(columns::record_meta_cells(&self.contact, &run.contact));
         c
     }
 }

@@ -223,6 +223,7 @@ pub(crate) fn contact_spec(
         k_linear: opt_axis("contact.k_n_per_m", c.k_linear)?,
         beta: opt_axis("contact.beta_n_per_m1_5", c.beta)?,
         records: recs,
+        record_meta: c.records.iter().map(|r| r.meta.clone()).collect(),
         intensities,
         scheme: c.scheme,
         tail: c.tail,
