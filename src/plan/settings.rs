@@ -188,7 +188,7 @@ pub fn picked_columns(plan: &Plan, asked: Option<&[String]>) -> Result<Picked, S
     let asked = &asked[..];
     let indices = crate::plan::columns::select_in(&header, asked).map_err(|bad| {
         SettingsError(format!(
-            "--columns: `{bad}` is not a column of this sweep ({}); its columns are: {}",
+            "--columns: `{bad}` is not a column of this sweep ({}); its columns are: {} (`pound columns CONFIG --all` lists them with their meanings, and the columns the + groups add)",
             plan.scene(),
             header.join(", ")
         ))

@@ -195,6 +195,8 @@ fn collapsed_runs_end_at_the_limit_and_are_counted_apart() {
             assert!((1..=3).contains(&r["collapse_storey"].parse::<u32>().unwrap()));
             assert!((drift - 0.1).abs() < 1e-9, "{drift}");
             assert_eq!(r["b1_residual_drift_ratio"], "");
+            // No residual, so no storey of it.
+            assert_eq!(r["b1_residual_storey"], "");
         } else {
             assert_eq!(r["status"], "ok");
             assert!(drift < 0.1);

@@ -671,4 +671,32 @@ fn a_series_is_the_study_of_each_value() {
         e.contains("--series gap_m: 1 value among the rows kept (0)"),
         "{e}"
     );
+    // Not a series of what each curve is made of: its IM, its demand, its bootstrap groups.
+    for (series, said) in [
+        ("pga_g", "the intensity measure"),
+        ("b1_peak_drift_ratio", "the demand"),
+        ("record", "the bootstrap draws"),
+    ] {
+        let e = refused(&[
+            "fragility",
+            &s(&runs),
+            "--im",
+            "pga_g",
+            "--edp",
+            "b1_peak_drift_ratio",
+            "--threshold",
+            "0.01",
+            "--bootstrap",
+            "100",
+            "--series",
+            series,
+            "-o",
+            &s(&d.path().join("x.csv")),
+        ]);
+        assert!(
+            e.contains(&format!("--series {series}: {series} is ")),
+            "{e}"
+        );
+        assert!(e.contains(said), "{e}");
+    }
 }

@@ -890,7 +890,8 @@ fn row_sweep_writes_the_chosen_columns() {
     assert!(!o.status.success());
     assert!(
         err.contains("`peak_u1_m` is not a column of this sweep (a row of 3 buildings")
-            && err.contains("b1_peak_roof_m"),
+            && err.contains("b1_peak_roof_m")
+            && err.contains("`pound columns CONFIG --all`"),
         "{err}"
     );
     assert!(!out.exists());

@@ -427,12 +427,18 @@ impl RowPlan {
                 ]);
             }
             if y.is_some() {
-                // A run that failed, or did not settle, has no residual drift: empty.
+                // A run that failed, or did not settle, has no residual drift: empty, and no
+                // storey of it.
                 let ie = b.inelastic.unwrap_or_default();
                 let known = |x: f64| if x.is_finite() { num(x) } else { String::new() };
+                let residual_known = ie.residual_drift_ratio.is_finite();
                 c.extend([
                     known(ie.residual_drift_ratio),
-                    ie.residual_storey.to_string(),
+                    if residual_known {
+                        ie.residual_storey.to_string()
+                    } else {
+                        String::new()
+                    },
                     num(ie.peak_ductility),
                     ie.ductility_storey.to_string(),
                     num(ie.hysteretic_energy),

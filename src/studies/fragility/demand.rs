@@ -342,6 +342,22 @@ pub fn bounding_column(edp: &str) -> Option<String> {
         .then(|| format!("b{k}_peak_drift_ratio"))
 }
 
+/// Whether demand column `edp` is signed: a storey's residual drift ratio
+/// (`bK_sJ_residual_drift_ratio`, the side the storey leans to), whose demand is its magnitude.
+pub fn is_signed(edp: &str) -> bool {
+    bounding_column(edp).is_some()
+        && edp
+            .split_once('_')
+            .is_some_and(|(_, rest)| rest != "residual_drift_ratio")
+}
+
+/// The notice of a study of a signed demand ([`is_signed`]): it reads the magnitude.
+pub fn signed_notice(edp: &str) -> Option<String> {
+    is_signed(edp).then(|| {
+        format!("notice: {edp} is signed (the side the storey leans to at rest): its magnitude is the demand")
+    })
+}
+
 /// A run's demand.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Demand {
@@ -380,6 +396,7 @@ pub fn demand_rows(
     let cs = table.col("status").ok();
     let edp = ce.map(|c| table.header[c].as_str());
     let may_be_empty = edp.is_some_and(crate::engine::aggregate::may_be_empty);
+    let signed = edp.is_some_and(is_signed);
     let cb = edp
         .and_then(bounding_column)
         .and_then(|b| table.col(&b).ok());
@@ -423,6 +440,7 @@ pub fn demand_rows(
             _ if collapsed => Demand::Collapsed,
             None => Demand::Value(0.0),
             Some(ce) => match table.num(i, ce)? {
+                Some(v) if signed => Demand::Value(v.abs()),
                 Some(v) => Demand::Value(v),
                 None if may_be_empty => {
                     let bound = cb.map(|c| table.num(i, c)).transpose()?.flatten();

@@ -306,6 +306,9 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
     if let Some(n) = no_status_notice(table) {
         t.note(n);
     }
+    if let Some(n) = signed_notice(&spec.edp) {
+        t.note(n);
+    }
     if grouped.ims.len() * 2 > runs && runs >= 10 {
         t.note(format_args!(
             "notice: {} takes {} values over {runs} runs: an intensity measure that differs from run to run (levels of one or two runs each) gives shares of little meaning; the level a sweep scales to is a target column (target_pga_g, target_sa_g, target_sa_avg_g)",
@@ -827,6 +830,36 @@ mod tests {
         assert_eq!(at(Undecided::Left), vec![(2, 0), (1, 1)]);
         assert_eq!(at(Undecided::NotExceeding), vec![(2, 0), (2, 1)]);
         assert_eq!(at(Undecided::Exceeding), vec![(2, 0), (2, 2)]);
+    }
+
+    /// A storey's residual drift is signed (the side it leans to): its demand is the magnitude,
+    /// so a storey leaning 0.006 to the negative side exceeds 0.005 as one leaning to the
+    /// positive side does; a building's (a magnitude already) is read as written.
+    #[test]
+    fn a_storeys_signed_residual_is_read_as_its_magnitude() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.csv");
+        std::fs::write(
+            &p,
+            "status,pga_g,b1_peak_drift_ratio,b1_s2_residual_drift_ratio\nok,0.1,0.01,-0.006\nok,0.1,0.01,0.001\nok,0.2,0.02,0.007\nok,0.2,0.02,-0.004\n",
+        )
+        .unwrap();
+        let table = Table::read(&p).unwrap();
+        let spec = FragilitySpec {
+            im: "pga_g".into(),
+            edp: "b1_s2_residual_drift_ratio".into(),
+            thresholds: vec![0.005],
+            filters: Vec::new(),
+        };
+        let (g, _) = Grouped::read(&table, &spec, None).unwrap();
+        let counts: Vec<(u64, u64)> = g.pooled(&[1])[0].iter().map(|l| (l.n, l.exceed)).collect();
+        assert_eq!(counts, vec![(2, 1), (2, 1)]);
+        assert!(is_signed("b1_s2_residual_drift_ratio"));
+        assert!(!is_signed("b1_residual_drift_ratio"));
+        assert!(!is_signed("b1_s2_peak_drift_ratio"));
+        assert!(
+            signed_notice("b1_s2_residual_drift_ratio").is_some_and(|n| n.contains("magnitude"))
+        );
     }
 
     /// A collapsed run counts as exceeding every threshold whatever its cell holds (empty, or

@@ -18,6 +18,23 @@ pub(super) fn study_series(
     column: &str,
 ) -> Result<StudyReport, FragilityError> {
     let c = table.col(column)?;
+    // A series splits the runs by a setting: not by what each curve is made of.
+    let im = o.im.clone().unwrap_or_else(|| super::default_im(table));
+    let by = o.by.as_deref().unwrap_or("record");
+    let clash = if column == im {
+        Some("the intensity measure, whose levels each curve is fitted over")
+    } else if column == o.edp {
+        Some("the demand the curves count")
+    } else if o.bootstrap > 0 && column == by {
+        Some("the column whose groups the bootstrap draws (--bootstrap-groups, default record): each value would hold one group")
+    } else {
+        None
+    };
+    if let Some(what) = clash {
+        return Err(FragilityError::Refused(format!(
+            "--series {column}: {column} is {what}; give --series a setting the runs differ in (a gap, a period, a law)"
+        )));
+    }
     let filters = Filter::parse_all(&o.filters)?;
     let mut values: Vec<String> = Vec::new();
     for i in table.select(&filters)? {

@@ -595,6 +595,9 @@ pub fn study(table: &Table, o: &IdaOptions) -> Result<StudyReport, IdaError> {
     if let Some(n) = crate::studies::fragility::no_status_notice(table) {
         t.note(n);
     }
+    if let Some(n) = crate::studies::fragility::signed_notice(&spec.edp) {
+        t.note(n);
+    }
     // Failed runs are left out of the fractiles. Where the table has no collapse criterion a
     // failed run may be a collapse, so the fractiles over the others are collapse-free; where it
     // has one, they are over the runs that did not fail. A table written with --columns that
