@@ -3,6 +3,7 @@ yielding, collapse, floor/column contact, chosen columns, aggregate summaries), 
 paths, TOML strings and dicts, typed buffers, errors as exceptions, Ctrl-C."""
 
 import os
+from pathlib import Path
 import signal
 import subprocess
 import sys
@@ -220,3 +221,74 @@ def test_numpy_values_and_awkward_paths_are_taken_as_meant(tmp_path):
     for bad in ({"threads": -1}, {"threads": 1.5}, {"chunk": 0}):
         with pytest.raises(pounding.SettingsError):
             pounding.sweep(CONFIGS / "quickstart.toml", progress=False, **bad)
+
+
+def test_a_peer_record_set_runs_as_the_command_lines_with_its_metadata(pound, tmp_path):
+    """`[[record]] set = "DIR"`: a PEER NGA-West2 download (its files and _SearchResults.csv)
+    runs one record per RSN and component, the search's metadata in typed columns."""
+    import shutil
+
+    records = Path(os.environ.get("POUND_RECORDS_DIR") or REPO.parent / "shared" / "records")
+    folder = tmp_path / "peer"
+    folder.mkdir()
+    for src, dst in [
+        ("elcentro1940_ns_RSN6_I-ELC180.AT2", "RSN6_IMPVALL.I_I-ELC180.AT2"),
+        ("kobe1995_jma_ns_RSN1106_KJM000.AT2", "RSN1106_KOBE_KJM000.AT2"),
+    ]:
+        shutil.copy(records / src, folder / dst)
+    (folder / "_SearchResults.csv").write_text(
+        " -- Summary of Metadata of Selected Records --,,,,\n"
+        " Result ID, Record Sequence Number, Scale Factor, Earthquake Name, Year, Magnitude,"
+        " Rjb (km), Rrup (km), Vs30 (m/sec), Horizontal-1 Acc. Filename,"
+        " Horizontal-2 Acc. Filename, Vertical Acc. Filename\n"
+        '1, 6, 1.25," ""Imperial Valley-02""", 1940, 6.95, 6.09, 6.09, 213.44,'
+        " RSN6_IMPVALL.I_I-ELC180.AT2, ---, ---\n"
+        '2, 1106, 0.8," ""Kobe_ Japan""", 1995, 6.9, 0.94, 0.96, 312,'
+        " RSN1106_KOBE_KJM000.AT2, ---, ---\n"
+        ",,,,\n"
+    )
+    config = tmp_path / "set.toml"
+    config.write_text(
+        textwrap.dedent(
+            """
+            [building1]
+            period_s = 0.5
+            mass_kg = 1.0e5
+            damping_ratio = 0.05
+            [building2]
+            period_s = 1.0
+            mass_kg = 2.0e5
+            damping_ratio = 0.05
+            [contact]
+            law = "linear"
+            k_n_per_m = 1e8
+            gap_m = 0.02
+            [[record]]
+            set = "peer"
+            components = ["H1"]
+            search_scale = true
+            [intensity]
+            scale = 1.0
+            """
+        )
+    )
+    out = tmp_path / "runs.csv"
+    pound("sweep", config, "-o", out, "--backend", "cpu")
+    table = pounding.sweep(config, backend="cpu", progress=False)
+    assert_same_cells(table, out)
+    rows = pa.table(table).to_pydict()
+    assert rows["record"] == ["RSN6_H1", "RSN1106_H1"]
+    assert rows["record_rsn"] == [6, 1106]
+    assert rows["record_event"] == ["Imperial Valley-02", "Kobe_ Japan"]
+    assert rows["record_magnitude"] == [6.95, 6.9]
+    with pytest.raises(pounding.PoundingError, match="components"):
+        pounding.sweep(_with(config, 'components = ["V"]'), backend="cpu", progress=False)
+
+
+def _with(config, line):
+    """`config` with its `components = [...]` line replaced by `line`, beside it."""
+    other = config.with_name("other.toml")
+    other.write_text(
+        "\n".join(line if l.startswith("components") else l for l in config.read_text().splitlines())
+    )
+    return other
