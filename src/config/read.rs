@@ -5,7 +5,7 @@ use crate::config::error::{toml_error, ConfigError};
 use crate::config::pair::RawConfig;
 use crate::config::row::RawRowConfig;
 use crate::config::sections::RawRecord;
-use crate::record::set::{read_set, COMPONENTS};
+use crate::record::set::{read_set, COMPONENTS, SEARCH_RESULTS};
 use std::path::{Path, PathBuf};
 
 /// Default directory of real records when `POUND_RECORDS_DIR` is unset (relative to the working
@@ -112,15 +112,27 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
             Err(_) => return Vec::new(),
         },
     };
-    // A set's records are its files.
-    let Ok(raw_records) = expand_sets(raw_records, path) else {
-        return Vec::new();
-    };
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    // A set's search results, and its records' files.
+    let results: Vec<PathBuf> = (raw_records.iter())
+        .filter_map(|r| r.set.as_ref())
+        .map(|dir| {
+            let dir = base.join(dir);
+            if dir.is_dir() {
+                dir.join(SEARCH_RESULTS)
+            } else {
+                dir
+            }
+        })
+        .collect();
+    let Ok(raw_records) = expand_sets(raw_records, path) else {
+        return results;
+    };
     let records = records_dir_for(&base);
     raw_records
         .iter()
         .filter_map(|r| r.file_path(&base, &records))
+        .chain(results)
         .collect()
 }
 

@@ -133,6 +133,12 @@ fn a_set_runs_each_listed_component_as_its_file_would() {
     assert_eq!(csv_column(&text, "record_rjb_km")[2], "0.94");
     assert_eq!(csv_column(&text, "record_rrup_km")[2], "0.96");
     assert_eq!(csv_column(&text, "record_vs30_m_s")[0], "213.44");
+    // The set's files are inputs: an output over its search results is refused.
+    let results = set.join("_SearchResults.csv");
+    let o = sweep(&cfg, &results, &[]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("would destroy it"));
+    assert_eq!(std::fs::read_to_string(&results).unwrap(), RESULTS);
     // A row's runs carry them too.
     let row = config("[[record]]\nset = \"peer\"\ncomponents = [\"H2\"]")
         .replace(
