@@ -68,6 +68,12 @@ impl Fingerprint {
             samples,
             s.records.iter().map(|r| &r.name).collect::<Vec<_>>(),
         );
+        // A record set's metadata is written in its runs' rows (sweeps without one hash as
+        // before).
+        let mut text = text;
+        if s.record_meta.iter().any(Option::is_some) {
+            text.push_str(&format!("|{:?}", s.record_meta));
+        }
         let mut rec = Sha256::new();
         for r in &s.records {
             rec.update(r.name.as_bytes());

@@ -139,6 +139,20 @@ fn a_set_runs_each_listed_component_as_its_file_would() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("would destroy it"));
     assert_eq!(std::fs::read_to_string(&results).unwrap(), RESULTS);
+    // The metadata is part of the sweep: a search that now says otherwise is another sweep.
+    write(
+        &set,
+        "_SearchResults.csv",
+        &RESULTS.replace(" 6.95,", " 7.1,"),
+    );
+    let o = sweep(&cfg, &out, &["--resume"]);
+    assert!(!o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("differs from the sweep that wrote it"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    write(&set, "_SearchResults.csv", RESULTS);
     // A row's runs carry them too.
     let row = config("[[record]]\nset = \"peer\"\ncomponents = [\"H2\"]")
         .replace(
