@@ -48,7 +48,8 @@ pub struct Args {
     #[arg(long)]
     seed: Option<u64>,
     /// The column whose groups the bootstrap draws with replacement (with --bootstrap; default
-    /// record).
+    /// record, or record_rsn where every run's record came from a PEER record set: a record's
+    /// components are drawn together).
     #[arg(long, value_name = "COLUMN")]
     bootstrap_groups: Option<String>,
     /// The old spelling of --bootstrap-groups.

@@ -348,9 +348,17 @@ fn set_info(args: &FileArgs) -> Result<()> {
         }
     }
     super::say_text(&out)?;
+    let files: usize = set
+        .records
+        .iter()
+        .map(|r| r.files.iter().flatten().count())
+        .sum();
+    let plural =
+        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
     eprintln!(
-        "{} records in {}; `[[record]] set = \"...\"` runs their horizontal components (components = [...] picks) under these labels",
-        set.records.len(),
+        "{} ({}) in {}; `[[record]] set = \"...\"` runs their horizontal components (components = [...] picks) under these labels",
+        plural(set.records.len(), "record", "records"),
+        plural(files, "file", "files"),
         set.results.display()
     );
     Ok(())

@@ -183,7 +183,7 @@ fn expand_sets(records: Vec<RawRecord>, path: &Path) -> Result<Vec<RawRecord>, C
     };
     let mut out = Vec::with_capacity(records.len());
     for (i, r) in records.into_iter().enumerate() {
-        let Some(dir) = &r.set else {
+        let Some(dir) = r.set.clone() else {
             if let Some(k) = [
                 ("components", r.components.is_some()),
                 ("search_scale", r.search_scale.is_some()),
@@ -196,7 +196,10 @@ fn expand_sets(records: Vec<RawRecord>, path: &Path) -> Result<Vec<RawRecord>, C
                     "applies to a record set (set = \"DIR\"), not to one record".into(),
                 ));
             }
-            out.push(r);
+            out.push(RawRecord {
+                written_at: Some(i),
+                ..r
+            });
             continue;
         };
         if r.file.is_some() || r.path.is_some() || r.synthetic.is_some() {
@@ -245,7 +248,13 @@ fn expand_sets(records: Vec<RawRecord>, path: &Path) -> Result<Vec<RawRecord>, C
                 picked
             }
         };
-        let set = read_set(&base.join(dir)).map_err(|error| ConfigError::Record {
+        if dir.trim().is_empty() {
+            return Err(invalid(
+                format!("record[{i}].set"),
+                "is empty: give the folder of a PEER NGA-West2 search (its records and _SearchResults.csv), relative to the config".into(),
+            ));
+        }
+        let set = read_set(&base.join(&dir)).map_err(|error| ConfigError::Record {
             path: path.into(),
             key: format!("record[{i}].set"),
             error,
@@ -291,6 +300,7 @@ fn expand_sets(records: Vec<RawRecord>, path: &Path) -> Result<Vec<RawRecord>, C
                     search_scale: None,
                     factor,
                     meta: Some(rec.meta(c)),
+                    written_at: Some(i),
                     ..r.clone()
                 });
             }

@@ -142,9 +142,26 @@ pub struct RawRecord {
     /// A set's record's metadata, set by the expansion (its runs' `record_...` columns).
     #[serde(skip)]
     pub meta: Option<crate::record::set::RecordMeta>,
+    /// Its `[[record]]`'s index as written, set by the expansion (a set is one entry and
+    /// several records).
+    #[serde(skip)]
+    pub written_at: Option<usize>,
 }
 
 impl RawRecord {
+    /// The key its messages name: `record[i]` as written, with a set's record's label
+    /// (`record[0] (RSN6_H2)`); `i` its index among the records read where it was not expanded.
+    pub fn key(&self, i: usize) -> String {
+        let at = self.written_at.unwrap_or(i);
+        match &self.meta {
+            Some(_) => format!(
+                "record[{at}] ({})",
+                self.name.as_deref().unwrap_or_default()
+            ),
+            None => format!("record[{at}]"),
+        }
+    }
+
     /// The file this record reads: `file =` in the records directory `records`, `path =`
     /// relative to the config's folder `base`; None for a synthetic record.
     pub fn file_path(&self, base: &Path, records: &Path) -> Option<PathBuf> {

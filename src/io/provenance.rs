@@ -74,6 +74,9 @@ impl Fingerprint {
         if s.record_meta.iter().any(Option::is_some) {
             text.push_str(&format!("|{:?}", s.record_meta));
         }
+        if s.record_factor.iter().any(|&f| f != 1.0) {
+            text.push_str(&format!("|{:?}", s.record_factor));
+        }
         let mut rec = Sha256::new();
         for r in &s.records {
             rec.update(r.name.as_bytes());

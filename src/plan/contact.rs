@@ -33,6 +33,9 @@ pub struct ContactSpec {
     /// Each record's metadata where it came from a record set (`[[record]] set = "DIR"`):
     /// its runs' [`crate::plan::columns::RECORD_META`] columns.
     pub record_meta: Vec<Option<crate::record::set::RecordMeta>>,
+    /// Each record's own factor under an `[intensity] scale` (a set's search scale factor with
+    /// `search_scale`; else 1): its runs' `scale_factor` is the product.
+    pub record_factor: Vec<f64>,
     pub intensities: Vec<Intensity>,
     pub scheme: Scheme,
     /// Free vibration after each record, s.
@@ -425,9 +428,7 @@ impl ContactPlan {
     /// these fundamental periods (left to right).
     pub fn scale(&self, run: &mut ContactRun, periods: &[f64]) {
         let r = run.record;
-        let s = run
-            .intensity
-            .scaling(r, &self.spec.records[r], self.pgas[r], periods, &self.ims);
+        let s = self.scaling(r, &run.intensity, periods);
         run.scale = s.scale;
         run.im_periods = s.periods;
         run.pga_g = self.pgas[r] * s.scale / G;
@@ -458,6 +459,17 @@ impl ContactPlan {
         self.motion_ims.sa(r, &self.spec.records[r], period) * run.scale / G
     }
 
+    /// Record `r`'s factor under intensity `i` for buildings of these periods: a target's, or
+    /// `[intensity] scale` times the record's own factor (a set's search scale factor).
+    fn scaling(&self, r: usize, i: &Intensity, periods: &[f64]) -> intensity::Scaling {
+        let rec = &self.spec.records[r];
+        let mut s = i.scaling(r, rec, self.pgas[r], periods, &self.ims);
+        if matches!(i, Intensity::Scale(_)) {
+            s.scale *= self.spec.record_factor[r];
+        }
+        s
+    }
+
     /// The records scaled past a PGA no earthquake reaches, or by more than the config's
     /// bound on the scale factor, for buildings of these fundamental periods (a spectral target
     /// at a building's period scales by the first run's).
@@ -468,7 +480,7 @@ impl ContactPlan {
                 .spec
                 .intensities
                 .iter()
-                .map(|i| i.scaling(r, rec, self.pgas[r], periods, &self.ims).scale)
+                .map(|i| self.scaling(r, i, periods).scale)
                 .fold(0.0, f64::max);
             if scale > self.spec.warn_scale {
                 let at = if self.spec.intensities.iter().any(|i| i.follows_a_building()) {

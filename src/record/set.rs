@@ -92,6 +92,17 @@ pub fn read_set(dir: &Path) -> Result<RecordSet, RecordError> {
         let parent = dir.parent().unwrap_or(Path::new("")).to_path_buf();
         (parent, dir.to_path_buf())
     };
+    if !results.is_file() {
+        let message = if dir.is_dir() {
+            format!("no {SEARCH_RESULTS} in it: a record set is the folder of a PEER NGA-West2 search, its records and the {SEARCH_RESULTS} the search wrote (a browser may have renamed it, e.g. `_SearchResults (1).csv`)")
+        } else {
+            format!("no such folder or file: a record set is the folder of a PEER NGA-West2 search, with its {SEARCH_RESULTS}")
+        };
+        return Err(RecordError::Invalid {
+            path: dir.to_path_buf(),
+            message,
+        });
+    }
     let text = std::fs::read_to_string(&results).map_err(|error| RecordError::Io {
         path: results.clone(),
         error,
@@ -118,6 +129,11 @@ pub fn read_set(dir: &Path) -> Result<RecordSet, RecordError> {
         .map(|c| c.trim().to_string())
         .collect();
     let column = |name: &str| header.iter().position(|h| h == name);
+    // The header's named cells (a line may be padded with empty ones).
+    let named = header
+        .iter()
+        .rposition(|h| !h.is_empty())
+        .map_or(0, |k| k + 1);
     let needed = |name: &str| {
         column(name).ok_or_else(|| {
             parse(
@@ -143,6 +159,24 @@ pub fn read_set(dir: &Path) -> Result<RecordSet, RecordError> {
         let rsn_text = text_at(Some(rsn_at));
         if rsn_text.is_empty() {
             break;
+        }
+        let extra = cells.iter().skip(named).any(|c| !c.trim().is_empty());
+        if cells.len() < named || extra {
+            return Err(parse(
+                i + 1,
+                format!(
+                    "has {} cells where the header names {named}{}",
+                    cells
+                        .iter()
+                        .rposition(|c| !c.trim().is_empty())
+                        .map_or(0, |k| k + 1),
+                    if extra {
+                        ": a cell with an unquoted comma?"
+                    } else {
+                        ""
+                    }
+                ),
+            ));
         }
         let rsn: u32 = rsn_text.parse().map_err(|_| {
             parse(

@@ -186,6 +186,8 @@ fn a_set_runs_each_listed_component_as_its_file_would() {
             .map(|x| x.parse().unwrap())
             .collect()
     };
+    // The search's factor is the runs' scale factor (at [intensity] scale = 1).
+    assert_eq!(csv_column(&scaled, "scale_factor"), ["1.25", "0.8"]);
     let (plain, scaled) = (pga(&text), pga(&scaled));
     for (i, f) in [(0, 1.25), (2, 0.8)] {
         let j = i / 2;
@@ -239,6 +241,12 @@ fn a_broken_set_is_refused_by_file_line_and_key() {
     let missing = RESULTS.replace("RSN1106_KOBE_KJM090.AT2", "RSN1106_KOBE_KJM999.AT2");
     make_set(dir.path(), "missing", &missing);
     make_set(dir.path(), "none", "Result ID, RSN\n1, 6\n");
+    make_set(
+        dir.path(),
+        "comma",
+        &RESULTS.replace("\" \"\"Kobe_ Japan\"\"\"", " Kobe, Japan"),
+    );
+    std::fs::create_dir_all(dir.path().join("bare")).unwrap();
     for (records, needles) in [
         (
             "set = \"missing\"",
@@ -268,12 +276,37 @@ fn a_broken_set_is_refused_by_file_line_and_key() {
             "set = \"none\"",
             vec!["Summary of Metadata of Selected Records"],
         ),
+        ("set = \"\"", vec!["record[0].set", "is empty"]),
+        (
+            "set = \"comma\"",
+            vec!["_SearchResults.csv:7", "unquoted comma"],
+        ),
+        ("set = \"bare\"", vec!["no _SearchResults.csv in it"]),
+        ("set = \"nowhere\"", vec!["nowhere", "no such folder"]),
+        // A set's factors where a target scales each record to itself.
+        (
+            "set = \"peer\"\nsearch_scale = true\n# target",
+            vec!["record[0].search_scale", "intensity.pga_g target replaces"],
+        ),
+        // A record of a set is named by its entry and its label.
+        (
+            "set = \"peer\"\nwindow_s = [0.0, 45.0]",
+            vec!["record[0] (RSN6_H2): window_s"],
+        ),
+        (
+            "set = \"peer\"\n[[record]]\nset = \"peer\"\ncomponents = [\"H2\"]",
+            vec![
+                "record[1] (RSN6_H2)",
+                "as record[0] (RSN6_H2) is",
+                "one record set only",
+            ],
+        ),
     ] {
-        let cfg = write(
-            dir.path(),
-            "bad.toml",
-            &config(&format!("[[record]]\n{records}")),
-        );
+        let mut text = config(&format!("[[record]]\n{records}"));
+        if records.ends_with("# target") {
+            text = text.replace("scale = 1.0", "pga_g = 0.3");
+        }
+        let cfg = write(dir.path(), "bad.toml", &text);
         let out = dir.path().join("bad.csv");
         let o = sweep(&cfg, &out, &[]);
         let err = String::from_utf8_lossy(&o.stderr).to_string();

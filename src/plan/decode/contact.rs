@@ -165,6 +165,22 @@ pub(crate) fn contact_spec(
     let axis = |key: &str, a: &Axis| a.values().map_err(|m| invalid(key, m));
     let opt_axis = |key: &str, a: Option<&Axis>| a.map_or(Ok(Vec::new()), |a| axis(key, a));
     let intensities = intensity_axis(c.intensity, c.buildings, &invalid)?;
+    // A set's search scale factors scale a record where `[intensity] scale` does; a target
+    // scales each record to itself whatever it was before.
+    if let Some(r) = c.records.iter().find(|r| r.factor.is_some()) {
+        if let Some(t) = intensities
+            .iter()
+            .find(|x| !matches!(x, crate::plan::intensity::Intensity::Scale(_)))
+        {
+            return Err(invalid(
+                &format!("record[{}].search_scale", r.written_at.unwrap_or(0)),
+                format!(
+                    "scales each record by its search's factor, which the {} target replaces (a target scales every record to itself): give [intensity] scale = [...] with it, or leave search_scale out",
+                    t.key()
+                ),
+            ));
+        }
+    }
     let warn_scale = c
         .intensity
         .warn_scale_factor
@@ -181,7 +197,7 @@ pub(crate) fn contact_spec(
     }
     let mut recs = Vec::new();
     for (i, r) in c.records.iter().enumerate() {
-        let key = format!("record[{i}]");
+        let key = r.key(i);
         let rec = load_record(r, base, records).map_err(|e| match e {
             LoadError::Invalid(m) => invalid(&key, m),
             LoadError::Record(error) => ConfigError::Record {
@@ -193,12 +209,15 @@ pub(crate) fn contact_spec(
         // A label names a record's runs in every output: two records of one label could not be
         // told apart (a name given twice, two windows of one file, one seed twice).
         if let Some(j) = recs.iter().position(|r: &Arc<Record>| r.name == rec.name) {
+            let other = c.records[j].key(j);
+            let advice = if r.meta.is_some() || c.records[j].meta.is_some() {
+                "list each RSN in one record set only (a set's records are labelled by RSN and component, not renamed)"
+            } else {
+                "give each a distinct name = \"...\""
+            };
             return Err(invalid(
                 &key,
-                format!(
-                    "is labelled `{}`, as record[{j}] is: give each a distinct name = \"...\"",
-                    rec.name
-                ),
+                format!("is labelled `{}`, as {other} is: {advice}", rec.name),
             ));
         }
         // The same motion under another label would repeat every run of the first.
@@ -209,8 +228,10 @@ pub(crate) fn contact_spec(
             return Err(invalid(
                 &key,
                 format!(
-                    "`{}` holds the same accelerations (same dt and start) as record[{j}] `{}`: its runs would repeat record[{j}]'s with the same physics; remove one",
-                    rec.name, recs[j].name
+                    "`{}` holds the same accelerations (same dt and start) as {other} `{}`: its runs would repeat {other}'s with the same physics; remove one",
+                    rec.name,
+                    recs[j].name,
+                    other = c.records[j].key(j)
                 ),
             ));
         }
@@ -224,6 +245,7 @@ pub(crate) fn contact_spec(
         beta: opt_axis("contact.beta_n_per_m1_5", c.beta)?,
         records: recs,
         record_meta: c.records.iter().map(|r| r.meta.clone()).collect(),
+        record_factor: c.records.iter().map(|r| r.factor.unwrap_or(1.0)).collect(),
         intensities,
         scheme: c.scheme,
         tail: c.tail,

@@ -77,9 +77,5 @@ pub(crate) fn load_record(r: &RawRecord, base: &Path, records: &Path) -> Result<
     if let Some(n) = &r.name {
         rec.name = n.clone();
     }
-    // A set's record at its search's scale factor.
-    if let Some(f) = r.factor {
-        rec.accel.iter_mut().for_each(|a| *a *= f);
-    }
     Ok(rec)
 }

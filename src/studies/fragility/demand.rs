@@ -324,6 +324,16 @@ pub fn default_im(table: &Table) -> String {
         .to_string()
 }
 
+/// The column whose groups a bootstrap draws unless `--bootstrap-groups` names one: the
+/// record's RSN where every run's record came from a PEER record set (`record_rsn`: the
+/// components of one record are one draw, not independent ones), else the record.
+pub fn default_groups(table: &Table) -> String {
+    let rsn = table
+        .col("record_rsn")
+        .is_ok_and(|i| !table.rows.is_empty() && table.rows.iter().all(|r| !r[i].is_empty()));
+    if rsn { "record_rsn" } else { "record" }.to_string()
+}
+
 /// The column whose value bounds demand column `edp` from above, for a demand that may be empty
 /// in a run that did not fail: a residual drift (`bK_residual_drift_ratio`, and a storey's signed
 /// `bK_sJ_residual_drift_ratio`) is a storey's plastic drift at rest, which never exceeds the

@@ -241,6 +241,11 @@ pub fn study(table: &Table, o: &FragilityOptions) -> Result<StudyReport, Fragili
         by,
         seed,
     } = o.settle()?;
+    let by = if o.by.is_some() {
+        by
+    } else {
+        default_groups(table)
+    };
     // Before any column is looked up: a name given twice would read the first silently.
     table.check_columns()?;
     let spec = FragilitySpec {
@@ -860,6 +865,31 @@ mod tests {
         assert!(
             signed_notice("b1_s2_residual_drift_ratio").is_some_and(|n| n.contains("magnitude"))
         );
+    }
+
+    /// A bootstrap draws a PEER record set's records by RSN (its components together), other
+    /// tables' (and one that mixes a set's records with others) by record.
+    #[test]
+    fn a_record_sets_runs_are_drawn_by_rsn() {
+        let dir = tempfile::tempdir().unwrap();
+        let read = |name: &str, text: &str| {
+            let p = dir.path().join(name);
+            std::fs::write(&p, text).unwrap();
+            Table::read(&p).unwrap()
+        };
+        let set = read(
+            "s.csv",
+            "record,pga_g,record_rsn\nRSN6_H1,0.1,6\nRSN6_H2,0.1,6\n",
+        );
+        let mixed = read(
+            "m.csv",
+            "record,pga_g,record_rsn\nRSN6_H1,0.1,6\nelcentro,0.1,\n",
+        );
+        let plain = read("p.csv", "record,pga_g,record_rsn\nelcentro,0.1,\n");
+        assert_eq!(default_groups(&set), "record_rsn");
+        // A record not of a set has no RSN: every record its own group then.
+        assert_eq!(default_groups(&mixed), "record");
+        assert_eq!(default_groups(&plain), "record");
     }
 
     /// A collapsed run counts as exceeding every threshold whatever its cell holds (empty, or

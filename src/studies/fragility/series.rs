@@ -20,7 +20,7 @@ pub(super) fn study_series(
     let c = table.col(column)?;
     // A series splits the runs by a setting: not by what each curve is made of.
     let im = o.im.clone().unwrap_or_else(|| super::default_im(table));
-    let by = o.by.as_deref().unwrap_or("record");
+    let by = o.by.clone().unwrap_or_else(|| super::default_groups(table));
     let clash = if column == im {
         Some("the intensity measure, whose levels each curve is fitted over")
     } else if column == o.edp {
