@@ -5,7 +5,7 @@ use crate::config::error::{toml_error, ConfigError};
 use crate::config::pair::RawConfig;
 use crate::config::row::RawRowConfig;
 use crate::config::sections::RawRecord;
-use crate::record::set::{read_set, COMPONENTS, SEARCH_RESULTS};
+use crate::record::set::{read_set, results_path, COMPONENTS};
 use std::path::{Path, PathBuf};
 
 /// Default directory of real records when `POUND_RECORDS_DIR` is unset (relative to the working
@@ -116,14 +116,7 @@ pub fn input_files(text: &str, path: &Path) -> Vec<PathBuf> {
     // A set's search results, and its records' files.
     let results: Vec<PathBuf> = (raw_records.iter())
         .filter_map(|r| r.set.as_ref())
-        .map(|dir| {
-            let dir = base.join(dir);
-            if dir.is_dir() {
-                dir.join(SEARCH_RESULTS)
-            } else {
-                dir
-            }
-        })
+        .map(|dir| results_path(&base.join(dir)))
         .collect();
     let Ok(raw_records) = expand_sets(raw_records, path) else {
         return results;
@@ -215,8 +208,13 @@ fn expand_sets(records: Vec<RawRecord>, path: &Path) -> Result<Vec<RawRecord>, C
                     .into(),
             ));
         }
+        let bad_components = |m: String| invalid(format!("record[{i}].components"), m);
+        let expected = "expected any of \"H1\", \"H2\", \"V\"";
         let components: Vec<usize> = match &r.components {
             None => vec![0, 1],
+            Some(list) if list.is_empty() => {
+                return Err(bad_components(format!("is empty: {expected}")))
+            }
             Some(list) => {
                 let mut picked = Vec::new();
                 for c in list {
@@ -225,25 +223,9 @@ fn expand_sets(records: Vec<RawRecord>, path: &Path) -> Result<Vec<RawRecord>, C
                         .position(|k| k.eq_ignore_ascii_case(c.trim()));
                     match at {
                         Some(at) if !picked.contains(&at) => picked.push(at),
-                        Some(_) => {
-                            return Err(invalid(
-                                format!("record[{i}].components"),
-                                format!("`{c}` is given twice"),
-                            ))
-                        }
-                        None => {
-                            return Err(invalid(
-                                format!("record[{i}].components"),
-                                format!("`{c}`: expected any of \"H1\", \"H2\", \"V\""),
-                            ))
-                        }
+                        Some(_) => return Err(bad_components(format!("`{c}` is given twice"))),
+                        None => return Err(bad_components(format!("`{c}`: {expected}"))),
                     }
-                }
-                if picked.is_empty() {
-                    return Err(invalid(
-                        format!("record[{i}].components"),
-                        "is empty: expected any of \"H1\", \"H2\", \"V\"".into(),
-                    ));
                 }
                 picked
             }

@@ -52,7 +52,7 @@ impl Fingerprint {
         gaps: &[f64],
         samples: &Option<crate::plan::Samples>,
     ) -> Fingerprint {
-        let text = format!(
+        let mut text = format!(
             "{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
             s.laws,
             s.formulas,
@@ -70,7 +70,6 @@ impl Fingerprint {
         );
         // A record set's metadata is written in its runs' rows (sweeps without one hash as
         // before).
-        let mut text = text;
         if s.record_meta.iter().any(Option::is_some) {
             text.push_str(&format!("|{:?}", s.record_meta));
         }

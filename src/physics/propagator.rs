@@ -400,7 +400,7 @@ impl CoupledPropagator {
     ) -> Self {
         let n = w2.len();
         let m = 2 * n + 2;
-        let a = Self::augmented((w2, stiffness, c, coupling, part), h);
+        let a = Self::augmented(w2, stiffness, c, coupling, part, h);
         // The modal propagators of a run's start as before; a tangent's, built as the run goes,
         // by the cheaper approximant.
         let e = if stiffness.is_some() {
@@ -423,15 +423,12 @@ impl CoupledPropagator {
 
     /// `A h` of the augmented system `[q, q', f, g]` (`2N + 2` square, row-major) of the modes'
     /// `w^2`, their stiffness coupling, `c`, damping coupling and participations.
-    #[allow(clippy::type_complexity)]
     fn augmented(
-        (w2, stiffness, c, coupling, part): (
-            &[f64],
-            Option<&[Vec<f64>]>,
-            &[f64],
-            &[Vec<f64>],
-            &[f64],
-        ),
+        w2: &[f64],
+        stiffness: Option<&[Vec<f64>]>,
+        c: &[f64],
+        coupling: &[Vec<f64>],
+        part: &[f64],
         h: f64,
     ) -> Vec<f64> {
         let n = w2.len();
@@ -748,7 +745,7 @@ mod tests {
             for h in [0.005, 0.02, 0.3] {
                 let m = 2 * modes + 2;
                 let a =
-                    CoupledPropagator::augmented((&w2, Some(&stiffness), &c, &coupling, &part), h);
+                    CoupledPropagator::augmented(&w2, Some(&stiffness), &c, &coupling, &part, h);
                 let dense: Vec<f64> = (0..m * m).map(|_| 3.0 * draw()).collect();
                 for a in [a, dense] {
                     let (fixed, general) = (expm_pade(&a, m), expm_pade_dyn(&a, m));

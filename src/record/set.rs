@@ -83,15 +83,21 @@ pub struct RecordSet {
     pub records: Vec<SetRecord>,
 }
 
+/// The search-results file of the set `dir` names: [`SEARCH_RESULTS`] in it where it is a
+/// folder, else `dir` itself (the file named directly).
+pub fn results_path(dir: &Path) -> PathBuf {
+    if dir.is_dir() {
+        dir.join(SEARCH_RESULTS)
+    } else {
+        dir.to_path_buf()
+    }
+}
+
 /// The set in `dir` (a folder holding [`SEARCH_RESULTS`], or that file itself). Every
 /// component file it names must be in the folder.
 pub fn read_set(dir: &Path) -> Result<RecordSet, RecordError> {
-    let (folder, results) = if dir.is_dir() {
-        (dir.to_path_buf(), dir.join(SEARCH_RESULTS))
-    } else {
-        let parent = dir.parent().unwrap_or(Path::new("")).to_path_buf();
-        (parent, dir.to_path_buf())
-    };
+    let results = results_path(dir);
+    let folder = results.parent().unwrap_or(Path::new("")).to_path_buf();
     if !results.is_file() {
         let message = if dir.is_dir() {
             format!("no {SEARCH_RESULTS} in it: a record set is the folder of a PEER NGA-West2 search, its records and the {SEARCH_RESULTS} the search wrote (a browser may have renamed it, e.g. `_SearchResults (1).csv`)")

@@ -86,14 +86,15 @@ scale = 1.0
 fn a_set_runs_each_listed_component_as_its_file_would() {
     let dir = tempdir();
     let set = make_set(dir.path(), "peer", RESULTS);
-    let cfg = write(
-        dir.path(),
-        "set.toml",
-        &config("[[record]]\nset = \"peer\""),
-    );
-    let out = dir.path().join("set.csv");
-    ok(&sweep(&cfg, &out, &[]));
-    let text = std::fs::read_to_string(&out).unwrap();
+    // Config `text` written as NAME.toml, swept into NAME.csv: its config, output and rows.
+    let swept = |name: &str, text: &str| {
+        let cfg = write(dir.path(), &format!("{name}.toml"), text);
+        let out = dir.path().join(format!("{name}.csv"));
+        ok(&sweep(&cfg, &out, &[]));
+        let rows = std::fs::read_to_string(&out).unwrap();
+        (cfg, out, rows)
+    };
+    let (cfg, out, text) = swept("set", &config("[[record]]\nset = \"peer\""));
     let labels = ["RSN6_H1", "RSN6_H2", "RSN1106_H1", "RSN1106_H2"];
     assert_eq!(csv_column(&text, "record"), labels);
     // The same runs, each file named by hand.
@@ -107,9 +108,7 @@ fn a_set_runs_each_listed_component_as_its_file_would() {
             )
         })
         .collect();
-    let cfg2 = write(dir.path(), "hand.toml", &config(&by_hand));
-    let out2 = dir.path().join("hand.csv");
-    ok(&sweep(&cfg2, &out2, &[]));
+    let (_, _, hand) = swept("hand", &config(&by_hand));
     // Every column but the set's metadata, which the set's runs carry after all others.
     let meta = pounding::plan::columns::RECORD_META;
     let without_meta = |t: &str| -> String {
@@ -121,7 +120,6 @@ fn a_set_runs_each_listed_component_as_its_file_would() {
             .collect::<Vec<_>>()
             .join("\n")
     };
-    let hand = std::fs::read_to_string(&out2).unwrap();
     assert_eq!(without_meta(&text), hand.trim_end());
     assert_eq!(csv_column(&text, "record_rsn"), ["6", "6", "1106", "1106"]);
     assert_eq!(
@@ -163,22 +161,15 @@ fn a_set_runs_each_listed_component_as_its_file_would() {
             "[building2]",
             "[[building]]\nstoreys = 1\nstorey_height_m = 3.0",
         );
-    let cfg_row = write(dir.path(), "row.toml", &row);
-    let out_row = dir.path().join("row.csv");
-    ok(&sweep(&cfg_row, &out_row, &[]));
-    let rows = std::fs::read_to_string(&out_row).unwrap();
+    let (_, _, rows) = swept("row", &row);
     assert_eq!(csv_column(&rows, "record"), ["RSN6_H2", "RSN1106_H2"]);
     assert_eq!(csv_column(&rows, "record_rsn"), ["6", "1106"]);
     assert_eq!(csv_column(&rows, "record_component"), ["H2", "H2"]);
     // At the search's scale factors.
-    let cfg3 = write(
-        dir.path(),
-        "scaled.toml",
+    let (_, _, scaled) = swept(
+        "scaled",
         &config("[[record]]\nset = \"peer\"\nsearch_scale = true\ncomponents = [\"H1\"]"),
     );
-    let out3 = dir.path().join("scaled.csv");
-    ok(&sweep(&cfg3, &out3, &[]));
-    let scaled = std::fs::read_to_string(&out3).unwrap();
     assert_eq!(csv_column(&scaled, "record"), ["RSN6_H1", "RSN1106_H1"]);
     let pga = |t: &str| -> Vec<f64> {
         csv_column(t, "pga_g")

@@ -9,6 +9,6 @@ pub mod row;
 
 pub(crate) use pair::num;
 pub use pair::{
-    at, contact_and_motion, header, pair_header, record_meta_cells, row, select, select_in,
-    CONTACT_AND_MOTION, HEADER, RECORD_IMS, RECORD_META, SUMMARISED,
+    at, contact_and_motion, header, pair_header, record_meta_cells, record_meta_columns, row,
+    select, select_in, CONTACT_AND_MOTION, HEADER, RECORD_IMS, RECORD_META, SUMMARISED,
 };

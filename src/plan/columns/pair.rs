@@ -166,6 +166,15 @@ pub const RECORD_META: [&str; 7] = [
     "record_vs30_m_s",
 ];
 
+/// The [`RECORD_META`] columns of a plan whose records came from a set; none otherwise.
+pub fn record_meta_columns(plan: &ContactPlan) -> &'static [&'static str] {
+    if plan.has_record_meta() {
+        &RECORD_META
+    } else {
+        &[]
+    }
+}
+
 /// A run's [`RECORD_META`] cells where its plan has those columns (empty where its own record
 /// is not a set's), none where it has not.
 pub fn record_meta_cells(plan: &ContactPlan, spec: &ContactRun) -> Vec<String> {
@@ -189,12 +198,9 @@ pub fn record_meta_cells(plan: &ContactPlan, spec: &ContactRun) -> Vec<String> {
 
 /// A pair's columns: [`HEADER`], and [`RECORD_META`] where its records came from a set.
 pub fn pair_header(plan: &PairPlan) -> Vec<String> {
-    let meta: &[&str] = if plan.contact.has_record_meta() {
-        &RECORD_META
-    } else {
-        &[]
-    };
-    HEADER.iter().chain(meta).map(|c| c.to_string()).collect()
+    (HEADER.iter().chain(record_meta_columns(&plan.contact)))
+        .map(|c| c.to_string())
+        .collect()
 }
 
 /// The first [`CONTACT_AND_MOTION`] fields of a row.

@@ -291,9 +291,11 @@ impl RowPlan {
         for c in ["input_energy_j", "damping_energy_j", "energy_residual"] {
             h.push(c.into());
         }
-        if self.contact.has_record_meta() {
-            h.extend(columns::RECORD_META.iter().map(|c| c.to_string()));
-        }
+        h.extend(
+            columns::record_meta_columns(&self.contact)
+                .iter()
+                .map(|c| c.to_string()),
+        );
         h
     }
 
