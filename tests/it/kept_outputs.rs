@@ -173,12 +173,14 @@ fn no_output_replaces_an_unfinished_sweeps_rows_or_a_sidecar() {
     assert_eq!(std::fs::read(&cut).unwrap(), whole_text);
 }
 
-/// 720 runs of a 10 s record, slow enough on one thread to be killed mid-sweep.
+/// 360 runs of a 1,000 s record, slow enough on one thread (about 2 s) to be killed
+/// mid-sweep: with a 10 s record the sweep took 60 ms, and a loaded machine that left the
+/// watching thread asleep that long saw it finish before the kill.
 fn long_sweep(dir: &Path) -> PathBuf {
     let cfg = dir.join("long.toml");
     std::fs::write(
         &cfg,
-        A.replace("duration_s = 3.0", "duration_s = 10.0")
+        A.replace("duration_s = 3.0", "duration_s = 1000.0")
             .replace(
                 "gap_m = [0.0, 0.005, 0.01, 0.02, 0.03, 0.04]",
                 "gap_m = { from = 0.0, to = 0.05, n = 30 }",
